@@ -1,0 +1,64 @@
+// Parameter descriptions shared by the MeshLab dialogs and the CLI flags: one
+// table per algorithm gives name, help, default, range and validation, so the
+// two front ends cannot drift apart.
+#pragma once
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+enum class ParamType {
+  Bool,
+  Int,
+  Float,
+  Distance,   // absolute length; default and range given as fractions of the bbox diagonal
+  Enum,       // index into choices
+  Color,      // sRGB in [0,1] (MeshLab colour picker / CLI "r,g,b" 0-255 or #rrggbb)
+  Direction,  // a vector, normalised on use
+};
+
+struct ParamSpec {
+  std::string name;   // id in .mlx scripts and --name on the CLI
+  std::string label;  // short text in the MeshLab dialog
+  std::string help;   // tooltip and --help text
+  ParamType type = ParamType::Float;
+  double def = 0.0, min = 0.0, max = 0.0;  // Distance: fractions of the diagonal
+  std::vector<std::string> choices;        // Enum
+  glm::vec3 defVec{0.f};                   // Color, Direction
+  bool meshlabOnly = false;                // e.g. layer choice (the CLI has one scene)
+};
+
+using ParamValue = std::variant<bool, int, double, glm::vec3>;
+
+class ParamValues {
+ public:
+  void set(const std::string& name, ParamValue v) { v_[name] = v; }
+  bool has(const std::string& name) const { return v_.count(name) != 0; }
+  bool getBool(const std::string& n) const { return std::get<bool>(at(n)); }
+  int getInt(const std::string& n) const { return std::get<int>(at(n)); }
+  double getFloat(const std::string& n) const { return std::get<double>(at(n)); }
+  glm::vec3 getVec(const std::string& n) const { return std::get<glm::vec3>(at(n)); }
+  const std::map<std::string, ParamValue>& all() const { return v_; }
+
+ private:
+  const ParamValue& at(const std::string& n) const;
+  std::map<std::string, ParamValue> v_;
+};
+
+// Defaults of a table for a scene of the given bbox diagonal.
+ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal);
+// Checks presence, types and ranges; returns an error sentence or nothing.
+std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal);
+// "name=value, ..." for logs and JSON-free summaries.
+std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v);
+// Parses a CLI value ("12.5", "10%" for Distance, "r,g,b" or "#rrggbb" for Color,
+// an enum's name or index). Throws std::invalid_argument with a sentence.
+ParamValue parseValue(const ParamSpec& spec, const std::string& text, double diagonal);
+const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name);
+
+}  // namespace gi

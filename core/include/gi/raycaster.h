@@ -1,0 +1,52 @@
+// The narrow ray-query contract the algorithms use. Embree implements it in
+// production; a brute-force caster cross-checks it in tests.
+#pragma once
+#include <cstdint>
+#include <limits>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+struct Scene;
+
+struct Ray {
+  glm::vec3 o{0.f};
+  float tnear = 0.f;
+  glm::vec3 d{0.f, 0.f, 1.f};
+  float tfar = std::numeric_limits<float>::infinity();
+};
+
+constexpr uint32_t kNoHit = 0xffffffffu;
+
+struct Hit {
+  float t = std::numeric_limits<float>::infinity();
+  uint32_t face = kNoHit;  // index into Scene::triangles
+  float u = 0.f, v = 0.f;  // barycentrics of vertices 1 and 2
+  glm::vec3 ng{0.f};       // geometric normal (unnormalised, winding order)
+  bool valid() const { return face != kNoHit; }
+};
+
+class RayCaster {
+ public:
+  virtual ~RayCaster() = default;
+  virtual Hit intersect(const Ray& r) const = 0;
+  virtual bool occluded(const Ray& r) const = 0;
+  // occ[i] = 1 if rays[i] hits anything in (tnear, tfar). Thread-safe.
+  virtual void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const {
+    for (size_t i = 0; i < n; ++i) occ[i] = occluded(rays[i]) ? 1 : 0;
+  }
+  virtual void intersectBatch(const Ray* rays, size_t n, Hit* hits) const {
+    for (size_t i = 0; i < n; ++i) hits[i] = intersect(rays[i]);
+  }
+};
+
+enum class BatchMode { Single, Packet8, Stream };
+
+// Builds over the scene's usable faces (see usableFaceMask).
+std::unique_ptr<RayCaster> makeEmbreeCaster(const Scene& s, BatchMode mode = BatchMode::Packet8);
+// O(n) per ray; for tests on small scenes.
+std::unique_ptr<RayCaster> makeBruteForceCaster(const Scene& s);
+
+}  // namespace gi

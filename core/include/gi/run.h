@@ -1,0 +1,56 @@
+// What every algorithm shares: progress reporting with cancellation, a log
+// summary of what was computed, and block-parallel loops that report progress
+// from the calling thread only (MeshLab's callback is not thread-safe).
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gi {
+
+// Returns false to ask for cancellation.
+using ProgressFn = std::function<bool(int percent, const std::string& stage)>;
+
+struct Cancelled : std::runtime_error {
+  Cancelled() : std::runtime_error("cancelled by the user") {}
+};
+
+struct RunStats {
+  std::vector<std::pair<std::string, double>> numbers;  // in insertion order
+  std::vector<std::string> notes;                        // what was skipped and why, etc.
+  void add(const std::string& key, double v) { numbers.emplace_back(key, v); }
+  void note(const std::string& s) { notes.push_back(s); }
+  double get(const std::string& key, double fallback = 0.0) const;
+  std::string line(const std::string& title) const;  // "title: k=v, ...; notes"
+};
+
+class Progress {
+ public:
+  explicit Progress(ProgressFn fn, int from = 0, int to = 100) : fn_(std::move(fn)), from_(from), to_(to) {}
+  // Reports fraction f in [0,1] of this stage; throws Cancelled if asked to stop.
+  void report(double f, const std::string& stage) const;
+  Progress sub(double f0, double f1) const;  // a sub-range of this one
+
+ private:
+  ProgressFn fn_;
+  int from_, to_;
+};
+
+// Runs body(begin, end) over [0, n) in parallel (oneTBB), in about `blocks`
+// sequential slices, reporting progress between slices from this thread.
+void parallelBlocks(size_t n, const Progress& progress, const std::string& stage,
+                    const std::function<void(size_t, size_t)>& body, size_t blocks = 64);
+
+// Wall-clock seconds since construction.
+class Timer {
+ public:
+  Timer();
+  double seconds() const;
+ private:
+  double t0_;
+};
+
+}  // namespace gi

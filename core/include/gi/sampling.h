@@ -1,0 +1,75 @@
+// Deterministic sampling keyed by (element, sample index, seed): results never
+// depend on thread identity or scheduling.
+#pragma once
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+inline uint32_t reverseBits(uint32_t x) {
+  x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+  x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+  x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+  x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+  return (x >> 16) | (x << 16);
+}
+
+// A 32-bit integer hash with good avalanche (lowbias32, C. Wellons).
+inline uint32_t hash32(uint32_t x) {
+  x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;
+  return x;
+}
+inline uint32_t hashCombine(uint32_t a, uint32_t b) { return hash32(a ^ (hash32(b) + 0x9e3779b9u + (a << 6) + (a >> 2))); }
+inline uint32_t hash3(uint32_t a, uint32_t b, uint32_t c) { return hashCombine(hashCombine(hash32(a), b), c); }
+
+inline float toUnitFloat(uint32_t x) { return float(x >> 8) * 0x1p-24f; }  // [0,1)
+
+// Nested uniform (Owen) scrambling by hashing, Burley 2020, "Practical
+// Hash-based Owen Scrambling", JCGT 9(4): Laine-Karras permutation on the
+// bit-reversed value.
+inline uint32_t laineKarrasPermutation(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu; x ^= x * 0xb82f1e52u; x ^= x * 0xc7afe638u; x ^= x * 0x8d22f6e6u;
+  return x;
+}
+inline uint32_t nestedUniformScramble(uint32_t x, uint32_t seed) {
+  return reverseBits(laineKarrasPermutation(reverseBits(x), seed));
+}
+
+// The first two Sobol dimensions (van der Corput and the Pascal-matrix one).
+uint32_t sobol2(uint32_t index);
+inline uint32_t sobol1(uint32_t index) { return reverseBits(index); }
+
+// Owen-scrambled 2D Sobol point `i` of the sequence keyed by `key`
+// (e.g. hash of element and seed). Each key gives an independent randomised
+// sequence whose prefixes of 2^k points are stratified.
+glm::vec2 sobolOwen2D(uint32_t i, uint32_t key);
+
+// Counter-based independent uniform numbers (for Russian roulette etc.).
+struct Rng {
+  uint32_t state;
+  explicit Rng(uint32_t key) : state(hash32(key ^ 0xa511e9b3u)) {}
+  uint32_t nextU32() { state = state * 747796405u + 2891336453u; uint32_t w = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u; return (w >> 22u) ^ w; }  // PCG-RXS-M-XS
+  float next() { return toUnitFloat(nextU32()); }
+};
+
+// Warps of [0,1)^2. Hemisphere warps return z-up local directions.
+glm::vec3 cosineHemisphere(glm::vec2 u);   // pdf = cos(theta) / pi
+inline float cosineHemispherePdf(float cosTheta) { return cosTheta * 0.318309886f; }
+glm::vec3 uniformSphere(glm::vec2 u);      // pdf = 1 / (4 pi)
+glm::vec3 uniformHemisphere(glm::vec2 u);  // pdf = 1 / (2 pi)
+// Uniform in a cone of half-angle with cos = cosMax around +z; pdf = 1 / (2 pi (1 - cosMax)).
+glm::vec3 uniformCone(glm::vec2 u, float cosMax);
+// Uniform point on a triangle: barycentrics (b1, b2) (Heitz 2019 low-distortion warp).
+glm::vec2 uniformTriangle(glm::vec2 u);
+
+// Orthonormal basis with n as z (Duff et al. 2017).
+struct Frame {
+  glm::vec3 t, b, n;
+  explicit Frame(const glm::vec3& nn);
+  glm::vec3 toWorld(const glm::vec3& v) const { return t * v.x + b * v.y + n * v.z; }
+  glm::vec3 toLocal(const glm::vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
+};
+
+}  // namespace gi

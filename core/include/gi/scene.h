@@ -1,0 +1,69 @@
+// The engine's scene: triangles with per-face materials. No Qt, no MeshLab.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gi {
+
+enum class Material : uint8_t { Diffuse = 0, Mirror = 1, Glass = 2 };
+
+// Positions are stored relative to `origin` (double), so that meshes far from
+// the coordinate origin (offsets of 1e6) keep full float precision in the
+// ray caster. Use Scene::addVertex to fill it from absolute coordinates.
+struct Scene {
+  glm::dvec3 origin{0.0};
+  std::vector<glm::vec3> positions;       // relative to origin
+  std::vector<glm::uvec3> triangles;      // vertex indices, counter-clockwise = front
+  std::vector<glm::vec3> vertexNormals;   // optional (empty: computed from faces)
+  std::vector<glm::vec3> rho;             // per-face linear RGB reflectance (empty: 0.5 grey)
+  std::vector<glm::vec3> emission;        // per-face emitted radiosity E, W/m^2 (empty: none)
+  std::vector<Material> material;         // per face (empty: all diffuse)
+  std::vector<float> ior;                 // per face index of refraction for Glass (empty: 1.5)
+
+  size_t vertexCount() const { return positions.size(); }
+  size_t faceCount() const { return triangles.size(); }
+  glm::vec3 faceRho(size_t f) const { return rho.empty() ? glm::vec3(0.5f) : rho[f]; }
+  glm::vec3 faceEmission(size_t f) const { return emission.empty() ? glm::vec3(0.f) : emission[f]; }
+  Material faceMaterial(size_t f) const { return material.empty() ? Material::Diffuse : material[f]; }
+  bool hasEmitters() const;
+
+  // Absolute <-> local coordinates.
+  glm::dvec3 toWorld(const glm::vec3& p) const { return origin + glm::dvec3(p); }
+  // Re-centres a scene given in absolute double coordinates.
+  static Scene fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris);
+  // Appends another scene (its vertices re-expressed relative to this origin).
+  // Returns the vertex offset of the appended part.
+  size_t append(const Scene& other);
+};
+
+// Geometry helpers (local coordinates).
+glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f);  // cross product, |n| = 2 * area
+double faceArea(const Scene& s, size_t f);
+// Angle-weighted vertex normals from the faces; zero vector for isolated vertices.
+std::vector<glm::vec3> computeVertexNormals(const Scene& s);
+
+struct SceneReport {
+  size_t vertices = 0, faces = 0;
+  size_t nonFiniteVertices = 0;    // NaN or Inf coordinates
+  size_t invalidFaces = 0;         // index out of range or repeated index
+  size_t degenerateFaces = 0;      // zero (or relatively tiny) area
+  size_t facesOnNonFinite = 0;     // faces touching a non-finite vertex
+  size_t isolatedVertices = 0;     // referenced by no usable face
+  size_t emitterFaces = 0;
+  double emittedPower = 0.0;       // luminance-weighted, W
+  glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
+  double diagonal = 0.0;           // bbox diagonal
+  double rayEpsilon = 0.0;         // offset for ray origins (local units)
+  size_t usableFaces() const { return faces - invalidFaces - degenerateFaces - facesOnNonFinite; }
+  std::string summary() const;     // one line for logs
+};
+
+// Counts every defect and computes the scale used for ray offsets.
+SceneReport analyzeScene(const Scene& s);
+// True for a face the ray caster builds (valid indices, finite, non-degenerate).
+std::vector<uint8_t> usableFaceMask(const Scene& s);
+
+}  // namespace gi

@@ -1,0 +1,52 @@
+// DESIGN.md §4 conventions in one place: how a mesh's colours, quality and
+// selection become reflectance and emission, for the MeshLab bridge and the
+// CLI alike; and how per-vertex results become quality and display colour.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/color.h"
+#include "gi/params.h"
+#include "gi/scene.h"
+
+namespace gi {
+
+// What a mesh file or a MeshLab layer carries beside geometry (each optional).
+struct MeshAttributes {
+  std::vector<glm::u8vec3> faceColor;    // sRGB bytes
+  std::vector<glm::u8vec3> vertexColor;  // sRGB bytes
+  std::vector<float> faceQuality;
+  std::vector<uint8_t> faceSelected;
+};
+
+enum class EmitterSource { SelectedFaces = 0, QualityAbove = 1, None = 2 };
+enum class ReflectanceSource { Auto = 0, FaceColor = 1, VertexColor = 2, Constant = 3 };
+
+// Scene parameters shared by radiosity, photon mapping and the reference.
+std::vector<ParamSpec> lightingSceneSpecs();
+// Only the reflectance/extent part (ambient occlusion needs no emitters).
+std::vector<ParamSpec> geometrySceneSpecs();
+// Display parameters (exposure) shared by every filter with radiometric output.
+std::vector<ParamSpec> displaySpecs();
+
+// Sets rho (and, if withEmitters, emission) of `s` from its attributes.
+// Returns an error sentence when the result cannot be used (e.g. rho >= 1).
+std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
+                                                 bool withEmitters, std::string* log = nullptr);
+
+// Per-vertex results in the common output convention.
+struct VertexOutput {
+  std::vector<float> quality;     // physical scalar (luminance, AO, ...)
+  std::vector<glm::vec3> rgb;     // linear values to display (empty: grey from quality)
+  float exposure = 1.f;           // applied before sRGB encoding
+  std::vector<Rgb8> displayColors() const;
+};
+
+// Vertex values from per-face values: area-weighted mean of incident usable faces.
+std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace);
+
+}  // namespace gi

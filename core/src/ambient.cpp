@@ -1,0 +1,261 @@
+#include "gi/ambient.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "gi/color.h"
+#include "gi/open_space.h"
+#include "gi/sampling.h"
+
+namespace gi {
+namespace {
+
+constexpr int kRound = 32;  // rays per adaptive round (a power of two keeps Sobol prefixes balanced)
+
+// Running mean and variance (Welford) of per-ray contributions.
+struct Welford {
+  double n = 0, mean = 0, m2 = 0;
+  void add(double x) { n += 1; double d = x - mean; mean += d / n; m2 += d * (x - mean); }
+  double stdError() const { return n > 1 ? std::sqrt(m2 / (n - 1) / n) : 1.0; }
+};
+
+struct VertexOut {
+  float value = 0.f, stdError = 0.f;
+  int rays = 0;
+  glm::vec3 rgb{0.f}, bent{0.f};
+};
+
+class AmbientKernel {
+ public:
+  AmbientKernel(const RayCaster& c, const AmbientOptions& o, float eps) : caster_(c), o_(o), eps_(eps) {
+    tfar_ = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
+    coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
+    sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
+  }
+
+  VertexOut run(uint32_t vi, const glm::vec3& p, const glm::vec3& n) const {
+    VertexOut out;
+    const Frame frame(n);
+    const Frame cone(o_.coneDirection);
+    const glm::vec3 org = p + n * eps_;
+    const uint32_t key = hash3(vi, o_.seed, 0x41u);
+    const bool adaptive = o_.targetError > 0.0;
+    const int maxN = adaptive ? o_.maxRays : o_.raysPerVertex;
+    Ray rays[kRound];
+    uint8_t occ[kRound];
+    Hit hits[kRound];
+    Welford w;                 // per-ray values (or ratio residuals for the cone)
+    double num = 0, den = 0;   // cone: sums of V cos and cos
+    double numSq = 0, denSq = 0, numDen = 0;
+    glm::vec3 bent(0.f);
+    int done = 0;
+    while (done < maxN) {
+      const int m = std::min(kRound, maxN - done);
+      for (int j = 0; j < m; ++j) {
+        const glm::vec2 u = sobolOwen2D(uint32_t(done + j), key);
+        const glm::vec3 d = o_.useCone ? cone.toWorld(uniformCone(u, coneCos_)) : frame.toWorld(cosineHemisphere(u));
+        rays[j].o = org; rays[j].d = d; rays[j].tnear = 0.f; rays[j].tfar = tfar_;
+      }
+      if (o_.mode == AmbientMode::Obscurance) caster_.intersectBatch(rays, size_t(m), hits);
+      else caster_.occludedBatch(rays, size_t(m), occ);
+      for (int j = 0; j < m; ++j) {
+        double f;
+        if (o_.mode == AmbientMode::Obscurance) {
+          f = hits[j].valid() ? std::pow(std::min(1.0, double(hits[j].t) / o_.maxDistance), double(o_.falloffExponent)) : 1.0;
+        } else {
+          f = occ[j] ? 0.0 : 1.0;
+        }
+        if (o_.bentNormals && f > 0.0) bent += rays[j].d * float(f);
+        if (o_.useCone) {
+          const double c = std::max(0.f, glm::dot(n, rays[j].d));
+          num += f * c; den += c; numSq += f * c * f * c; denSq += c * c; numDen += f * c * c;
+        } else {
+          w.add(f);
+        }
+      }
+      done += m;
+      if (!adaptive || done < o_.minRays) continue;
+      if (stdError(w, done, num, den, numSq, denSq, numDen) <= o_.targetError) break;
+    }
+    out.rays = done;
+    if (o_.useCone) out.value = den > 0 ? float(num / den) : 0.f;
+    else out.value = float(w.mean);
+    out.stdError = float(stdError(w, done, num, den, numSq, denSq, numDen));
+    if (o_.bentNormals) out.bent = glm::length(bent) > 0.f ? glm::normalize(bent) : n;
+    if (o_.mode == AmbientMode::Sky) out = addSun(out, vi, p, n, org);
+    return out;
+  }
+
+ private:
+  double stdError(const Welford& w, int n, double num, double den, double numSq, double denSq, double numDen) const {
+    if (!o_.useCone) return w.stdError();
+    if (den <= 0.0 || n < 2) return 0.0;
+    // Ratio estimator R = sum(f c) / sum(c): delta-method variance of mean(f c - R c) / mean(c).
+    const double R = num / den, N = n;
+    const double varRes = (numSq - 2 * R * numDen + R * R * denSq) / (N - 1);
+    const double meanC = den / N;
+    return std::sqrt(std::max(0.0, varRes) / N) / meanC;
+  }
+
+  VertexOut addSun(VertexOut out, uint32_t vi, const glm::vec3& p, const glm::vec3& n, const glm::vec3& org) const {
+    const glm::vec3 sky = o_.skyRadiantColor * o_.skyIrradiance * out.value;
+    glm::vec3 sun(0.f);
+    int sunRays = 0;
+    double sunErr = 0.0;
+    if (o_.sunIrradiance > 0.f && glm::dot(n, o_.sunDirection) > -std::sin(glm::radians(o_.sunAngularRadiusDeg)) - 1e-6f) {
+      // Distributed ray tracing over the sun's disk: uniform directions in its cone.
+      const Frame sf(o_.sunDirection);
+      const uint32_t key = hash3(vi, o_.seed, 0x5u);
+      Ray rays[kRound];
+      uint8_t occ[kRound];
+      Welford w;
+      for (int done = 0; done < o_.sunRays; done += kRound) {
+        const int m = std::min(kRound, o_.sunRays - done);
+        for (int j = 0; j < m; ++j) {
+          rays[j].o = org; rays[j].d = sf.toWorld(uniformCone(sobolOwen2D(uint32_t(done + j), key), sunCos_));
+          rays[j].tnear = 0.f; rays[j].tfar = std::numeric_limits<float>::infinity();
+        }
+        caster_.occludedBatch(rays, size_t(m), occ);
+        for (int j = 0; j < m; ++j) w.add(occ[j] ? 0.0 : std::max(0.f, glm::dot(n, rays[j].d)));
+      }
+      sunRays = o_.sunRays;
+      sun = o_.sunColor * float(o_.sunIrradiance * w.mean);
+      sunErr = o_.sunIrradiance * w.stdError() * luminance(o_.sunColor);
+    }
+    const double skyErr = double(out.stdError) * o_.skyIrradiance * luminance(o_.skyRadiantColor);
+    out.rgb = sky + sun;
+    out.value = luminance(out.rgb);
+    out.stdError = float(std::sqrt(skyErr * skyErr + sunErr * sunErr));
+    out.rays += sunRays;
+    return out;
+  }
+
+  const RayCaster& caster_;
+  const AmbientOptions& o_;
+  float eps_, tfar_, coneCos_, sunCos_;
+};
+
+void checkOptions(const AmbientOptions& o) {
+  if (o.targetError > 0.0 && o.minRays > o.maxRays)
+    throw std::invalid_argument("min_rays (" + std::to_string(o.minRays) + ") exceeds max_rays (" + std::to_string(o.maxRays) + ")");
+  if (o.mode == AmbientMode::Obscurance && !(o.maxDistance > 0.0))
+    throw std::invalid_argument("obscurance needs a maximum distance > 0 (its falloff is relative to it)");
+  if (!(o.maxDistance >= 0.0)) throw std::invalid_argument("max_distance must be >= 0");
+  if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
+}
+
+}  // namespace
+
+AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& opt, const Progress& progress) {
+  checkOptions(opt);
+  Timer timer;
+  const SceneReport rep = analyzeScene(scene);
+  if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
+  const size_t nv = scene.vertexCount();
+  const std::vector<glm::vec3> normals =
+      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
+
+  // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
+  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen };
+  std::vector<uint8_t> status(nv, kTrace);
+  std::vector<uint32_t> rep_of(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    rep_of[i] = uint32_t(i);
+    const glm::vec3& n = normals[i];
+    const glm::vec3& p = scene.positions[i];
+    const bool ok = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(n.x) &&
+                    glm::dot(n, n) > 0.5f;
+    if (!ok) status[i] = kInvalid;
+  }
+  size_t duplicates = 0, open = 0, invalid = 0;
+  if (opt.mergeDuplicates) {
+    struct Key { float v[6]; bool operator==(const Key& o) const { return std::memcmp(v, o.v, sizeof v) == 0; } };
+    struct KeyHash { size_t operator()(const Key& k) const { uint32_t h = 0; for (float f : k.v) { uint32_t b; std::memcpy(&b, &f, 4); h = hashCombine(h, b); } return h; } };
+    std::unordered_map<Key, uint32_t, KeyHash> first;
+    first.reserve(nv);
+    for (size_t i = 0; i < nv; ++i) {
+      if (status[i] != kTrace) continue;
+      const auto& p = scene.positions[i];
+      const auto& n = normals[i];
+      Key k{{p.x + 0.f, p.y + 0.f, p.z + 0.f, n.x + 0.f, n.y + 0.f, n.z + 0.f}};  // + 0 folds -0 into 0
+      auto [it, inserted] = first.emplace(k, uint32_t(i));
+      if (!inserted) { status[i] = kDuplicate; rep_of[i] = it->second; ++duplicates; }
+    }
+  }
+  if (opt.skipOpenVertices && opt.maxDistance > 0.0 && opt.mode != AmbientMode::Sky && !opt.useCone) {
+    OpenSpaceTest test(scene, float(rep.rayEpsilon));
+    std::vector<uint8_t> isOpen(nv, 0);
+    parallelBlocks(nv, progress.sub(0.0, 0.05), "finding open vertices", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (status[i] == kTrace) isOpen[i] = test.hemisphereEmpty(scene.positions[i], normals[i], float(opt.maxDistance)) ? 1 : 0;
+    });
+    for (size_t i = 0; i < nv; ++i)
+      if (isOpen[i]) { status[i] = kOpen; ++open; }
+  }
+
+  AmbientResult res;
+  res.value.assign(nv, 0.f);
+  res.stdError.assign(nv, 0.f);
+  res.rays.assign(nv, 0);
+  if (opt.mode == AmbientMode::Sky) res.rgb.assign(nv, glm::vec3(0.f));
+  if (opt.bentNormals) res.bentNormal = normals;
+  const AmbientKernel kernel(caster, opt, float(rep.rayEpsilon));
+  Timer traceTimer;
+  parallelBlocks(nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (status[i] == kOpen) {
+        res.value[i] = 1.f;  // provably nothing within reach above the tangent plane
+        if (opt.bentNormals) res.bentNormal[i] = normals[i];
+        continue;
+      }
+      if (status[i] != kTrace) continue;
+      const VertexOut o = kernel.run(uint32_t(i), scene.positions[i], normals[i]);
+      res.value[i] = o.value;
+      res.stdError[i] = o.stdError;
+      res.rays[i] = o.rays;
+      if (opt.mode == AmbientMode::Sky) res.rgb[i] = o.rgb;
+      if (opt.bentNormals) res.bentNormal[i] = o.bent;
+    }
+  });
+  const double traceSeconds = traceTimer.seconds();
+  for (size_t i = 0; i < nv; ++i) {
+    if (status[i] == kDuplicate) {
+      const uint32_t r = rep_of[i];
+      res.value[i] = res.value[r]; res.stdError[i] = res.stdError[r];
+      if (!res.rgb.empty()) res.rgb[i] = res.rgb[r];
+      if (opt.bentNormals) res.bentNormal[i] = res.bentNormal[r];
+    } else if (status[i] == kInvalid) {
+      ++invalid;
+      res.value[i] = 0.f;  // no hemisphere (isolated, NaN, or degenerate-only vertex)
+    }
+  }
+  // Summary (sequential: deterministic).
+  double rays = 0, sum = 0, var = 0;
+  size_t counted = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    rays += res.rays[i];
+    if (status[i] == kInvalid) continue;
+    sum += res.value[i]; var += double(res.stdError[i]) * res.stdError[i]; ++counted;
+  }
+  auto& st = res.stats;
+  st.add("vertices", double(nv));
+  st.add("rays", rays);
+  st.add("seconds", timer.seconds());
+  st.add("rays_per_second", traceSeconds > 0 ? rays / traceSeconds : 0.0);
+  st.add("mean", counted ? sum / double(counted) : 0.0);
+  st.add("rms_error_estimate", counted ? std::sqrt(var / double(counted)) : 0.0);
+  st.add("skipped_open", double(open));
+  st.add("skipped_duplicates", double(duplicates));
+  st.add("skipped_invalid", double(invalid));
+  if (open) st.note(std::to_string(open) + " vertices provably open within max_distance got 1 without rays");
+  if (duplicates) st.note(std::to_string(duplicates) + " duplicate vertices (same position and normal) computed once");
+  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
+  if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)
+    st.note(std::to_string(rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite) + " degenerate/invalid faces ignored");
+  return res;
+}
+
+}  // namespace gi

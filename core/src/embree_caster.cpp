@@ -1,0 +1,169 @@
+// Embree 3 implementation of RayCaster: move-only RAII handles, the error
+// callback installed before anything else, primitives limited to usable faces.
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gi/raycaster.h"
+#include "gi/scene.h"
+
+namespace gi {
+namespace {
+
+struct ErrorSink {
+  std::mutex m;
+  std::string first;
+};
+
+void onEmbreeError(void* user, RTCError code, const char* str) {
+  auto* sink = static_cast<ErrorSink*>(user);
+  std::lock_guard<std::mutex> lock(sink->m);
+  if (sink->first.empty()) sink->first = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
+}
+
+class Device {
+ public:
+  explicit Device(ErrorSink* sink) : d_(rtcNewDevice(nullptr)) {
+    if (!d_) throw std::runtime_error("Embree: cannot create a device (" + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    rtcSetDeviceErrorFunction(d_, onEmbreeError, sink);
+  }
+  ~Device() { if (d_) rtcReleaseDevice(d_); }
+  Device(Device&& o) noexcept : d_(std::exchange(o.d_, nullptr)) {}
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+  RTCDevice get() const { return d_; }
+ private:
+  RTCDevice d_;
+};
+
+class SceneHandle {
+ public:
+  explicit SceneHandle(RTCDevice d) : s_(rtcNewScene(d)) {}
+  ~SceneHandle() { if (s_) rtcReleaseScene(s_); }
+  SceneHandle(SceneHandle&& o) noexcept : s_(std::exchange(o.s_, nullptr)) {}
+  SceneHandle(const SceneHandle&) = delete;
+  SceneHandle& operator=(const SceneHandle&) = delete;
+  RTCScene get() const { return s_; }
+ private:
+  RTCScene s_;
+};
+
+inline void toRTC(const Ray& r, RTCRay& e) {
+  e.org_x = r.o.x; e.org_y = r.o.y; e.org_z = r.o.z; e.tnear = r.tnear;
+  e.dir_x = r.d.x; e.dir_y = r.d.y; e.dir_z = r.d.z; e.time = 0.f;
+  e.tfar = r.tfar; e.mask = 0xffffffffu; e.id = 0; e.flags = 0;
+}
+
+class EmbreeCaster final : public RayCaster {
+ public:
+  EmbreeCaster(const Scene& s, BatchMode mode) : device_(&errors_), scene_(device_.get()), mode_(mode) {
+    check("creating the scene");
+    const auto ok = usableFaceMask(s);
+    for (size_t f = 0; f < ok.size(); ++f)
+      if (ok[f]) primToFace_.push_back(uint32_t(f));
+    if (!primToFace_.empty()) {
+      RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                             3 * sizeof(float), s.positions.size()));
+      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                3 * sizeof(uint32_t), primToFace_.size()));
+      if (!vb || !ib) { rtcReleaseGeometry(g); check("allocating buffers"); throw std::runtime_error("Embree: out of memory"); }
+      for (size_t i = 0; i < s.positions.size(); ++i) {
+        const auto& p = s.positions[i];
+        const bool fin = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+        vb[3 * i] = fin ? p.x : 0.f; vb[3 * i + 1] = fin ? p.y : 0.f; vb[3 * i + 2] = fin ? p.z : 0.f;
+      }
+      for (size_t k = 0; k < primToFace_.size(); ++k) {
+        const auto& t = s.triangles[primToFace_[k]];
+        ib[3 * k] = t.x; ib[3 * k + 1] = t.y; ib[3 * k + 2] = t.z;
+      }
+      rtcCommitGeometry(g);
+      rtcAttachGeometry(scene_.get(), g);
+      rtcReleaseGeometry(g);
+    }
+    rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(scene_.get());
+    check("building the BVH");
+  }
+
+  Hit intersect(const Ray& r) const override {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    toRTC(r, rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_.get(), &ctx, &rh);
+    Hit h;
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+      h.t = rh.ray.tfar; h.face = primToFace_[rh.hit.primID]; h.u = rh.hit.u; h.v = rh.hit.v;
+      h.ng = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+    }
+    return h;
+  }
+
+  bool occluded(const Ray& r) const override {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay e;
+    toRTC(r, e);
+    rtcOccluded1(scene_.get(), &ctx, &e);
+    return e.tfar < 0.f;
+  }
+
+  void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const override {
+    if (mode_ == BatchMode::Single) return RayCaster::occludedBatch(rays, n, occ);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    if (mode_ == BatchMode::Stream) {
+      constexpr size_t kChunk = 64;
+      RTCRay buf[kChunk];
+      for (size_t b = 0; b < n; b += kChunk) {
+        const size_t m = std::min(kChunk, n - b);
+        for (size_t i = 0; i < m; ++i) toRTC(rays[b + i], buf[i]);
+        rtcOccluded1M(scene_.get(), &ctx, buf, unsigned(m), sizeof(RTCRay));
+        for (size_t i = 0; i < m; ++i) occ[b + i] = buf[i].tfar < 0.f ? 1 : 0;
+      }
+      return;
+    }
+    alignas(32) RTCRay8 p;
+    alignas(32) int valid[8];
+    for (size_t b = 0; b < n; b += 8) {
+      const size_t m = std::min<size_t>(8, n - b);
+      for (size_t i = 0; i < 8; ++i) {
+        const Ray& r = rays[b + (i < m ? i : 0)];
+        valid[i] = i < m ? -1 : 0;
+        p.org_x[i] = r.o.x; p.org_y[i] = r.o.y; p.org_z[i] = r.o.z; p.tnear[i] = r.tnear;
+        p.dir_x[i] = r.d.x; p.dir_y[i] = r.d.y; p.dir_z[i] = r.d.z; p.time[i] = 0.f;
+        p.tfar[i] = r.tfar; p.mask[i] = 0xffffffffu; p.id[i] = 0; p.flags[i] = 0;
+      }
+      rtcOccluded8(valid, scene_.get(), &ctx, &p);
+      for (size_t i = 0; i < m; ++i) occ[b + i] = p.tfar[i] < 0.f ? 1 : 0;
+    }
+  }
+
+ private:
+  void check(const char* what) {
+    std::lock_guard<std::mutex> lock(errors_.m);
+    if (!errors_.first.empty()) throw std::runtime_error(errors_.first + " (while " + what + ")");
+  }
+  ErrorSink errors_;  // outlives the device (declared first)
+  Device device_;
+  SceneHandle scene_;
+  BatchMode mode_;
+  std::vector<uint32_t> primToFace_;
+};
+
+}  // namespace
+
+std::unique_ptr<RayCaster> makeEmbreeCaster(const Scene& s, BatchMode mode) {
+  return std::make_unique<EmbreeCaster>(s, mode);
+}
+
+}  // namespace gi

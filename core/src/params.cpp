@@ -1,0 +1,198 @@
+#include "gi/params.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace gi {
+
+const ParamValue& ParamValues::at(const std::string& n) const {
+  auto it = v_.find(n);
+  if (it == v_.end()) throw std::invalid_argument("missing parameter '" + n + "'");
+  return it->second;
+}
+
+const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name) {
+  for (const auto& s : specs)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) {
+  ParamValues v;
+  for (const auto& s : specs) {
+    switch (s.type) {
+      case ParamType::Bool: v.set(s.name, s.def != 0.0); break;
+      case ParamType::Int:
+      case ParamType::Enum: v.set(s.name, int(s.def)); break;
+      case ParamType::Float: v.set(s.name, s.def); break;
+      case ParamType::Distance: v.set(s.name, s.def * diagonal); break;
+      case ParamType::Color:
+      case ParamType::Direction: v.set(s.name, s.defVec); break;
+    }
+  }
+  return v;
+}
+
+static std::string num(double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
+std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal) {
+  for (const auto& s : specs) {
+    if (!v.has(s.name)) return "parameter '" + s.name + "' is missing";
+    try {
+      switch (s.type) {
+        case ParamType::Bool: (void)v.getBool(s.name); break;
+        case ParamType::Int: {
+          int x = v.getInt(s.name);
+          if (x < s.min || x > s.max)
+            return "parameter '" + s.name + "' = " + std::to_string(x) + " is outside [" + num(s.min) + ", " + num(s.max) + "]";
+          break;
+        }
+        case ParamType::Float: {
+          double x = v.getFloat(s.name);
+          if (!std::isfinite(x) || x < s.min || x > s.max)
+            return "parameter '" + s.name + "' = " + num(x) + " is outside [" + num(s.min) + ", " + num(s.max) + "]";
+          break;
+        }
+        case ParamType::Distance: {
+          double x = v.getFloat(s.name);
+          if (!std::isfinite(x) || x < 0.0)
+            return "parameter '" + s.name + "' = " + num(x) + " must be a finite distance >= 0";
+          if (s.max > 0.0 && diagonal > 0.0 && x > s.max * diagonal * (1.0 + 1e-6))
+            return "parameter '" + s.name + "' = " + num(x) + " exceeds " + num(s.max) + " x the bbox diagonal (" + num(diagonal) + ")";
+          break;
+        }
+        case ParamType::Enum: {
+          int x = v.getInt(s.name);
+          if (x < 0 || x >= int(s.choices.size()))
+            return "parameter '" + s.name + "' = " + std::to_string(x) + " is not one of 0.." + std::to_string(s.choices.size() - 1);
+          break;
+        }
+        case ParamType::Color: {
+          glm::vec3 c = v.getVec(s.name);
+          for (int k = 0; k < 3; ++k)
+            if (!(c[k] >= 0.f && c[k] <= 1.f)) return "parameter '" + s.name + "' has a channel outside [0, 1]";
+          break;
+        }
+        case ParamType::Direction: {
+          glm::vec3 d = v.getVec(s.name);
+          if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || glm::length(d) == 0.f)
+            return "parameter '" + s.name + "' must be a non-zero finite direction";
+          break;
+        }
+      }
+    } catch (const std::bad_variant_access&) {
+      return "parameter '" + s.name + "' has the wrong type";
+    }
+  }
+  return std::nullopt;
+}
+
+std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) {
+  std::ostringstream o;
+  bool first = true;
+  for (const auto& s : specs) {
+    if (!v.has(s.name)) continue;
+    o << (first ? "" : ", ") << s.name << '=';
+    first = false;
+    switch (s.type) {
+      case ParamType::Bool: o << (v.getBool(s.name) ? "true" : "false"); break;
+      case ParamType::Int: o << v.getInt(s.name); break;
+      case ParamType::Enum: o << s.choices.at(size_t(v.getInt(s.name))); break;
+      case ParamType::Float:
+      case ParamType::Distance: o << num(v.getFloat(s.name)); break;
+      case ParamType::Color:
+      case ParamType::Direction: {
+        glm::vec3 c = v.getVec(s.name);
+        o << num(c.x) << ',' << num(c.y) << ',' << num(c.z);
+        break;
+      }
+    }
+  }
+  return o.str();
+}
+
+static std::vector<double> splitNumbers(const std::string& t) {
+  std::vector<double> out;
+  std::stringstream ss(t);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    size_t pos = 0;
+    double x = std::stod(item, &pos);
+    while (pos < item.size() && std::isspace(static_cast<unsigned char>(item[pos]))) ++pos;
+    if (pos != item.size()) throw std::invalid_argument(item);
+    out.push_back(x);
+  }
+  return out;
+}
+
+ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagonal) {
+  auto bad = [&](const std::string& why) {
+    return std::invalid_argument("--" + s.name + " '" + text + "': " + why);
+  };
+  try {
+    switch (s.type) {
+      case ParamType::Bool:
+        if (text == "1" || text == "true" || text == "on" || text == "yes") return true;
+        if (text == "0" || text == "false" || text == "off" || text == "no") return false;
+        throw bad("expected true or false");
+      case ParamType::Int: {
+        size_t pos = 0;
+        long x = std::stol(text, &pos);
+        if (pos != text.size()) throw bad("expected an integer");
+        return int(x);
+      }
+      case ParamType::Float: {
+        size_t pos = 0;
+        double x = std::stod(text, &pos);
+        if (pos != text.size()) throw bad("expected a number");
+        return x;
+      }
+      case ParamType::Distance: {
+        size_t pos = 0;
+        double x = std::stod(text, &pos);
+        if (pos + 1 == text.size() && text[pos] == '%') return x * 0.01 * diagonal;
+        if (pos != text.size()) throw bad("expected a length or a percentage of the bbox diagonal like 10%");
+        return x;
+      }
+      case ParamType::Enum: {
+        for (size_t i = 0; i < s.choices.size(); ++i)
+          if (s.choices[i] == text) return int(i);
+        size_t pos = 0;
+        long x = std::stol(text, &pos);
+        if (pos != text.size()) throw std::invalid_argument("");
+        return int(x);
+      }
+      case ParamType::Color: {
+        if (text.size() == 7 && text[0] == '#') {
+          unsigned r, g, b;
+          if (std::sscanf(text.c_str() + 1, "%2x%2x%2x", &r, &g, &b) != 3) throw bad("expected #rrggbb");
+          return glm::vec3(r / 255.f, g / 255.f, b / 255.f);
+        }
+        auto n = splitNumbers(text);
+        if (n.size() != 3) throw bad("expected r,g,b (0-255) or #rrggbb");
+        return glm::vec3(float(n[0] / 255.0), float(n[1] / 255.0), float(n[2] / 255.0));
+      }
+      case ParamType::Direction: {
+        auto n = splitNumbers(text);
+        if (n.size() != 3) throw bad("expected x,y,z");
+        return glm::vec3(float(n[0]), float(n[1]), float(n[2]));
+      }
+    }
+  } catch (const std::invalid_argument& e) {
+    if (std::string(e.what()).rfind("--", 0) == 0) throw;
+    std::string choices;
+    for (const auto& c : s.choices) choices += (choices.empty() ? "" : ", ") + c;
+    throw bad(s.type == ParamType::Enum ? "expected one of: " + choices : "not a valid value");
+  } catch (const std::out_of_range&) {
+    throw bad("out of range");
+  }
+  throw bad("unknown type");
+}
+
+}  // namespace gi

@@ -1,0 +1,63 @@
+#include "gi/run.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace gi {
+
+double RunStats::get(const std::string& key, double fallback) const {
+  for (const auto& kv : numbers)
+    if (kv.first == key) return kv.second;
+  return fallback;
+}
+
+std::string RunStats::line(const std::string& title) const {
+  std::string s = title + ":";
+  char buf[96];
+  bool first = true;
+  for (const auto& kv : numbers) {
+    std::snprintf(buf, sizeof buf, "%s %s=%.6g", first ? "" : ",", kv.first.c_str(), kv.second);
+    s += buf;
+    first = false;
+  }
+  for (const auto& n : notes) s += "; " + n;
+  return s;
+}
+
+void Progress::report(double f, const std::string& stage) const {
+  if (!fn_) return;
+  f = std::fmin(1.0, std::fmax(0.0, f));
+  int pct = from_ + int(std::lround(f * (to_ - from_)));
+  if (!fn_(pct, stage)) throw Cancelled();
+}
+
+Progress Progress::sub(double f0, double f1) const {
+  int a = from_ + int(std::lround(f0 * (to_ - from_)));
+  int b = from_ + int(std::lround(f1 * (to_ - from_)));
+  return Progress(fn_, a, b);
+}
+
+void parallelBlocks(size_t n, const Progress& progress, const std::string& stage,
+                    const std::function<void(size_t, size_t)>& body, size_t blocks) {
+  if (n == 0) return;
+  blocks = std::max<size_t>(1, std::min(blocks, n));
+  const size_t step = (n + blocks - 1) / blocks;
+  progress.report(0.0, stage);
+  for (size_t b0 = 0; b0 < n; b0 += step) {
+    const size_t b1 = std::min(n, b0 + step);
+    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 16),
+                      [&](const tbb::blocked_range<size_t>& r) { body(r.begin(), r.end()); });
+    progress.report(double(b1) / double(n), stage);
+  }
+}
+
+Timer::Timer() : t0_(std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count()) {}
+double Timer::seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - t0_;
+}
+
+}  // namespace gi

@@ -1,0 +1,75 @@
+#include "gi/sampling.h"
+
+#include <cmath>
+
+namespace gi {
+
+uint32_t sobol2(uint32_t index) {
+  // Direction numbers of Sobol dimension 2 (primitive polynomial x + 1):
+  // v_0 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1).
+  uint32_t x = 0, v = 0x80000000u;
+  for (; index; index >>= 1, v ^= v >> 1)
+    if (index & 1u) x ^= v;
+  return x;
+}
+
+glm::vec2 sobolOwen2D(uint32_t i, uint32_t key) {
+  // Shuffle the index (Owen scramble of the index), then scramble each
+  // dimension with its own seed: Burley 2020, section 4.
+  uint32_t idx = nestedUniformScramble(i, hash32(key));
+  uint32_t x = nestedUniformScramble(sobol1(idx), hashCombine(key, 0x68bc21ebu));
+  uint32_t y = nestedUniformScramble(sobol2(idx), hashCombine(key, 0x02e5be93u));
+  return {toUnitFloat(x), toUnitFloat(y)};
+}
+
+glm::vec3 cosineHemisphere(glm::vec2 u) {
+  // Malley's method on a uniform disk (concentric map, Shirley and Chiu 1997).
+  float a = 2.f * u.x - 1.f, b = 2.f * u.y - 1.f;
+  float r, phi;
+  if (a == 0.f && b == 0.f) return {0.f, 0.f, 1.f};
+  if (std::fabs(a) > std::fabs(b)) { r = a; phi = 0.785398163f * (b / a); }
+  else { r = b; phi = 1.570796327f - 0.785398163f * (a / b); }
+  float x = r * std::cos(phi), y = r * std::sin(phi);
+  float z = std::sqrt(std::fmax(0.f, 1.f - x * x - y * y));
+  return {x, y, z};
+}
+
+glm::vec3 uniformSphere(glm::vec2 u) {
+  float z = 1.f - 2.f * u.x;
+  float r = std::sqrt(std::fmax(0.f, 1.f - z * z));
+  float phi = 6.283185307f * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+glm::vec3 uniformHemisphere(glm::vec2 u) {
+  float z = u.x;
+  float r = std::sqrt(std::fmax(0.f, 1.f - z * z));
+  float phi = 6.283185307f * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+glm::vec3 uniformCone(glm::vec2 u, float cosMax) {
+  float z = 1.f - u.x * (1.f - cosMax);
+  float r = std::sqrt(std::fmax(0.f, 1.f - z * z));
+  float phi = 6.283185307f * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+glm::vec2 uniformTriangle(glm::vec2 u) {
+  // Heitz 2019, "A Low-Distortion Map Between Triangle and Square".
+  float b0, b1;
+  if (u.y > u.x) { b0 = u.x / 2.f; b1 = u.y - b0; }
+  else { b1 = u.y / 2.f; b0 = u.x - b1; }
+  return {b0, b1};
+}
+
+Frame::Frame(const glm::vec3& nn) : n(nn) {
+  // Duff et al. 2017, "Building an Orthonormal Basis, Revisited".
+  float sign = std::copysign(1.f, n.z);
+  float a = -1.f / (sign + n.z);
+  float k = n.x * n.y * a;
+  t = {1.f + sign * n.x * n.x * a, sign * k, -sign * n.x};
+  b = {k, sign + n.y * n.y * a, -n.y};
+}
+
+}  // namespace gi

@@ -1,0 +1,160 @@
+#include "gi/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "gi/color.h"
+
+namespace gi {
+
+bool Scene::hasEmitters() const {
+  for (const auto& e : emission)
+    if (e.r > 0.f || e.g > 0.f || e.b > 0.f) return true;
+  return false;
+}
+
+Scene Scene::fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris) {
+  Scene s;
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  for (const auto& p : pts)
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  s.origin = lo.x <= hi.x ? (lo + hi) * 0.5 : glm::dvec3(0.0);
+  s.positions.reserve(pts.size());
+  for (const auto& p : pts) s.positions.push_back(glm::vec3(p - s.origin));
+  s.triangles = std::move(tris);
+  return s;
+}
+
+size_t Scene::append(const Scene& o) {
+  const size_t vOff = positions.size(), fOff = triangles.size();
+  auto fillTo = [](auto& v, size_t n, auto value) { if (v.size() < n) v.resize(n, value); };
+  // Per-face arrays become explicit as soon as one part has them.
+  const bool anyRho = !rho.empty() || !o.rho.empty(), anyE = !emission.empty() || !o.emission.empty();
+  const bool anyMat = !material.empty() || !o.material.empty(), anyIor = !ior.empty() || !o.ior.empty();
+  const bool anyN = !vertexNormals.empty() || !o.vertexNormals.empty();
+  if (anyRho) fillTo(rho, fOff, glm::vec3(0.5f));
+  if (anyE) fillTo(emission, fOff, glm::vec3(0.f));
+  if (anyMat) fillTo(material, fOff, Material::Diffuse);
+  if (anyIor) fillTo(ior, fOff, 1.5f);
+  if (anyN) fillTo(vertexNormals, vOff, glm::vec3(0.f));
+  const glm::dvec3 shift = o.origin - origin;
+  for (const auto& p : o.positions) positions.push_back(glm::vec3(glm::dvec3(p) + shift));
+  for (const auto& t : o.triangles) triangles.push_back(t + glm::uvec3(uint32_t(vOff)));
+  for (size_t f = 0; f < o.faceCount(); ++f) {
+    if (anyRho) rho.push_back(o.faceRho(f));
+    if (anyE) emission.push_back(o.faceEmission(f));
+    if (anyMat) material.push_back(o.faceMaterial(f));
+    if (anyIor) ior.push_back(o.ior.empty() ? 1.5f : o.ior[f]);
+  }
+  if (anyN) {
+    if (o.vertexNormals.empty()) vertexNormals.resize(positions.size(), glm::vec3(0.f));
+    else vertexNormals.insert(vertexNormals.end(), o.vertexNormals.begin(), o.vertexNormals.end());
+  }
+  return vOff;
+}
+
+glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f) {
+  const auto& t = s.triangles[f];
+  // Double precision: slivers of large meshes lose their normal in float.
+  glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+  return glm::vec3(glm::cross(b - a, c - a));
+}
+
+double faceArea(const Scene& s, size_t f) {
+  const auto& t = s.triangles[f];
+  glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+  return 0.5 * glm::length(glm::cross(b - a, c - a));
+}
+
+static bool finite3(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+std::vector<uint8_t> usableFaceMask(const Scene& s) {
+  const size_t nv = s.positions.size();
+  std::vector<uint8_t> ok(s.faceCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const auto& t = s.triangles[f];
+    if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) continue;
+    if (!finite3(s.positions[t.x]) || !finite3(s.positions[t.y]) || !finite3(s.positions[t.z])) continue;
+    glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+    double l2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+    double area2 = glm::length(glm::cross(b - a, c - a));
+    // Degenerate: zero area, or height below float resolution of its longest edge.
+    if (!(area2 > 1e-12 * l2) || l2 == 0.0) continue;
+    ok[f] = 1;
+  }
+  return ok;
+}
+
+std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
+  std::vector<glm::dvec3> acc(s.positions.size(), glm::dvec3(0.0));
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const auto& t = s.triangles[f];
+    const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
+    const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
+    for (int k = 0; k < 3; ++k) {
+      // Angle-weighted (Thürmer and Wüthrich 1998): independent of tessellation.
+      glm::dvec3 e1 = glm::normalize(p[(k + 1) % 3] - p[k]), e2 = glm::normalize(p[(k + 2) % 3] - p[k]);
+      double angle = std::acos(std::clamp(glm::dot(e1, e2), -1.0, 1.0));
+      acc[t[k]] += angle * n;
+    }
+  }
+  std::vector<glm::vec3> n(acc.size());
+  for (size_t i = 0; i < acc.size(); ++i) {
+    double l = glm::length(acc[i]);
+    n[i] = l > 0.0 ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
+  }
+  return n;
+}
+
+SceneReport analyzeScene(const Scene& s) {
+  SceneReport r;
+  r.vertices = s.vertexCount();
+  r.faces = s.faceCount();
+  const size_t nv = r.vertices;
+  std::vector<uint8_t> used(nv, 0), finite(nv, 0);
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  for (size_t i = 0; i < nv; ++i) {
+    finite[i] = finite3(s.positions[i]);
+    if (!finite[i]) { ++r.nonFiniteVertices; continue; }
+    lo = glm::min(lo, s.toWorld(s.positions[i]));
+    hi = glm::max(hi, s.toWorld(s.positions[i]));
+  }
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < r.faces; ++f) {
+    const auto& t = s.triangles[f];
+    if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) { ++r.invalidFaces; continue; }
+    if (!finite[t.x] || !finite[t.y] || !finite[t.z]) { ++r.facesOnNonFinite; continue; }
+    if (!ok[f]) { ++r.degenerateFaces; continue; }
+    used[t.x] = used[t.y] = used[t.z] = 1;
+    glm::vec3 E = s.faceEmission(f);
+    if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
+      ++r.emitterFaces;
+      r.emittedPower += double(luminance(E)) * faceArea(s, f);
+    }
+  }
+  for (size_t i = 0; i < nv; ++i) r.isolatedVertices += (finite[i] && !used[i]) ? 1 : 0;
+  if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; r.diagonal = glm::length(hi - lo); }
+  // Ray offsets: a small fraction of the scene size, and never below the float
+  // resolution of the largest local coordinate (positions are centred).
+  double maxAbs = 0.0;
+  for (size_t i = 0; i < nv; ++i)
+    if (finite[i]) maxAbs = std::max({maxAbs, double(std::fabs(s.positions[i].x)), double(std::fabs(s.positions[i].y)), double(std::fabs(s.positions[i].z))});
+  r.rayEpsilon = std::max(r.diagonal * 1e-5, maxAbs * 64.0 * 1.19e-7);
+  if (r.rayEpsilon == 0.0) r.rayEpsilon = 1e-6;
+  return r;
+}
+
+std::string SceneReport::summary() const {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%zu vertices, %zu faces (%zu usable); skipped: %zu degenerate, %zu invalid, %zu on NaN/Inf vertices; "
+                "%zu NaN/Inf vertices, %zu isolated vertices; %zu emitter faces; bbox diagonal %.6g",
+                vertices, faces, usableFaces(), degenerateFaces, invalidFaces, facesOnNonFinite, nonFiniteVertices,
+                isolatedVertices, emitterFaces, diagonal);
+  return buf;
+}
+
+}  // namespace gi

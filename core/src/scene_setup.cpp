@@ -1,0 +1,133 @@
+#include "gi/scene_setup.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace gi {
+
+std::vector<ParamSpec> geometrySceneSpecs() {
+  std::vector<ParamSpec> s;
+  s.push_back({"scene_extent", "Scene extent",
+               "Which meshes form the scene. 'Current layer': only the selected layer casts and receives. "
+               "'All visible layers': every visible layer occludes (and reflects) as one scene and every one of them "
+               "receives the result, e.g. a Cornell box built from several meshes.",
+               ParamType::Enum, 0, 0, 0, {"Current layer", "All visible layers"}, {}, true});
+  s.push_back({"reflectance_source", "Reflectance from",
+               "Where the diffuse reflectance (albedo) rho of each face comes from. 'Auto': face colour if the mesh has "
+               "face colours, else the mean of its vertex colours, else the constant below. Colours are sRGB and are "
+               "converted to linear reflectance. Every channel must stay below 1 (energy conservation).",
+               ParamType::Enum, 0, 0, 0, {"Auto", "Face color", "Vertex color", "Constant"}});
+  s.push_back({"reflectance", "Constant reflectance",
+               "Reflectance used when the mesh has no colours or 'Constant' is chosen (sRGB colour; 0.5 linear is "
+               "sRGB 188).",
+               ParamType::Color, 0, 0, 0, {}, glm::vec3(188.f / 255.f)});
+  return s;
+}
+
+std::vector<ParamSpec> lightingSceneSpecs() {
+  auto s = geometrySceneSpecs();
+  s.push_back({"emitter_source", "Emitters",
+               "Which faces emit light. 'Selected faces': select the light in MeshLab (or with a selection filter in "
+               "a script). 'Face quality above threshold': faces whose quality exceeds the threshold below. "
+               "'None': only for scenes lit otherwise.",
+               ParamType::Enum, 0, 0, 0, {"Selected faces", "Face quality above threshold", "None"}});
+  s.push_back({"emitter_quality_threshold", "Emitter quality threshold",
+               "With 'Face quality above threshold', faces with quality strictly above this value emit.",
+               ParamType::Float, 0.5, -1e30, 1e30});
+  s.push_back({"emitter_color", "Emitter colour",
+               "Chromaticity of the emitted light (sRGB colour, converted to linear).", ParamType::Color, 0, 0, 0, {},
+               glm::vec3(1.f, 219.f / 255.f, 133.f / 255.f)});
+  s.push_back({"emitter_intensity", "Emitter radiosity (W/m^2)",
+               "Emitted radiosity E (exitance, one-sided, towards the face normal) = intensity x linear colour. The "
+               "default reproduces the Cornell box light of radiance (17, 12, 4): E = pi x 17 for red.",
+               ParamType::Float, 53.407, 0.0, 1e12});
+  return s;
+}
+
+std::vector<ParamSpec> displaySpecs() {
+  return {{"exposure", "Exposure",
+           "Vertex colour = sRGB(exposure x linear value); 0 chooses it automatically so that the 99th percentile of "
+           "the luminance maps to white. Quality always holds the physical value.",
+           ParamType::Float, 0.0, 0.0, 1e12}};
+}
+
+std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
+                                                 bool withEmitters, std::string* log) {
+  const size_t nf = s.faceCount();
+  auto src = ReflectanceSource(v.getInt("reflectance_source"));
+  const glm::vec3 constant = v.getVec("reflectance");
+  const glm::vec3 constantLin(srgbToLinear(constant.r), srgbToLinear(constant.g), srgbToLinear(constant.b));
+  const bool hasFace = a.faceColor.size() == nf && nf > 0;
+  const bool hasVert = a.vertexColor.size() == s.vertexCount() && s.vertexCount() > 0;
+  if (src == ReflectanceSource::Auto) src = hasFace ? ReflectanceSource::FaceColor : hasVert ? ReflectanceSource::VertexColor : ReflectanceSource::Constant;
+  if (src == ReflectanceSource::FaceColor && !hasFace) return std::string("reflectance from face colour was asked for, but the mesh has no face colours");
+  if (src == ReflectanceSource::VertexColor && !hasVert) return std::string("reflectance from vertex colour was asked for, but the mesh has no vertex colours");
+  s.rho.assign(nf, constantLin);
+  for (size_t f = 0; f < nf; ++f) {
+    if (src == ReflectanceSource::FaceColor) {
+      const auto& c = a.faceColor[f];
+      s.rho[f] = srgb8ToLinear(c.r, c.g, c.b);
+    } else if (src == ReflectanceSource::VertexColor) {
+      glm::vec3 sum(0.f);
+      const auto& t = s.triangles[f];
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] >= s.vertexCount()) continue;
+        const auto& c = a.vertexColor[t[k]];
+        sum += srgb8ToLinear(c.r, c.g, c.b);
+      }
+      s.rho[f] = sum / 3.f;
+    }
+  }
+  // Energy conservation: a white 255 colour is rho = 1, which never converges.
+  size_t clamped = 0;
+  for (auto& r : s.rho)
+    for (int k = 0; k < 3; ++k)
+      if (r[k] > 0.999f) { r[k] = 0.999f; ++clamped; }
+  const char* srcName[] = {"auto", "face colour", "vertex colour", "constant"};
+  std::string msg = std::string("reflectance from ") + srcName[int(src)];
+  if (clamped) msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
+  if (withEmitters) {
+    const auto es = EmitterSource(v.getInt("emitter_source"));
+    const glm::vec3 col = v.getVec("emitter_color");
+    const glm::vec3 E = float(v.getFloat("emitter_intensity")) * glm::vec3(srgbToLinear(col.r), srgbToLinear(col.g), srgbToLinear(col.b));
+    s.emission.assign(nf, glm::vec3(0.f));
+    size_t count = 0;
+    if (es == EmitterSource::SelectedFaces && a.faceSelected.size() == nf) {
+      for (size_t f = 0; f < nf; ++f)
+        if (a.faceSelected[f]) { s.emission[f] = E; ++count; }
+    } else if (es == EmitterSource::QualityAbove && a.faceQuality.size() == nf) {
+      const float th = float(v.getFloat("emitter_quality_threshold"));
+      for (size_t f = 0; f < nf; ++f)
+        if (a.faceQuality[f] > th) { s.emission[f] = E; ++count; }
+    }
+    msg += "; " + std::to_string(count) + " emitter faces";
+  }
+  if (log) *log = msg;
+  return std::nullopt;
+}
+
+std::vector<Rgb8> VertexOutput::displayColors() const {
+  std::vector<Rgb8> out(quality.size());
+  for (size_t i = 0; i < quality.size(); ++i) {
+    glm::vec3 c = rgb.empty() ? glm::vec3(quality[i]) : rgb[i];
+    out[i] = displayMap(c, exposure);
+  }
+  return out;
+}
+
+std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace) {
+  std::vector<glm::dvec3> acc(s.vertexCount(), glm::dvec3(0.0));
+  std::vector<double> w(s.vertexCount(), 0.0);
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const double a = faceArea(s, f);
+    for (int k = 0; k < 3; ++k) { acc[s.triangles[f][k]] += a * glm::dvec3(perFace[f]); w[s.triangles[f][k]] += a; }
+  }
+  std::vector<glm::vec3> out(s.vertexCount(), glm::vec3(0.f));
+  for (size_t i = 0; i < out.size(); ++i)
+    if (w[i] > 0.0) out[i] = glm::vec3(acc[i] / w[i]);
+  return out;
+}
+
+}  // namespace gi

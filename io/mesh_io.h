@@ -1,0 +1,30 @@
+// Mesh files for the command-line tool (OpenMesh): PLY/OBJ/OFF/STL in, PLY out.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "gi/scene.h"
+#include "gi/scene_setup.h"
+
+namespace gi::io {
+
+struct LoadedMesh {
+  Scene scene;            // positions (re-centred), triangles (polygons fan-triangulated), normals if the file has them
+  MeshAttributes attrs;   // face/vertex colours (sRGB bytes), face quality, if present in the file
+  std::vector<uint32_t> triangleToFace;  // source polygon of each triangle
+};
+
+// Throws std::runtime_error with one sentence ("cannot read X: ...") on failure.
+LoadedMesh loadMesh(const std::string& path);
+
+// Writes a binary PLY: vertices with colour (uchar red/green/blue) and
+// "quality" (float), faces with colour if attrs has face colours, and optionally
+// extra per-vertex float3 properties (e.g. bent normals as nx, ny, nz).
+struct PlyExtras {
+  std::vector<glm::vec3> normals;  // written as nx, ny, nz if not empty
+};
+void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
+              const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,
+              const PlyExtras& extras = {});
+
+}  // namespace gi::io
