@@ -1,0 +1,88 @@
+// The one bridge between MeshLab (MeshDocument / CMeshO, 2020.09 API) and the
+// engine's Scene: layers in, per-vertex results out, parameter tables to
+// RichParameterList and back. Plugins call this and contain no algorithm code.
+#pragma once
+#include <QString>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <common/interfaces.h>
+
+#include "gi/params.h"
+#include "gi/run.h"
+#include "gi/scene.h"
+#include "gi/scene_setup.h"
+
+namespace gi::ml {
+
+struct LayerPart {
+  MeshModel* mm = nullptr;
+  std::vector<int> sceneVertex;  // per cm.vert index: scene vertex, -1 if deleted
+  size_t vertexOffset = 0, vertexCount = 0;
+  size_t faceOffset = 0, faceCount = 0;
+};
+
+struct BridgeScene {
+  Scene scene;
+  MeshAttributes attrs;
+  std::vector<LayerPart> parts;
+};
+
+// Layers taking part: the current one, or every visible one (extent enum of
+// geometrySceneSpecs()). Throws std::invalid_argument if there is none.
+std::vector<MeshModel*> participatingLayers(MeshDocument& md, int sceneExtent);
+// Converts the layers (deleted elements skipped) into one scene. Throws
+// std::invalid_argument when there is nothing to work on (no faces).
+BridgeScene toScene(const std::vector<MeshModel*>& layers);
+
+// Dialog <-> engine parameters. Distances become RichAbsPerc over the diagonal.
+void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, double diagonal);
+ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>& specs);
+// Diagonal of the layers' bounding boxes (current layer or all visible ones).
+double documentDiagonal(MeshDocument& md);
+
+// Writes quality and colour to every vertex of every part (non-finite values
+// become 0 and are counted in the return value). Colour is skipped if empty.
+size_t writeVertexResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors);
+// Per-vertex Point3m attribute `name` (e.g. "BentNormal"), optionally into the normals too.
+void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v,
+                                bool alsoNormals);
+// Multiplies existing vertex colours by a factor in [0,1] (AO "multiply colour").
+void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor);
+
+// MeshLab progress callback -> engine progress (cancellation not supported by 2020.09's cb).
+ProgressFn progressFrom(vcg::CallBackPos* cb);
+
+// Runs `body`; converts engine exceptions into errorMessage + a log line + false.
+// `log` prints one line into MeshLab's log (shown by the GUI and meshlabserver).
+bool guarded(QString& errorMessage, const std::function<void(const std::string&)>& log, const QString& filter,
+             const std::function<void()>& body);
+
+}  // namespace gi::ml
+
+namespace gi::ml {
+
+// Everything a filter does before its algorithm: parameters read and
+// validated, layers gathered into a scene, scene conventions applied.
+struct PreparedRun {
+  ParamValues values;
+  BridgeScene bridge;
+  SceneReport report;
+  std::string setupLog;  // reflectance / emitters summary
+};
+PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::vector<ParamSpec>& specs,
+                    bool withEmitters);
+
+// Quality and display colour from per-vertex linear RGB (exposure 0 = auto).
+VertexOutput radiometricOutput(const std::vector<glm::vec3>& rgb, double exposureParam);
+
+}  // namespace gi::ml
+
+namespace gi {
+struct VertexRadiometry;
+}
+namespace gi::ml {
+// Writes B as quality (luminance) and display colour; adds the exposure to the stats.
+void writeRadiometry(PreparedRun& run, VertexRadiometry& r);
+}  // namespace gi::ml

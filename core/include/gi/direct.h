@@ -1,0 +1,42 @@
+// Direct illumination from area emitters at every vertex — the zero-bounce
+// radiosity solution B = E + rho H_direct, with
+//   H_direct(x) = ∫_A E_e/pi cos(theta_x) cos(theta_e) / r^2 V(x, y) dA_y
+// estimated by sampling emitter points in proportion to power, with shadow rays.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/params.h"
+#include "gi/raycaster.h"
+#include "gi/run.h"
+#include "gi/scene.h"
+
+namespace gi {
+
+struct DirectOptions {
+  int lightSamples = 64;  // shadow rays per vertex
+  uint32_t seed = 0;
+  static std::vector<ParamSpec> specs();
+  static DirectOptions fromParams(const ParamValues& v);
+};
+
+struct VertexRadiometry {
+  std::vector<glm::vec3> B;        // radiosity per vertex (W/m^2, RGB)
+  std::vector<glm::vec3> H;        // incident irradiance per vertex
+  std::vector<float> stdError;     // standard error of luminance(B)
+  RunStats stats;
+};
+
+// Per-vertex reflectance, emission and normal from the incident faces (area-weighted).
+struct VertexMaterial {
+  std::vector<glm::vec3> rho, E, n;
+  std::vector<uint8_t> valid;
+};
+VertexMaterial vertexMaterial(const Scene& s);
+
+VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt,
+                               const Progress& progress = Progress(nullptr));
+
+}  // namespace gi

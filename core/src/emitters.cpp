@@ -1,0 +1,41 @@
+#include "gi/emitters.h"
+
+#include <algorithm>
+
+#include "gi/color.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+EmitterSampler::EmitterSampler(const Scene& s) : s_(s) {
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const double p = double(luminance(s.faceEmission(f))) * faceArea(s, f);
+    if (!(p > 0.0)) continue;
+    faces_.push_back(uint32_t(f));
+    area_.push_back(float(faceArea(s, f)));
+    total_ += p;
+    cdf_.push_back(total_);
+  }
+}
+
+EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
+  const double x = double(u.x) * total_;
+  size_t k = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), x) - cdf_.begin());
+  k = std::min(k, faces_.size() - 1);
+  const double lo = k ? cdf_[k - 1] : 0.0, w = cdf_[k] - lo;
+  const float ux = w > 0 ? float(std::clamp((x - lo) / w, 0.0, 0.99999994)) : 0.5f;
+  const uint32_t f = faces_[k];
+  const auto& t = s_.triangles[f];
+  const glm::vec2 b = uniformTriangle({ux, u.y});
+  Sample smp;
+  smp.p = b.x * s_.positions[t.x] + b.y * s_.positions[t.y] + (1.f - b.x - b.y) * s_.positions[t.z];
+  smp.n = glm::normalize(faceNormalUnnormalized(s_, f));
+  smp.E = s_.faceEmission(f);
+  smp.pdfArea = float(w / total_) / area_[k];
+  smp.face = f;
+  return smp;
+}
+
+}  // namespace gi

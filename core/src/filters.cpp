@@ -1,0 +1,130 @@
+#include "gi/filters.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+#include "gi/ambient.h"
+#include "gi/direct.h"
+#include "gi/photon.h"
+#include "gi/scene_setup.h"
+
+namespace gi {
+
+const std::vector<FilterDesc>& allFilters() {
+  static const std::vector<FilterDesc> f = {
+      {FilterKind::AmbientOcclusion, "GI: Ambient Occlusion", "ao", "per-vertex cosine-weighted ambient occlusion"},
+      {FilterKind::AmbientObscurance, "GI: Ambient Obscurance", "obscurance", "per-vertex ambient obscurance"},
+      {FilterKind::SkyLighting, "GI: Sky Lighting", "sky", "per-vertex irradiance from a uniform sky and a sun"},
+      {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "radiosity from area emitters (direct light)"},
+      {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "photon-mapped radiosity from area emitters"},
+  };
+  return f;
+}
+
+const FilterDesc& filterDesc(FilterKind k) {
+  for (const auto& d : allFilters())
+    if (d.kind == k) return d;
+  throw std::logic_error("unknown filter");
+}
+
+std::vector<ParamSpec> filterSpecs(FilterKind k) {
+  std::vector<ParamSpec> s;
+  auto add = [&s](const std::vector<ParamSpec>& more) { s.insert(s.end(), more.begin(), more.end()); };
+  switch (k) {
+    case FilterKind::AmbientOcclusion:
+    case FilterKind::AmbientObscurance:
+    case FilterKind::SkyLighting: {
+      const AmbientMode m = k == FilterKind::AmbientOcclusion ? AmbientMode::Occlusion
+                            : k == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
+                                                                 : AmbientMode::Sky;
+      s.push_back(geometrySceneSpecs().front());  // scene extent (reflectance plays no part)
+      add(AmbientOptions::specs(m));
+      if (m == AmbientMode::Sky) add(displaySpecs());
+      break;
+    }
+    case FilterKind::Radiosity:
+      add(lightingSceneSpecs());
+      add(DirectOptions::specs());
+      add(displaySpecs());
+      break;
+    case FilterKind::PhotonMapping:
+      add(lightingSceneSpecs());
+      add(PhotonOptions::specs());
+      add(displaySpecs());
+      break;
+  }
+  return s;
+}
+
+static std::string xmlEscape(const std::string& t) {
+  std::string o;
+  for (char c : t) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+static std::string fnum(double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.9g", x);
+  return b;
+}
+
+std::string mlxScript(const std::vector<ScriptStep>& steps, double diagonal) {
+  std::ostringstream o;
+  o << "<!DOCTYPE FilterScript>\n<FilterScript>\n";
+  for (const auto& st : steps) {
+    o << " <filter name=\"" << xmlEscape(filterDesc(st.kind).meshlabName) << "\">\n";
+    for (const ParamSpec& p : filterSpecs(st.kind)) {
+      const std::string n = "name=\"" + p.name + "\"";
+      switch (p.type) {
+        case ParamType::Bool:
+          o << "  <Param type=\"RichBool\" value=\"" << (st.values.getBool(p.name) ? "true" : "false") << "\" " << n << "/>\n";
+          break;
+        case ParamType::Int:
+          o << "  <Param type=\"RichInt\" value=\"" << st.values.getInt(p.name) << "\" " << n << "/>\n";
+          break;
+        case ParamType::Float:
+          o << "  <Param type=\"RichFloat\" value=\"" << fnum(st.values.getFloat(p.name)) << "\" " << n << "/>\n";
+          break;
+        case ParamType::Distance:
+          o << "  <Param type=\"RichAbsPerc\" value=\"" << fnum(st.values.getFloat(p.name)) << "\" min=\"0\" max=\""
+            << fnum((p.max > 0 ? p.max : 1.0) * (diagonal > 0 ? diagonal : 1.0)) << "\" " << n << "/>\n";
+          break;
+        case ParamType::Enum: {
+          o << "  <Param type=\"RichEnum\" value=\"" << st.values.getInt(p.name) << "\" enum_cardinality=\""
+            << p.choices.size() << "\"";
+          for (size_t i = 0; i < p.choices.size(); ++i) o << " enum_val" << i << "=\"" << xmlEscape(p.choices[i]) << "\"";
+          o << " " << n << "/>\n";
+          break;
+        }
+        case ParamType::Color: {
+          const glm::vec3 c = st.values.getVec(p.name);
+          auto b = [](float x) { return int(std::lround(x * 255.f)); };
+          o << "  <Param type=\"RichColor\" r=\"" << b(c.r) << "\" g=\"" << b(c.g) << "\" b=\"" << b(c.b)
+            << "\" a=\"255\" " << n << "/>\n";
+          break;
+        }
+        case ParamType::Direction: {
+          const glm::vec3 d = st.values.getVec(p.name);
+          o << "  <Param type=\"RichPoint3f\" x=\"" << fnum(d.x) << "\" y=\"" << fnum(d.y) << "\" z=\"" << fnum(d.z)
+            << "\" " << n << "/>\n";
+          break;
+        }
+      }
+    }
+    o << " </filter>\n";
+  }
+  o << "</FilterScript>\n";
+  return o.str();
+}
+
+}  // namespace gi
