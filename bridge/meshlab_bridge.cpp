@@ -229,8 +229,9 @@ PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::v
   if (auto err = validate(specs, r.values, diag)) throw std::invalid_argument(*err);
   const int extent = r.values.has("scene_extent") ? r.values.getInt("scene_extent") : 0;
   r.bridge = toScene(participatingLayers(md, extent));
-  if (auto err = applySceneConventions(r.bridge.scene, r.bridge.attrs, r.values, withEmitters, &r.setupLog))
-    throw std::invalid_argument(*err);
+  if (r.values.has("reflectance_source"))
+    if (auto err = applySceneConventions(r.bridge.scene, r.bridge.attrs, r.values, withEmitters, &r.setupLog))
+      throw std::invalid_argument(*err);
   r.report = analyzeScene(r.bridge.scene);
   if (r.report.usableFaces() == 0)
     throw std::invalid_argument("the mesh has no usable triangles (" + r.report.summary() + ")");

@@ -30,17 +30,16 @@ struct VertexOut {
 
 class AmbientKernel {
  public:
-  AmbientKernel(const RayCaster& c, const AmbientOptions& o, float eps) : caster_(c), o_(o), eps_(eps) {
+  AmbientKernel(const RayCaster& c, const AmbientOptions& o) : caster_(c), o_(o) {
     tfar_ = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
     coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
   }
 
-  VertexOut run(uint32_t vi, const glm::vec3& p, const glm::vec3& n) const {
+  VertexOut run(uint32_t vi, const glm::vec3& org, const glm::vec3& n) const {
     VertexOut out;
     const Frame frame(n);
     const Frame cone(o_.coneDirection);
-    const glm::vec3 org = p + n * eps_;
     const uint32_t key = hash3(vi, o_.seed, 0x41u);
     const bool adaptive = o_.targetError > 0.0;
     const int maxN = adaptive ? o_.maxRays : o_.raysPerVertex;
@@ -85,7 +84,7 @@ class AmbientKernel {
     else out.value = float(w.mean);
     out.stdError = float(stdError(w, done, num, den, numSq, denSq, numDen));
     if (o_.bentNormals) out.bent = glm::length(bent) > 0.f ? glm::normalize(bent) : n;
-    if (o_.mode == AmbientMode::Sky) out = addSun(out, vi, p, n, org);
+    if (o_.mode == AmbientMode::Sky) out = addSun(out, vi, n, org);
     return out;
   }
 
@@ -100,7 +99,7 @@ class AmbientKernel {
     return std::sqrt(std::max(0.0, varRes) / N) / meanC;
   }
 
-  VertexOut addSun(VertexOut out, uint32_t vi, const glm::vec3& p, const glm::vec3& n, const glm::vec3& org) const {
+  VertexOut addSun(VertexOut out, uint32_t vi, const glm::vec3& n, const glm::vec3& org) const {
     const glm::vec3 sky = o_.skyRadiantColor * o_.skyIrradiance * out.value;
     glm::vec3 sun(0.f);
     int sunRays = 0;
@@ -135,7 +134,7 @@ class AmbientKernel {
 
   const RayCaster& caster_;
   const AmbientOptions& o_;
-  float eps_, tfar_, coneCos_, sunCos_;
+  float tfar_, coneCos_, sunCos_;
 };
 
 void checkOptions(const AmbientOptions& o) {
@@ -202,7 +201,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   res.rays.assign(nv, 0);
   if (opt.mode == AmbientMode::Sky) res.rgb.assign(nv, glm::vec3(0.f));
   if (opt.bentNormals) res.bentNormal = normals;
-  const AmbientKernel kernel(caster, opt, float(rep.rayEpsilon));
+  const AmbientKernel kernel(caster, opt);
+  const std::vector<glm::vec3> origins = vertexRayOrigins(scene, normals, float(rep.rayEpsilon));
   Timer traceTimer;
   parallelBlocks(nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -212,7 +212,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
         continue;
       }
       if (status[i] != kTrace) continue;
-      const VertexOut o = kernel.run(uint32_t(i), scene.positions[i], normals[i]);
+      const VertexOut o = kernel.run(uint32_t(i), origins[i], normals[i]);
       res.value[i] = o.value;
       res.stdError[i] = o.stdError;
       res.rays[i] = o.rays;

@@ -66,6 +66,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   const float eps = float(rep.rayEpsilon);
   const VertexMaterial mat = vertexMaterial(s);
   const size_t nv = s.vertexCount();
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
   VertexRadiometry out;
   out.B.assign(nv, glm::vec3(0.f));
   out.H.assign(nv, glm::vec3(0.f));
@@ -78,7 +79,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
       const glm::vec3 n = mat.n[i];
-      const glm::vec3 x = s.positions[i] + n * eps;
+      const glm::vec3 x = origins[i];
       const uint32_t key = hash3(uint32_t(i), opt.seed, 0xd1u);
       for (int j = 0; j < N; ++j) {
         const auto L = lights.sample(sobolOwen2D(uint32_t(j), key));

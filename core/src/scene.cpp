@@ -158,3 +158,32 @@ std::string SceneReport::summary() const {
 }
 
 }  // namespace gi
+
+namespace gi {
+std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps) {
+  const size_t nv = s.vertexCount();
+  std::vector<glm::dvec3> pull(nv, glm::dvec3(0.0));
+  std::vector<int> count(nv, 0);
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const auto& t = s.triangles[f];
+    const glm::dvec3 c = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 d = c - glm::dvec3(s.positions[t[k]]);
+      const double l = glm::length(d);
+      if (l > 0) { pull[t[k]] += d / l; ++count[t[k]]; }
+    }
+  }
+  std::vector<glm::vec3> o(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    const glm::dvec3 n(normals[i]);
+    glm::dvec3 p = count[i] ? pull[i] / double(count[i]) : glm::dvec3(0.0);
+    p -= n * glm::dot(p, n);  // tangential part only
+    const double l = glm::length(p);
+    const glm::dvec3 shift = l > 0.2 ? p / l : glm::dvec3(0.0);  // symmetric one-rings need no pull
+    o[i] = glm::vec3(glm::dvec3(s.positions[i]) + double(eps) * (n + shift));
+  }
+  return o;
+}
+}  // namespace gi

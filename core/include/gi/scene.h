@@ -67,3 +67,11 @@ SceneReport analyzeScene(const Scene& s);
 std::vector<uint8_t> usableFaceMask(const Scene& s);
 
 }  // namespace gi
+
+namespace gi {
+// Ray origins for per-vertex estimators: lifted by eps along the normal and,
+// where the one-ring is lopsided (mesh borders, the edge where a floor meets a
+// separate wall sheet), pulled by eps into the incident faces, so that rays
+// cannot slip under an adjacent wall at t = 0 and leak.
+std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps);
+}  // namespace gi

@@ -1,0 +1,274 @@
+// gi: the engine on mesh files. One subcommand per filter, with the same
+// parameter names, defaults and validation as the MeshLab dialogs (both come
+// from gi::filterSpecs), plus `script` to write complete .mlx files.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include "gi/ambient.h"
+#include "gi/direct.h"
+#include "gi/filters.h"
+#include "gi/photon.h"
+#include "gi/scene_setup.h"
+#include "mesh_io.h"
+
+using namespace gi;
+using json = nlohmann::json;
+
+namespace {
+
+struct CommonArgs {
+  std::string input, output, mesh;
+  bool json = false, quiet = false;
+  int threads = 0;
+  std::map<std::string, std::string> raw;  // parameter texts as given
+};
+
+ProgressFn stderrProgress(bool quiet) {
+  if (quiet) return nullptr;
+  const bool tty = isatty(fileno(stderr));
+  auto last = std::make_shared<int>(-1);
+  auto lastStage = std::make_shared<std::string>();
+  return [tty, last, lastStage](int pct, const std::string& stage) {
+    if (pct == *last && stage == *lastStage) return true;
+    if (tty) {
+      const int w = 30, fill = pct * w / 100;
+      std::fprintf(stderr, "\r[%.*s%*s] %3d%% %-28s", fill, "##############################", w - fill, "", pct, stage.c_str());
+      if (pct >= 100) std::fputc('\n', stderr);
+    } else if (pct / 10 != *last / 10 || stage != *lastStage) {
+      std::fprintf(stderr, "%3d%% %s\n", pct, stage.c_str());
+    }
+    *last = pct;
+    *lastStage = stage;
+    return true;
+  };
+}
+
+json statsJson(const RunStats& s) {
+  json j = json::object();
+  for (const auto& [k, v] : s.numbers) j[k] = v;
+  return j;
+}
+
+json valuesJson(const std::vector<ParamSpec>& specs, const ParamValues& v) {
+  json j = json::object();
+  for (const auto& p : specs) {
+    if (!v.has(p.name)) continue;
+    switch (p.type) {
+      case ParamType::Bool: j[p.name] = v.getBool(p.name); break;
+      case ParamType::Int: j[p.name] = v.getInt(p.name); break;
+      case ParamType::Enum: j[p.name] = p.choices.at(size_t(v.getInt(p.name))); break;
+      case ParamType::Float:
+      case ParamType::Distance: j[p.name] = v.getFloat(p.name); break;
+      case ParamType::Color:
+      case ParamType::Direction: {
+        const glm::vec3 c = v.getVec(p.name);
+        j[p.name] = {c.x, c.y, c.z};
+        break;
+      }
+    }
+  }
+  return j;
+}
+
+std::string defaultText(const ParamSpec& p) {
+  char b[96];
+  switch (p.type) {
+    case ParamType::Bool: return p.def != 0 ? "true" : "false";
+    case ParamType::Int: std::snprintf(b, sizeof b, "%d", int(p.def)); return b;
+    case ParamType::Float: std::snprintf(b, sizeof b, "%g", p.def); return b;
+    case ParamType::Distance: std::snprintf(b, sizeof b, "%g%%", p.def * 100); return b;
+    case ParamType::Enum: return p.choices.at(size_t(p.def));
+    case ParamType::Color:
+      std::snprintf(b, sizeof b, "%d,%d,%d", int(p.defVec.r * 255 + .5f), int(p.defVec.g * 255 + .5f), int(p.defVec.b * 255 + .5f));
+      return b;
+    case ParamType::Direction: std::snprintf(b, sizeof b, "%g,%g,%g", p.defVec.x, p.defVec.y, p.defVec.z); return b;
+  }
+  return "";
+}
+
+void addParamOptions(CLI::App* sub, const std::vector<ParamSpec>& specs, CommonArgs& a, bool includeMeshlabOnly) {
+  for (const auto& p : specs) {
+    if (p.meshlabOnly && !includeMeshlabOnly) continue;
+    std::string help = p.label + ". " + p.help + " [default: " + defaultText(p) + "]";
+    if (p.type == ParamType::Enum) {
+      help += " {";
+      for (size_t i = 0; i < p.choices.size(); ++i) help += (i ? ", " : "") + p.choices[i];
+      help += "}";
+    }
+    auto* opt = sub->add_option_function<std::string>(
+        "--" + p.name, [&a, name = p.name](const std::string& t) { a.raw[name] = t; }, help);
+    opt->type_name(p.type == ParamType::Distance ? "LEN|PCT%" : p.type == ParamType::Bool ? "BOOL" : "VALUE");
+  }
+}
+
+ParamValues resolve(const std::vector<ParamSpec>& specs, const CommonArgs& a, double diag) {
+  ParamValues v = defaultValues(specs, diag);
+  for (const auto& [name, text] : a.raw) v.set(name, parseValue(*findSpec(specs, name), text, diag));
+  if (auto err = validate(specs, v, diag)) throw std::invalid_argument(*err);
+  return v;
+}
+
+int runFilter(FilterKind kind, const CommonArgs& a) {
+  const auto specs = filterSpecs(kind);
+  const FilterDesc& desc = filterDesc(kind);
+  std::unique_ptr<tbb::global_control> threads;
+  if (a.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(a.threads));
+  Timer timer;
+  io::LoadedMesh mesh = io::loadMesh(a.input);
+  if (mesh.scene.faceCount() == 0)
+    throw std::invalid_argument(a.input + " has no faces (a point cloud?): these filters need triangles");
+  const SceneReport pre = analyzeScene(mesh.scene);
+  ParamValues v = resolve(specs, a, pre.diagonal);
+  const bool lighting = kind == FilterKind::Radiosity || kind == FilterKind::PhotonMapping;
+  std::string setupLog;
+  if (lighting || findSpec(specs, "reflectance_source"))
+    if (auto err = applySceneConventions(mesh.scene, mesh.attrs, v, lighting, &setupLog)) throw std::invalid_argument(*err);
+  const SceneReport rep = analyzeScene(mesh.scene);
+  if (rep.usableFaces() == 0) throw std::invalid_argument(a.input + " has no usable triangles (" + rep.summary() + ")");
+  const Progress progress(stderrProgress(a.quiet));
+
+  VertexOutput out;
+  RunStats stats;
+  io::PlyExtras extras;
+  if (kind == FilterKind::AmbientOcclusion || kind == FilterKind::AmbientObscurance || kind == FilterKind::SkyLighting) {
+    const AmbientMode mode = kind == FilterKind::AmbientOcclusion ? AmbientMode::Occlusion
+                             : kind == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
+                                                                     : AmbientMode::Sky;
+    const AmbientOptions opt = AmbientOptions::fromParams(mode, v);
+    auto caster = makeEmbreeCaster(mesh.scene, opt.batch);
+    AmbientResult r = computeAmbient(mesh.scene, *caster, opt, progress);
+    stats = r.stats;
+    if (mode == AmbientMode::Sky) {
+      out.rgb = r.rgb;
+      out.quality = r.value;
+      const double e = v.getFloat("exposure");
+      out.exposure = e > 0 ? float(e) : autoExposure(out.quality.data(), out.quality.size());
+      stats.add("exposure", out.exposure);
+    } else {
+      out.quality = r.value;
+      if (opt.bentNormals) extras.normals = r.bentNormal;
+    }
+  } else {
+    VertexRadiometry r;
+    if (kind == FilterKind::Radiosity) {
+      auto caster = makeEmbreeCaster(mesh.scene);
+      r = computeDirect(mesh.scene, *caster, DirectOptions::fromParams(v), progress);
+    } else {
+      auto caster = makeEmbreeCaster(mesh.scene);
+      r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v), progress);
+    }
+    stats = r.stats;
+    out.rgb = r.B;
+    out.quality.resize(r.B.size());
+    for (size_t i = 0; i < r.B.size(); ++i) out.quality[i] = luminance(r.B[i]);
+    const double e = v.getFloat("exposure");
+    out.exposure = e > 0 ? float(e) : autoExposure(out.quality.data(), out.quality.size());
+    stats.add("exposure", out.exposure);
+  }
+  if (!a.output.empty()) io::writePly(a.output, mesh.scene, mesh.attrs, out.quality, out.displayColors(), extras);
+  stats.add("total_seconds", timer.seconds());
+  if (a.json) {
+    json j;
+    j["filter"] = desc.meshlabName;
+    j["input"] = a.input;
+    if (!a.output.empty()) j["output"] = a.output;
+    j["parameters"] = valuesJson(specs, v);
+    j["scene"] = {{"vertices", rep.vertices}, {"faces", rep.faces}, {"usable_faces", rep.usableFaces()},
+                  {"degenerate_faces", rep.degenerateFaces}, {"invalid_faces", rep.invalidFaces},
+                  {"nonfinite_vertices", rep.nonFiniteVertices}, {"isolated_vertices", rep.isolatedVertices},
+                  {"emitter_faces", rep.emitterFaces}, {"diagonal", rep.diagonal}};
+    j["stats"] = statsJson(stats);
+    j["notes"] = stats.notes;
+    if (!setupLog.empty()) j["setup"] = setupLog;
+    std::cout << j.dump(2) << std::endl;
+  } else if (!a.quiet) {
+    std::cerr << rep.summary() << (setupLog.empty() ? "" : "; " + setupLog) << "\n";
+    std::cerr << stats.line(desc.meshlabName) << "\n";
+    if (!a.output.empty()) std::cerr << "wrote " << a.output << "\n";
+  }
+  return 0;
+}
+
+int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
+  double diag = 1.0;
+  if (!a.mesh.empty()) diag = analyzeScene(io::loadMesh(a.mesh).scene).diagonal;
+  std::vector<ScriptStep> steps;
+  for (FilterKind k : kinds) steps.push_back({k, resolve(filterSpecs(k), a, diag)});
+  const std::string text = mlxScript(steps, diag);
+  if (a.output.empty() || a.output == "-") {
+    std::cout << text;
+  } else {
+    std::ofstream f(a.output);
+    if (!(f << text)) throw std::runtime_error("cannot write " + a.output);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"gi: global illumination on meshes (ambient occlusion, sky lighting, radiosity, photon mapping).\n"
+               "Reads PLY/OBJ/OFF/STL, writes PLY with per-vertex colour and quality."};
+  app.require_subcommand(1);
+  CommonArgs a;
+  std::map<CLI::App*, FilterKind> subs;
+  for (const FilterDesc& d : allFilters()) {
+    CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
+    sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required()->check(CLI::ExistingFile);
+    sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality");
+    sub->add_flag("--json", a.json, "print a machine-readable summary on stdout");
+    sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");
+    sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it");
+    addParamOptions(sub, filterSpecs(d.kind), a, false);
+    subs[sub] = d.kind;
+  }
+  CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
+  std::string filterName;
+  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap)")->required();
+  script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
+  script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
+  script->allow_extras();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    for (auto& [sub, kind] : subs)
+      if (sub->parsed()) return runFilter(kind, a);
+    if (script->parsed()) {
+      const FilterDesc* d = nullptr;
+      for (const auto& f : allFilters())
+        if (f.cliName == filterName) d = &f;
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap)");
+      // Parameters after the filter name: --name value pairs, checked against the filter's table.
+      const auto specs = filterSpecs(d->kind);
+      const auto extras = script->remaining();
+      for (size_t i = 0; i < extras.size(); ++i) {
+        std::string k = extras[i];
+        if (k.rfind("--", 0) != 0) throw std::invalid_argument("unexpected argument '" + k + "'");
+        k = k.substr(2);
+        std::string val;
+        const size_t eq = k.find('=');
+        if (eq != std::string::npos) { val = k.substr(eq + 1); k = k.substr(0, eq); }
+        else if (i + 1 < extras.size()) val = extras[++i];
+        else throw std::invalid_argument("--" + k + " needs a value");
+        if (!findSpec(specs, k)) throw std::invalid_argument("'" + d->cliName + "' has no parameter --" + k);
+        a.raw[k] = val;
+      }
+      return writeScript({d->kind}, a);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gi: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
