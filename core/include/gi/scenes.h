@@ -1,0 +1,56 @@
+// Canonical test scenes with analytic references (DESIGN.md §5), built in
+// double precision. Every triangle is counter-clockwise seen from its front
+// (the side light reflects from); walls are split into roughly square patches
+// of two triangles each.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "gi/scene.h"
+#include "gi/scene_setup.h"
+
+namespace gi::scenes {
+
+// A scene and the same data as mesh attributes, so it can be written to PLY:
+// faceColor = sRGB bytes of rho, faceQuality = 1 for emitters, 0 otherwise.
+struct SceneFile {
+  Scene scene;            // rho (linear) and emission set per face
+  MeshAttributes attrs;
+};
+
+// Cornell box, published geometry in millimetres (camera side z = 0 open).
+// Light 130 x 105 mm at y = 548.7 facing down, E = pi * (17, 12, 4) W/m^2.
+SceneFile cornellBox(double patchSize);
+// Two coaxial unit squares at distance L facing each other, n x n patches each.
+// The one at z = 0 emits E = 1; rho = 0 everywhere (irradiance = form factor).
+SceneFile parallelPlates(double L, int n);
+// Unit squares in z = 0 (emitting, E = 1) and x = 0 sharing the edge along y,
+// both facing into the quadrant x, z > 0; rho = 0.
+SceneFile perpendicularPlates(int n);
+// Icosphere of 20 * 4^subdivisions faces centred at 0, rho 0.5, no emission.
+SceneFile sphere(double radius, int subdivisions, bool inward);
+// Cube [-size/2, size/2]^3, n x n patches per side, rho 0.5.
+SceneFile closedBox(double size, int n, bool inward);
+// Square [-size/2, size/2]^2 in z = 0 facing +z.
+SceneFile openPlane(double size, int n);
+// Floor z = 0 (x in [0, floorSize]) facing +z and wall x = 0 (z in [0, wallHeight])
+// facing +x, both max(floorSize, 20 * wallHeight) wide in y (about infinite).
+// Patch edge floorSize / n.
+SceneFile floorWithWall(double floorSize, double wallHeight, int n);
+// Inside of the lower hemisphere of radius r centred at 0 (rim at z = 0), normals
+// towards the centre, a vertex at (0, 0, -radius); n rings from bottom to rim.
+SceneFile hemisphericalBowl(double radius, int n);
+// Ground z = 0 from radius a to 10 a, cylinder wall of radius a down to z = -h,
+// bottom disk with a vertex at (0, 0, -h); faces towards the open space.
+// Patch edge a / n.
+SceneFile cylindricalHole(double a, double h, int n);
+
+// Sets uniform reflectance and emission on every face (and the attributes).
+void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E);
+
+// Names accepted by byName, each with default parameters.
+std::vector<std::string> names();
+// Throws std::invalid_argument for an unknown name.
+SceneFile byName(const std::string& name);
+
+}  // namespace gi::scenes

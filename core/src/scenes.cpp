@@ -1,0 +1,340 @@
+#include "gi/scenes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <utility>
+
+#include "gi/color.h"
+
+namespace gi::scenes {
+
+namespace {
+
+using glm::dvec3;
+constexpr double kPi = 3.14159265358979323846;
+
+glm::u8vec3 srgbBytes(const glm::vec3& linear) {
+  auto q = [](float v) { return uint8_t(std::lround(linearToSrgb(v) * 255.f)); };
+  return {q(linear.r), q(linear.g), q(linear.b)};
+}
+
+// The attributes mirror rho and emission, so a PLY carries the same scene.
+void refreshAttributes(SceneFile& sf) {
+  const Scene& s = sf.scene;
+  const size_t nf = s.faceCount();
+  sf.attrs = MeshAttributes{};
+  sf.attrs.faceColor.resize(nf);
+  sf.attrs.faceQuality.resize(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    sf.attrs.faceColor[f] = srgbBytes(s.faceRho(f));
+    const glm::vec3 e = s.faceEmission(f);
+    sf.attrs.faceQuality[f] = (e.r > 0.f || e.g > 0.f || e.b > 0.f) ? 1.f : 0.f;
+  }
+}
+
+// Collects absolute double positions and oriented triangles with materials.
+struct Builder {
+  std::vector<dvec3> pts;
+  std::vector<glm::uvec3> tris;
+  std::vector<glm::vec3> rho, E;
+
+  uint32_t vertex(const dvec3& p) {
+    pts.push_back(p);
+    return uint32_t(pts.size() - 1);
+  }
+
+  // Orientation is fixed here, from the wanted front direction, so that the
+  // generators need not care about winding.
+  void tri(uint32_t a, uint32_t b, uint32_t c, const dvec3& front, const glm::vec3& r, const glm::vec3& e) {
+    if (a == b || b == c || a == c) return;
+    const dvec3 n = glm::cross(pts[b] - pts[a], pts[c] - pts[a]);
+    if (glm::dot(n, front) < 0.0) std::swap(b, c);
+    tris.push_back({a, b, c});
+    rho.push_back(r);
+    E.push_back(e);
+  }
+
+  // Bilinear nu x nv grid over the quad p00 p10 p11 p01, two triangles per cell.
+  void quad(const dvec3& p00, const dvec3& p10, const dvec3& p11, const dvec3& p01, int nu, int nv,
+            const dvec3& front, const glm::vec3& r, const glm::vec3& e = glm::vec3(0.f)) {
+    nu = std::max(nu, 1);
+    nv = std::max(nv, 1);
+    const uint32_t base = uint32_t(pts.size());
+    for (int j = 0; j <= nv; ++j)
+      for (int i = 0; i <= nu; ++i) {
+        const double u = double(i) / nu, v = double(j) / nv;
+        vertex((1 - u) * (1 - v) * p00 + u * (1 - v) * p10 + u * v * p11 + (1 - u) * v * p01);
+      }
+    auto id = [&](int i, int j) { return base + uint32_t(j * (nu + 1) + i); };
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i) {
+        tri(id(i, j), id(i + 1, j), id(i + 1, j + 1), front, r, e);
+        tri(id(i, j), id(i + 1, j + 1), id(i, j + 1), front, r, e);
+      }
+  }
+
+  // Same, with the cell counts chosen for a patch edge of about h.
+  void quadH(const dvec3& p00, const dvec3& p10, const dvec3& p11, const dvec3& p01, double h, const dvec3& front,
+             const glm::vec3& r, const glm::vec3& e = glm::vec3(0.f)) {
+    auto cells = [h](double len) { return std::max(1, int(std::lround(len / h))); };
+    const int nu = cells(std::max(glm::length(p10 - p00), glm::length(p11 - p01)));
+    const int nv = cells(std::max(glm::length(p01 - p00), glm::length(p11 - p10)));
+    quad(p00, p10, p11, p01, nu, nv, front, r, e);
+  }
+
+  // Ring of `count` vertices at radius r in the plane z (count 1: the centre).
+  std::vector<uint32_t> ring(double r, double z, int count) {
+    std::vector<uint32_t> ids;
+    if (count <= 1) return {vertex(dvec3(0.0, 0.0, z))};
+    for (int j = 0; j < count; ++j) {
+      const double phi = 2.0 * kPi * j / count;
+      ids.push_back(vertex(dvec3(r * std::cos(phi), r * std::sin(phi), z)));
+    }
+    return ids;
+  }
+
+  // Triangulates the band between two rings (vertex counts may differ) by
+  // advancing along whichever ring has the next vertex at the smaller angle.
+  template <class FrontFn>
+  void zip(const std::vector<uint32_t>& A, const std::vector<uint32_t>& B, FrontFn front, const glm::vec3& r,
+           const glm::vec3& e = glm::vec3(0.f)) {
+    const size_t a = A.size(), b = B.size();
+    size_t i = 0, j = 0;
+    while (i < a || j < b) {
+      const bool advanceA = j >= b || (i < a && double(i + 1) / a <= double(j + 1) / b);
+      uint32_t v0 = A[i % a], v1, v2;
+      if (advanceA) { v1 = A[(i + 1) % a]; v2 = B[j % b]; ++i; }
+      else { v1 = B[(j + 1) % b]; v2 = B[j % b]; ++j; }
+      const dvec3 c = (pts[v0] + pts[v1] + pts[v2]) / 3.0;
+      tri(v0, v1, v2, front(c), r, e);
+    }
+  }
+
+  SceneFile finish() {
+    SceneFile sf;
+    sf.scene = Scene::fromAbsolute(pts, std::move(tris));
+    sf.scene.rho = std::move(rho);
+    sf.scene.emission = std::move(E);
+    refreshAttributes(sf);
+    return sf;
+  }
+};
+
+const glm::vec3 kGrey(0.5f);
+
+}  // namespace
+
+void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E) {
+  sf.scene.rho.assign(sf.scene.faceCount(), rho);
+  sf.scene.emission.assign(sf.scene.faceCount(), E);
+  refreshAttributes(sf);
+}
+
+SceneFile cornellBox(double h) {
+  // Published data (Cornell Program of Computer Graphics, "Cornell Box data").
+  const glm::vec3 white(0.725f, 0.71f, 0.68f), red(0.63f, 0.065f, 0.05f), green(0.14f, 0.45f, 0.091f);
+  const glm::vec3 lightRho(0.78f), lightE = float(kPi) * glm::vec3(17.f, 12.f, 4.f);
+  const dvec3 inside(278.0, 274.4, 279.6);
+  Builder b;
+  // Walls face the interior of the box.
+  auto wall = [&](dvec3 p0, dvec3 p1, dvec3 p2, dvec3 p3, const glm::vec3& r) {
+    dvec3 n = glm::cross(p2 - p0, p3 - p1);
+    if (glm::dot(n, inside - (p0 + p1 + p2 + p3) * 0.25) < 0.0) n = -n;
+    b.quadH(p0, p1, p2, p3, h, n, r);
+  };
+  wall({552.8, 0, 0}, {0, 0, 0}, {0, 0, 559.2}, {549.6, 0, 559.2}, white);              // floor
+  wall({549.6, 0, 559.2}, {0, 0, 559.2}, {0, 548.8, 559.2}, {556.0, 548.8, 559.2}, white);  // back
+  wall({0, 0, 559.2}, {0, 0, 0}, {0, 548.8, 0}, {0, 548.8, 559.2}, green);              // x = 0
+  wall({552.8, 0, 0}, {549.6, 0, 559.2}, {556.0, 548.8, 559.2}, {556.0, 548.8, 0}, red);  // x ~ 556
+  // Ceiling 556 x 559.2 cut into 3 x 3 rectangles around the light's hole.
+  const double xs[4] = {0.0, 213.0, 343.0, 556.0}, zs[4] = {0.0, 227.0, 332.0, 559.2}, yc = 548.8;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (i != 1 || k != 1)
+        wall({xs[i], yc, zs[k]}, {xs[i + 1], yc, zs[k]}, {xs[i + 1], yc, zs[k + 1]}, {xs[i], yc, zs[k + 1]}, white);
+  // The light, 0.1 mm below the ceiling plane: no coplanar faces.
+  const double yl = 548.7;
+  b.quadH({343, yl, 227}, {343, yl, 332}, {213, yl, 332}, {213, yl, 227}, h, {0, -1, 0}, lightRho, lightE);
+  // Blocks: top corners; the 4 sides and the top face away from the block's centre.
+  auto block = [&](const dvec3 (&top)[4], const glm::vec3& r) {
+    const double y = top[0].y;
+    const dvec3 centre = (top[0] + top[1] + top[2] + top[3]) * 0.25 - dvec3(0, y / 2, 0);
+    b.quadH(top[0], top[1], top[2], top[3], h, {0, 1, 0}, r);
+    for (int s = 0; s < 4; ++s) {
+      const dvec3 a = top[s], c = top[(s + 1) % 4];
+      const dvec3 a0(a.x, 0, a.z), c0(c.x, 0, c.z);
+      b.quadH(a0, c0, c, a, h, (a + c0) * 0.5 - centre, r);
+    }
+  };
+  const dvec3 shortTop[4] = {{130, 165, 65}, {82, 165, 225}, {240, 165, 272}, {290, 165, 114}};
+  const dvec3 tallTop[4] = {{423, 330, 247}, {265, 330, 296}, {314, 330, 456}, {472, 330, 406}};
+  block(shortTop, white);
+  block(tallTop, white);
+  return b.finish();
+}
+
+SceneFile parallelPlates(double L, int n) {
+  Builder b;
+  const glm::vec3 black(0.f), E(1.f);
+  b.quad({-0.5, -0.5, 0}, {0.5, -0.5, 0}, {0.5, 0.5, 0}, {-0.5, 0.5, 0}, n, n, {0, 0, 1}, black, E);
+  b.quad({-0.5, -0.5, L}, {0.5, -0.5, L}, {0.5, 0.5, L}, {-0.5, 0.5, L}, n, n, {0, 0, -1}, black);
+  return b.finish();
+}
+
+SceneFile perpendicularPlates(int n) {
+  Builder b;
+  const glm::vec3 black(0.f), E(1.f);
+  b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, n, n, {0, 0, 1}, black, E);
+  b.quad({0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}, n, n, {1, 0, 0}, black);
+  return b.finish();
+}
+
+SceneFile sphere(double radius, int subdivisions, bool inward) {
+  // Icosahedron, then 4-to-1 splits with midpoints pushed onto the sphere.
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<dvec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<glm::uvec3> f = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  for (auto& p : v) p = glm::normalize(p);
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
+    auto midpoint = [&](uint32_t a, uint32_t c) {
+      auto key = std::minmax(a, c);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(glm::normalize(v[a] + v[c]));
+      return mid[key] = uint32_t(v.size() - 1);
+    };
+    std::vector<glm::uvec3> g;
+    g.reserve(f.size() * 4);
+    for (const auto& tr : f) {
+      const uint32_t ab = midpoint(tr.x, tr.y), bc = midpoint(tr.y, tr.z), ca = midpoint(tr.z, tr.x);
+      g.insert(g.end(), {{tr.x, ab, ca}, {tr.y, bc, ab}, {tr.z, ca, bc}, {ab, bc, ca}});
+    }
+    f.swap(g);
+  }
+  Builder b;
+  for (const auto& p : v) b.vertex(p * radius);
+  for (const auto& tr : f) {
+    const dvec3 c = (b.pts[tr.x] + b.pts[tr.y] + b.pts[tr.z]) / 3.0;
+    b.tri(tr.x, tr.y, tr.z, inward ? -c : c, kGrey, glm::vec3(0.f));
+  }
+  return b.finish();
+}
+
+SceneFile closedBox(double size, int n, bool inward) {
+  Builder b;
+  const double s = size / 2;
+  for (int k = 0; k < 3; ++k)
+    for (double sign : {-1.0, 1.0}) {
+      // Axis k fixed at sign * s; the other two axes span the face.
+      const int u = (k + 1) % 3, w = (k + 2) % 3;
+      auto P = [&](double a, double c) {
+        dvec3 p;
+        p[k] = sign * s;
+        p[u] = a;
+        p[w] = c;
+        return p;
+      };
+      dvec3 out(0.0);
+      out[k] = sign;
+      b.quad(P(-s, -s), P(s, -s), P(s, s), P(-s, s), n, n, inward ? -out : out, kGrey);
+    }
+  return b.finish();
+}
+
+SceneFile openPlane(double size, int n) {
+  Builder b;
+  const double s = size / 2;
+  b.quad({-s, -s, 0}, {s, -s, 0}, {s, s, 0}, {-s, s, 0}, n, n, {0, 0, 1}, kGrey);
+  return b.finish();
+}
+
+SceneFile floorWithWall(double floorSize, double wallHeight, int n) {
+  Builder b;
+  const double hp = floorSize / std::max(n, 1), W = std::max(floorSize, 20.0 * wallHeight), y = W / 2;
+  const int ny = std::max(1, int(std::lround(W / hp))), nz = std::max(1, int(std::lround(wallHeight / hp)));
+  b.quad({0, -y, 0}, {floorSize, -y, 0}, {floorSize, y, 0}, {0, y, 0}, n, ny, {0, 0, 1}, kGrey);
+  b.quad({0, -y, 0}, {0, -y, wallHeight}, {0, y, wallHeight}, {0, y, 0}, nz, ny, {1, 0, 0}, kGrey);
+  return b.finish();
+}
+
+SceneFile hemisphericalBowl(double radius, int n) {
+  Builder b;
+  n = std::max(n, 1);
+  // Ring k at polar angle theta_k from the bottom; about 4n sin(theta) patches
+  // around keeps them near square (edge radius * pi / 2n).
+  std::vector<uint32_t> prev = b.ring(0.0, -radius, 1);
+  for (int k = 1; k <= n; ++k) {
+    const double theta = 0.5 * kPi * k / n;
+    const int count = std::max(3, int(std::lround(4.0 * n * std::sin(theta))));
+    const double r = k == n ? radius : radius * std::sin(theta), z = k == n ? 0.0 : -radius * std::cos(theta);
+    std::vector<uint32_t> cur = b.ring(r, z, count);
+    b.zip(prev, cur, [](const dvec3& c) { return -c; }, kGrey);
+    prev.swap(cur);
+  }
+  return b.finish();
+}
+
+SceneFile cylindricalHole(double a, double h, int n) {
+  Builder b;
+  n = std::max(n, 1);
+  const double hp = a / n;
+  const int m = std::max(3, int(std::lround(2.0 * kPi * n)));
+  const dvec3 up(0, 0, 1);
+  auto towardsAxis = [](const dvec3& c) { return dvec3(-c.x, -c.y, 0.0); };
+  // Wall rings from z = 0 down to z = -h; the top ring is shared with the ground.
+  const int nz = std::max(1, int(std::lround(h / hp)));
+  std::vector<uint32_t> top = b.ring(a, 0.0, m), prev = top;
+  for (int k = 1; k <= nz; ++k) {
+    std::vector<uint32_t> cur = b.ring(a, -h * k / nz, m);
+    b.zip(prev, cur, towardsAxis, kGrey);
+    prev.swap(cur);
+  }
+  // Bottom disk: rings of radius a k / n around the centre vertex, outer ring shared.
+  std::vector<uint32_t> inner = b.ring(0.0, -h, 1);
+  for (int k = 1; k < n; ++k) {
+    std::vector<uint32_t> cur = b.ring(a * k / n, -h, std::max(3, int(std::lround(2.0 * kPi * k))));
+    b.zip(inner, cur, [&](const dvec3&) { return up; }, kGrey);
+    inner.swap(cur);
+  }
+  b.zip(inner, prev, [&](const dvec3&) { return up; }, kGrey);
+  // Ground: radii growing geometrically to 10 a, so the patches stay about square.
+  const int nr = std::max(1, int(std::ceil(std::log(10.0) / std::log1p(2.0 * kPi / m))));
+  prev = top;
+  for (int k = 1; k <= nr; ++k) {
+    std::vector<uint32_t> cur = b.ring(a * std::pow(10.0, double(k) / nr), 0.0, m);
+    b.zip(prev, cur, [&](const dvec3&) { return up; }, kGrey);
+    prev.swap(cur);
+  }
+  return b.finish();
+}
+
+std::vector<std::string> names() {
+  return {"cornell_box", "cornell_box_fine", "parallel_plates", "perpendicular_plates", "furnace_sphere",
+          "closed_box",  "open_plane",       "floor_wall",      "bowl",                 "cylinder_hole"};
+}
+
+SceneFile byName(const std::string& name) {
+  if (name == "cornell_box") return cornellBox(50.0);
+  if (name == "cornell_box_fine") return cornellBox(25.0);
+  if (name == "parallel_plates") return parallelPlates(1.0, 16);
+  if (name == "perpendicular_plates") return perpendicularPlates(16);
+  if (name == "furnace_sphere") {
+    SceneFile sf = sphere(1.0, 3, true);
+    setUniform(sf, glm::vec3(0.5f), glm::vec3(1.f));
+    return sf;
+  }
+  if (name == "closed_box") return closedBox(1.0, 8, true);
+  if (name == "open_plane") return openPlane(1.0, 16);
+  if (name == "floor_wall") return floorWithWall(4.0, 1.0, 20);
+  if (name == "bowl") return hemisphericalBowl(1.0, 16);
+  if (name == "cylinder_hole") return cylindricalHole(1.0, 1.0, 8);
+  throw std::invalid_argument("unknown scene '" + name + "'");
+}
+
+}  // namespace gi::scenes

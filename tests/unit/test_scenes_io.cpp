@@ -1,0 +1,386 @@
+// Canonical scenes (gi::scenes) and mesh files (gi::io): geometry against the
+// analytic sizes of DESIGN.md §5, orientation, and PLY round trips.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "gi/scenes.h"
+#include "mesh_io.h"
+
+namespace fs = std::filesystem;
+using gi::scenes::SceneFile;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+glm::dvec3 centroid(const gi::Scene& s, size_t f) {
+  const auto& t = s.triangles[f];
+  return (s.toWorld(s.positions[t.x]) + s.toWorld(s.positions[t.y]) + s.toWorld(s.positions[t.z])) / 3.0;
+}
+glm::dvec3 unitNormal(const gi::Scene& s, size_t f) {
+  return glm::normalize(glm::dvec3(gi::faceNormalUnnormalized(s, f)));
+}
+// Total area of the faces whose world centroid satisfies `pick`.
+double areaWhere(const gi::Scene& s, const std::function<bool(const glm::dvec3&)>& pick) {
+  double a = 0.0;
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (pick(centroid(s, f))) a += gi::faceArea(s, f);
+  return a;
+}
+double totalArea(const gi::Scene& s) {
+  return areaWhere(s, [](const glm::dvec3&) { return true; });
+}
+double emitterArea(const SceneFile& sf) {
+  double a = 0.0;
+  for (size_t f = 0; f < sf.scene.faceCount(); ++f)
+    if (sf.attrs.faceQuality[f] > 0.f) a += gi::faceArea(sf.scene, f);
+  return a;
+}
+bool hasVertexAt(const gi::Scene& s, const glm::dvec3& p) {
+  for (const auto& q : s.positions)
+    if (s.toWorld(q) == p) return true;
+  return false;
+}
+// Every face whose centroid satisfies `pick` has its normal along want(centroid).
+void expectFacing(const gi::Scene& s, const std::function<bool(const glm::dvec3&)>& pick,
+                  const std::function<glm::dvec3(const glm::dvec3&)>& want, const char* what) {
+  size_t checked = 0, wrong = 0;
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::dvec3 c = centroid(s, f);
+    if (!pick(c)) continue;
+    ++checked;
+    if (glm::dot(unitNormal(s, f), glm::normalize(want(c))) <= 0.0) ++wrong;
+  }
+  EXPECT_GT(checked, 0u) << what;
+  EXPECT_EQ(wrong, 0u) << what;
+}
+auto all = [](const glm::dvec3&) { return true; };
+
+std::string tempPath(const std::string& name) {
+  return (fs::temp_directory_path() / ("gi_test_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+void writeBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+}  // namespace
+
+TEST(Scenes, EveryNamedSceneIsUsable) {
+  for (const auto& name : gi::scenes::names()) {
+    SCOPED_TRACE(name);
+    const SceneFile sf = gi::scenes::byName(name);
+    const auto& s = sf.scene;
+    const gi::SceneReport r = gi::analyzeScene(s);
+    EXPECT_GT(s.faceCount(), 0u);
+    EXPECT_EQ(r.nonFiniteVertices, 0u);
+    EXPECT_EQ(r.usableFaces(), s.faceCount());
+    EXPECT_EQ(r.isolatedVertices, 0u);
+    ASSERT_EQ(s.rho.size(), s.faceCount());
+    ASSERT_EQ(s.emission.size(), s.faceCount());
+    ASSERT_EQ(sf.attrs.faceColor.size(), s.faceCount());
+    ASSERT_EQ(sf.attrs.faceQuality.size(), s.faceCount());
+    for (size_t f = 0; f < s.faceCount(); ++f) {
+      const bool emits = gi::luminance(s.emission[f]) > 0.f;
+      EXPECT_EQ(sf.attrs.faceQuality[f], emits ? 1.f : 0.f);
+      EXPECT_LT(std::max({s.rho[f].r, s.rho[f].g, s.rho[f].b}), 1.f);
+      const glm::vec3 back = gi::srgb8ToLinear(sf.attrs.faceColor[f].r, sf.attrs.faceColor[f].g, sf.attrs.faceColor[f].b);
+      EXPECT_NEAR(back.g, s.rho[f].g, 0.01f);
+    }
+  }
+  EXPECT_THROW(gi::scenes::byName("no_such_scene"), std::invalid_argument);
+}
+
+TEST(Scenes, CornellBoxGeometry) {
+  const SceneFile sf = gi::scenes::cornellBox(50.0);
+  const auto& s = sf.scene;
+  const double floorArea = areaWhere(s, [](const glm::dvec3& c) { return std::abs(c.y) < 1e-3; });
+  EXPECT_NEAR(floorArea, 0.5 * (552.8 + 549.6) * 559.2, 1e-6 * floorArea);
+  // Ceiling 556 x 559.2 without the light's hole.
+  const double ceilingArea = areaWhere(s, [](const glm::dvec3& c) { return std::abs(c.y - 548.8) < 1e-3; });
+  EXPECT_NEAR(ceilingArea, 556.0 * 559.2 - 130.0 * 105.0, 1e-6 * ceilingArea);
+  EXPECT_NEAR(emitterArea(sf), 130.0 * 105.0, 0.01 * 130.0 * 105.0);
+  // Walls (faces on the box's boundary) face the interior.
+  const glm::dvec3 centre(278.0, 274.4, 279.6);
+  auto onWall = [](const glm::dvec3& c) {
+    return c.y < 1e-3 || c.y > 548.75 || c.z > 559.1 || c.x < 1e-3 || c.x > 549.0;
+  };
+  expectFacing(s, onWall, [&](const glm::dvec3& c) { return centre - c; }, "walls face the interior");
+  // Light faces down; block tops face up; nothing but the open front at z = 0.
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (sf.attrs.faceQuality[f] > 0.f) {
+      EXPECT_NEAR(unitNormal(s, f).y, -1.0, 1e-6);
+      EXPECT_NEAR(s.emission[f].r, kPi * 17.0, 1e-4);
+    }
+    const glm::dvec3 c = centroid(s, f);
+    if (std::abs(c.y - 165.0) < 1e-3 || std::abs(c.y - 330.0) < 1e-3) {
+      EXPECT_NEAR(unitNormal(s, f).y, 1.0, 1e-6);
+    }
+  }
+  // Block sides face away from their block: no side normal points to the block's axis.
+  expectFacing(s, [](const glm::dvec3& c) { return c.y > 1 && c.y < 164 && c.x > 82 && c.x < 290 && c.z < 272; },
+               [](const glm::dvec3& c) { return c - glm::dvec3(185.5, c.y, 169.0); }, "short block sides");
+  const double blockSides =
+      165.0 * (std::hypot(48, 160) + std::hypot(158, 47) + std::hypot(50, 158) + std::hypot(160, 49)) +
+      330.0 * (std::hypot(158, 49) + std::hypot(49, 160) + std::hypot(158, 50) + std::hypot(49, 159));
+  const double sideArea = areaWhere(s, [&](const glm::dvec3& c) { return !onWall(c) && c.y < 329.9 && c.y > 0.1 &&
+                                                                       std::abs(c.y - 165.0) > 1e-3; });
+  EXPECT_NEAR(sideArea, blockSides, 1e-3 * blockSides);
+  // Patch edge about 50 mm: a few hundred patches per wall set.
+  EXPECT_GT(s.faceCount(), 1000u);
+  EXPECT_GT(gi::scenes::cornellBox(25.0).scene.faceCount(), 3 * s.faceCount());
+}
+
+TEST(Scenes, PlatesAreUnitSquaresFacingEachOther) {
+  const SceneFile pp = gi::scenes::parallelPlates(0.5, 8);
+  EXPECT_EQ(pp.scene.faceCount(), 2u * 8 * 8 * 2);
+  EXPECT_NEAR(totalArea(pp.scene), 2.0, 1e-9);
+  EXPECT_NEAR(emitterArea(pp), 1.0, 1e-9);
+  expectFacing(pp.scene, [](const glm::dvec3& c) { return c.z < 0.25; }, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "bottom");
+  expectFacing(pp.scene, [](const glm::dvec3& c) { return std::abs(c.z - 0.5) < 1e-9; },
+               [](const glm::dvec3&) { return glm::dvec3(0, 0, -1); }, "top at L");
+  const SceneFile pq = gi::scenes::perpendicularPlates(4);
+  EXPECT_NEAR(totalArea(pq.scene), 2.0, 1e-9);
+  EXPECT_NEAR(emitterArea(pq), 1.0, 1e-9);
+  expectFacing(pq.scene, [](const glm::dvec3& c) { return c.z == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "floor");
+  expectFacing(pq.scene, [](const glm::dvec3& c) { return c.x == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(1, 0, 0); }, "wall");
+}
+
+TEST(Scenes, SpheresAndBoxes) {
+  const SceneFile in = gi::scenes::byName("furnace_sphere");
+  EXPECT_NEAR(totalArea(in.scene), 4 * kPi, 0.02 * 4 * kPi);
+  expectFacing(in.scene, all, [](const glm::dvec3& c) { return -c; }, "inward sphere");
+  EXPECT_NEAR(emitterArea(in), totalArea(in.scene), 1e-9);
+  for (size_t f = 0; f < in.scene.faceCount(); ++f) EXPECT_EQ(in.scene.rho[f], glm::vec3(0.5f));
+  const SceneFile out = gi::scenes::sphere(2.0, 4, false);
+  EXPECT_EQ(out.scene.faceCount(), 20u * 256);
+  EXPECT_NEAR(totalArea(out.scene), 16 * kPi, 0.01 * 16 * kPi);
+  expectFacing(out.scene, all, [](const glm::dvec3& c) { return c; }, "outward sphere");
+
+  const SceneFile box = gi::scenes::closedBox(2.0, 3, true);
+  EXPECT_NEAR(totalArea(box.scene), 24.0, 1e-9);
+  expectFacing(box.scene, all, [](const glm::dvec3& c) { return -c; }, "inward box");
+  expectFacing(gi::scenes::closedBox(1.0, 2, false).scene, all, [](const glm::dvec3& c) { return c; }, "outward box");
+}
+
+TEST(Scenes, OpenGeometriesForAmbientOcclusion) {
+  const SceneFile plane = gi::scenes::openPlane(3.0, 5);
+  EXPECT_NEAR(totalArea(plane.scene), 9.0, 1e-9);
+  expectFacing(plane.scene, all, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "plane");
+
+  const SceneFile fw = gi::scenes::floorWithWall(4.0, 1.0, 20);
+  const double W = 20.0;  // 20 x wall height
+  EXPECT_NEAR(areaWhere(fw.scene, [](const glm::dvec3& c) { return c.z == 0.0; }), 4.0 * W, 1e-6);
+  EXPECT_NEAR(areaWhere(fw.scene, [](const glm::dvec3& c) { return c.x == 0.0; }), 1.0 * W, 1e-6);
+  expectFacing(fw.scene, [](const glm::dvec3& c) { return c.z == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "floor");
+  expectFacing(fw.scene, [](const glm::dvec3& c) { return c.x == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(1, 0, 0); }, "wall");
+  // Reference points of DESIGN.md §5 (d = 0, H, 2H) are vertices.
+  for (double d : {0.0, 1.0, 2.0}) EXPECT_TRUE(hasVertexAt(fw.scene, {d, 0.0, 0.0})) << d;
+
+  const SceneFile bowl = gi::scenes::hemisphericalBowl(2.0, 12);
+  EXPECT_NEAR(totalArea(bowl.scene), 8 * kPi, 0.02 * 8 * kPi);
+  expectFacing(bowl.scene, all, [](const glm::dvec3& c) { return -c; }, "bowl");
+  EXPECT_TRUE(hasVertexAt(bowl.scene, {0.0, 0.0, -2.0}));
+
+  const double a = 0.5, h = 1.5;
+  const SceneFile hole = gi::scenes::cylindricalHole(a, h, 8);
+  auto ground = [](const glm::dvec3& c) { return c.z == 0.0; };
+  auto bottom = [h](const glm::dvec3& c) { return c.z == -h; };
+  auto wall = [h](const glm::dvec3& c) { return c.z < 0.0 && c.z > -h; };
+  EXPECT_NEAR(areaWhere(hole.scene, ground), 99 * kPi * a * a, 0.02 * 99 * kPi * a * a);
+  EXPECT_NEAR(areaWhere(hole.scene, bottom), kPi * a * a, 0.02 * kPi * a * a);
+  EXPECT_NEAR(areaWhere(hole.scene, wall), 2 * kPi * a * h, 0.02 * 2 * kPi * a * h);
+  expectFacing(hole.scene, ground, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "ground");
+  expectFacing(hole.scene, bottom, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "bottom");
+  expectFacing(hole.scene, wall, [](const glm::dvec3& c) { return glm::dvec3(-c.x, -c.y, 0); }, "wall");
+  EXPECT_TRUE(hasVertexAt(hole.scene, {0.0, 0.0, -h}));
+}
+
+TEST(ScenesIo, PlyRoundTripKeepsGeometryAndAttributes) {
+  for (const char* name : {"cornell_box", "furnace_sphere", "cylinder_hole"}) {
+    SCOPED_TRACE(name);
+    const SceneFile sf = gi::scenes::byName(name);
+    const auto& s = sf.scene;
+    std::vector<float> q(s.vertexCount());
+    std::vector<gi::Rgb8> col(s.vertexCount());
+    gi::io::PlyExtras extras;
+    for (size_t v = 0; v < s.vertexCount(); ++v) {
+      q[v] = 0.25f * float(v);
+      col[v] = {uint8_t(v), uint8_t(v / 7), 200};
+      extras.normals.push_back(glm::normalize(glm::vec3(1.f, float(v % 5), 2.f)));
+    }
+    const std::string path = tempPath(std::string(name) + ".ply");
+    gi::io::writePly(path, s, sf.attrs, q, col, extras);
+    const gi::io::LoadedMesh m = gi::io::loadMesh(path);
+    fs::remove(path);
+    ASSERT_EQ(m.scene.vertexCount(), s.vertexCount());
+    ASSERT_EQ(m.scene.faceCount(), s.faceCount());
+    // Float rounding on write and again on re-centring: a few ulps of the extent.
+    const double tol = 1e-6 * std::max(1.0, gi::analyzeScene(s).diagonal);
+    for (size_t v = 0; v < s.vertexCount(); ++v) {
+      const glm::dvec3 a = s.toWorld(s.positions[v]), b = m.scene.toWorld(m.scene.positions[v]);
+      ASSERT_NEAR(glm::length(a - b), 0.0, tol) << v;
+    }
+    // OpenMesh 9 keeps the vertex order and each face's first vertex.
+    for (size_t f = 0; f < s.faceCount(); ++f) {
+      ASSERT_EQ(m.scene.triangles[f], s.triangles[f]) << f;
+      EXPECT_EQ(m.triangleToFace[f], f);
+    }
+    EXPECT_EQ(m.attrs.faceColor, sf.attrs.faceColor);
+    EXPECT_EQ(m.attrs.faceQuality, sf.attrs.faceQuality);
+    ASSERT_EQ(m.attrs.vertexColor.size(), s.vertexCount());
+    EXPECT_EQ(m.attrs.vertexColor[5], glm::u8vec3(col[5].r, col[5].g, col[5].b));
+    ASSERT_EQ(m.scene.vertexNormals.size(), s.vertexCount());
+    EXPECT_NEAR(glm::length(m.scene.vertexNormals[3] - extras.normals[3]), 0.f, 1e-6f);
+  }
+}
+
+TEST(ScenesIo, PlyFarFromOriginKeepsFloatPrecision) {
+  SceneFile sf = gi::scenes::openPlane(1.0, 2);
+  sf.scene.origin += glm::dvec3(1e5, -2e5, 3e4);  // representable in float to ~0.01
+  const std::string path = tempPath("far.ply");
+  gi::io::writePly(path, sf.scene, sf.attrs, {}, {});
+  const auto m = gi::io::loadMesh(path);
+  fs::remove(path);
+  ASSERT_EQ(m.scene.vertexCount(), sf.scene.vertexCount());
+  for (size_t v = 0; v < m.scene.vertexCount(); ++v)
+    EXPECT_NEAR(glm::length(m.scene.toWorld(m.scene.positions[v]) - sf.scene.toWorld(sf.scene.positions[v])), 0.0, 0.02);
+  EXPECT_TRUE(m.attrs.vertexColor.empty());
+  EXPECT_EQ(m.attrs.faceQuality, sf.attrs.faceQuality);
+}
+
+TEST(ScenesIo, AsciiPolygonsAreFanTriangulated) {
+  const std::string path = tempPath("quad.ply");
+  writeBytes(path,
+             "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+             "element face 2\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+             "property uchar blue\nproperty float quality\nend_header\n"
+             "0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3 200 100 50 1.5\n3 1 4 2 1 2 3 0.25\n");
+  const auto m = gi::io::loadMesh(path);
+  fs::remove(path);
+  ASSERT_EQ(m.scene.faceCount(), 3u);
+  EXPECT_EQ(m.triangleToFace, (std::vector<uint32_t>{0, 0, 1}));
+  EXPECT_EQ(m.attrs.faceQuality, (std::vector<float>{1.5f, 1.5f, 0.25f}));
+  ASSERT_EQ(m.attrs.faceColor.size(), 3u);
+  EXPECT_EQ(m.attrs.faceColor[1], glm::u8vec3(200, 100, 50));
+  EXPECT_EQ(m.attrs.faceColor[2], glm::u8vec3(1, 2, 3));
+  EXPECT_TRUE(m.attrs.vertexColor.empty());
+  EXPECT_TRUE(m.scene.vertexNormals.empty());
+  for (size_t f = 0; f < 3; ++f) EXPECT_GT(gi::faceNormalUnnormalized(m.scene, f).z, 0.f);
+}
+
+TEST(ScenesIo, ObjOffAndStlAreRead) {
+  const std::string obj = tempPath("quad.obj"), off = tempPath("quad.off");
+  writeBytes(obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+  writeBytes(off, "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  for (const auto& p : {obj, off}) {
+    const auto m = gi::io::loadMesh(p);
+    fs::remove(p);
+    EXPECT_EQ(m.scene.faceCount(), 2u) << p;
+    EXPECT_NEAR(totalArea(m.scene), 1.0, 1e-9) << p;
+    EXPECT_TRUE(m.attrs.faceColor.empty()) << p;
+  }
+  // Face colours after the indices, as MeshLab writes them (OpenMesh 9's OFF
+  // reader loses the faces there); integer and float colours; COFF vertex colours.
+  writeBytes(off, "OFF\n# comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n"
+                  "4 0 1 2 3 221 219 215\n3 1 4 2 0.5 1.0 0\n");
+  auto m = gi::io::loadMesh(off);
+  ASSERT_EQ(m.scene.faceCount(), 3u);
+  EXPECT_EQ(m.triangleToFace, (std::vector<uint32_t>{0, 0, 1}));
+  EXPECT_EQ(m.attrs.faceColor, (std::vector<glm::u8vec3>{{221, 219, 215}, {221, 219, 215}, {128, 255, 0}}));
+  writeBytes(off, "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n");
+  m = gi::io::loadMesh(off);
+  fs::remove(off);
+  EXPECT_EQ(m.attrs.vertexColor, (std::vector<glm::u8vec3>{{255, 0, 0}, {0, 255, 0}, {0, 0, 255}}));
+  EXPECT_TRUE(m.attrs.faceColor.empty());
+
+  // Binary STL: coincident corners merged, no colours (its colour bytes are not a standard).
+  std::string stl(80, ' ');
+  auto u32 = [&](uint32_t v) { stl.append(reinterpret_cast<const char*>(&v), 4); };
+  auto f32 = [&](float v) { stl.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(2);
+  for (const auto& tri : {std::vector<float>{0, 0, 0, 1, 0, 0, 1, 1, 0}, std::vector<float>{0, 0, 0, 1, 1, 0, 0, 1, 0}}) {
+    for (int k = 0; k < 3; ++k) f32(k == 2 ? 1.f : 0.f);
+    for (float c : tri) f32(c);
+    stl.append(2, '\0');
+  }
+  const std::string stlPath = tempPath("quad.stl");
+  writeBytes(stlPath, stl);
+  m = gi::io::loadMesh(stlPath);
+  fs::remove(stlPath);
+  EXPECT_EQ(m.scene.vertexCount(), 4u);
+  EXPECT_EQ(m.scene.faceCount(), 2u);
+  EXPECT_TRUE(m.attrs.faceColor.empty());
+  EXPECT_TRUE(m.attrs.vertexColor.empty());
+  EXPECT_GT(gi::faceNormalUnnormalized(m.scene, 0).z, 0.f);
+}
+
+TEST(ScenesIo, StanfordBunnyIsClosedAndOutward) {
+  const std::string path = std::string(GI_TEST_MESHES) + "/bunny.ply";
+  if (!fs::exists(path)) GTEST_SKIP() << "run test_meshes/bunny_from_npm.sh";
+  const auto m = gi::io::loadMesh(path);
+  EXPECT_EQ(m.scene.vertexCount(), 1839u);
+  EXPECT_EQ(m.scene.faceCount(), 3674u);
+  EXPECT_EQ(gi::analyzeScene(m.scene).usableFaces(), 3674u);
+  // Divergence theorem: positive volume means outward normals.
+  double volume = 0.0;
+  for (const auto& t : m.scene.triangles)
+    volume += glm::dot(glm::dvec3(m.scene.positions[t.x]),
+                       glm::cross(glm::dvec3(m.scene.positions[t.y]), glm::dvec3(m.scene.positions[t.z]))) / 6.0;
+  EXPECT_GT(volume, 0.0);
+}
+
+TEST(ScenesIo, BadFilesThrowOneSentenceNamingTheFile) {
+  auto expectFails = [](const std::string& path) {
+    try {
+      gi::io::loadMesh(path);
+      ADD_FAILURE() << "no exception for " << path;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  expectFails(tempPath("does_not_exist.ply"));
+  const std::string garbage = tempPath("garbage.ply"), garbageObj = tempPath("garbage.obj");
+  const std::string huge = tempPath("huge.ply"), truncated = tempPath("truncated.ply"), txt = tempPath("mesh.txt");
+  writeBytes(garbage, std::string("\x00\xff garbage \x13\x37", 14) + std::string(3000, '\x7f'));
+  writeBytes(garbageObj, "hello world\nthis is not a mesh\n");
+  writeBytes(huge, "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
+                   "property float y\nproperty float z\nend_header\n\x01\x02");
+  // A valid header whose body stops after one vertex.
+  writeBytes(truncated, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+                            std::string(12, '\0'));
+  writeBytes(txt, "v 0 0 0\n");
+  const std::string badOff = tempPath("bad_index.off"), shortOff = tempPath("short.off");
+  writeBytes(badOff, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  writeBytes(shortOff, "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  for (const auto& p : {garbage, garbageObj, huge, truncated, txt, badOff, shortOff}) {
+    expectFails(p);
+    fs::remove(p);
+  }
+  // Writing where no file can be created.
+  const SceneFile sf = gi::scenes::openPlane(1.0, 1);
+  EXPECT_THROW(gi::io::writePly("/nonexistent_dir/x.ply", sf.scene, sf.attrs, {}, {}), std::runtime_error);
+  EXPECT_THROW(gi::io::writePly(tempPath("bad.ply"), sf.scene, sf.attrs, {1.f}, {}), std::runtime_error);
+}
+
+TEST(ScenesIo, CommittedTestMeshesMatchTheGenerators) {
+  for (const auto& name : gi::scenes::names()) {
+    const std::string path = std::string(GI_TEST_MESHES) + "/" + name + ".ply";
+    if (!fs::exists(path)) continue;  // large ones are not committed
+    SCOPED_TRACE(path);
+    const SceneFile sf = gi::scenes::byName(name);
+    const auto m = gi::io::loadMesh(path);
+    EXPECT_EQ(m.scene.vertexCount(), sf.scene.vertexCount());
+    EXPECT_EQ(m.scene.faceCount(), sf.scene.faceCount());
+    EXPECT_EQ(m.attrs.faceQuality, sf.attrs.faceQuality);
+    EXPECT_EQ(m.attrs.faceColor, sf.attrs.faceColor);
+  }
+}
