@@ -199,7 +199,15 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
 
 int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   double diag = 1.0;
-  if (!a.mesh.empty()) diag = analyzeScene(io::loadMesh(a.mesh).scene).diagonal;
+  if (!a.mesh.empty()) {
+    diag = analyzeScene(io::loadMesh(a.mesh).scene).diagonal;
+  } else {
+    for (FilterKind k : kinds)
+      for (const auto& p : filterSpecs(k))
+        if (p.type == ParamType::Distance && p.def > 0 && !a.raw.count(p.name))
+          std::fprintf(stderr, "gi: note: --%s defaults to %g%% of a bounding-box diagonal of 1; pass --mesh FILE to scale it to your mesh\n",
+                       p.name.c_str(), p.def * 100);
+  }
   std::vector<ScriptStep> steps;
   for (FilterKind k : kinds) steps.push_back({k, resolve(filterSpecs(k), a, diag)});
   const std::string text = mlxScript(steps, diag);
@@ -222,7 +230,7 @@ int main(int argc, char** argv) {
   std::map<CLI::App*, FilterKind> subs;
   for (const FilterDesc& d : allFilters()) {
     CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
-    sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required()->check(CLI::ExistingFile);
+    sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required();
     sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality");
     sub->add_flag("--json", a.json, "print a machine-readable summary on stdout");
     sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");

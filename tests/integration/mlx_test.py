@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""meshlabserver integration tests: each filter runs from a complete .mlx
+script (written by `gi script`) in the real, staged meshlabserver under
+xvfb-run, and the saved PLY must carry per-vertex quality and colour with the
+values expected for the scene. Bad inputs must fail with a non-zero exit and
+a clear reason in the log.
+
+usage: mlx_test.py CASE --build BUILD_DIR --meshes TEST_MESHES_DIR
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plyread import read_ply  # noqa: E402
+
+
+class Ctx:
+    def __init__(self, build, meshes, tmp):
+        self.build, self.meshes, self.tmp = build, meshes, tmp
+        self.gi = os.path.join(build, "tools", "gi")
+        self.mlx_run = os.path.join(build, "mlx-run")
+
+    def script(self, name, filt, *params):
+        path = os.path.join(self.tmp, name + ".mlx")
+        subprocess.run([self.gi, "script", filt, "-o", path] + list(params), check=True)
+        return path
+
+    def server(self, mesh, script, out=None, expect_ok=True):
+        cmd = [self.mlx_run, "-i", mesh]
+        if out:
+            cmd += ["-o", out, "-m", "vc", "vq"]
+        cmd += ["-s", script]
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+        log = p.stdout.decode("utf-8", "replace")
+        if expect_ok and p.returncode != 0:
+            fail("meshlabserver exited %d:\n%s" % (p.returncode, log[-3000:]))
+        if not expect_ok and p.returncode == 0:
+            fail("meshlabserver should have failed but exited 0:\n%s" % log[-3000:])
+        return log
+
+
+def fail(msg):
+    print("FAIL: " + msg)
+    sys.exit(1)
+
+
+def check(cond, msg):
+    if not cond:
+        fail(msg)
+    print("ok: " + msg)
+
+
+def vertices(path):
+    v = read_ply(path)["vertex"]
+    for row in v:
+        for k in ("quality", "red", "green", "blue"):
+            if k not in row:
+                fail("%s lacks vertex property %s" % (path, k))
+        if not math.isfinite(row["quality"]):
+            fail("non-finite quality in " + path)
+    return v
+
+
+def nearest(verts, p, keep=lambda r: True):
+    best = min((r for r in verts if keep(r)),
+               key=lambda r: (r["x"] - p[0]) ** 2 + (r["y"] - p[1]) ** 2 + (r["z"] - p[2]) ** 2)
+    return best
+
+
+def case_ao(c):
+    out = os.path.join(c.tmp, "ao.ply")
+    log = c.server(os.path.join(c.meshes, "floor_wall.ply"), c.script("ao", "ao", "--rays_per_vertex", "2048"), out)
+    check("GI: Ambient Occlusion: vertices=" in log, "log line with what was computed")
+    v = vertices(out)
+    check(all(0.0 <= r["quality"] <= 1.0 for r in v), "AO quality in [0, 1]")
+    check(all(r["red"] == r["green"] == r["blue"] for r in v), "AO colour is grey")
+    # Floor vertex at distance d = 1 from a wall of height 1: 1/2 + d / (2 sqrt(d^2 + 1)) = 0.8536.
+    r = nearest(v, (1.0, 0.0, 0.0), lambda r: r["z"] == 0.0 and r["x"] > 0.5)
+    d = r["x"]
+    expect = 0.5 + d / (2 * math.sqrt(d * d + 1))
+    check(abs(r["quality"] - expect) < 0.03, "floor AO %.4f vs analytic %.4f (2048 rays, tol 0.03)" % (r["quality"], expect))
+    far = nearest(v, (4.0, 0.0, 0.0), lambda r: r["z"] == 0.0)
+    check(far["quality"] > r["quality"], "AO grows away from the wall")
+
+
+def case_obscurance_sky(c):
+    out = os.path.join(c.tmp, "ob.ply")
+    bowl = os.path.join(c.meshes, "bowl.ply")
+    c.server(bowl, c.script("ob", "obscurance", "--mesh", bowl, "--max_distance", "25%"), out)
+    v = vertices(out)
+    check(all(0.0 <= r["quality"] <= 1.0 for r in v), "obscurance quality in [0, 1]")
+    out = os.path.join(c.tmp, "sky.ply")
+    log = c.server(os.path.join(c.meshes, "open_plane.ply"),
+                   c.script("sky", "sky", "--sky_irradiance", "1", "--sun_irradiance", "2", "--sun_direction", "0,0,1"), out)
+    v = vertices(out)
+    # Open plane facing +z: E = E_sky + E_sun cos(0) = 3 (luminance, white sky; sun colour is warm, Y < 1).
+    check(all(2.5 < r["quality"] <= 3.0 + 1e-3 for r in v), "sky irradiance on an open plane in (2.5, 3]")
+
+
+def case_radiosity(c):
+    mesh = os.path.join(c.meshes, "cornell_box.ply")
+    out = os.path.join(c.tmp, "rad.ply")
+    log = c.server(mesh, c.script("rad", "radiosity", "--emitter_source", "Face quality above threshold"), out)
+    check("GI: Radiosity:" in log and "12 emitter faces" in log, "radiosity log names the emitters")
+    v = vertices(out)
+    floor = nearest(v, (400, 0, 150))
+    ceil = nearest(v, (100, 548.8, 100))
+    check(floor["quality"] > 0.2, "floor under the light is lit (B = %.3f W/m^2)" % floor["quality"])
+    check(ceil["quality"] < 0.05 * floor["quality"], "ceiling gets no direct light (zero bounces)")
+    red = nearest(v, (552, 270, 280))
+    green = nearest(v, (0, 270, 280))
+    check(red["red"] > 2 * red["green"], "the +x wall is red")
+    check(green["green"] > 1.5 * green["red"], "the x = 0 wall is green")
+    # Same engine, same input and seed through the CLI: the same numbers.
+    cli = os.path.join(c.tmp, "rad_cli.ply")
+    subprocess.run([c.gi, "radiosity", mesh, "-o", cli, "-q", "--emitter_source", "1"], check=True)
+    w = vertices(cli)
+    diff = max(abs(a["quality"] - b["quality"]) / max(1e-6, abs(b["quality"])) for a, b in zip(v, w) if b["quality"] > 1e-3)
+    check(diff < 1e-3, "meshlabserver and CLI agree (max relative difference %.2g)" % diff)
+
+
+def case_photonmap(c):
+    mesh = os.path.join(c.meshes, "cornell_box.ply")
+    out = os.path.join(c.tmp, "pm.ply")
+    log = c.server(mesh, c.script("pm", "photonmap", "--mesh", mesh, "--emitter_source", "1", "--photons", "100000"), out)
+    check("GI: Photon Mapping:" in log and "photons_stored=" in log, "photon map log line")
+    v = vertices(out)
+    ceil = nearest(v, (100, 548.8, 100))
+    floor = nearest(v, (400, 0, 150))
+    check(floor["quality"] > 0.2, "floor lit by photons (B = %.3f)" % floor["quality"])
+    check(ceil["quality"] > 0.0, "indirect light reaches the ceiling (B = %.4f)" % ceil["quality"])
+
+
+def case_bad_input(c):
+    # A point cloud, an empty mesh, an invalid parameter, a scene without emitters.
+    pc = os.path.join(c.tmp, "points.ply")
+    with open(pc, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n")
+    log = c.server(pc, c.script("ao_pc", "ao"), expect_ok=False)
+    check("no faces" in log, "point cloud: clear reason in the log")
+    empty = os.path.join(c.tmp, "empty.ply")
+    with open(empty, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 0\nproperty list uchar int vertex_indices\nend_header\n")
+    log = c.server(empty, c.script("ao_empty", "ao"), expect_ok=False)
+    check("empty" in log or "no faces" in log, "empty mesh: clear reason in the log")
+    bad = c.script("ao_bad", "ao")
+    with open(bad) as f:
+        text = f.read()
+    with open(bad, "w") as f:
+        f.write(text.replace('value="256" name="rays_per_vertex"', 'value="0" name="rays_per_vertex"'))
+    log = c.server(os.path.join(c.meshes, "open_plane.ply"), bad, expect_ok=False)
+    check("rays_per_vertex" in log and "outside" in log, "invalid parameter: named in the log")
+    log = c.server(os.path.join(c.meshes, "open_plane.ply"), c.script("rad_none", "radiosity"), expect_ok=False)
+    check("no emitters" in log, "no emitter: clear reason in the log")
+
+
+def case_dump(c):
+    dump = os.path.join(c.tmp, "filters.txt")
+    p = subprocess.run([c.mlx_run, "-d", dump], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
+    with open(dump, encoding="utf-8", errors="replace") as f:
+        text = f.read()
+    for name in ("GI: Ambient Occlusion", "GI: Ambient Obscurance", "GI: Sky Lighting", "GI: Radiosity", "GI: Photon Mapping"):
+        check(name in text, "meshlabserver -d lists '%s'" % name)
+    for param in ("rays_per_vertex", "emitter_source", "photons", "sun_direction"):
+        check(".mlx name: " + param in text, "meshlabserver -d lists parameter %s" % param)
+
+
+def case_cli(c):
+    import json
+    p = subprocess.run([c.gi, "--help"], stdout=subprocess.PIPE, text=True)
+    check(p.returncode == 0 and "radiosity" in p.stdout and "photonmap" in p.stdout, "gi --help lists the subcommands")
+    p = subprocess.run([c.gi, "ao", "--help"], stdout=subprocess.PIPE, text=True)
+    check("--rays_per_vertex" in p.stdout and "default: 256" in p.stdout, "gi ao --help shows parameters and defaults")
+    mesh = os.path.join(c.meshes, "floor_wall.ply")
+    out = os.path.join(c.tmp, "cli.ply")
+    p = subprocess.run([c.gi, "ao", mesh, "-o", out, "--json", "--rays_per_vertex", "64", "--max_distance", "10%"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "gi ao runs")
+    j = json.loads(p.stdout)
+    check(j["filter"] == "GI: Ambient Occlusion" and j["stats"]["rays"] > 0, "--json summary with rays")
+    check(abs(j["parameters"]["max_distance"] - 0.1 * j["scene"]["diagonal"]) < 1e-6, "10% means 10% of the diagonal")
+    check("%" in p.stderr, "progress on stderr")
+    vertices(out)
+    for args, words in ((["ao", mesh, "--rays_per_vertex", "0"], "rays_per_vertex"),
+                        (["ao", mesh, "--max_distance", "-1"], "max_distance"),
+                        (["radiosity", os.path.join(c.meshes, "open_plane.ply")], "no emitters"),
+                        (["ao", os.path.join(c.tmp, "missing.ply")], "missing.ply")):
+        p = subprocess.run([c.gi] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        lines = [l for l in p.stderr.splitlines() if l.strip()]
+        check(p.returncode != 0 and len(lines) == 1 and words in lines[0],
+              "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
+
+
+CASES = {"cli": case_cli, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+         "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser()
+    ap.add_argument("case", choices=sorted(CASES))
+    ap.add_argument("--build", required=True)
+    ap.add_argument("--meshes", required=True)
+    a = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        CASES[a.case](Ctx(a.build, a.meshes, tmp))
+    print("PASS")
