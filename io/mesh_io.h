@@ -17,8 +17,8 @@ struct LoadedMesh {
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure.
 LoadedMesh loadMesh(const std::string& path);
 
-// Writes a binary PLY: vertices with colour (uchar red/green/blue) and
-// "quality" (float), faces with colour if attrs has face colours, and optionally
+// Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and
+// "quality" (float, if given), faces with colour if attrs has face colours, and optionally
 // extra per-vertex float3 properties (e.g. bent normals as nx, ny, nz).
 struct PlyExtras {
   std::vector<glm::vec3> normals;  // written as nx, ny, nz if not empty
