@@ -165,7 +165,9 @@ TEST(AmbientOcclusion, AdaptiveMeetsTargetError) {
   EXPECT_LT(test::rms(r.value, ref.value), 0.015);
   EXPECT_LT(r.stats.get("rays"), 0.5 * 4096.0 * double(sf.scene.vertexCount()));
   for (size_t i = 0; i < r.value.size(); ++i) {
-    if (r.rays[i] < 4096) EXPECT_LE(r.stdError[i], 0.01);
+    if (r.rays[i] < 4096) {
+      EXPECT_LE(r.stdError[i], 0.01);
+    }
   }
 }
 
