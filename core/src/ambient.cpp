@@ -15,11 +15,17 @@ namespace {
 
 constexpr int kRound = 32;  // rays per adaptive round (a power of two keeps Sobol prefixes balanced)
 
-// Running mean and variance (Welford) of per-ray contributions.
-struct Welford {
-  double n = 0, mean = 0, m2 = 0;
-  void add(double x) { n += 1; double d = x - mean; mean += d / n; m2 += d * (x - mean); }
-  double stdError() const { return n > 1 ? std::sqrt(m2 / (n - 1) / n) : 1.0; }
+// Running sums of per-ray contributions (a division-free Welford stand-in;
+// values are in [0,1] so double sums lose nothing that matters).
+struct Moments {
+  double n = 0, sum = 0, sumSq = 0;
+  void add(double x) { n += 1; sum += x; sumSq += x * x; }
+  double mean() const { return n > 0 ? sum / n : 0.0; }
+  double stdError() const {
+    if (n < 2) return 1.0;
+    const double m = sum / n;
+    return std::sqrt(std::max(0.0, (sumSq - n * m * m) / (n - 1)) / n);
+  }
 };
 
 struct VertexOut {
@@ -40,13 +46,13 @@ class AmbientKernel {
     VertexOut out;
     const Frame frame(n);
     const Frame cone(o_.coneDirection);
-    const uint32_t key = hash3(vi, o_.seed, 0x41u);
+    SobolOwenStream seq(hash3(vi, o_.seed, 0x41u));
     const bool adaptive = o_.targetError > 0.0;
     const int maxN = adaptive ? o_.maxRays : o_.raysPerVertex;
     Ray rays[kRound];
     uint8_t occ[kRound];
     Hit hits[kRound];
-    Welford w;                 // per-ray values (or ratio residuals for the cone)
+    Moments w;                 // per-ray values (or ratio residuals for the cone)
     double num = 0, den = 0;   // cone: sums of V cos and cos
     double numSq = 0, denSq = 0, numDen = 0;
     glm::vec3 bent(0.f);
@@ -54,7 +60,7 @@ class AmbientKernel {
     while (done < maxN) {
       const int m = std::min(kRound, maxN - done);
       for (int j = 0; j < m; ++j) {
-        const glm::vec2 u = sobolOwen2D(uint32_t(done + j), key);
+        const glm::vec2 u = seq.next();
         const glm::vec3 d = o_.useCone ? cone.toWorld(uniformCone(u, coneCos_)) : frame.toWorld(cosineHemisphere(u));
         rays[j].o = org; rays[j].d = d; rays[j].tnear = 0.f; rays[j].tfar = tfar_;
       }
@@ -81,7 +87,7 @@ class AmbientKernel {
     }
     out.rays = done;
     if (o_.useCone) out.value = den > 0 ? float(num / den) : 0.f;
-    else out.value = float(w.mean);
+    else out.value = float(w.mean());
     out.stdError = float(stdError(w, done, num, den, numSq, denSq, numDen));
     if (o_.bentNormals) out.bent = glm::length(bent) > 0.f ? glm::normalize(bent) : n;
     if (o_.mode == AmbientMode::Sky) out = addSun(out, vi, n, org);
@@ -89,7 +95,7 @@ class AmbientKernel {
   }
 
  private:
-  double stdError(const Welford& w, int n, double num, double den, double numSq, double denSq, double numDen) const {
+  double stdError(const Moments& w, int n, double num, double den, double numSq, double denSq, double numDen) const {
     if (!o_.useCone) return w.stdError();
     if (den <= 0.0 || n < 2) return 0.0;
     // Ratio estimator R = sum(f c) / sum(c): delta-method variance of mean(f c - R c) / mean(c).
@@ -107,21 +113,21 @@ class AmbientKernel {
     if (o_.sunIrradiance > 0.f && glm::dot(n, o_.sunDirection) > -std::sin(glm::radians(o_.sunAngularRadiusDeg)) - 1e-6f) {
       // Distributed ray tracing over the sun's disk: uniform directions in its cone.
       const Frame sf(o_.sunDirection);
-      const uint32_t key = hash3(vi, o_.seed, 0x5u);
+      SobolOwenStream seq(hash3(vi, o_.seed, 0x5u));
       Ray rays[kRound];
       uint8_t occ[kRound];
-      Welford w;
+      Moments w;
       for (int done = 0; done < o_.sunRays; done += kRound) {
         const int m = std::min(kRound, o_.sunRays - done);
         for (int j = 0; j < m; ++j) {
-          rays[j].o = org; rays[j].d = sf.toWorld(uniformCone(sobolOwen2D(uint32_t(done + j), key), sunCos_));
+          rays[j].o = org; rays[j].d = sf.toWorld(uniformCone(seq.next(), sunCos_));
           rays[j].tnear = 0.f; rays[j].tfar = std::numeric_limits<float>::infinity();
         }
         caster_.occludedBatch(rays, size_t(m), occ);
         for (int j = 0; j < m; ++j) w.add(occ[j] ? 0.0 : std::max(0.f, glm::dot(n, rays[j].d)));
       }
       sunRays = o_.sunRays;
-      sun = o_.sunColor * float(o_.sunIrradiance * w.mean);
+      sun = o_.sunColor * float(o_.sunIrradiance * w.mean());
       sunErr = o_.sunIrradiance * w.stdError() * luminance(o_.sunColor);
     }
     const double skyErr = double(out.stdError) * o_.skyIrradiance * luminance(o_.skyRadiantColor);

@@ -44,12 +44,14 @@ Progress Progress::sub(double f0, double f1) const {
 void parallelBlocks(size_t n, const Progress& progress, const std::string& stage,
                     const std::function<void(size_t, size_t)>& body, size_t blocks) {
   if (n == 0) return;
-  blocks = std::max<size_t>(1, std::min(blocks, n));
+  // Slices of at least 256 elements: each slice ends in a barrier, and small
+  // slices leave threads idle while the last task finishes.
+  blocks = std::max<size_t>(1, std::min(blocks, n / 256));
   const size_t step = (n + blocks - 1) / blocks;
   progress.report(0.0, stage);
   for (size_t b0 = 0; b0 < n; b0 += step) {
     const size_t b1 = std::min(n, b0 + step);
-    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 16),
+    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 1),
                       [&](const tbb::blocked_range<size_t>& r) { body(r.begin(), r.end()); });
     progress.report(double(b1) / double(n), stage);
   }

@@ -7,7 +7,7 @@
 
 namespace gi {
 
-inline uint32_t reverseBits(uint32_t x) {
+constexpr uint32_t reverseBits(uint32_t x) {
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
   x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
   x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
@@ -45,6 +45,37 @@ inline uint32_t sobol1(uint32_t index) { return reverseBits(index); }
 // (e.g. hash of element and seed). Each key gives an independent randomised
 // sequence whose prefixes of 2^k points are stratified.
 glm::vec2 sobolOwen2D(uint32_t i, uint32_t key);
+
+// The same kind of sequence, generated in order at O(1) per point: Sobol
+// points in Gray-code order (every power-of-two prefix is the same point set
+// as in natural order), each dimension Owen-scrambled with its own seed.
+// No index shuffle: used where every vertex starts at index 0.
+struct SobolRevDir1 {
+  uint32_t v[32];
+  constexpr SobolRevDir1() : v() {
+    uint32_t d = 0x80000000u;
+    for (int k = 0; k < 32; ++k, d ^= d >> 1) v[k] = reverseBits(d);
+  }
+};
+inline constexpr SobolRevDir1 kSobolRevDir1{};
+
+class SobolOwenStream {
+ public:
+  explicit SobolOwenStream(uint32_t key) : s0_(hashCombine(key, 0x68bc21ebu)), s1_(hashCombine(key, 0x02e5be93u)) {}
+  glm::vec2 next() {
+    const glm::vec2 p{toUnitFloat(reverseBits(laineKarrasPermutation(r0_, s0_))),
+                      toUnitFloat(reverseBits(laineKarrasPermutation(r1_, s1_)))};
+    // Gray-code step: flip direction number ctz(i + 1). In the bit-reversed
+    // domain, dimension 1's value is the Gray code itself.
+    const int c = __builtin_ctz(++i_);
+    r0_ ^= 1u << c;
+    r1_ ^= kSobolRevDir1.v[c];
+    return p;
+  }
+
+ private:
+  uint32_t s0_, s1_, i_ = 0, r0_ = 0, r1_ = 0;
+};
 
 // Counter-based independent uniform numbers (for Russian roulette etc.).
 struct Rng {

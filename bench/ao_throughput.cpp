@@ -1,0 +1,104 @@
+// Rays per second of our ambient occlusion against a bare Embree loop over
+// the same rays (same origins, same directions, same thread pool).
+//   ao_throughput MESH RAYS_PER_VERTEX [REPEATS]  ->  JSON on stdout
+// The bare loop gets its rays pre-generated (not timed), so it is the upper
+// bound of what tracing alone costs; ours includes sampling and bookkeeping.
+#include <embree3/rtcore.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "gi/ambient.h"
+#include "gi/run.h"
+#include "gi/sampling.h"
+#include "mesh_io.h"
+
+using namespace gi;
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+struct BareEmbree {
+  RTCDevice dev = rtcNewDevice(nullptr);
+  RTCScene scene = rtcNewScene(dev);
+  explicit BareEmbree(const Scene& s) {
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 12, s.positions.size()));
+    auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 12, s.triangles.size()));
+    for (size_t i = 0; i < s.positions.size(); ++i) { vb[3 * i] = s.positions[i].x; vb[3 * i + 1] = s.positions[i].y; vb[3 * i + 2] = s.positions[i].z; }
+    for (size_t i = 0; i < s.triangles.size(); ++i) { ib[3 * i] = s.triangles[i].x; ib[3 * i + 1] = s.triangles[i].y; ib[3 * i + 2] = s.triangles[i].z; }
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitScene(scene);
+  }
+  ~BareEmbree() { rtcReleaseScene(scene); rtcReleaseDevice(dev); }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) { std::fprintf(stderr, "usage: ao_throughput MESH RAYS_PER_VERTEX [REPEATS]\n"); return 2; }
+  const int rpv = std::atoi(argv[2]);
+  const int repeats = argc > 3 ? std::atoi(argv[3]) : 5;
+  io::LoadedMesh mesh = io::loadMesh(argv[1]);
+  const Scene& s = mesh.scene;
+  const SceneReport rep = analyzeScene(s);
+  const auto normals = computeVertexNormals(s);
+  const auto origins = vertexRayOrigins(s, normals, float(rep.rayEpsilon));
+  // The same rays as computeAmbient casts (seed 0, fixed count).
+  const size_t nv = s.vertexCount();
+  std::vector<RTCRay> rays(nv * size_t(rpv));
+  for (size_t i = 0; i < nv; ++i) {
+    const Frame f(normals[i]);
+    SobolOwenStream seq(hash3(uint32_t(i), 0u, 0x41u));
+    for (int j = 0; j < rpv; ++j) {
+      const glm::vec3 d = f.toWorld(cosineHemisphere(seq.next()));
+      RTCRay& r = rays[i * size_t(rpv) + size_t(j)];
+      r.org_x = origins[i].x; r.org_y = origins[i].y; r.org_z = origins[i].z; r.tnear = 0.f;
+      r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z; r.time = 0.f;
+      r.tfar = HUGE_VALF; r.mask = 0xffffffffu; r.id = 0; r.flags = 0;
+    }
+  }
+  BareEmbree bare(s);
+  std::vector<double> tBare, tOurs, tOursSingle, tOursStream;
+  size_t occludedBare = 0;
+  for (int rep_i = 0; rep_i < repeats; ++rep_i) {
+    std::vector<RTCRay> work = rays;
+    Timer t;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (size_t k = r.begin(); k < r.end(); ++k) rtcOccluded1(bare.scene, &ctx, &work[k]);
+    });
+    tBare.push_back(t.seconds());
+    occludedBare = size_t(std::count_if(work.begin(), work.end(), [](const RTCRay& r) { return r.tfar < 0.f; }));
+    for (auto [mode, out] : {std::pair{BatchMode::Packet8, &tOurs}, std::pair{BatchMode::Single, &tOursSingle},
+                             std::pair{BatchMode::Stream, &tOursStream}}) {
+      auto caster = makeEmbreeCaster(s, mode);
+      AmbientOptions o;
+      o.raysPerVertex = rpv;
+      o.batch = mode;
+      o.mergeDuplicates = false;
+      AmbientResult res = computeAmbient(s, *caster, o);
+      out->push_back(res.stats.get("rays") / res.stats.get("rays_per_second"));
+    }
+  }
+  const double n = double(rays.size());
+  std::printf("{\"mesh\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"rays\": %.0f, \"occluded_fraction\": %.6f,\n"
+              " \"bare_embree_occluded1_rays_per_second\": %.6g,\n"
+              " \"ours_packet8_rays_per_second\": %.6g, \"ours_single_rays_per_second\": %.6g, \"ours_stream_rays_per_second\": %.6g,\n"
+              " \"ratio_ours_packet8_to_bare\": %.4f, \"ratio_ours_single_to_bare\": %.4f, \"ratio_ours_stream_to_bare\": %.4f, \"repeats\": %d}\n",
+              argv[1], nv, s.faceCount(), n, double(occludedBare) / n, n / median(tBare), n / median(tOurs),
+              n / median(tOursSingle), n / median(tOursStream), median(tBare) / median(tOurs),
+              median(tBare) / median(tOursSingle), median(tBare) / median(tOursStream), repeats);
+  return 0;
+}
