@@ -145,6 +145,7 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         size_t pos = 0;
         long x = std::stol(text, &pos);
         if (pos != text.size()) throw bad("expected an integer");
+        if (x < -2147483647L - 1 || x > 2147483647L) throw bad("out of range");
         return int(x);
       }
       case ParamType::Float: {
@@ -165,11 +166,12 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
           if (s.choices[i] == text) return int(i);
         size_t pos = 0;
         long x = std::stol(text, &pos);
-        if (pos != text.size()) throw std::invalid_argument("");
+        if (pos != text.size() || x < -2147483647L - 1 || x > 2147483647L) throw std::invalid_argument("");
         return int(x);
       }
       case ParamType::Color: {
         if (text.size() == 7 && text[0] == '#') {
+          if (text.find_first_not_of("0123456789abcdefABCDEF", 1) != std::string::npos) throw bad("expected #rrggbb");
           unsigned r, g, b;
           if (std::sscanf(text.c_str() + 1, "%2x%2x%2x", &r, &g, &b) != 3) throw bad("expected #rrggbb");
           return glm::vec3(r / 255.f, g / 255.f, b / 255.f);
