@@ -86,6 +86,9 @@ class EmbreeCaster final : public RayCaster {
       rtcAttachGeometry(scene_.get(), g);
       rtcReleaseGeometry(g);
     }
+    // Robust (watertight) traversal: rays through a shared edge or vertex never
+    // slip between two triangles, which would leak light into closed rooms.
+    rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
     rtcCommitScene(scene_.get());
     check("building the BVH");
