@@ -1,0 +1,32 @@
+# GUI tests: the real staged MeshLab GUI on a private Xvfb, checked by screenshot.
+# include()d from tests/integration/CMakeLists.txt; needs GI_STAGE_DIR (set by
+# cmake/StageMeshLab.cmake) and, at test time, xvfb, xdotool, imagemagick,
+# x11-utils and python3-numpy (the script exits 77 = skipped if one is missing).
+#   ctest -L gui --output-on-failure
+# The screenshots stay in the build folder for people to look at.
+if(NOT DEFINED GI_STAGE_DIR)
+  message(STATUS "gui tests: GI_STAGE_DIR not set (no staged MeshLab), not added")
+else()
+  # '-' : the script generates make_colored_quad.py's red/green quad itself.
+  add_test(NAME gui_screenshot
+    COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/gui_screenshot.sh
+            ${GI_STAGE_DIR}/bin - ${CMAKE_BINARY_DIR}/gui_screenshot.png)
+  set_tests_properties(gui_screenshot PROPERTIES
+    TIMEOUT 180
+    LABELS gui
+    SKIP_RETURN_CODE 77
+    ATTACHED_FILES_ON_FAIL ${CMAKE_BINARY_DIR}/gui_screenshot.png)
+
+  # Negative control: the same quad in plain grey must make the colour check fail
+  # (and only the colour check: MeshLab must have come up and been screenshotted).
+  add_test(NAME gui_screenshot_grey_control
+    COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/gui_screenshot.sh
+            ${GI_STAGE_DIR}/bin -grey ${CMAKE_BINARY_DIR}/gui_screenshot_grey.png)
+  set_tests_properties(gui_screenshot_grey_control PROPERTIES
+    TIMEOUT 180
+    LABELS gui
+    SKIP_REGULAR_EXPRESSION "gui_screenshot: SKIP:"
+    PASS_REGULAR_EXPRESSION "gui_screenshot: FAIL: too little red and green in the screenshot"
+    # the check retakes screenshots until it passes; for the control a few s will do
+    ENVIRONMENT "GUI_RENDER_WAIT=6")
+endif()
