@@ -1,12 +1,15 @@
 // Rays per second of our ambient occlusion against a bare Embree loop over
 // the same rays (same origins, same directions, same thread pool).
-//   ao_throughput MESH RAYS_PER_VERTEX [REPEATS]  ->  JSON on stdout
+//   ao_throughput MESH RAYS_PER_VERTEX [REPEATS] [THREADS]  ->  JSON on stdout
 // The bare loop gets its rays pre-generated (not timed), so it is the upper
 // bound of what tracing alone costs; ours includes sampling and bookkeeping.
 // Ours builds its BVH with RTC_SCENE_FLAG_ROBUST (watertight: no leaks through
 // shared edges); the bare loop is timed with and without that flag.
 #include <embree3/rtcore.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+
+#include <memory>
 
 #include <algorithm>
 #include <cstdio>
@@ -49,9 +52,12 @@ struct BareEmbree {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) { std::fprintf(stderr, "usage: ao_throughput MESH RAYS_PER_VERTEX [REPEATS]\n"); return 2; }
+  if (argc < 3) { std::fprintf(stderr, "usage: ao_throughput MESH RAYS_PER_VERTEX [REPEATS] [THREADS]\n"); return 2; }
   const int rpv = std::atoi(argv[2]);
   const int repeats = argc > 3 ? std::atoi(argv[3]) : 5;
+  const int threads = argc > 4 ? std::atoi(argv[4]) : 0;
+  std::unique_ptr<tbb::global_control> gc;
+  if (threads > 0) gc = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
   io::LoadedMesh mesh = io::loadMesh(argv[1]);
   const Scene& s = mesh.scene;
   const SceneReport rep = analyzeScene(s);
@@ -63,8 +69,15 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < nv; ++i) {
     const Frame f(normals[i]);
     SobolOwenStream seq(hash3(uint32_t(i), 0u, 0x41u));
+    const size_t nr = static_cast<size_t>(rpv);
+    std::vector<float> u0(nr), u1(nr), lx(nr), ly(nr), lz(nr);
+    for (int b = 0; b < rpv; b += 32) {
+      const int m = std::min(32, rpv - b);
+      seq.nextBlock(m, &u0[size_t(b)], &u1[size_t(b)]);
+      cosineHemisphereBlock(m, &u0[size_t(b)], &u1[size_t(b)], &lx[size_t(b)], &ly[size_t(b)], &lz[size_t(b)]);
+    }
     for (int j = 0; j < rpv; ++j) {
-      const glm::vec3 d = f.toWorld(cosineHemisphere(seq.next()));
+      const glm::vec3 d = f.t * lx[size_t(j)] + f.b * ly[size_t(j)] + f.n * lz[size_t(j)];
       RTCRay& r = rays[i * size_t(rpv) + size_t(j)];
       r.org_x = origins[i].x; r.org_y = origins[i].y; r.org_z = origins[i].z; r.tnear = 0.f;
       r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z; r.time = 0.f;

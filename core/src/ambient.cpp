@@ -50,8 +50,11 @@ class AmbientKernel {
     const bool adaptive = o_.targetError > 0.0;
     const int maxN = adaptive ? o_.maxRays : o_.raysPerVertex;
     Ray rays[kRound];
+    glm::vec3 dirs[kRound];
+    float u0[kRound], u1[kRound], lx[kRound], ly[kRound], lz[kRound];
     uint8_t occ[kRound];
     Hit hits[kRound];
+    const bool fan = o_.batch == BatchMode::Single && o_.mode != AmbientMode::Obscurance;
     Moments w;                 // per-ray values (or ratio residuals for the cone)
     double num = 0, den = 0;   // cone: sums of V cos and cos
     double numSq = 0, denSq = 0, numDen = 0;
@@ -59,12 +62,17 @@ class AmbientKernel {
     int done = 0;
     while (done < maxN) {
       const int m = std::min(kRound, maxN - done);
-      for (int j = 0; j < m; ++j) {
-        const glm::vec2 u = seq.next();
-        const glm::vec3 d = o_.useCone ? cone.toWorld(uniformCone(u, coneCos_)) : frame.toWorld(cosineHemisphere(u));
-        rays[j].o = org; rays[j].d = d; rays[j].tnear = 0.f; rays[j].tfar = tfar_;
+      seq.nextBlock(m, u0, u1);
+      if (o_.useCone) {
+        for (int j = 0; j < m; ++j) dirs[j] = cone.toWorld(uniformCone({u0[j], u1[j]}, coneCos_));
+      } else {
+        cosineHemisphereBlock(m, u0, u1, lx, ly, lz);
+        for (int j = 0; j < m; ++j) dirs[j] = frame.t * lx[j] + frame.b * ly[j] + frame.n * lz[j];
       }
+      if (!fan)
+        for (int j = 0; j < m; ++j) { rays[j].o = org; rays[j].d = dirs[j]; rays[j].tnear = 0.f; rays[j].tfar = tfar_; }
       if (o_.mode == AmbientMode::Obscurance) caster_.intersectBatch(rays, size_t(m), hits);
+      else if (fan) caster_.occludedFan(org, dirs, size_t(m), tfar_, occ);
       else caster_.occludedBatch(rays, size_t(m), occ);
       for (int j = 0; j < m; ++j) {
         double f;
@@ -73,9 +81,9 @@ class AmbientKernel {
         } else {
           f = occ[j] ? 0.0 : 1.0;
         }
-        if (o_.bentNormals && f > 0.0) bent += rays[j].d * float(f);
+        if (o_.bentNormals && f > 0.0) bent += dirs[j] * float(f);
         if (o_.useCone) {
-          const double c = std::max(0.f, glm::dot(n, rays[j].d));
+          const double c = std::max(0.f, glm::dot(n, dirs[j]));
           num += f * c; den += c; numSq += f * c * f * c; denSq += c * c; numDen += f * c * c;
         } else {
           w.add(f);

@@ -119,6 +119,19 @@ class EmbreeCaster final : public RayCaster {
     return e.tfar < 0.f;
   }
 
+  void occludedFan(const glm::vec3& o, const glm::vec3* dirs, size_t n, float tfar, uint8_t* occ) const override {
+    if (mode_ != BatchMode::Single) return RayCaster::occludedFan(o, dirs, n, tfar, occ);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay e;
+    e.org_x = o.x; e.org_y = o.y; e.org_z = o.z; e.tnear = 0.f; e.time = 0.f; e.mask = 0xffffffffu; e.id = 0; e.flags = 0;
+    for (size_t i = 0; i < n; ++i) {
+      e.dir_x = dirs[i].x; e.dir_y = dirs[i].y; e.dir_z = dirs[i].z; e.tfar = tfar;
+      rtcOccluded1(scene_.get(), &ctx, &e);
+      occ[i] = e.tfar < 0.f ? 1 : 0;
+    }
+  }
+
   void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const override {
     if (mode_ == BatchMode::Single) return RayCaster::occludedBatch(rays, n, occ);
     RTCIntersectContext ctx;

@@ -39,7 +39,7 @@ struct AmbientOptions {
   glm::vec3 sunDirection{0.3f, 1.f, 0.2f};  // towards the sun
   float sunAngularRadiusDeg = 0.27f;
   int sunRays = 64;
-  BatchMode batch = BatchMode::Packet8;
+  BatchMode batch = BatchMode::Single;
   bool skipOpenVertices = true;  // prove-and-skip vertices with nothing within maxDistance
   bool mergeDuplicates = true;   // same position and normal computed once
 

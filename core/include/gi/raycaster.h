@@ -37,12 +37,20 @@ class RayCaster {
   virtual void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const {
     for (size_t i = 0; i < n; ++i) occ[i] = occluded(rays[i]) ? 1 : 0;
   }
+  // Rays sharing one origin (tnear 0) and one tfar: the shape of every
+  // per-vertex estimator. occ[i] = 1 if direction i is blocked.
+  virtual void occludedFan(const glm::vec3& o, const glm::vec3* dirs, size_t n, float tfar, uint8_t* occ) const {
+    Ray r;
+    r.o = o;
+    r.tfar = tfar;
+    for (size_t i = 0; i < n; ++i) { r.d = dirs[i]; occ[i] = occluded(r) ? 1 : 0; }
+  }
   virtual void intersectBatch(const Ray* rays, size_t n, Hit* hits) const {
     for (size_t i = 0; i < n; ++i) hits[i] = intersect(rays[i]);
   }
 };
 
-enum class BatchMode { Single, Packet8, Stream };
+enum class BatchMode { Single, Packet8, Stream };  // how batches reach Embree
 
 // Builds over the scene's usable faces (see usableFaceMask).
 std::unique_ptr<RayCaster> makeEmbreeCaster(const Scene& s, BatchMode mode = BatchMode::Packet8);

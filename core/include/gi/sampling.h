@@ -62,6 +62,20 @@ inline constexpr SobolRevDir1 kSobolRevDir1{};
 class SobolOwenStream {
  public:
   explicit SobolOwenStream(uint32_t key) : s0_(hashCombine(key, 0x68bc21ebu)), s1_(hashCombine(key, 0x02e5be93u)) {}
+  // The next n points as two arrays (scrambling vectorises over the block).
+  void nextBlock(int n, float* u0, float* u1) {  // n <= 64
+    uint32_t a[64], b[64];
+    for (int j = 0; j < n; ++j) {
+      a[j] = r0_; b[j] = r1_;
+      const int c = __builtin_ctz(++i_);
+      r0_ ^= 1u << c;
+      r1_ ^= kSobolRevDir1.v[c];
+    }
+    for (int j = 0; j < n; ++j) {
+      u0[j] = toUnitFloat(reverseBits(laineKarrasPermutation(a[j], s0_)));
+      u1[j] = toUnitFloat(reverseBits(laineKarrasPermutation(b[j], s1_)));
+    }
+  }
   glm::vec2 next() {
     const glm::vec2 p{toUnitFloat(reverseBits(laineKarrasPermutation(r0_, s0_))),
                       toUnitFloat(reverseBits(laineKarrasPermutation(r1_, s1_)))};
@@ -87,6 +101,8 @@ struct Rng {
 
 // Warps of [0,1)^2. Hemisphere warps return z-up local directions.
 glm::vec3 cosineHemisphere(glm::vec2 u);   // pdf = cos(theta) / pi
+// The same warp for n points at once (branch-free, vectorisable), z-up local.
+void cosineHemisphereBlock(int n, const float* u0, const float* u1, float* x, float* y, float* z);
 inline float cosineHemispherePdf(float cosTheta) { return cosTheta * 0.318309886f; }
 glm::vec3 uniformSphere(glm::vec2 u);      // pdf = 1 / (4 pi)
 glm::vec3 uniformHemisphere(glm::vec2 u);  // pdf = 1 / (2 pi)
