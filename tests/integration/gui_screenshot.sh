@@ -79,12 +79,12 @@ done
 [[ -n "$py" ]] || skip "no python3 with numpy found (set PYTHON)"
 
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/gui_screenshot.XXXXXX") || fail "mktemp failed"
-xvfb_pid= ml_pid= dog_pid=
+xvfb_pid='' ml_pid='' dog_pid=''
 stop() {  # stop PID: TERM, up to 3 s grace, then KILL
-  local pid=$1 i
+  local pid=$1
   [[ -n "$pid" ]] && kill -0 "$pid" 2>/dev/null || return 0
   kill -TERM "$pid" 2>/dev/null
-  for i in 1 2 3 4 5 6; do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+  for _ in 1 2 3 4 5 6; do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
   kill -KILL "$pid" 2>/dev/null
   wait "$pid" 2>/dev/null
 }
@@ -126,7 +126,7 @@ for n in $(seq 90 189); do
   xvfb_pid=$!
   for _ in $(seq 1 50); do  # up to 10 s for the server to answer
     # ours only if the lock file names our Xvfb (another run may have won :$n)
-    if [[ "$(tr -dc 0-9 2>/dev/null </tmp/.X$n-lock)" == "$xvfb_pid" ]] \
+    if [[ "$(tr -dc 0-9 2>/dev/null <"/tmp/.X$n-lock")" == "$xvfb_pid" ]] \
        && timeout 5 xdpyinfo -display ":$n" >/dev/null 2>&1; then disp=:$n; break; fi
     kill -0 "$xvfb_pid" 2>/dev/null || break  # lost a race for this display: next one
     sleep 0.2
@@ -191,7 +191,8 @@ done
 # resize itself right after start-up (seen once in ~10 runs), so this is checked
 # again before every screenshot.
 fill_screen() {
-  local WIDTH= HEIGHT= X= Y= SCREEN= WINDOW=
+  # shellcheck disable=SC2034  # all set by --shell's output; SCREEN, WINDOW unused
+  local WIDTH='' HEIGHT='' X='' Y='' SCREEN='' WINDOW=''
   eval "$(xdo getwindowgeometry --shell "$main_win")"
   [[ "$WIDTH" == "$width" && "$HEIGHT" == "$height" && "$X" == 0 && "$Y" == 0 ]] && return 0
   xdo windowmove "$main_win" 0 0
@@ -226,7 +227,7 @@ if not xr < xg:
 print(f"{msg}; red left of green (mean x {xr:.0f} < {xg:.0f})")
 PY
 )
-verdict= status=1
+verdict='' status=1
 shot_deadline=$((SECONDS + render_wait))
 while :; do
   kill -0 "$ml_pid" 2>/dev/null || { ml_log; fail "meshlab exited before the screenshot"; }
