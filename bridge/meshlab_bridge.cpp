@@ -239,22 +239,15 @@ PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::v
   return r;
 }
 
-VertexOutput radiometricOutput(const std::vector<glm::vec3>& rgb, double exposureParam) {
-  VertexOutput o;
-  o.rgb = rgb;
-  o.quality.resize(rgb.size());
-  for (size_t i = 0; i < rgb.size(); ++i) o.quality[i] = luminance(rgb[i]);
-  o.exposure = exposureParam > 0 ? float(exposureParam) : autoExposure(o.quality.data(), o.quality.size());
-  return o;
-}
 
 }  // namespace gi::ml
 
 #include "gi/direct.h"
+#include "gi/output.h"
 
 namespace gi::ml {
 void writeRadiometry(PreparedRun& run, VertexRadiometry& r) {
-  VertexOutput out = radiometricOutput(r.B, run.values.getFloat("exposure"));
+  VertexOutput out = radiometricOutput(run.bridge.scene, r.B, run.values.getFloat("exposure"));
   const size_t bad = writeVertexResults(run.bridge, out.quality, out.displayColors());
   r.stats.add("exposure", out.exposure);
   if (bad) r.stats.note(std::to_string(bad) + " non-finite values written as 0");

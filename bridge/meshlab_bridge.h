@@ -74,9 +74,6 @@ struct PreparedRun {
 PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::vector<ParamSpec>& specs,
                     bool withEmitters);
 
-// Quality and display colour from per-vertex linear RGB (exposure 0 = auto).
-VertexOutput radiometricOutput(const std::vector<glm::vec3>& rgb, double exposureParam);
-
 }  // namespace gi::ml
 
 namespace gi {

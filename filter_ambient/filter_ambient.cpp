@@ -2,6 +2,7 @@
 
 #include "gi/ambient.h"
 #include "gi/filters.h"
+#include "gi/output.h"
 #include "meshlab_bridge.h"
 
 using namespace gi;
@@ -44,7 +45,7 @@ QString FilterAmbientPlugin::filterInfo(FilterIDType f) const {
              "Directions are cosine-distributed (so each ray counts 0 or 1) and come from an Owen-scrambled Sobol "
              "sequence per vertex: the error falls faster than plain Monte Carlo's N<sup>-1/2</sup>. "
              "With a target error each vertex stops as soon as its own standard error is small enough. "
-             "The result goes to vertex <b>quality</b> (the AO value) and vertex <b>colour</b> (grey, sRGB).<br>"
+             "The result goes to vertex <b>quality</b> (the AO value) and vertex <b>colour</b> (grey, AO x 255).<br>"
              "Unlike MeshLab's depth-map 'Ambient Occlusion' it needs no GPU, is seeded and deterministic, and its "
              "values span [0,1] (MeshLab's top out at 0.25). Other visible layers can occlude (Scene extent).";
     case FP_AMBIENT_OBSCURANCE:
@@ -85,15 +86,13 @@ bool FilterAmbientPlugin::applyFilter(QAction* a, MeshDocument& md, const RichPa
     AmbientResult r = computeAmbient(run.bridge.scene, *caster, opt, Progress(ml::progressFrom(cb)));
     // Everything is computed: only now does the mesh change.
     if (opt.mode == AmbientMode::Sky) {
-      VertexOutput out = ml::radiometricOutput(r.rgb, run.values.getFloat("exposure"));
+      VertexOutput out = radiometricOutput(run.bridge.scene, r.rgb, run.values.getFloat("exposure"));
       ml::writeVertexResults(run.bridge, out.quality, out.displayColors());
       r.stats.add("exposure", out.exposure);
     } else {
       const int mapping = opt.mode == AmbientMode::Occlusion ? run.values.getInt("color_mapping") : 0;
-      VertexOutput out;
-      out.quality = r.value;
-      ml::writeVertexResults(run.bridge, out.quality,
-                             mapping == int(AOColorMapping::Grey) ? out.displayColors() : std::vector<Rgb8>{});
+      ml::writeVertexResults(run.bridge, r.value,
+                             mapping == int(AOColorMapping::Grey) ? greyColors(r.value) : std::vector<Rgb8>{});
       if (mapping == int(AOColorMapping::MultiplyColor)) ml::multiplyVertexColors(run.bridge, r.value);
       if (opt.bentNormals)
         ml::writeVertexVectorAttribute(run.bridge, "BentNormal", r.bentNormal,

@@ -15,6 +15,7 @@
 #include "gi/ambient.h"
 #include "gi/direct.h"
 #include "gi/filters.h"
+#include "gi/output.h"
 #include "gi/photon.h"
 #include "gi/scene_setup.h"
 #include "mesh_io.h"
@@ -136,6 +137,7 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
   const Progress progress(stderrProgress(a.quiet));
 
   VertexOutput out;
+  std::vector<Rgb8> colors;
   RunStats stats;
   io::PlyExtras extras;
   if (kind == FilterKind::AmbientOcclusion || kind == FilterKind::AmbientObscurance || kind == FilterKind::SkyLighting) {
@@ -147,13 +149,12 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
     AmbientResult r = computeAmbient(mesh.scene, *caster, opt, progress);
     stats = r.stats;
     if (mode == AmbientMode::Sky) {
-      out.rgb = r.rgb;
-      out.quality = r.value;
-      const double e = v.getFloat("exposure");
-      out.exposure = e > 0 ? float(e) : autoExposure(out.quality.data(), out.quality.size());
+      out = radiometricOutput(mesh.scene, r.rgb, v.getFloat("exposure"));
+      colors = out.displayColors();
       stats.add("exposure", out.exposure);
     } else {
       out.quality = r.value;
+      colors = greyColors(r.value);
       if (opt.bentNormals) extras.normals = r.bentNormal;
     }
   } else {
@@ -166,14 +167,11 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
       r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v), progress);
     }
     stats = r.stats;
-    out.rgb = r.B;
-    out.quality.resize(r.B.size());
-    for (size_t i = 0; i < r.B.size(); ++i) out.quality[i] = luminance(r.B[i]);
-    const double e = v.getFloat("exposure");
-    out.exposure = e > 0 ? float(e) : autoExposure(out.quality.data(), out.quality.size());
+    out = radiometricOutput(mesh.scene, r.B, v.getFloat("exposure"));
+    colors = out.displayColors();
     stats.add("exposure", out.exposure);
   }
-  if (!a.output.empty()) io::writePly(a.output, mesh.scene, mesh.attrs, out.quality, out.displayColors(), extras);
+  if (!a.output.empty()) io::writePly(a.output, mesh.scene, mesh.attrs, out.quality, colors, extras);
   stats.add("total_seconds", timer.seconds());
   if (a.json) {
     json j;

@@ -46,8 +46,8 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
     s.push_back({"cone_angle", "Cone half-angle (deg)", "Half-angle of the cone in degrees.", ParamType::Float, 45,
                  0.5, 180});
     s.push_back({"color_mapping", "Colour output",
-                 "'Grey': vertex colour = AO as grey (sRGB-encoded). 'Multiply colour': the existing vertex colour "
-                 "times AO. 'Keep colour': only the quality is written.",
+                 "'Grey': vertex colour = AO x 255 as grey (the usual AO display). 'Multiply colour': the existing "
+                 "vertex colour times AO (in linear light). 'Keep colour': only the quality is written.",
                  ParamType::Enum, 0, 0, 0, {"Grey", "Multiply colour", "Keep colour"}});
   }
   if (mode == AmbientMode::Obscurance)

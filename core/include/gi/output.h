@@ -1,0 +1,23 @@
+// Per-vertex results into the common output convention (DESIGN.md §4):
+// quality = the physical scalar, colour = its display mapping.
+#pragma once
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/scene.h"
+#include "gi/scene_setup.h"
+
+namespace gi {
+
+// Radiometric output (radiosity, irradiance): quality = luminance, colour =
+// sRGB(exposure x value). exposureParam <= 0 picks the exposure that maps the
+// 99th percentile of the non-emitting vertices' luminance to white (emitters
+// would otherwise darken everything they light).
+VertexOutput radiometricOutput(const Scene& s, const std::vector<glm::vec3>& rgb, double exposureParam);
+
+// Ambient occlusion / obscurance: quality = value in [0,1], colour = grey
+// value x 255 (the usual AO display, not sRGB-encoded).
+std::vector<Rgb8> greyColors(const std::vector<float>& value);
+
+}  // namespace gi
