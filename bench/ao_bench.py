@@ -180,6 +180,33 @@ def terrain(path, n):
         f.write(buf)
 
 
+def subdivided(src, dst, levels):
+    """Midpoint (1-to-4) subdivision, flat: the same surface with more vertices."""
+    import struct
+    ply = read_ply(src)
+    verts = [(r["x"], r["y"], r["z"]) for r in ply["vertex"]]
+    faces = [tuple(r["vertex_indices"]) for r in ply["face"]]
+    for _ in range(levels):
+        mid = {}
+        def m(a, b):
+            k = (min(a, b), max(a, b))
+            if k not in mid:
+                mid[k] = len(verts)
+                verts.append(tuple((p + q) / 2 for p, q in zip(verts[a], verts[b])))
+            return mid[k]
+        nf = []
+        for a, b, c in faces:
+            ab, bc, ca = m(a, b), m(b, c), m(c, a)
+            nf += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+        faces = nf
+    with open(dst, "wb") as f:
+        f.write(("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+                 "property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n"
+                 % (len(verts), len(faces))).encode())
+        f.write(b"".join(struct.pack("<3f", *v) for v in verts))
+        f.write(b"".join(struct.pack("<B3i", 3, *t) for t in faces))
+
+
 def scaling(b, sizes, rays):
     rows = []
     for n in sizes:
@@ -235,25 +262,34 @@ def main():
     repeats = 1 if a.quick else 3
     b = Bench(a.build, a.out, repeats)
     meshes = os.path.join(ROOT, "test_meshes")
-    scenes = {"bunny": os.path.join(meshes, "bunny.ply"), "cylinder_hole": os.path.join(meshes, "cylinder_hole.ply"),
-              "floor_wall": os.path.join(meshes, "floor_wall.ply")}
+    fine = os.path.join(a.out, "bunny_fine.ply")
+    if not os.path.exists(fine):
+        subdivided(os.path.join(meshes, "bunny.ply"), fine, 2)  # 29,394 vertices, like the 37k-vertex Stanford bunny
+    scenes = {"bunny_fine": fine, "bunny": os.path.join(meshes, "bunny.ply"),
+              "cylinder_hole": os.path.join(meshes, "cylinder_hole.ply"), "floor_wall": os.path.join(meshes, "floor_wall.ply")}
     rays = [16, 64, 256, 1024] if a.quick else [8, 16, 32, 64, 128, 256, 512, 1024, 2048]
     server_rays = [16, 256] if a.quick else [16, 64, 256, 1024]
-    views = [16, 64] if a.quick else [8, 16, 32, 64, 128, 256, 512]
+    views = [16, 64] if a.quick else [8, 16, 32, 64, 128, 256, 512, 1024]
     for scene, mesh in scenes.items():
         ref = b.reference(mesh, 4096 if a.quick else 16384)
         b.ours_cli(scene, mesh, ref, rays)
         b.ours_server(scene, mesh, ref, server_rays)
         b.meshlab_ao(scene, mesh, ref, views)
+        if not a.quick:
+            b.meshlab_ao(scene, mesh, ref, [128, 512], tex=2048)
     summary = []
     for scene in scenes:
         ours = [r for r in b.rows if r["scene"] == scene and r["method"] == "ours (CLI)"]
         ml = [r for r in b.rows if r["scene"] == scene and r["method"].startswith("MeshLab")]
-        for target in (0.01, 0.005):
+        best = min(ml, key=lambda r: r["rms_error"])
+        for target in (0.01, 0.005, best["rms_error"]):
             to, tm = time_to_reach(ours, target), time_to_reach(ml, target)
+            if target == best["rms_error"]:
+                tm = min(r["filter_seconds"] for r in ml if r["rms_error"] <= target * 1.000001)
             summary.append({"scene": scene, "target_rms": target, "ours_seconds": to, "meshlab_seconds": tm,
                             "speedup": (tm / to) if (to and tm) else None,
-                            "meshlab_best_rms": min(r["rms_error"] for r in ml)})
+                            "meshlab_best_rms": best["rms_error"],
+                            "at_meshlab_best": target == best["rms_error"]})
     throughput = {}
     for scene, mesh in scenes.items():
         text, _ = run([os.path.join(a.build, "bench", "ao_throughput"), mesh, "256", "3" if a.quick else "7"])
@@ -270,8 +306,8 @@ def main():
     fmt = lambda x: "never (best %.4f)" if x is None else "%.3f s" % x
     lines = ["| scene | target RMS | ours (CLI) | MeshLab AO | speed-up |", "|---|---|---|---|---|"]
     for s in summary:
-        lines.append("| %s | %.3f | %s | %s | %s |" % (
-            s["scene"], s["target_rms"], "n/a" if s["ours_seconds"] is None else "%.3f s" % s["ours_seconds"],
+        lines.append("| %s | %s | %s | %s | %s |" % (
+            s["scene"], ("%.4f (MeshLab's best)" % s["target_rms"]) if s["at_meshlab_best"] else "%.3f" % s["target_rms"], "n/a" if s["ours_seconds"] is None else "%.3f s" % s["ours_seconds"],
             ("not reached (best %.4f)" % s["meshlab_best_rms"]) if s["meshlab_seconds"] is None else "%.3f s" % s["meshlab_seconds"],
             "%.0fx" % s["speedup"] if s["speedup"] else "-"))
     lines += ["", "| scene | bare Embree rays/s | bare robust rays/s | ours rays/s | ours / bare | ours / bare robust |",
