@@ -155,6 +155,25 @@ size_t writeVertexResults(BridgeScene& b, const std::vector<float>& quality, con
   return bad;
 }
 
+size_t writeFaceResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors) {
+  size_t bad = 0;
+  for (LayerPart& p : b.parts) {
+    p.mm->updateDataMask(int(MeshModel::MM_FACEQUALITY) | int(MeshModel::MM_FACECOLOR));
+    CMeshO& m = p.mm->cm;
+    size_t k = p.faceOffset;
+    for (size_t i = 0; i < m.face.size(); ++i) {
+      if (m.face[i].IsD()) continue;
+      float q = quality[k];
+      if (!std::isfinite(q)) { q = 0.f; ++bad; }
+      m.face[i].Q() = q;
+      const Rgb8 c = colors[k];
+      m.face[i].C() = vcg::Color4b(c.r, c.g, c.b, 255);
+      ++k;
+    }
+  }
+  return bad;
+}
+
 void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v, bool alsoNormals) {
   for (LayerPart& p : b.parts) {
     CMeshO& m = p.mm->cm;
@@ -246,6 +265,21 @@ PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::v
 #include "gi/output.h"
 
 namespace gi::ml {
+void writeRadiosity(PreparedRun& run, const std::vector<glm::vec3>& Bvertex, const std::vector<glm::vec3>& Bface,
+                    bool faces, RunStats& stats) {
+  VertexOutput out = radiometricOutput(run.bridge.scene, Bvertex, run.values.getFloat("exposure"));
+  size_t bad = writeVertexResults(run.bridge, out.quality, out.displayColors());
+  if (faces) {
+    VertexOutput f;
+    f.rgb = Bface;
+    f.exposure = out.exposure;
+    for (const auto& b : Bface) f.quality.push_back(luminance(b));
+    bad += writeFaceResults(run.bridge, f.quality, f.displayColors());
+  }
+  stats.add("exposure", out.exposure);
+  if (bad) stats.note(std::to_string(bad) + " non-finite values written as 0");
+}
+
 void writeRadiometry(PreparedRun& run, VertexRadiometry& r) {
   VertexOutput out = radiometricOutput(run.bridge.scene, r.B, run.values.getFloat("exposure"));
   const size_t bad = writeVertexResults(run.bridge, out.quality, out.displayColors());

@@ -45,6 +45,8 @@ double documentDiagonal(MeshDocument& md);
 // Writes quality and colour to every vertex of every part (non-finite values
 // become 0 and are counted in the return value). Colour is skipped if empty.
 size_t writeVertexResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors);
+// The same per face (scene face order).
+size_t writeFaceResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors);
 // Per-vertex Point3m attribute `name` (e.g. "BentNormal"), optionally into the normals too.
 void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v,
                                 bool alsoNormals);
@@ -82,4 +84,7 @@ struct VertexRadiometry;
 namespace gi::ml {
 // Writes B as quality (luminance) and display colour; adds the exposure to the stats.
 void writeRadiometry(PreparedRun& run, VertexRadiometry& r);
+// Per-vertex radiosity and, optionally, per-face radiosity with the same exposure.
+void writeRadiosity(PreparedRun& run, const std::vector<glm::vec3>& Bvertex, const std::vector<glm::vec3>& Bface,
+                    bool faces, RunStats& stats);
 }  // namespace gi::ml

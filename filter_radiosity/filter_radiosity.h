@@ -1,4 +1,4 @@
-// MeshLab adapter for the engine's radiosity (gi/direct.h for now). No algorithm code here.
+// MeshLab adapter for the engine's radiosity (gi/radiosity.h). No algorithm code here.
 #pragma once
 #include <common/interfaces.h>
 

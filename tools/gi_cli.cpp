@@ -17,6 +17,7 @@
 #include "gi/filters.h"
 #include "gi/output.h"
 #include "gi/photon.h"
+#include "gi/radiosity.h"
 #include "gi/scene_setup.h"
 #include "mesh_io.h"
 
@@ -158,16 +159,28 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
       if (opt.bentNormals) extras.normals = r.bentNormal;
     }
   } else {
-    VertexRadiometry r;
+    auto caster = makeEmbreeCaster(mesh.scene);
+    std::vector<glm::vec3> B, faceB;
     if (kind == FilterKind::Radiosity) {
-      auto caster = makeEmbreeCaster(mesh.scene);
-      r = computeDirect(mesh.scene, *caster, DirectOptions::fromParams(v), progress);
+      RadiosityResult r = solveRadiosity(mesh.scene, *caster, RadiosityOptions::fromParams(v), progress);
+      stats = r.stats;
+      B = r.Bvertex;
+      faceB = r.B;
     } else {
-      auto caster = makeEmbreeCaster(mesh.scene);
-      r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v), progress);
+      VertexRadiometry r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v), progress);
+      stats = r.stats;
+      B = r.B;
     }
-    stats = r.stats;
-    out = radiometricOutput(mesh.scene, r.B, v.getFloat("exposure"));
+    out = radiometricOutput(mesh.scene, B, v.getFloat("exposure"));
+    if (!faceB.empty() && v.getBool("face_output")) {  // patches' radiosity as face colour and quality
+      mesh.attrs.faceColor.clear();
+      mesh.attrs.faceQuality.clear();
+      for (const auto& b : faceB) {
+        const Rgb8 c = displayMap(b, out.exposure);
+        mesh.attrs.faceColor.push_back({c.r, c.g, c.b});
+        mesh.attrs.faceQuality.push_back(luminance(b));
+      }
+    }
     colors = out.displayColors();
     stats.add("exposure", out.exposure);
   }

@@ -8,6 +8,7 @@
 #include "gi/ambient.h"
 #include "gi/direct.h"
 #include "gi/photon.h"
+#include "gi/radiosity.h"
 #include "gi/scene_setup.h"
 
 namespace gi {
@@ -17,7 +18,7 @@ const std::vector<FilterDesc>& allFilters() {
       {FilterKind::AmbientOcclusion, "GI: Ambient Occlusion", "ao", "per-vertex cosine-weighted ambient occlusion"},
       {FilterKind::AmbientObscurance, "GI: Ambient Obscurance", "obscurance", "per-vertex ambient obscurance"},
       {FilterKind::SkyLighting, "GI: Sky Lighting", "sky", "per-vertex irradiance from a uniform sky and a sun"},
-      {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "radiosity from area emitters (direct light)"},
+      {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "the radiosity method: form factors and a solver"},
       {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "photon-mapped radiosity from area emitters"},
   };
   return f;
@@ -46,7 +47,11 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     }
     case FilterKind::Radiosity:
       add(lightingSceneSpecs());
-      add(DirectOptions::specs());
+      add(RadiosityOptions::specs());
+      s.push_back({"face_output", "Also write per-face results",
+                   "Besides the per-vertex result (area-weighted mean of the incident patches), write each patch's "
+                   "radiosity to face quality and face colour: the flat-shaded look of the course's images.",
+                   ParamType::Bool, 0});
       add(displaySpecs());
       break;
     case FilterKind::PhotonMapping:

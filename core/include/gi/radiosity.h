@@ -1,0 +1,86 @@
+// The radiosity method over the triangles of a scene (Goral et al. 1984;
+// Cohen and Greenberg 1985):
+//   B_i = E_i + rho_i sum_j F_ij B_j          (RGB, W/m^2)
+// with form factors F_ij estimated by Monte Carlo ray casting from each patch
+// (cosine-weighted hemisphere directions from stratified points on the
+// patch: F_ij ~ (rays from i hitting j's front) / N) and solved by Jacobi,
+// Gauss-Seidel or progressive refinement (Cohen et al. 1988: shoot the patch
+// with the most unshot power). Rows are sparse; only hit patches are stored.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/params.h"
+#include "gi/raycaster.h"
+#include "gi/run.h"
+#include "gi/scene.h"
+
+namespace gi {
+
+enum class RadiositySolver { Auto = 0, Jacobi = 1, GaussSeidel = 2, Progressive = 3 };
+
+struct RadiosityOptions {
+  int raysPerPatch = 1024;        // form-factor rays per patch
+  int lightSamples = 64;          // shadow rays per patch for the direct light
+  RadiositySolver solver = RadiositySolver::Auto;
+  int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
+  double tolerance = 1e-4;        // on the relative residual / unshot power
+  int maxIterations = 1000;       // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive)
+  double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
+  uint32_t seed = 0;
+  static std::vector<ParamSpec> specs();
+  static RadiosityOptions fromParams(const ParamValues& v);
+};
+
+// Sparse form-factor row of patch i: F_ij for the patches j its rays reached.
+struct FormFactorRow {
+  std::vector<uint32_t> j;
+  std::vector<float> F;
+  float escaped = 0.f;  // fraction of rays that hit nothing (open scenes) or a back face
+};
+
+// Computes rows (one per face; unusable faces get empty rows).
+class FormFactors {
+ public:
+  FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed);
+  FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
+  size_t patchCount() const { return area_.size(); }
+  double area(uint32_t i) const { return area_[i]; }
+  uint64_t raysCast() const;
+
+ private:
+  const Scene& s_;
+  const RayCaster& caster_;
+  int n_;
+  uint32_t seed_;
+  float eps_;
+  std::vector<double> area_;
+  std::vector<glm::vec3> normal_;
+  std::vector<uint8_t> ok_;
+  mutable std::vector<uint64_t> rays_;  // per patch, for the statistics
+};
+
+struct RadiosityResult {
+  std::vector<glm::vec3> B;         // per face
+  std::vector<glm::vec3> Bvertex;   // per vertex (area-weighted mean of incident faces)
+  int iterations = 0;
+  double residual = 0.0;            // relative, at the end
+  std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
+  RunStats stats;
+};
+
+RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
+                               const Progress& progress = Progress(nullptr));
+
+// Direct irradiance per face from the emitters (shadow rays, power sampling).
+std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                             const Progress& progress = Progress(nullptr));
+
+// Solvers on precomputed rows and direct irradiance (exposed for tests).
+RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
+                              RadiositySolver solver, int bounces, double tolerance, int maxIterations,
+                              const Progress& progress);
+
+}  // namespace gi

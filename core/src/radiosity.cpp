@@ -1,0 +1,433 @@
+#include "gi/radiosity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+
+#include "gi/color.h"
+#include "gi/emitters.h"
+#include "gi/form_factor_analytic.h"
+#include "gi/sampling.h"
+#include "gi/scene_setup.h"
+
+namespace gi {
+
+std::vector<ParamSpec> RadiosityOptions::specs() {
+  return {
+      {"form_factor_method", "Form factors",
+       "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
+       "cosine-weighted directions; the fraction that lands on patch j's front is F_ij (visibility included, "
+       "no hemicube aliasing). Rays that leave the scene or hit a back face are lost (absorbed).",
+       ParamType::Enum, 0, 0, 0, {"Monte Carlo"}},
+      {"rays_per_patch", "Rays per patch",
+       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N); the radiosity error "
+       "averages over many patches and falls faster.",
+       ParamType::Int, 1024, 16, 1 << 22},
+      {"light_samples", "Shadow rays per patch",
+       "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to 256 "
+       "emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter face, "
+       "times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the emitters "
+       "sampled in proportion to power with a shadow ray each.",
+       ParamType::Int, 64, 1, 1 << 20},
+      {"solver", "Solver",
+       "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses new values "
+       "as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): repeatedly shoots the "
+       "unshot power of the brightest patch; useful images early. Auto: Gauss-Seidel, or progressive refinement "
+       "when the form factors do not fit the memory budget.",
+       ParamType::Enum, 0, 0, 0, {"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement"}},
+      {"bounces", "Bounces",
+       "-1: iterate until the tolerance is met (all bounces). 0: direct light only (B = E + rho H_direct); k: "
+       "light after k further diffuse inter-reflections (exactly k Jacobi sweeps, as in the course's progressive "
+       "images).",
+       ParamType::Int, -1, -1, 100000},
+      {"tolerance", "Tolerance",
+       "Stop when the change of a sweep (Jacobi, Gauss-Seidel) or the unshot power (progressive), as power "
+       "relative to the emitted power, is below this.",
+       ParamType::Float, 1e-4, 1e-12, 1.0},
+      {"max_iterations", "Maximum iterations",
+       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement).",
+       ParamType::Int, 1000, 1, 1000000},
+      {"memory_budget_mb", "Memory budget (MB)",
+       "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
+       "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
+       ParamType::Float, 1024, 1, 1e7},
+      {"seed", "Random seed", "Seed of the form-factor rays; the same seed gives bit-identical results.",
+       ParamType::Int, 0, 0, 2147483647},
+  };
+}
+
+RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
+  RadiosityOptions o;
+  o.raysPerPatch = v.getInt("rays_per_patch");
+  o.lightSamples = v.getInt("light_samples");
+  o.solver = RadiositySolver(v.getInt("solver"));
+  o.bounces = v.getInt("bounces");
+  o.tolerance = v.getFloat("tolerance");
+  o.maxIterations = v.getInt("max_iterations");
+  o.memoryBudgetMB = v.getFloat("memory_budget_mb");
+  o.seed = uint32_t(v.getInt("seed"));
+  return o;
+}
+
+FormFactors::FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
+    : s_(s), caster_(caster), n_(raysPerPatch), seed_(seed), eps_(float(analyzeScene(s).rayEpsilon)) {
+  ok_ = usableFaceMask(s);
+  area_.resize(s.faceCount());
+  normal_.resize(s.faceCount());
+  rays_.assign(s.faceCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    area_[f] = ok_[f] ? faceArea(s, f) : 0.0;
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    normal_[f] = ok_[f] ? glm::normalize(n) : glm::vec3(0.f);
+  }
+}
+
+uint64_t FormFactors::raysCast() const {
+  uint64_t t = 0;
+  for (uint64_t r : rays_) t += r;
+  return t;
+}
+
+FormFactorRow FormFactors::row(uint32_t i) const {
+  FormFactorRow r;
+  if (!ok_[i]) return r;
+  const auto& t = s_.triangles[i];
+  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
+  const glm::vec3 n = normal_[i];
+  const Frame frame(n);
+  // Two independently scrambled 2D sequences (points, directions): padding.
+  SobolOwenStream pts(hash3(i, seed_, 0xf1u)), dirs(hash3(i, seed_, 0xf2u));
+  std::vector<uint32_t> hits;
+  hits.reserve(size_t(n_));
+  int lost = 0;
+  Ray ray;
+  for (int k = 0; k < n_; ++k) {
+    const glm::vec2 bc = uniformTriangle(pts.next());
+    // Keep the origin strictly inside the triangle, then lift it off the plane.
+    const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
+    ray.o = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
+    ray.d = frame.toWorld(cosineHemisphere(dirs.next()));
+    ray.tnear = 0.f;
+    ray.tfar = std::numeric_limits<float>::infinity();
+    const Hit h = caster_.intersect(ray);
+    if (h.valid() && h.face != i && glm::dot(ray.d, normal_[h.face]) < 0.f) hits.push_back(h.face);
+    else ++lost;
+  }
+  rays_[i] += uint64_t(n_);
+  std::sort(hits.begin(), hits.end());
+  for (size_t k = 0; k < hits.size();) {
+    size_t e = k;
+    while (e < hits.size() && hits[e] == hits[k]) ++e;
+    r.j.push_back(hits[k]);
+    r.F.push_back(float(double(e - k) / n_));
+    k = e;
+  }
+  r.escaped = float(double(lost) / n_);
+  return r;
+}
+
+std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                             const Progress& progress) {
+  if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
+  const EmitterSampler lights(s);
+  std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
+  if (lights.empty()) return H;
+  const auto ok = usableFaceMask(s);
+  const float eps = float(analyzeScene(s).rayEpsilon);
+  std::vector<uint32_t> emitters;
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters.push_back(uint32_t(f));
+  // Few emitter faces: the exact point-to-triangle factor per sample point and
+  // emitter, times visibility from one shadow ray to a random point on it
+  // (Wallace et al. 1989). Many: power-proportional point sampling.
+  const bool analytic = emitters.size() <= 256;
+  const int points = analytic ? std::max(1, lightSamples / int(emitters.size())) : lightSamples;
+  parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!ok[i]) continue;
+      const auto& t = s.triangles[i];
+      const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
+      SobolOwenStream pts(hash3(uint32_t(i), seed, 0xd3u)), lsmp(hash3(uint32_t(i), seed, 0xd4u));
+      Rng rng(hash3(uint32_t(i), seed, 0xd5u));
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < points; ++k) {
+        const glm::vec2 bc = uniformTriangle(pts.next());
+        const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
+        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] + n * eps;
+        if (analytic) {
+          for (uint32_t L : emitters) {
+            if (L == i) continue;
+            const auto& te = s.triangles[L];
+            const glm::vec3 nL = faceNormalUnnormalized(s, L);
+            if (glm::dot(nL, x - s.positions[te.x]) <= 0.f) continue;  // behind the emitter: it emits one-sided
+            const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s.positions[te.x]),
+                                                       glm::dvec3(s.positions[te.y]), glm::dvec3(s.positions[te.z]));
+            if (F <= 0) continue;
+            const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
+            const glm::vec3 y = ub.x * s.positions[te.x] + ub.y * s.positions[te.y] + (1.f - ub.x - ub.y) * s.positions[te.z];
+            glm::vec3 w = y - x;
+            const float r = glm::length(w);
+            Ray ray;
+            ray.o = x;
+            ray.d = w / r;
+            ray.tfar = r * (1.f - 1e-4f) - eps;
+            if (ray.tfar > 0.f && caster.occluded(ray)) continue;
+            sum += F * glm::dvec3(s.faceEmission(L));
+          }
+          continue;
+        }
+        const auto L = lights.sample(lsmp.next());
+        if (L.face == i) continue;
+        glm::vec3 w = L.p - x;
+        const float r2 = glm::dot(w, w);
+        if (!(r2 > 0.f)) continue;
+        const float r = std::sqrt(r2);
+        w /= r;
+        const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
+        if (cx <= 0.f || ce <= 0.f) continue;
+        Ray ray;
+        ray.o = x;
+        ray.d = w;
+        ray.tfar = r * (1.f - 1e-4f) - eps;
+        if (ray.tfar > 0.f && caster.occluded(ray)) continue;
+        sum += glm::dvec3(L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea)));
+      }
+      H[i] = glm::vec3(sum / double(points));
+    }
+  });
+  return H;
+}
+
+namespace {
+
+using RowFn = std::function<const FormFactorRow&(uint32_t)>;
+
+struct Setup {
+  size_t n;
+  std::vector<double> A;
+  std::vector<glm::vec3> E, rho, Hd;  // emission, reflectance, direct irradiance
+  double P = 0;  // emitted power (luminance), W
+};
+
+Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd) {
+  Setup u;
+  u.n = s.faceCount();
+  const auto ok = usableFaceMask(s);
+  u.A.resize(u.n);
+  u.E.resize(u.n);
+  u.rho.resize(u.n);
+  for (size_t i = 0; i < u.n; ++i) {
+    u.A[i] = ok[i] ? faceArea(s, i) : 0.0;
+    u.E[i] = ok[i] ? s.faceEmission(i) : glm::vec3(0.f);
+    u.rho[i] = s.faceRho(i);
+    for (int k = 0; k < 3; ++k)
+      if (!(u.rho[i][k] >= 0.f && u.rho[i][k] < 1.f))
+        throw std::invalid_argument("reflectance must be in [0, 1) in every channel (face " + std::to_string(i) +
+                                    " has " + std::to_string(u.rho[i][k]) + "): rho >= 1 creates energy");
+    u.P += u.A[i] * luminance(u.E[i]);
+  }
+  if (!(u.P > 0))
+    throw std::invalid_argument("the scene has no emitters: select the light's faces (or mark them by face quality) "
+                                "and choose the matching 'Emitters' option");
+  u.Hd = Hd;
+  if (u.Hd.size() != u.n) throw std::logic_error("direct irradiance has the wrong size");
+  return u;
+}
+
+glm::vec3 gather(const FormFactorRow& r, const std::vector<glm::vec3>& B) {
+  glm::dvec3 h(0.0);
+  for (size_t k = 0; k < r.j.size(); ++k) h += double(r.F[k]) * glm::dvec3(B[r.j[k]]);
+  return glm::vec3(h);
+}
+
+// Emitted = absorbed + escaped, with the direct light's share from the
+// shadow rays and the reflected share from the rows (R = reflected radiosity).
+void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R, RunStats& st) {
+  double absorbed = 0, escaped = u.P;
+  for (size_t i = 0; i < u.n; ++i) {
+    if (u.A[i] == 0) continue;
+    const FormFactorRow& r = row(uint32_t(i));
+    const glm::vec3 H = u.Hd[i] + gather(r, R);
+    absorbed += u.A[i] * luminance((glm::vec3(1.f) - u.rho[i]) * H);
+    escaped += u.A[i] * (luminance(R[i]) * r.escaped - luminance(u.Hd[i]));
+  }
+  st.add("emitted_power_W", u.P);
+  st.add("absorbed_power_W", absorbed);
+  st.add("escaped_power_W", escaped);
+  st.add("energy_balance_error", std::fabs(u.P - absorbed - escaped) / u.P);
+}
+
+RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
+                      int bounces, double tol, int maxIter, const Progress& progress) {
+  RadiosityResult res;
+  std::vector<glm::vec3> S(u.n);  // source: once-reflected direct light
+  for (size_t i = 0; i < u.n; ++i) S[i] = u.rho[i] * u.Hd[i];
+  std::vector<glm::vec3> B = S;   // the reflected radiosity R while solving
+  size_t skippedBlack = 0;
+  for (size_t i = 0; i < u.n; ++i) skippedBlack += (u.A[i] > 0 && u.rho[i] == glm::vec3(0.f)) ? 1 : 0;
+  const bool fixedBounces = bounces >= 0;
+  if (fixedBounces) solver = RadiositySolver::Jacobi;
+  const char* names[] = {"auto", "Jacobi", "Gauss-Seidel", "progressive refinement"};
+  res.stats.note(std::string("solver ") + names[int(solver)] +
+                 (fixedBounces ? " (" + std::to_string(bounces) + " bounces requested)" : ""));
+  if (solver == RadiositySolver::Jacobi || solver == RadiositySolver::GaussSeidel) {
+    const int sweeps = fixedBounces ? bounces : maxIter;
+    std::vector<glm::vec3> Bn = B;
+    for (int it = 0; it < sweeps; ++it) {
+      double change = 0;
+      if (solver == RadiositySolver::Jacobi) {
+        parallelBlocks(u.n, Progress(nullptr), "", [&](size_t b, size_t e) {
+          for (size_t i = b; i < e; ++i)
+            Bn[i] = (u.A[i] > 0 && u.rho[i] != glm::vec3(0.f)) ? S[i] + u.rho[i] * gather(row(uint32_t(i)), B) : S[i];
+        });
+        for (size_t i = 0; i < u.n; ++i) change += u.A[i] * std::fabs(luminance(Bn[i] - B[i]));
+        B.swap(Bn);
+      } else {
+        for (size_t i = 0; i < u.n; ++i) {
+          if (u.A[i] == 0 || u.rho[i] == glm::vec3(0.f)) continue;
+          const glm::vec3 nb = S[i] + u.rho[i] * gather(row(uint32_t(i)), B);
+          change += u.A[i] * std::fabs(luminance(nb - B[i]));
+          B[i] = nb;
+        }
+      }
+      res.residual = change / u.P;
+      res.residualHistory.push_back(res.residual);
+      res.iterations = it + 1;
+      progress.report(fixedBounces ? double(it + 1) / sweeps : std::min(1.0, std::log(res.residual + 1e-300) / std::log(tol)),
+                      "solving");
+      if (!fixedBounces && res.residual < tol) break;
+    }
+  } else {
+    // Progressive refinement: shoot the unshot radiosity dB of the patch with
+    // the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
+    // the receivers' gain is read from their own rows, dB_j = rho_j F_ji dB_i
+    // (Southwell relaxation of the very system Jacobi and Gauss-Seidel solve,
+    // so all solvers agree); with rows on the fly, from the shooter's row by
+    // reciprocity, dB_j = rho_j dB_i F_ij A_i / A_j (the classical form; Monte
+    // Carlo rows are reciprocal only in expectation).
+    std::vector<std::vector<std::pair<uint32_t, float>>> columns;
+    if (transpose) {
+      columns.resize(u.n);
+      for (size_t j = 0; j < u.n; ++j) {
+        const FormFactorRow& r = row(uint32_t(j));
+        for (size_t k = 0; k < r.j.size(); ++k) columns[r.j[k]].push_back({uint32_t(j), r.F[k]});
+      }
+    }
+    std::vector<glm::vec3> dB = S;
+    std::vector<double> unshot(u.n);
+    double U = 0;
+    for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * luminance(dB[i]); U += unshot[i]; }
+    const long maxShots = long(maxIter) * long(std::max<size_t>(u.n, 1));
+    long shots = 0;
+    auto receive = [&](uint32_t j, const glm::vec3& d) {
+      B[j] += d;
+      dB[j] += d;
+      const double nu = u.A[j] * luminance(dB[j]);
+      U += nu - unshot[j];
+      unshot[j] = nu;
+    };
+    while (U / u.P > tol && shots < maxShots) {
+      const size_t i = size_t(std::max_element(unshot.begin(), unshot.end()) - unshot.begin());
+      if (!(unshot[i] > 0)) break;
+      const glm::vec3 shoot = dB[i];
+      dB[i] = glm::vec3(0.f);
+      U -= unshot[i];
+      unshot[i] = 0;
+      if (transpose) {
+        for (const auto& [j, F] : columns[i])
+          if (u.rho[j] != glm::vec3(0.f)) receive(j, u.rho[j] * shoot * F);
+      } else {
+        const FormFactorRow& r = row(uint32_t(i));
+        for (size_t k = 0; k < r.j.size(); ++k) {
+          const uint32_t j = r.j[k];
+          if (u.rho[j] == glm::vec3(0.f)) continue;  // black receivers reflect nothing
+          receive(j, u.rho[j] * shoot * float(double(r.F[k]) * u.A[i] / u.A[j]));
+        }
+      }
+      ++shots;
+      if (shots % long(std::max<size_t>(u.n, 1)) == 0) {  // re-sum: no drift
+        U = 0;
+        for (double x : unshot) U += x;
+      }
+      res.residualHistory.push_back(U / u.P);
+      if ((shots & 255) == 0) progress.report(std::min(1.0, std::log(U / u.P + 1e-300) / std::log(tol)), "shooting");
+    }
+    res.iterations = int(shots);
+    res.residual = U / u.P;
+    // Ambient term for display (Cohen et al. 1988): the unshot power spread
+    // evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
+    double Atot = 0, rhoA = 0;
+    glm::dvec3 unshotSum(0.0);
+    for (size_t i = 0; i < u.n; ++i) { Atot += u.A[i]; rhoA += u.A[i] * luminance(u.rho[i]); unshotSum += u.A[i] * glm::dvec3(dB[i]); }
+    const double rhoAvg = Atot > 0 ? rhoA / Atot : 0;
+    const glm::dvec3 ambient = Atot > 0 ? unshotSum / Atot / (1.0 - rhoAvg) : glm::dvec3(0.0);
+    res.stats.add("ambient_term", luminance(glm::vec3(ambient)));
+  }
+  energyStats(u, row, B, res.stats);
+  for (size_t i = 0; i < u.n; ++i) B[i] += u.E[i];
+  res.B = B;
+  res.Bvertex = faceToVertex(s, B);
+  res.stats.add("iterations", res.iterations);
+  res.stats.add("residual", res.residual);
+  if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");
+  return res;
+}
+
+}  // namespace
+
+RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
+                              RadiositySolver solver, int bounces, double tolerance, int maxIterations,
+                              const Progress& progress) {
+  const Setup u = setup(s, Hd);
+  if (solver == RadiositySolver::Auto) solver = RadiositySolver::GaussSeidel;
+  return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, bounces,
+               tolerance, maxIterations, progress);
+}
+
+RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
+  if (opt.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
+  Timer timer;
+  Timer directTimer;
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
+  const double directSeconds = directTimer.seconds();
+  const FormFactors ff(s, caster, opt.raysPerPatch, opt.seed);
+  // Upper bound of the sparse matrix: every ray of every patch a distinct entry.
+  const double bytes = double(u.n) * std::min<double>(opt.raysPerPatch, double(u.n)) * 8.0 + double(u.n) * 64.0;
+  const bool fits = bytes <= opt.memoryBudgetMB * 1048576.0;
+  RadiositySolver solver = opt.solver;
+  if (solver == RadiositySolver::Auto) solver = fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
+  RadiosityResult res;
+  if (fits) {
+    std::vector<FormFactorRow> rows(u.n);
+    Timer ffTimer;
+    parallelBlocks(u.n, progress.sub(0.1, 0.8), "form factors", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) rows[i] = ff.row(uint32_t(i));
+    });
+    const double ffSeconds = ffTimer.seconds();
+    size_t entries = 0;
+    for (const auto& r : rows) entries += r.j.size();
+    res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, opt.bounces,
+                opt.tolerance, opt.maxIterations, progress.sub(0.8, 1.0));
+    res.stats.add("form_factor_seconds", ffSeconds);
+    res.stats.add("form_factor_entries", double(entries));
+    res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
+    res.stats.note("full sparse form-factor matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
+                   " MB <= budget)");
+  } else {
+    if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
+    thread_local FormFactorRow scratch;
+    res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; }, false, solver,
+                opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
+    res.stats.note("form factors on the fly: the matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
+                   " MB) exceeds the memory budget");
+  }
+  res.stats.add("direct_light_seconds", directSeconds);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
+  res.stats.add("patches", double(u.n));
+  res.stats.add("rays", double(ff.raysCast()));
+  res.stats.add("seconds", timer.seconds());
+  return res;
+}
+
+}  // namespace gi
