@@ -88,6 +88,53 @@ def case_ao(c):
     check(far["quality"] > r["quality"], "AO grows away from the wall")
 
 
+def split_floor_wall(c):
+    """floor_wall.ply as two layers: the floor (z = 0) and the wall."""
+    ply = read_ply(os.path.join(c.meshes, "floor_wall.ply"))
+    v, f = ply["vertex"], ply["face"]
+    out = []
+    for name, keep in (("floor", True), ("wall", False)):
+        faces = [t for t in f if all(v[i]["z"] == 0 for i in t["vertex_indices"]) == keep]
+        used = sorted({i for t in faces for i in t["vertex_indices"]})
+        remap = {o: n for n, o in enumerate(used)}
+        path = os.path.join(c.tmp, name + ".ply")
+        with open(path, "w") as fh:
+            fh.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(used), len(faces)))
+            for i in used:
+                fh.write("%r %r %r\n" % (v[i]["x"], v[i]["y"], v[i]["z"]))
+            for t in faces:
+                fh.write("3 %s\n" % " ".join(str(remap[i]) for i in t["vertex_indices"]))
+        out.append(path)
+    return out
+
+
+def case_layers(c):
+    # Two layers, "All visible layers": the wall (layer 1) occludes the floor (layer 0) and both receive.
+    floor, wall = split_floor_wall(c)
+    script = c.script("ao_all", "ao", "--scene_extent", "All visible layers", "--rays_per_vertex", "2048")
+    results = []
+    for layer in ("0", "1"):
+        out = os.path.join(c.tmp, "layer%s.ply" % layer)
+        p = subprocess.run([c.mlx_run, "-i", floor, "-i", wall, "-o", out, "-l", layer, "-m", "vc", "vq", "-s", script],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+        if p.returncode != 0:
+            fail("meshlabserver failed:\n" + p.stdout.decode("utf-8", "replace")[-2000:])
+        results.append(vertices(out))
+    r = nearest(results[0], (1.0, 0.0, 0.0))
+    expect = 0.5 + r["x"] / (2 * math.sqrt(r["x"] ** 2 + 1))
+    check(abs(r["quality"] - expect) < 0.03, "the wall layer occludes the floor layer: AO %.4f vs %.4f" % (r["quality"], expect))
+    w = nearest(results[1], (0.0, 0.0, 0.5))
+    check(0.0 < w["quality"] < 1.0 and w["red"] == w["green"], "the wall layer received its AO too (%.4f)" % w["quality"])
+    # Current layer only (the wall, loaded last): nothing occludes the wall's front but the floor, which is absent.
+    script1 = c.script("ao_cur", "ao", "--rays_per_vertex", "256")
+    out = os.path.join(c.tmp, "cur.ply")
+    p = subprocess.run([c.mlx_run, "-i", floor, "-i", wall, "-o", out, "-l", "1", "-m", "vc", "vq", "-s", script1],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+    check(p.returncode == 0 and all(x["quality"] == 1.0 for x in vertices(out)),
+          "current layer only: the wall alone is fully open")
+
+
 def case_obscurance_sky(c):
     out = os.path.join(c.tmp, "ob.ply")
     bowl = os.path.join(c.meshes, "bowl.ply")
@@ -212,7 +259,7 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+CASES = {"cli": case_cli, "layers": case_layers, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
          "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":
