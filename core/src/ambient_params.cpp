@@ -27,9 +27,7 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                    : "Geometry farther than this does not occlude (0 = infinite). Rays stop there, and vertices "
                      "with no geometry above their tangent plane within this distance get 1 without casting rays.",
                ParamType::Distance, mode == AmbientMode::Obscurance ? 0.1 : 0.0, 0.0, 10.0});
-  s.push_back({"seed", "Random seed",
-               "Seed of the sampling sequences. The same seed gives bit-identical results for any thread count.",
-               ParamType::Int, 0, 0, 2147483647});
+  s.push_back(seedSpec("sampling sequences"));
   if (mode == AmbientMode::Occlusion) {
     s.push_back({"bent_normals", "Write bent normals",
                  "Store the mean unoccluded direction of each vertex in the per-vertex attribute 'BentNormal'.",

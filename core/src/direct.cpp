@@ -15,8 +15,7 @@ std::vector<ParamSpec> DirectOptions::specs() {
        "Points sampled on the emitters (in proportion to their power) for each vertex, each with a shadow ray. "
        "More samples give smoother soft shadows; the error falls as about N^-1/2 to N^-3/4.",
        ParamType::Int, 64, 1, 1 << 20},
-      {"seed", "Random seed", "Seed of the sampling sequences; the same seed gives bit-identical results.",
-       ParamType::Int, 0, 0, 2147483647},
+      seedSpec("sampling sequences"),
   };
 }
 
@@ -73,46 +72,17 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   out.stdError.assign(nv, 0.f);
   const int N = opt.lightSamples;
   parallelBlocks(nv, progress, "direct light", [&](size_t b, size_t e) {
-    std::vector<Ray> rays(static_cast<size_t>(N));
-    std::vector<uint8_t> occ(static_cast<size_t>(N));
-    std::vector<glm::vec3> contrib(static_cast<size_t>(N));
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
-      const glm::vec3 n = mat.n[i];
-      const glm::vec3 x = origins[i];
-      const uint32_t key = hash3(uint32_t(i), opt.seed, 0xd1u);
-      for (int j = 0; j < N; ++j) {
-        const auto L = lights.sample(sobolOwen2D(uint32_t(j), key));
-        glm::vec3 w = L.p - x;
-        const float r2 = glm::dot(w, w);
-        contrib[size_t(j)] = glm::vec3(0.f);
-        rays[size_t(j)].o = x;
-        rays[size_t(j)].tnear = 0.f;
-        rays[size_t(j)].tfar = -1.f;  // marks "no ray needed"
-        if (!(r2 > 0.f)) continue;
-        const float r = std::sqrt(r2);
-        w /= r;
-        const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
-        if (cx <= 0.f || ce <= 0.f) continue;  // behind the vertex or the emitter's back
-        contrib[size_t(j)] = L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea));
-        rays[size_t(j)].d = w;
-        rays[size_t(j)].tfar = r * (1.f - 1e-4f) - eps;
-      }
-      // Compact the rays that need a shadow test.
-      size_t m = 0;
-      std::vector<int> idx;
-      idx.reserve(size_t(N));
-      for (int j = 0; j < N; ++j)
-        if (rays[size_t(j)].tfar > 0.f) { rays[m++] = rays[size_t(j)]; idx.push_back(j); }
-      caster.occludedBatch(rays.data(), m, occ.data());
-      for (size_t k = 0; k < m; ++k)
-        if (occ[k]) contrib[size_t(idx[k])] = glm::vec3(0.f);
+      SobolOwenStream seq(hash3(uint32_t(i), opt.seed, 0xd1u));
       glm::dvec3 sum(0.0);
       double sl = 0, sl2 = 0;
       for (int j = 0; j < N; ++j) {
-        sum += glm::dvec3(contrib[size_t(j)]);
-        const double l = luminance(contrib[size_t(j)] * mat.rho[i]);
-        sl += l; sl2 += l * l;
+        const glm::vec3 c = sampleDirectIrradiance(lights, caster, origins[i], mat.n[i], seq.next(), eps);
+        sum += glm::dvec3(c);
+        const double l = luminance(c * mat.rho[i]);
+        sl += l;
+        sl2 += l * l;
       }
       const glm::vec3 H = glm::vec3(sum / double(N));
       out.H[i] = H;
@@ -133,7 +103,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   st.add("seconds", timer.seconds());
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_error_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
-  st.note("bounces=0 (direct light only: the full radiosity solver comes with the radiosity issue)");
+  st.note("direct light only (per-vertex light sampling)");
   if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable face got 0");
   return out;
 }

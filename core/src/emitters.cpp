@@ -1,8 +1,10 @@
 #include "gi/emitters.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "gi/color.h"
+#include "gi/raycaster.h"
 #include "gi/sampling.h"
 
 namespace gi {
@@ -36,6 +38,25 @@ EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
   smp.pdfArea = float(w / total_) / area_[k];
   smp.face = f;
   return smp;
+}
+
+glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
+                                 const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip) {
+  const auto L = lights.sample(u);
+  if (L.face == skip) return glm::vec3(0.f);
+  glm::vec3 w = L.p - x;
+  const float r2 = glm::dot(w, w);
+  if (!(r2 > 0.f)) return glm::vec3(0.f);
+  const float r = std::sqrt(r2);
+  w /= r;
+  const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
+  if (cx <= 0.f || ce <= 0.f) return glm::vec3(0.f);  // behind x or the emitter's back
+  Ray ray;
+  ray.o = x;
+  ray.d = w;
+  ray.tfar = r * (1.f - 1e-4f) - eps;
+  if (ray.tfar > 0.f && caster.occluded(ray)) return glm::vec3(0.f);
+  return L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea));
 }
 
 }  // namespace gi

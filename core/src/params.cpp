@@ -19,6 +19,12 @@ const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string
   return nullptr;
 }
 
+ParamSpec seedSpec(const std::string& what) {
+  return {"seed", "Random seed",
+          "Seed of the " + what + ". The same seed gives bit-identical results for any thread count.",
+          ParamType::Int, 0, 0, 2147483647};
+}
+
 ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) {
   ParamValues v;
   for (const auto& s : specs) {

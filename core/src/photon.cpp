@@ -28,8 +28,7 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        ParamType::Distance, 0.05, 0.0, 1.0},
       {"max_depth", "Maximum bounces", "Paths end after this many diffuse bounces (Russian roulette ends most earlier).",
        ParamType::Int, 16, 1, 1000},
-      {"seed", "Random seed", "Seed of the photon paths; the same seed gives bit-identical results.", ParamType::Int,
-       0, 0, 2147483647},
+      seedSpec("photon paths"),
   };
 }
 

@@ -52,8 +52,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
        "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
        ParamType::Float, 1024, 1, 1e7},
-      {"seed", "Random seed", "Seed of the form-factor rays; the same seed gives bit-identical results.",
-       ParamType::Int, 0, 0, 2147483647},
+      seedSpec("form-factor rays"),
   };
 }
 
@@ -177,21 +176,7 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
           }
           continue;
         }
-        const auto L = lights.sample(lsmp.next());
-        if (L.face == i) continue;
-        glm::vec3 w = L.p - x;
-        const float r2 = glm::dot(w, w);
-        if (!(r2 > 0.f)) continue;
-        const float r = std::sqrt(r2);
-        w /= r;
-        const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
-        if (cx <= 0.f || ce <= 0.f) continue;
-        Ray ray;
-        ray.o = x;
-        ray.d = w;
-        ray.tfar = r * (1.f - 1e-4f) - eps;
-        if (ray.tfar > 0.f && caster.occluded(ray)) continue;
-        sum += glm::dvec3(L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea)));
+        sum += glm::dvec3(sampleDirectIrradiance(lights, caster, x, n, lsmp.next(), eps, uint32_t(i)));
       }
       H[i] = glm::vec3(sum / double(points));
     }

@@ -32,4 +32,12 @@ class EmitterSampler {
   double total_ = 0.0;
 };
 
+class RayCaster;
+
+// One-sample estimate of the direct irradiance at x (unit normal n) from the
+// emitters: a power-sampled emitter point y, E_y cos(x) cos(y) / (pi r^2 pdf)
+// if the shadow ray x -> y is free, else 0. Points on face `skip` are ignored.
+glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
+                                 const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip = 0xffffffffu);
+
 }  // namespace gi

@@ -60,5 +60,7 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v);
 // an enum's name or index). Throws std::invalid_argument with a sentence.
 ParamValue parseValue(const ParamSpec& spec, const std::string& text, double diagonal);
 const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name);
+// The "seed" parameter every stochastic filter has; `what` names what it seeds.
+ParamSpec seedSpec(const std::string& what);
 
 }  // namespace gi
