@@ -20,6 +20,9 @@ EmitterSampler::EmitterSampler(const Scene& s) : s_(s) {
     total_ += p;
     cdf_.push_back(total_);
   }
+  pdfOfFace_.assign(s.faceCount(), 0.f);
+  for (size_t k = 0; k < faces_.size(); ++k)
+    pdfOfFace_[faces_[k]] = float((cdf_[k] - (k ? cdf_[k - 1] : 0.0)) / total_) / area_[k];
 }
 
 EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {

@@ -118,7 +118,8 @@ std::string mlxScript(const std::vector<ScriptStep>& steps, double diagonal) {
             << "\" a=\"255\" " << n << "/>\n";
           break;
         }
-        case ParamType::Direction: {
+        case ParamType::Direction:
+        case ParamType::Point: {
           const glm::vec3 d = st.values.getVec(p.name);
           o << "  <Param type=\"RichPoint3f\" x=\"" << fnum(d.x) << "\" y=\"" << fnum(d.y) << "\" z=\"" << fnum(d.z)
             << "\" " << n << "/>\n";

@@ -35,7 +35,8 @@ ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) 
       case ParamType::Float: v.set(s.name, s.def); break;
       case ParamType::Distance: v.set(s.name, s.def * diagonal); break;
       case ParamType::Color:
-      case ParamType::Direction: v.set(s.name, s.defVec); break;
+      case ParamType::Direction:
+      case ParamType::Point: v.set(s.name, s.defVec); break;
     }
   }
   return v;
@@ -91,6 +92,12 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
             return "parameter '" + s.name + "' must be a non-zero finite direction";
           break;
         }
+        case ParamType::Point: {
+          glm::vec3 d = v.getVec(s.name);
+          if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z))
+            return "parameter '" + s.name + "' must be a finite position";
+          break;
+        }
       }
     } catch (const std::bad_variant_access&) {
       return "parameter '" + s.name + "' has the wrong type";
@@ -113,7 +120,8 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
       case ParamType::Float:
       case ParamType::Distance: o << num(v.getFloat(s.name)); break;
       case ParamType::Color:
-      case ParamType::Direction: {
+      case ParamType::Direction:
+      case ParamType::Point: {
         glm::vec3 c = v.getVec(s.name);
         o << num(c.x) << ',' << num(c.y) << ',' << num(c.z);
         break;
@@ -186,7 +194,8 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         if (n.size() != 3) throw bad("expected r,g,b (0-255) or #rrggbb");
         return glm::vec3(float(n[0] / 255.0), float(n[1] / 255.0), float(n[2] / 255.0));
       }
-      case ParamType::Direction: {
+      case ParamType::Direction:
+      case ParamType::Point: {
         auto n = splitNumbers(text);
         if (n.size() != 3) throw bad("expected x,y,z");
         return glm::vec3(float(n[0]), float(n[1]), float(n[2]));

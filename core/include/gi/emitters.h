@@ -23,12 +23,15 @@ class EmitterSampler {
   // u in [0,1)^2: u.x picks the face (power CDF) and is reused, rescaled, for the point.
   Sample sample(glm::vec2 u) const;
   size_t faceCount() const { return faces_.size(); }
+  // The area density sample() uses on `face` (0 for faces that do not emit).
+  float pdfArea(uint32_t face) const { return face < pdfOfFace_.size() ? pdfOfFace_[face] : 0.f; }
 
  private:
   const Scene& s_;
   std::vector<uint32_t> faces_;
   std::vector<double> cdf_;
   std::vector<float> area_;
+  std::vector<float> pdfOfFace_;
   double total_ = 0.0;
 };
 

@@ -20,6 +20,7 @@ enum class ParamType {
   Enum,       // index into choices
   Color,      // sRGB in [0,1] (MeshLab colour picker / CLI "r,g,b" 0-255 or #rrggbb)
   Direction,  // a vector, normalised on use
+  Point,      // a position (absolute coordinates)
 };
 
 struct ParamSpec {

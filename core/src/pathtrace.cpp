@@ -1,0 +1,317 @@
+#include "gi/pathtrace.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+
+#include "gi/color.h"
+#include "gi/direct.h"
+#include "gi/emitters.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+std::vector<ParamSpec> PathTraceOptions::specs() {
+  return {
+      {"samples_per_vertex", "Paths per vertex",
+       "Paths traced from each vertex when no target error is set. The error falls as 1/sqrt(N) (independent "
+       "random numbers: the reported standard error is an honest error bar).",
+       ParamType::Int, 256, 1, 1 << 24},
+      {"target_relative_error", "Target relative error",
+       "If > 0, each vertex traces paths in rounds of 32 until the standard error of its radiosity is below this "
+       "fraction of it (or of a tenth of the scene's mean, for dark vertices).",
+       ParamType::Float, 0.0, 0.0, 1.0},
+      {"min_samples", "Minimum paths (adaptive)", "Adaptive sampling never stops before this many paths.",
+       ParamType::Int, 64, 2, 1 << 24},
+      {"max_samples", "Maximum paths (adaptive)", "Adaptive sampling never traces more than this many paths.",
+       ParamType::Int, 65536, 2, 1 << 26},
+      {"max_depth", "Maximum bounces",
+       "Paths end after this many bounces (0 = direct light only); Russian roulette (survival = the largest "
+       "reflectance channel) ends them earlier without bias.",
+       ParamType::Int, 1000, 0, 100000},
+      {"sky_color", "Sky colour", "Colour of a uniform sky around the scene (sRGB).", ParamType::Color, 0, 0, 0, {},
+       glm::vec3(1.f)},
+      {"sky_irradiance", "Sky irradiance (W/m^2)",
+       "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.", ParamType::Float, 0.0, 0.0,
+       1e9},
+      {"sun_direction", "Sun direction", "Direction towards the sun.", ParamType::Direction, 0, 0, 0, {},
+       glm::vec3(0.3f, 1.f, 0.2f)},
+      {"sun_color", "Sun colour", "Colour of the sun (sRGB).", ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)},
+      {"sun_irradiance", "Sun irradiance (W/m^2)", "Irradiance of the sun on a surface facing it; 0 = no sun.",
+       ParamType::Float, 0.0, 0.0, 1e9},
+      {"sun_angular_radius", "Sun angular radius (deg)", "0 gives a sharp directional light.", ParamType::Float,
+       0.27, 0.0, 45},
+      {"point_position", "Point light position", "Position of a point light (absolute coordinates).",
+       ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
+      {"point_intensity", "Point light intensity (W/sr)", "Radiant intensity of the point light; 0 = none.",
+       ParamType::Float, 0.0, 0.0, 1e12},
+      seedSpec("paths"),
+  };
+}
+
+PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::dvec3& origin) {
+  PathTraceOptions o;
+  auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
+  o.samplesPerVertex = v.getInt("samples_per_vertex");
+  o.targetRelativeError = v.getFloat("target_relative_error");
+  o.minSamples = v.getInt("min_samples");
+  o.maxSamples = v.getInt("max_samples");
+  o.maxDepth = v.getInt("max_depth");
+  o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
+  o.sunDirection = glm::normalize(v.getVec("sun_direction"));
+  o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
+  o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
+  o.pointPosition = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
+  o.pointIntensity = glm::vec3(float(v.getFloat("point_intensity")));
+  o.seed = uint32_t(v.getInt("seed"));
+  return o;
+}
+
+namespace {
+
+inline float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
+
+class Tracer {
+ public:
+  Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
+      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+    faceN_.resize(s.faceCount());
+    for (size_t f = 0; f < s.faceCount(); ++f) {
+      const glm::vec3 n = faceNormalUnnormalized(s, f);
+      const float l = glm::length(n);
+      faceN_[f] = l > 0 ? n / l : glm::vec3(0.f, 0.f, 1.f);
+    }
+    sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
+    const float omega = 2.f * float(M_PI) * (1.f - sunCos_);
+    hasSun_ = luminance(o.sunIrradiance) > 0.f;
+    sunDisk_ = hasSun_ && o.sunAngularRadiusDeg > 0.f;
+    sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
+    sunL_ = sunDisk_ ? o.sunIrradiance / omega : glm::vec3(0.f);
+    hasPoint_ = luminance(o.pointIntensity) > 0.f;
+    if (lights_.empty() && luminance(o.skyRadiance) <= 0.f && !hasSun_ && !hasPoint_)
+      throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
+                                  "quality), no sky, no sun and no point light");
+  }
+
+  // One-sample estimate of the irradiance at x (unit normal n, the lit side).
+  glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int depth, Rng& rng, uint64_t& rays) const {
+    glm::vec3 H = nextEvent(x, n, rng, rays);
+    const glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
+    const float pdfB = glm::dot(n, w) * 0.318309886f;
+    if (pdfB > 0.f) H += float(M_PI) * radiance(x, w, pdfB, depth, rng, rays);  // cos / pdf = pi
+    return H;
+  }
+
+ private:
+  // Direct irradiance from every light, each sampled once (MIS with the
+  // cosine-weighted direction for the lights a BSDF ray can also hit).
+  glm::vec3 nextEvent(const glm::vec3& x, const glm::vec3& n, Rng& rng, uint64_t& rays) const {
+    glm::vec3 H(0.f);
+    Ray ray;
+    ray.o = x;
+    if (!lights_.empty()) {
+      const auto L = lights_.sample({rng.next(), rng.next()});
+      glm::vec3 w = L.p - x;
+      const float r2 = glm::dot(w, w);
+      if (r2 > 0.f) {
+        const float r = std::sqrt(r2);
+        w /= r;
+        const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
+        if (cx > 0.f && ce > 0.f) {
+          ray.d = w;
+          ray.tfar = r * (1.f - 1e-4f) - eps_;
+          ++rays;
+          if (ray.tfar <= 0.f || !caster_.occluded(ray)) {
+            const float pdfL = L.pdfArea * r2 / ce;  // solid angle
+            H += L.E * 0.318309886f * cx / pdfL * powerHeuristic(pdfL, cx * 0.318309886f);
+          }
+        }
+      }
+    }
+    if (hasSun_) {
+      const glm::vec3 w = sunDisk_ ? Frame(o_.sunDirection).toWorld(uniformCone({rng.next(), rng.next()}, sunCos_))
+                                   : o_.sunDirection;
+      const float cx = glm::dot(n, w);
+      if (cx > 0.f) {
+        ray.d = w;
+        ray.tfar = std::numeric_limits<float>::infinity();
+        ++rays;
+        if (!caster_.occluded(ray)) {
+          const float mis = sunDisk_ ? powerHeuristic(sunPdf_, cx * 0.318309886f) : 1.f;
+          H += (sunDisk_ ? sunL_ * cx / sunPdf_ : o_.sunIrradiance * cx) * mis;
+        }
+      }
+    }
+    if (hasPoint_) {
+      glm::vec3 w = o_.pointPosition - x;
+      const float r2 = glm::dot(w, w);
+      const float r = std::sqrt(r2);
+      w /= r;
+      const float cx = glm::dot(n, w);
+      if (cx > 0.f && r2 > 0.f) {
+        ray.d = w;
+        ray.tfar = r * (1.f - 1e-4f);
+        ++rays;
+        if (!caster_.occluded(ray)) H += o_.pointIntensity * cx / r2;
+      }
+    }
+    return H;
+  }
+
+  // Radiance arriving at the ray's origin from direction w, sampled with
+  // solid-angle density pdfB (for the MIS weight of emitters it hits).
+  glm::vec3 radiance(const glm::vec3& o, const glm::vec3& w, float pdfB, int depth, Rng& rng, uint64_t& rays) const {
+    Ray ray;
+    ray.o = o;
+    ray.d = w;
+    ++rays;
+    const Hit h = caster_.intersect(ray);
+    if (!h.valid()) {
+      glm::vec3 L = o_.skyRadiance;
+      if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_) L += sunL_ * powerHeuristic(pdfB, sunPdf_);
+      return L;
+    }
+    const glm::vec3 ng = faceN_[h.face];
+    const float cosY = -glm::dot(ng, w);
+    if (cosY <= 0.f) return glm::vec3(0.f);  // a back face: black, as in the radiosity filter
+    glm::vec3 L(0.f);
+    const glm::vec3 E = s_.faceEmission(h.face);
+    if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
+      const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
+      L += E * 0.318309886f * powerHeuristic(pdfB, pdfL);
+    }
+    const glm::vec3 rho = s_.faceRho(h.face);
+    const float q = std::min(0.95f, std::max({rho.r, rho.g, rho.b}));
+    if (!(q > 0.f) || depth >= o_.maxDepth) return L;
+    float scale = 1.f;
+    if (depth >= 3) {  // Russian roulette
+      if (rng.next() >= q) return L;
+      scale = 1.f / q;
+    }
+    const glm::vec3 y = o + w * h.t + ng * eps_;
+    return L + rho * 0.318309886f * scale * irradiance(y, ng, depth + 1, rng, rays);
+  }
+
+  const Scene& s_;
+  const RayCaster& caster_;
+  const PathTraceOptions& o_;
+  EmitterSampler lights_;
+  float eps_;
+  std::vector<glm::vec3> faceN_;
+  float sunCos_ = 1.f, sunPdf_ = 0.f;
+  glm::vec3 sunL_{0.f};
+  bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
+};
+
+struct Accum {
+  double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
+  glm::dvec3 sumH{0.0};
+};
+
+}  // namespace
+
+PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& opt, const Progress& progress) {
+  if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
+    throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
+  Timer timer;
+  const Tracer tracer(s, caster, opt);
+  const SceneReport rep = analyzeScene(s);
+  if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
+  const VertexMaterial mat = vertexMaterial(s);
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(rep.rayEpsilon));
+  const size_t nv = s.vertexCount();
+  std::vector<Accum> acc(nv);
+  std::vector<uint64_t> rays(nv, 0);
+  auto trace = [&](size_t i, int count) {
+    Accum& a = acc[i];
+    for (int k = 0; k < count; ++k) {
+      Rng rng(hash3(uint32_t(i), uint32_t(a.n), opt.seed ^ 0x9a7eu));
+      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], 0, rng, rays[i]);
+      const double l = luminance(mat.rho[i] * H);
+      a.n += 1;
+      a.sumL += l;
+      a.sumL2 += l * l;
+      a.sumH += glm::dvec3(H);
+      const double lh = luminance(H);
+      a.sumHL += lh;
+      a.sumHL2 += lh * lh;
+    }
+  };
+  auto stdErr = [](const Accum& a) {
+    if (a.n < 2) return 0.0;
+    const double m = a.sumL / a.n;
+    return std::sqrt(std::max(0.0, (a.sumL2 - a.n * m * m) / (a.n - 1)) / a.n);
+  };
+  const bool adaptive = opt.targetRelativeError > 0;
+  Timer traceTimer;
+  if (!adaptive) {
+    parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (mat.valid[i]) trace(i, opt.samplesPerVertex);
+    });
+  } else {
+    // Pilot pass, then rounds of 32 paths for the vertices still above target.
+    parallelBlocks(nv, progress.sub(0.0, 0.2), "tracing paths (pilot)", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (mat.valid[i]) trace(i, opt.minSamples);
+    });
+    double meanB = 0;
+    size_t valid = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (mat.valid[i]) { meanB += luminance(mat.E[i]) + acc[i].sumL / acc[i].n; ++valid; }
+    meanB = valid ? meanB / double(valid) : 0.0;
+    const double floorB = 0.1 * meanB;
+    parallelBlocks(nv, progress.sub(0.2, 1.0), "tracing paths (adaptive)", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        if (!mat.valid[i]) continue;
+        while (acc[i].n < opt.maxSamples) {
+          const double B = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
+          if (stdErr(acc[i]) <= opt.targetRelativeError * std::max(B, floorB)) break;
+          trace(i, std::min(32, opt.maxSamples - int(acc[i].n)));
+        }
+      }
+    });
+  }
+  const double traceSeconds = traceTimer.seconds();
+  PathTraceResult res;
+  res.B.assign(nv, glm::vec3(0.f));
+  res.H.assign(nv, glm::vec3(0.f));
+  res.stdError.assign(nv, 0.f);
+  res.stdErrorH.assign(nv, 0.f);
+  res.samples.assign(nv, 0);
+  double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0;
+  size_t valid = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    totalRays += double(rays[i]);
+    if (!mat.valid[i] || acc[i].n == 0) continue;
+    res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
+    res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
+    res.stdError[i] = float(stdErr(acc[i]));
+    Accum h;
+    h.n = acc[i].n;
+    h.sumL = acc[i].sumHL;
+    h.sumL2 = acc[i].sumHL2;
+    res.stdErrorH[i] = float(stdErr(h));
+    res.samples[i] = int(acc[i].n);
+    samples += acc[i].n;
+    const double b = luminance(res.B[i]);
+    lum += b;
+    err2 += double(res.stdError[i]) * res.stdError[i];
+    if (b > 0) rel += res.stdError[i] / b;
+    ++valid;
+  }
+  auto& st = res.stats;
+  st.add("vertices", double(nv));
+  st.add("paths", samples);
+  st.add("rays", totalRays);
+  st.add("seconds", timer.seconds());
+  st.add("rays_per_second", traceSeconds > 0 ? totalRays / traceSeconds : 0.0);
+  st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
+  st.add("rms_std_error", valid ? std::sqrt(err2 / double(valid)) : 0.0);
+  st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
+  if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable face got 0");
+  return res;
+}
+
+}  // namespace gi
