@@ -94,6 +94,7 @@ void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, doub
       }
       case ParamType::Color: out.addParam(RichColor(name, toColor(s.defVec), label, help)); break;
       case ParamType::Direction:
+      case ParamType::Point:
         out.addParam(RichPoint3f(name, vcg::Point3f(s.defVec.x, s.defVec.y, s.defVec.z), label, help));
         break;
     }
@@ -116,7 +117,8 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
         v.set(s.name, glm::vec3(c.red() / 255.f, c.green() / 255.f, c.blue() / 255.f));
         break;
       }
-      case ParamType::Direction: {
+      case ParamType::Direction:
+      case ParamType::Point: {
         vcg::Point3f p = in.getPoint3f(n);
         v.set(s.name, glm::vec3(p[0], p[1], p[2]));
         break;
@@ -186,6 +188,19 @@ void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const s
       if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) x = glm::vec3(0.f);
       h[m.vert[i]] = Point3m(x.x, x.y, x.z);
       if (alsoNormals) m.vert[i].N() = Point3m(x.x, x.y, x.z);
+    }
+  }
+}
+
+void writeVertexScalarAttribute(BridgeScene& b, const std::string& name, const std::vector<float>& v) {
+  for (LayerPart& p : b.parts) {
+    CMeshO& m = p.mm->cm;
+    auto h = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<Scalarm>(m, name);
+    for (size_t i = 0; i < m.vert.size(); ++i) {
+      const int s = p.sceneVertex[i];
+      if (s < 0) continue;
+      const float x = v[size_t(s)];
+      h[m.vert[i]] = std::isfinite(x) ? x : 0.f;
     }
   }
 }

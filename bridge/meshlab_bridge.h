@@ -50,6 +50,8 @@ size_t writeFaceResults(BridgeScene& b, const std::vector<float>& quality, const
 // Per-vertex Point3m attribute `name` (e.g. "BentNormal"), optionally into the normals too.
 void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v,
                                 bool alsoNormals);
+// Per-vertex scalar attribute `name` (e.g. "StdError").
+void writeVertexScalarAttribute(BridgeScene& b, const std::string& name, const std::vector<float>& v);
 // Multiplies existing vertex colours by a factor in [0,1] (AO "multiply colour").
 void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor);
 

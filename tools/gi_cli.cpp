@@ -17,9 +17,11 @@
 #include "gi/filters.h"
 #include "gi/output.h"
 #include "gi/photon.h"
+#include "gi/pathtrace.h"
 #include "gi/radiosity.h"
 #include "gi/scene_setup.h"
 #include "mesh_io.h"
+#include "reference.h"
 
 using namespace gi;
 using json = nlohmann::json;
@@ -27,7 +29,7 @@ using json = nlohmann::json;
 namespace {
 
 struct CommonArgs {
-  std::string input, output, mesh;
+  std::string input, output, mesh, cacheDir, saveReference;
   bool json = false, quiet = false;
   int threads = 0;
   std::map<std::string, std::string> raw;  // parameter texts as given
@@ -70,7 +72,8 @@ json valuesJson(const std::vector<ParamSpec>& specs, const ParamValues& v) {
       case ParamType::Float:
       case ParamType::Distance: j[p.name] = v.getFloat(p.name); break;
       case ParamType::Color:
-      case ParamType::Direction: {
+      case ParamType::Direction:
+      case ParamType::Point: {
         const glm::vec3 c = v.getVec(p.name);
         j[p.name] = {c.x, c.y, c.z};
         break;
@@ -91,7 +94,8 @@ std::string defaultText(const ParamSpec& p) {
     case ParamType::Color:
       std::snprintf(b, sizeof b, "%d,%d,%d", int(p.defVec.r * 255 + .5f), int(p.defVec.g * 255 + .5f), int(p.defVec.b * 255 + .5f));
       return b;
-    case ParamType::Direction: std::snprintf(b, sizeof b, "%g,%g,%g", p.defVec.x, p.defVec.y, p.defVec.z); return b;
+    case ParamType::Direction:
+    case ParamType::Point: std::snprintf(b, sizeof b, "%g,%g,%g", p.defVec.x, p.defVec.y, p.defVec.z); return b;
   }
   return "";
 }
@@ -129,7 +133,8 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
     throw std::invalid_argument(a.input + " has no faces (a point cloud?): these filters need triangles");
   const SceneReport pre = analyzeScene(mesh.scene);
   ParamValues v = resolve(specs, a, pre.diagonal);
-  const bool lighting = kind == FilterKind::Radiosity || kind == FilterKind::PhotonMapping;
+  const bool lighting = kind == FilterKind::Radiosity || kind == FilterKind::PhotonMapping ||
+                        kind == FilterKind::PathTracedReference;
   std::string setupLog;
   if (lighting || findSpec(specs, "reflectance_source"))
     if (auto err = applySceneConventions(mesh.scene, mesh.attrs, v, lighting, &setupLog)) throw std::invalid_argument(*err);
@@ -158,6 +163,35 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
       colors = greyColors(r.value);
       if (opt.bentNormals) extras.normals = r.bentNormal;
     }
+  } else if (kind == FilterKind::PathTracedReference) {
+    // Cached by scene hash and parameters: computed once, reused by benchmarks.
+    const std::string params = describe(specs, v);
+    const uint64_t hash = sceneHash(mesh.scene);
+    const std::string cached = a.cacheDir.empty() ? "" : io::referenceCachePath(a.cacheDir, a.input, hash, params);
+    io::ReferenceFile ref;
+    bool reused = false;
+    if (!cached.empty() && std::ifstream(cached)) {
+      ref = io::readReference(cached);
+      reused = ref.sceneHash == hash && ref.parameters == params && ref.B.size() == mesh.scene.vertexCount();
+    }
+    if (reused) {
+      stats.add("vertices", double(ref.B.size()));
+      stats.add("reference_seconds", ref.seconds);
+      stats.note("reused the cached reference " + cached);
+    } else {
+      auto caster = makeEmbreeCaster(mesh.scene);
+      PathTraceResult r = pathTrace(mesh.scene, *caster, PathTraceOptions::fromParams(v, mesh.scene.origin), progress);
+      stats = r.stats;
+      ref = {a.input, hash, params, r.stats.get("seconds"), r.B, r.H, r.stdError, r.stdErrorH, r.samples};
+      if (!cached.empty()) {
+        io::writeReference(cached, ref);
+        stats.note("cached as " + cached);
+      }
+    }
+    if (!a.saveReference.empty()) io::writeReference(a.saveReference, ref);
+    out = radiometricOutput(mesh.scene, ref.B, v.getFloat("exposure"));
+    colors = out.displayColors();
+    stats.add("exposure", out.exposure);
   } else {
     auto caster = makeEmbreeCaster(mesh.scene);
     std::vector<glm::vec3> B, faceB;
@@ -247,11 +281,16 @@ int main(int argc, char** argv) {
     sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");
     sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it");
     addParamOptions(sub, filterSpecs(d.kind), a, false);
+    if (d.kind == FilterKind::PathTracedReference) {
+      sub->add_option("--cache", a.cacheDir, "folder of cached references: reuse one computed with the same scene and "
+                                             "parameters, or store the new one there");
+      sub->add_option("--save-reference", a.saveReference, "also write the reference (JSON: B, H, standard errors, paths)");
+    }
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
   std::string filterName;
-  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap)")->required();
+  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference)")->required();
   script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
@@ -267,7 +306,7 @@ int main(int argc, char** argv) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())
         if (f.cliName == filterName) d = &f;
-      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap)");
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap, reference)");
       // Parameters after the filter name: --name value pairs, checked against the filter's table.
       const auto specs = filterSpecs(d->kind);
       const auto extras = script->remaining();

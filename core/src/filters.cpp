@@ -7,6 +7,7 @@
 
 #include "gi/ambient.h"
 #include "gi/direct.h"
+#include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/radiosity.h"
 #include "gi/scene_setup.h"
@@ -20,6 +21,8 @@ const std::vector<FilterDesc>& allFilters() {
       {FilterKind::SkyLighting, "GI: Sky Lighting", "sky", "per-vertex irradiance from a uniform sky and a sun"},
       {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "the radiosity method: form factors and a solver"},
       {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "photon-mapped radiosity from area emitters"},
+      {FilterKind::PathTracedReference, "GI: Path Traced Reference", "reference",
+       "per-vertex path-traced reference solution with error bars"},
   };
   return f;
 }
@@ -57,6 +60,11 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::PhotonMapping:
       add(lightingSceneSpecs());
       add(PhotonOptions::specs());
+      add(displaySpecs());
+      break;
+    case FilterKind::PathTracedReference:
+      add(lightingSceneSpecs());
+      add(PathTraceOptions::specs());
       add(displaySpecs());
       break;
   }

@@ -54,6 +54,22 @@ size_t Scene::append(const Scene& o) {
   return vOff;
 }
 
+uint64_t sceneHash(const Scene& s) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) { h ^= b[i]; h *= 1099511628211ull; }
+  };
+  for (const auto& p : s.positions) { const glm::dvec3 w = s.toWorld(p); mix(&w, sizeof w); }
+  mix(s.triangles.data(), s.triangles.size() * sizeof(glm::uvec3));
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 r = s.faceRho(f), e = s.faceEmission(f);
+    const auto m = uint8_t(s.faceMaterial(f));
+    mix(&r, sizeof r); mix(&e, sizeof e); mix(&m, 1);
+  }
+  return h;
+}
+
 glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f) {
   const auto& t = s.triangles[f];
   // Double precision: slivers of large meshes lose their normal in float.

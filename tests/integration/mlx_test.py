@@ -197,6 +197,35 @@ def case_photonmap(c):
     check(ceil["quality"] > 0.0, "indirect light reaches the ceiling (B = %.4f)" % ceil["quality"])
 
 
+def case_reference(c):
+    import json
+    mesh = os.path.join(c.meshes, "cornell_box.ply")
+    out = os.path.join(c.tmp, "ref.ply")
+    log = c.server(mesh, c.script("ref", "reference", "--mesh", mesh, "--emitter_source", "1", "--samples_per_vertex", "64"), out)
+    m = re.search(r"GI: Path Traced Reference: .*?rays_per_second=([0-9.e+]+)", log)
+    check(m is not None, "reference log line with rays per second (%s)" % (m.group(1) if m else "?"))
+    v = vertices(out)
+    check(nearest(v, (400, 0, 150))["quality"] > 0.2 and nearest(v, (100, 548.8, 100))["quality"] > 0.01,
+          "floor lit directly, ceiling lit by inter-reflection")
+    # CLI: the same numbers, a cached reference file reused the second time.
+    cache = os.path.join(c.tmp, "refs")
+    os.makedirs(cache)
+    cli = os.path.join(c.tmp, "ref_cli.ply")
+    args = [c.gi, "reference", mesh, "-o", cli, "--json", "--emitter_source", "1", "--samples_per_vertex", "64", "--cache", cache]
+    j1 = json.loads(subprocess.run(args, stdout=subprocess.PIPE, check=True).stdout)
+    w = vertices(cli)
+    diff = max(abs(a["quality"] - b["quality"]) / max(1e-6, b["quality"]) for a, b in zip(v, w) if b["quality"] > 1e-3)
+    check(diff < 1e-3, "meshlabserver and CLI agree (max relative difference %.2g)" % diff)
+    j2 = json.loads(subprocess.run(args, stdout=subprocess.PIPE, check=True).stdout)
+    check(any("reused the cached reference" in n for n in j2["notes"]) and "rays" not in j2["stats"],
+          "second run reuses the cached reference")
+    files = os.listdir(cache)
+    with open(os.path.join(cache, files[0])) as f:
+        ref = json.load(f)
+    check(ref["format"] == "gi-reference" and len(ref["std_error_B"]) == len(v) and min(ref["samples"]) >= 64,
+          "reference file holds B, H, standard errors and path counts")
+
+
 def case_bad_input(c):
     # A point cloud, an empty mesh, an invalid parameter, a scene without emitters.
     pc = os.path.join(c.tmp, "points.ply")
@@ -227,7 +256,8 @@ def case_dump(c):
     p = subprocess.run([c.mlx_run, "-d", dump], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
     with open(dump, encoding="utf-8", errors="replace") as f:
         text = f.read()
-    for name in ("GI: Ambient Occlusion", "GI: Ambient Obscurance", "GI: Sky Lighting", "GI: Radiosity", "GI: Photon Mapping"):
+    for name in ("GI: Ambient Occlusion", "GI: Ambient Obscurance", "GI: Sky Lighting", "GI: Radiosity", "GI: Photon Mapping",
+                 "GI: Path Traced Reference"):
         check(name in text, "meshlabserver -d lists '%s'" % name)
     for param in ("rays_per_vertex", "emitter_source", "photons", "sun_direction"):
         check(".mlx name: " + param in text, "meshlabserver -d lists parameter %s" % param)
@@ -259,7 +289,7 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "layers": case_layers, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+CASES = {"cli": case_cli, "layers": case_layers, "reference": case_reference, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
          "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":

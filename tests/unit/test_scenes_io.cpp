@@ -13,6 +13,7 @@
 
 #include "gi/scenes.h"
 #include "mesh_io.h"
+#include "reference.h"
 
 namespace fs = std::filesystem;
 using gi::scenes::SceneFile;
@@ -383,4 +384,39 @@ TEST(ScenesIo, CommittedTestMeshesMatchTheGenerators) {
     EXPECT_EQ(m.attrs.faceQuality, sf.attrs.faceQuality);
     EXPECT_EQ(m.attrs.faceColor, sf.attrs.faceColor);
   }
+}
+
+// Reference files: a round trip keeps every array; the cache path depends on
+// the scene hash and the parameters; a damaged file is a clear error.
+TEST(ReferenceFile, RoundTripAndCacheKey) {
+  gi::io::ReferenceFile r;
+  r.mesh = "m.ply";
+  r.sceneHash = 0x0123456789abcdefull;
+  r.parameters = "samples_per_vertex=64";
+  r.seconds = 1.5;
+  r.B = {{1, 2, 3}, {4, 5, 6}};
+  r.H = {{0.5f, 0.25f, 0.125f}, {0, 0, 0}};
+  r.stdErrorB = {0.1f, 0.2f};
+  r.stdErrorH = {0.01f, 0.02f};
+  r.samples = {64, 128};
+  const std::string path = ::testing::TempDir() + "ref_roundtrip.giref.json";
+  gi::io::writeReference(path, r);
+  const auto q = gi::io::readReference(path);
+  EXPECT_EQ(q.sceneHash, r.sceneHash);
+  EXPECT_EQ(q.parameters, r.parameters);
+  EXPECT_EQ(q.B, r.B);
+  EXPECT_EQ(q.H, r.H);
+  EXPECT_EQ(q.stdErrorB, r.stdErrorB);
+  EXPECT_EQ(q.samples, r.samples);
+  const auto a = gi::io::referenceCachePath("d", "x/m.ply", 1, "p=1");
+  EXPECT_NE(a, gi::io::referenceCachePath("d", "x/m.ply", 2, "p=1"));
+  EXPECT_NE(a, gi::io::referenceCachePath("d", "x/m.ply", 1, "p=2"));
+  EXPECT_EQ(a.rfind("d/m-", 0), 0u);
+  { std::ofstream(path) << "{\"format\": \"gi-reference\", \"version\": 1}"; }
+  EXPECT_THROW(gi::io::readReference(path), std::runtime_error);
+  // The scene hash sees geometry and materials.
+  auto sf = gi::scenes::openPlane(1.0, 2);
+  const uint64_t h0 = gi::sceneHash(sf.scene);
+  sf.scene.rho[0] = glm::vec3(0.3f);
+  EXPECT_NE(gi::sceneHash(sf.scene), h0);
 }

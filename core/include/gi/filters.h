@@ -9,7 +9,7 @@
 
 namespace gi {
 
-enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping };
+enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping, PathTracedReference };
 
 struct FilterDesc {
   FilterKind kind;

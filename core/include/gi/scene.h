@@ -39,6 +39,10 @@ struct Scene {
   size_t append(const Scene& other);
 };
 
+// FNV-1a hash of what a lighting result depends on: absolute positions,
+// triangles, reflectance, emission and materials. Keys cached references.
+uint64_t sceneHash(const Scene& s);
+
 // Geometry helpers (local coordinates).
 glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f);  // cross product, |n| = 2 * area
 double faceArea(const Scene& s, size_t f);
