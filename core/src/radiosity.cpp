@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "gi/color.h"
+#include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/form_factor_analytic.h"
 #include "gi/sampling.h"
@@ -29,7 +30,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter face, "
        "times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the emitters "
        "sampled in proportion to power with a shadow ray each.",
-       ParamType::Int, 64, 1, 1 << 20},
+       ParamType::Int, 256, 1, 1 << 20},
       {"solver", "Solver",
        "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses new values "
        "as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): repeatedly shoots the "
@@ -52,6 +53,17 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
        "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
        ParamType::Float, 1024, 1, 1e7},
+      {"vertex_output", "Vertex values",
+       "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
+       "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is gathered "
+       "from the patch solution with rays from the vertex (no light leaking under objects that cut through "
+       "patches). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of the incident "
+       "patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity (the classical look "
+       "of the course's images).",
+       ParamType::Enum, 0, 0, 0, {"Final gather", "Interpolated indirect", "Patch average"}},
+      {"gather_rays", "Final-gather rays per vertex",
+       "Rays per vertex for the final gather of the indirect light (cosine-weighted).", ParamType::Int, 256, 1,
+       1 << 20},
       seedSpec("form-factor rays"),
   };
 }
@@ -66,6 +78,8 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.maxIterations = v.getInt("max_iterations");
   o.memoryBudgetMB = v.getFloat("memory_budget_mb");
   o.seed = uint32_t(v.getInt("seed"));
+  o.vertexOutput = RadiosityVertexOutput(v.getInt("vertex_output"));
+  o.gatherRays = v.getInt("gather_rays");
   return o;
 }
 
@@ -126,22 +140,69 @@ FormFactorRow FormFactors::row(uint32_t i) const {
   return r;
 }
 
+namespace {
+
+// Direct irradiance from the emitters at points of the scene. With up to 256
+// emitter faces: the exact point-to-triangle factor to every emitter face
+// times the visibility of one shadow ray to a random point on it (Wallace et
+// al. 1989); with more: power-proportional point sampling.
+class DirectLight {
+ public:
+  DirectLight(const Scene& s, const RayCaster& c) : s_(s), caster_(c), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+    const auto ok = usableFaceMask(s);
+    for (size_t f = 0; f < s.faceCount(); ++f)
+      if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
+    analytic_ = emitters_.size() <= 256;
+  }
+  bool empty() const { return lights_.empty(); }
+  float eps() const { return eps_; }
+  // Shadow rays per estimate() call.
+  int raysPerPoint() const { return analytic_ ? int(emitters_.size()) : 1; }
+
+  glm::vec3 estimate(const glm::vec3& x, const glm::vec3& n, SobolOwenStream& lsmp, Rng& rng, uint32_t skip) const {
+    if (!analytic_) return sampleDirectIrradiance(lights_, caster_, x, n, lsmp.next(), eps_, skip);
+    glm::dvec3 sum(0.0);
+    for (uint32_t L : emitters_) {
+      if (L == skip) continue;
+      const auto& te = s_.triangles[L];
+      const glm::vec3 nL = faceNormalUnnormalized(s_, L);
+      if (glm::dot(nL, x - s_.positions[te.x]) <= 0.f) continue;  // behind the emitter: it emits one-sided
+      const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s_.positions[te.x]),
+                                                 glm::dvec3(s_.positions[te.y]), glm::dvec3(s_.positions[te.z]));
+      if (F <= 0) continue;
+      const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
+      const glm::vec3 y = ub.x * s_.positions[te.x] + ub.y * s_.positions[te.y] + (1.f - ub.x - ub.y) * s_.positions[te.z];
+      const glm::vec3 w = y - x;
+      const float r = glm::length(w);
+      Ray ray;
+      ray.o = x;
+      ray.d = w / r;
+      ray.tfar = r * (1.f - 1e-4f) - eps_;
+      if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
+      sum += F * glm::dvec3(s_.faceEmission(L));
+    }
+    return glm::vec3(sum);
+  }
+
+ private:
+  const Scene& s_;
+  const RayCaster& caster_;
+  EmitterSampler lights_;
+  float eps_;
+  std::vector<uint32_t> emitters_;
+  bool analytic_ = true;
+};
+
+}  // namespace
+
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                              const Progress& progress) {
   if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
-  const EmitterSampler lights(s);
   std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
-  if (lights.empty()) return H;
+  const DirectLight direct(s, caster);
+  if (direct.empty()) return H;
   const auto ok = usableFaceMask(s);
-  const float eps = float(analyzeScene(s).rayEpsilon);
-  std::vector<uint32_t> emitters;
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters.push_back(uint32_t(f));
-  // Few emitter faces: the exact point-to-triangle factor per sample point and
-  // emitter, times visibility from one shadow ray to a random point on it
-  // (Wallace et al. 1989). Many: power-proportional point sampling.
-  const bool analytic = emitters.size() <= 256;
-  const int points = analytic ? std::max(1, lightSamples / int(emitters.size())) : lightSamples;
+  const int points = std::max(1, lightSamples / direct.raysPerPoint());
   parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!ok[i]) continue;
@@ -153,31 +214,31 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       for (int k = 0; k < points; ++k) {
         const glm::vec2 bc = uniformTriangle(pts.next());
         const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
-        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] + n * eps;
-        if (analytic) {
-          for (uint32_t L : emitters) {
-            if (L == i) continue;
-            const auto& te = s.triangles[L];
-            const glm::vec3 nL = faceNormalUnnormalized(s, L);
-            if (glm::dot(nL, x - s.positions[te.x]) <= 0.f) continue;  // behind the emitter: it emits one-sided
-            const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s.positions[te.x]),
-                                                       glm::dvec3(s.positions[te.y]), glm::dvec3(s.positions[te.z]));
-            if (F <= 0) continue;
-            const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
-            const glm::vec3 y = ub.x * s.positions[te.x] + ub.y * s.positions[te.y] + (1.f - ub.x - ub.y) * s.positions[te.z];
-            glm::vec3 w = y - x;
-            const float r = glm::length(w);
-            Ray ray;
-            ray.o = x;
-            ray.d = w / r;
-            ray.tfar = r * (1.f - 1e-4f) - eps;
-            if (ray.tfar > 0.f && caster.occluded(ray)) continue;
-            sum += F * glm::dvec3(s.faceEmission(L));
-          }
-          continue;
-        }
-        sum += glm::dvec3(sampleDirectIrradiance(lights, caster, x, n, lsmp.next(), eps, uint32_t(i)));
+        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] +
+                            n * direct.eps();
+        sum += glm::dvec3(direct.estimate(x, n, lsmp, rng, uint32_t(i)));
       }
+      H[i] = glm::vec3(sum / double(points));
+    }
+  });
+  return H;
+}
+
+std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                              const Progress& progress) {
+  const VertexMaterial mat = vertexMaterial(s);
+  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  const DirectLight direct(s, caster);
+  if (direct.empty()) return H;
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, direct.eps());
+  const int points = std::max(1, lightSamples / direct.raysPerPoint());
+  parallelBlocks(s.vertexCount(), progress, "direct light at vertices", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!mat.valid[i]) continue;
+      SobolOwenStream lsmp(hash3(uint32_t(i), seed, 0xd6u));
+      Rng rng(hash3(uint32_t(i), seed, 0xd7u));
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < points; ++k) sum += glm::dvec3(direct.estimate(origins[i], mat.n[i], lsmp, rng, kNoHit));
       H[i] = glm::vec3(sum / double(points));
     }
   });
@@ -246,6 +307,7 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
 RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
                       int bounces, double tol, int maxIter, const Progress& progress) {
   RadiosityResult res;
+  std::vector<glm::vec3> prevR;   // fixed bounces: the iterate before the last sweep
   std::vector<glm::vec3> S(u.n);  // source: once-reflected direct light
   for (size_t i = 0; i < u.n; ++i) S[i] = u.rho[i] * u.Hd[i];
   std::vector<glm::vec3> B = S;   // the reflected radiosity R while solving
@@ -259,7 +321,9 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   if (solver == RadiositySolver::Jacobi || solver == RadiositySolver::GaussSeidel) {
     const int sweeps = fixedBounces ? bounces : maxIter;
     std::vector<glm::vec3> Bn = B;
+    if (fixedBounces) prevR.assign(u.n, glm::vec3(0.f));  // bounces = 0: no indirect light at vertices
     for (int it = 0; it < sweeps; ++it) {
+      if (fixedBounces) prevR = B;
       double change = 0;
       if (solver == RadiositySolver::Jacobi) {
         parallelBlocks(u.n, Progress(nullptr), "", [&](size_t b, size_t e) {
@@ -350,6 +414,12 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
     res.stats.add("ambient_term", luminance(glm::vec3(ambient)));
   }
   energyStats(u, row, B, res.stats);
+  // What vertices gather their indirect light from: the reflected radiosity,
+  // one sweep behind when a bounce count is fixed (the gather adds that bounce).
+  res.Rgather = fixedBounces ? prevR : B;
+  res.Hindirect.assign(u.n, glm::vec3(0.f));
+  for (size_t i = 0; i < u.n; ++i)
+    if (u.A[i] > 0) res.Hindirect[i] = gather(row(uint32_t(i)), res.Rgather);
   for (size_t i = 0; i < u.n; ++i) B[i] += u.E[i];
   res.B = B;
   res.Bvertex = faceToVertex(s, B);
@@ -406,6 +476,54 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
                 opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
     res.stats.note("form factors on the fly: the matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
                    " MB) exceeds the memory budget");
+  }
+  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) {
+    // Per vertex: exact direct light there; the indirect light either
+    // gathered from the patch solution with rays from the vertex (final
+    // gather: visibility at the vertex itself, no leaks under objects that
+    // cut through patches) or interpolated from the incident patches.
+    Timer vt;
+    const VertexMaterial mat = vertexMaterial(s);
+    const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed);
+    std::vector<glm::vec3> Hi;
+    if (opt.vertexOutput == RadiosityVertexOutput::FinalGather) {
+      Hi.assign(s.vertexCount(), glm::vec3(0.f));
+      std::vector<glm::vec3> R(res.B.size());
+      std::vector<glm::vec3> faceN(res.B.size());
+      for (size_t f = 0; f < R.size(); ++f) {
+        R[f] = res.Rgather[f];
+        const glm::vec3 n = faceNormalUnnormalized(s, f);
+        faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f);
+      }
+      const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(analyzeScene(s).rayEpsilon));
+      parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+        for (size_t v = b; v < e; ++v) {
+          if (!mat.valid[v]) continue;
+          SobolOwenStream seq(hash3(uint32_t(v), opt.seed, 0xf9u));
+          const Frame frame(mat.n[v]);
+          glm::dvec3 sum(0.0);
+          Ray ray;
+          ray.o = origins[v];
+          for (int k = 0; k < opt.gatherRays; ++k) {
+            // Cosine-weighted: the irradiance estimate is the mean of the radiosity seen.
+            ray.d = frame.toWorld(cosineHemisphere(seq.next()));
+            ray.tfar = std::numeric_limits<float>::infinity();
+            const Hit h = caster.intersect(ray);
+            if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f) sum += glm::dvec3(R[h.face]);
+          }
+          Hi[v] = glm::vec3(sum / double(opt.gatherRays));
+        }
+      });
+      res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
+    } else {
+      Hi = faceToVertex(s, res.Hindirect);
+    }
+    for (size_t v = 0; v < s.vertexCount(); ++v)
+      res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v]) : glm::vec3(0.f);
+    res.stats.add("vertex_output_seconds", vt.seconds());
+    res.stats.note(opt.vertexOutput == RadiosityVertexOutput::FinalGather
+                       ? "vertices: direct light and a final gather of the patch solution at each vertex"
+                       : "vertices: direct light at each vertex, indirect interpolated from the patches");
   }
   res.stats.add("direct_light_seconds", directSeconds);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);

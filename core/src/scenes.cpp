@@ -322,7 +322,8 @@ std::vector<std::string> names() {
 SceneFile byName(const std::string& name) {
   if (name == "cornell_box") return cornellBox(50.0);
   if (name == "cornell_box_fine") return cornellBox(25.0);
-  if (name == "cornell_box_10k") return cornellBox(19.5);  // benchmarks only (not shipped)
+  if (name == "cornell_box_10k") return cornellBox(19.5);   // benchmarks only (not shipped)
+  if (name == "cornell_box_100k") return cornellBox(6.15);  // benchmarks only (not shipped)
   if (name == "parallel_plates") return parallelPlates(1.0, 16);
   if (name == "perpendicular_plates") return perpendicularPlates(16);
   if (name == "furnace_sphere") {

@@ -200,6 +200,43 @@ TEST(PathTracer, AgreesWithRadiosityOnCornellBox) {
     ++compared;
   }
   EXPECT_GE(compared, 8);
+  // Per-vertex output against the path tracer at vertices off the borders:
+  // the final gather beats interpolating the patches, which beats the plain
+  // patch average (the error of each printed as a test property).
+  auto vertexError = [&](RadiosityVertexOutput mode) {
+    RadiosityOptions o = ro;
+    o.vertexOutput = mode;
+    const auto r = solveRadiosity(s, *caster, o);
+    double num = 0, den = 0;
+    for (size_t v = 0; v < s.vertexCount(); ++v) {
+      if (border[v] || luminance(pt.B[v]) > 5.0) continue;  // borders and the light
+      num += std::pow(luminance(r.Bvertex[v]) - luminance(pt.B[v]), 2.0);
+      den += luminance(pt.B[v]);
+    }
+    return std::sqrt(num / double(s.vertexCount())) / (den / double(s.vertexCount()));
+  };
+  const double eGather = vertexError(RadiosityVertexOutput::FinalGather);
+  const double eInterp = vertexError(RadiosityVertexOutput::InterpolatedIndirect);
+  const double ePatch = vertexError(RadiosityVertexOutput::PatchAverage);
+  RecordProperty("vertex_error_final_gather", std::to_string(eGather));
+  RecordProperty("vertex_error_patch_average", std::to_string(ePatch));
+  EXPECT_LT(eGather, eInterp);
+  EXPECT_LT(eInterp, ePatch);
+}
+
+// Bounces = 0 at vertices is direct light only: B = E + rho H_direct there.
+TEST(PathTracer, RadiosityZeroBouncesAtVerticesIsDirectLight) {
+  auto sf = scenes::cornellBox(100.0);
+  const Scene& s = sf.scene;
+  auto caster = makeEmbreeCaster(s);
+  RadiosityOptions o;
+  o.bounces = 0;
+  o.raysPerPatch = 64;
+  const auto r = solveRadiosity(s, *caster, o);
+  const auto Hd = vertexDirectIrradiance(s, *caster, o.lightSamples, o.seed);
+  const VertexMaterial m = vertexMaterial(s);
+  for (size_t v = 0; v < s.vertexCount(); ++v)
+    EXPECT_NEAR(luminance(r.Bvertex[v]), luminance(m.E[v] + m.rho[v] * Hd[v]), 1e-5f * (1 + luminance(r.Bvertex[v])));
 }
 
 TEST(PathTracer, DeterministicAcrossThreadCounts) {

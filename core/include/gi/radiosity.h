@@ -20,16 +20,19 @@
 namespace gi {
 
 enum class RadiositySolver { Auto = 0, Jacobi = 1, GaussSeidel = 2, Progressive = 3 };
+enum class RadiosityVertexOutput { FinalGather = 0, InterpolatedIndirect = 1, PatchAverage = 2 };
 
 struct RadiosityOptions {
   int raysPerPatch = 1024;        // form-factor rays per patch
-  int lightSamples = 64;          // shadow rays per patch for the direct light
+  int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
   double tolerance = 1e-4;        // on the relative residual / unshot power
   int maxIterations = 1000;       // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
   uint32_t seed = 0;
+  RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
+  int gatherRays = 256;           // final-gather rays per vertex
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
@@ -64,7 +67,9 @@ class FormFactors {
 
 struct RadiosityResult {
   std::vector<glm::vec3> B;         // per face
-  std::vector<glm::vec3> Bvertex;   // per vertex (area-weighted mean of incident faces)
+  std::vector<glm::vec3> Bvertex;   // per vertex (see RadiosityOptions::vertexDirect)
+  std::vector<glm::vec3> Rgather;   // per face: reflected radiosity the vertices gather from
+  std::vector<glm::vec3> Hindirect; // per face: irradiance from Rgather
   int iterations = 0;
   double residual = 0.0;            // relative, at the end
   std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
@@ -77,6 +82,10 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
 // Direct irradiance per face from the emitters (shadow rays, power sampling).
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                              const Progress& progress = Progress(nullptr));
+
+// The same at every vertex (used for the per-vertex output).
+std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                              const Progress& progress = Progress(nullptr));
 
 // Solvers on precomputed rows and direct irradiance (exposed for tests).
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
