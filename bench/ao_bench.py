@@ -93,6 +93,27 @@ class Bench:
                        "rms_error_estimate": json.loads(text)["stats"]["rms_error_estimate"]}, f)
         return q
 
+    def cross_check(self, scene, mesh, ref, spp=1024):
+        """Our AO reference against the independent path tracer (`gi reference`, cached): a uniform white sky of
+        irradiance 1, black surfaces, no bounce, so its irradiance H is the AO. Returns the RMS of the z-scores
+        (about 1 when the two agree within the path tracer's honest error bars) and the RMS difference."""
+        cache = os.path.join(self.results, "refs")
+        os.makedirs(cache, exist_ok=True)
+        text, _ = run([self.gi, "reference", mesh, "-q", "--json", "--cache", cache, "--emitter_source", "None",
+                       "--reflectance_source", "Constant", "--reflectance", "0,0,0", "--sky_irradiance", "1",
+                       "--max_depth", "0", "--samples_per_vertex", str(spp)])
+        note = [n for n in json.loads(text)["notes"] if "cached" in n][0]
+        with open(note.split(" ")[-1]) as f:
+            pt = json.load(f)
+        H = [pt["H"][3 * i + 1] for i in range(pt["vertices"])]
+        se = pt["std_error_H"]
+        z = [(a - h) / s for a, h, s in zip(ref, H, se) if s > 0]
+        out = {"scene": scene, "path_tracer_paths_per_vertex": spp, "rms_z": math.sqrt(sum(x * x for x in z) / len(z)),
+               "rms_difference": rms(ref, H), "cached_file": os.path.relpath(note.split(" ")[-1], ROOT)}
+        print("cross-check %s: our AO reference vs the path tracer: RMS z %.3f, RMS difference %.4f" % (
+            scene, out["rms_z"], out["rms_difference"]), flush=True)
+        return out
+
     def ours_cli(self, scene, mesh, ref, rays_list):
         for n in rays_list:
             times, walls = [], []
@@ -270,8 +291,10 @@ def main():
     rays = [16, 64, 256, 1024] if a.quick else [8, 16, 32, 64, 128, 256, 512, 1024, 2048]
     server_rays = [16, 256] if a.quick else [16, 64, 256, 1024]
     views = [16, 64] if a.quick else [8, 16, 32, 64, 128, 256, 512, 1024]
+    checks = []
     for scene, mesh in scenes.items():
         ref = b.reference(mesh, 4096 if a.quick else 16384)
+        checks.append(b.cross_check(scene, mesh, ref, 256 if a.quick else 1024))
         b.ours_cli(scene, mesh, ref, rays)
         b.ours_server(scene, mesh, ref, server_rays)
         b.meshlab_ao(scene, mesh, ref, views)
@@ -295,7 +318,7 @@ def main():
         text, _ = run([os.path.join(a.build, "bench", "ao_throughput"), mesh, "256", "3" if a.quick else "7"])
         throughput[scene] = json.loads(text)
     scale = scaling(b, [70, 224, 708] if not a.quick else [70, 224], 64)
-    result = {"rows": b.rows, "summary": summary, "throughput": throughput, "scaling": scale,
+    result = {"rows": b.rows, "summary": summary, "throughput": throughput, "scaling": scale, "reference_cross_check": checks,
               "machine": {"cpus": os.cpu_count()}}
     with open(os.path.join(a.out, "ao_bench.json"), "w") as f:
         json.dump(result, f, indent=1)
@@ -321,6 +344,9 @@ def main():
         lines.append("| %d | %.2f | %.1f |" % (r["triangles"], r["wall_seconds"], r["peak_rss_mb"]))
     lines.append("")
     lines.append("log-log slopes against triangle count: time %.2f, memory %.2f" % (scale["time_loglog_slope"], scale["memory_loglog_slope"]))
+    lines += ["", "| scene | path tracer paths | RMS z-score (ours vs path tracer) | RMS difference |", "|---|---|---|---|"]
+    for c in checks:
+        lines.append("| %s | %d | %.3f | %.4f |" % (c["scene"], c["path_tracer_paths_per_vertex"], c["rms_z"], c["rms_difference"]))
     with open(os.path.join(a.out, "ao_bench.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     plot(b.rows, list(scenes), os.path.join(a.out, "ao_bench.png"))
