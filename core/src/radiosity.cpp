@@ -18,9 +18,17 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
   return {
       {"form_factor_method", "Form factors",
        "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
-       "cosine-weighted directions; the fraction that lands on patch j's front is F_ij (visibility included, "
-       "no hemicube aliasing). Rays that leave the scene or hit a back face are lost (absorbed).",
-       ParamType::Enum, 0, 0, 0, {"Monte Carlo"}},
+       "cosine-weighted directions; the fraction that lands on patch j's front is F_ij (visibility included; cost "
+       "n x rays). Analytic point-to-polygon (Wallace et al. 1989): at a few points of each patch the exact "
+       "unoccluded factor to every other patch, times one visibility ray each (none in an empty convex room; cost "
+       "n^2). Hemicube (Cohen and Greenberg 1985): all patches rasterised onto a hemicube at each patch centre "
+       "with a depth buffer (cost n^2 x resolution; aliasing for small or distant patches). Auto: analytic up to "
+       "2,000 patches, else Monte Carlo. Light that leaves the scene or meets a back face is lost (absorbed).",
+       ParamType::Enum, 0, 0, 0, {"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
+      {"analytic_points", "Points per patch (analytic)",
+       "Points on each patch where the analytic factors are evaluated and averaged.", ParamType::Int, 4, 1, 4096},
+      {"hemicube_resolution", "Hemicube resolution",
+       "Cells across the hemicube's top face (the sides have half as many rows).", ParamType::Int, 128, 4, 4096},
       {"rays_per_patch", "Rays per patch",
        "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N); the radiosity error "
        "averages over many patches and falls faster.",
@@ -70,7 +78,10 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
 
 RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   RadiosityOptions o;
+  o.formFactorMethod = FormFactorMethod(v.getInt("form_factor_method"));
   o.raysPerPatch = v.getInt("rays_per_patch");
+  o.analyticPoints = v.getInt("analytic_points");
+  o.hemicubeResolution = v.getInt("hemicube_resolution");
   o.lightSamples = v.getInt("light_samples");
   o.solver = RadiositySolver(v.getInt("solver"));
   o.bounces = v.getInt("bounces");
@@ -81,63 +92,6 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.vertexOutput = RadiosityVertexOutput(v.getInt("vertex_output"));
   o.gatherRays = v.getInt("gather_rays");
   return o;
-}
-
-FormFactors::FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
-    : s_(s), caster_(caster), n_(raysPerPatch), seed_(seed), eps_(float(analyzeScene(s).rayEpsilon)) {
-  ok_ = usableFaceMask(s);
-  area_.resize(s.faceCount());
-  normal_.resize(s.faceCount());
-  rays_.assign(s.faceCount(), 0);
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    area_[f] = ok_[f] ? faceArea(s, f) : 0.0;
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
-    normal_[f] = ok_[f] ? glm::normalize(n) : glm::vec3(0.f);
-  }
-}
-
-uint64_t FormFactors::raysCast() const {
-  uint64_t t = 0;
-  for (uint64_t r : rays_) t += r;
-  return t;
-}
-
-FormFactorRow FormFactors::row(uint32_t i) const {
-  FormFactorRow r;
-  if (!ok_[i]) return r;
-  const auto& t = s_.triangles[i];
-  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
-  const glm::vec3 n = normal_[i];
-  const Frame frame(n);
-  // Two independently scrambled 2D sequences (points, directions): padding.
-  SobolOwenStream pts(hash3(i, seed_, 0xf1u)), dirs(hash3(i, seed_, 0xf2u));
-  std::vector<uint32_t> hits;
-  hits.reserve(size_t(n_));
-  int lost = 0;
-  Ray ray;
-  for (int k = 0; k < n_; ++k) {
-    const glm::vec2 bc = uniformTriangle(pts.next());
-    // Keep the origin strictly inside the triangle, then lift it off the plane.
-    const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
-    ray.o = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
-    ray.d = frame.toWorld(cosineHemisphere(dirs.next()));
-    ray.tnear = 0.f;
-    ray.tfar = std::numeric_limits<float>::infinity();
-    const Hit h = caster_.intersect(ray);
-    if (h.valid() && h.face != i && glm::dot(ray.d, normal_[h.face]) < 0.f) hits.push_back(h.face);
-    else ++lost;
-  }
-  rays_[i] += uint64_t(n_);
-  std::sort(hits.begin(), hits.end());
-  for (size_t k = 0; k < hits.size();) {
-    size_t e = k;
-    while (e < hits.size() && hits[e] == hits[k]) ++e;
-    r.j.push_back(hits[k]);
-    r.F.push_back(float(double(e - k) / n_));
-    k = e;
-  }
-  r.escaped = float(double(lost) / n_);
-  return r;
 }
 
 namespace {
@@ -446,9 +400,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   Timer directTimer;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
   const double directSeconds = directTimer.seconds();
-  const FormFactors ff(s, caster, opt.raysPerPatch, opt.seed);
-  // Upper bound of the sparse matrix: every ray of every patch a distinct entry.
-  const double bytes = double(u.n) * std::min<double>(opt.raysPerPatch, double(u.n)) * 8.0 + double(u.n) * 64.0;
+  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed});
+  const double bytes = ff.matrixBytesBound();
   const bool fits = bytes <= opt.memoryBudgetMB * 1048576.0;
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
@@ -527,6 +480,10 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   }
   res.stats.add("direct_light_seconds", directSeconds);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
+  const char* methodName[] = {"Monte Carlo", "analytic point-to-polygon", "hemicube", "auto"};
+  res.stats.note(std::string("form factors: ") + methodName[int(ff.method())] +
+                 (opt.formFactorMethod == FormFactorMethod::Auto ? " (auto)" : "") +
+                 (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));
   res.stats.add("patches", double(u.n));
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());

@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/form_factors.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
@@ -23,7 +24,10 @@ enum class RadiositySolver { Auto = 0, Jacobi = 1, GaussSeidel = 2, Progressive 
 enum class RadiosityVertexOutput { FinalGather = 0, InterpolatedIndirect = 1, PatchAverage = 2 };
 
 struct RadiosityOptions {
-  int raysPerPatch = 1024;        // form-factor rays per patch
+  FormFactorMethod formFactorMethod = FormFactorMethod::MonteCarlo;
+  int raysPerPatch = 1024;        // form-factor rays per patch (Monte Carlo)
+  int analyticPoints = 4;         // points per patch (analytic point-to-polygon)
+  int hemicubeResolution = 128;   // cells across the top face (hemicube)
   int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
@@ -35,34 +39,6 @@ struct RadiosityOptions {
   int gatherRays = 256;           // final-gather rays per vertex
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
-};
-
-// Sparse form-factor row of patch i: F_ij for the patches j its rays reached.
-struct FormFactorRow {
-  std::vector<uint32_t> j;
-  std::vector<float> F;
-  float escaped = 0.f;  // fraction of rays that hit nothing (open scenes) or a back face
-};
-
-// Computes rows (one per face; unusable faces get empty rows).
-class FormFactors {
- public:
-  FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed);
-  FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
-  size_t patchCount() const { return area_.size(); }
-  double area(uint32_t i) const { return area_[i]; }
-  uint64_t raysCast() const;
-
- private:
-  const Scene& s_;
-  const RayCaster& caster_;
-  int n_;
-  uint32_t seed_;
-  float eps_;
-  std::vector<double> area_;
-  std::vector<glm::vec3> normal_;
-  std::vector<uint8_t> ok_;
-  mutable std::vector<uint64_t> rays_;  // per patch, for the statistics
 };
 
 struct RadiosityResult {

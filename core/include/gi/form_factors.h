@@ -1,0 +1,75 @@
+// Form factors F_ij (the fraction of the power leaving patch i that arrives
+// at patch j) by three methods of the course, row by row:
+//  - Monte Carlo: from stratified points on patch i, cosine-weighted rays;
+//    F_ij ~ (rays landing on the front of j) / N. Visibility comes free.
+//  - Analytic point-to-polygon (Wallace et al. 1989): at a few points on i,
+//    the exact unoccluded differential-area-to-triangle factor to every patch
+//    j in front (Lambert's contour integral), times the visibility of one
+//    ray to a random point of j; no rays at all in a scene where nothing can
+//    block anything (an empty convex room).
+//  - Hemicube (Cohen and Greenberg 1985): at the patch centre, every patch
+//    rasterised onto the five faces of a hemicube with a depth buffer; each
+//    cell adds its exact delta form factor to the patch it shows.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/raycaster.h"
+#include "gi/scene.h"
+
+namespace gi {
+
+enum class FormFactorMethod { MonteCarlo = 0, Analytic = 1, Hemicube = 2, Auto = 3 };
+
+// Sparse form-factor row of patch i: F_ij for the patches j its rays reached.
+struct FormFactorRow {
+  std::vector<uint32_t> j;
+  std::vector<float> F;
+  float escaped = 0.f;  // fraction of rays that hit nothing (open scenes) or a back face
+};
+
+// Computes rows (one per face; unusable faces get empty rows).
+class FormFactors {
+ public:
+  struct Settings {
+    FormFactorMethod method = FormFactorMethod::MonteCarlo;
+    int raysPerPatch = 1024;
+    int analyticPoints = 4;
+    int hemicubeResolution = 128;
+    uint32_t seed = 0;
+  };
+  FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings);
+  FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
+      : FormFactors(s, caster, Settings{FormFactorMethod::MonteCarlo, raysPerPatch, 4, 128, seed}) {}
+  FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
+  size_t patchCount() const { return area_.size(); }
+  double area(uint32_t i) const { return area_[i]; }
+  uint64_t raysCast() const;
+  FormFactorMethod method() const { return set_.method; }  // never Auto
+  bool unoccluded() const { return unoccluded_; }            // visibility rays skipped
+  // Upper bound of the bytes a full sparse matrix of these rows needs.
+  double matrixBytesBound() const;
+
+ private:
+  FormFactorRow monteCarloRow(uint32_t i) const;
+  FormFactorRow analyticRow(uint32_t i) const;
+  FormFactorRow hemicubeRow(uint32_t i) const;
+  const Scene& s_;
+  const RayCaster& caster_;
+  Settings set_;
+  bool unoccluded_ = false;
+  float eps_;
+  std::vector<double> area_;
+  std::vector<glm::vec3> normal_;
+  std::vector<uint8_t> ok_;
+  mutable std::vector<uint64_t> rays_;  // per patch, for the statistics
+};
+
+// True when no face can block the view between two others: every vertex
+// lies on or in front of every face's plane (an empty convex room seen from
+// inside). Then visibility rays are unnecessary.
+bool pairwiseUnoccluded(const Scene& s);
+
+}  // namespace gi

@@ -1,0 +1,162 @@
+#include "gi/form_factors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gi/form_factor_analytic.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings)
+    : s_(s), caster_(caster), set_(settings), eps_(float(analyzeScene(s).rayEpsilon)) {
+  ok_ = usableFaceMask(s);
+  area_.resize(s.faceCount());
+  normal_.resize(s.faceCount());
+  rays_.assign(s.faceCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    area_[f] = ok_[f] ? faceArea(s, f) : 0.0;
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    normal_[f] = ok_[f] ? glm::normalize(n) : glm::vec3(0.f);
+  }
+  if (set_.method == FormFactorMethod::Auto) {
+    // Exact-per-point factors are affordable for small scenes (n^2 work);
+    // Monte Carlo rays scale as n N.
+    size_t usable = 0;
+    for (uint8_t o : ok_) usable += o;
+    set_.method = usable <= 2000 ? FormFactorMethod::Analytic : FormFactorMethod::MonteCarlo;
+  }
+  if (set_.method == FormFactorMethod::Analytic) unoccluded_ = pairwiseUnoccluded(s);
+}
+
+double FormFactors::matrixBytesBound() const {
+  const double n = double(area_.size());
+  const double perRow = set_.method == FormFactorMethod::MonteCarlo ? std::min<double>(set_.raysPerPatch, n) : n;
+  return n * perRow * 8.0 + n * 64.0;
+}
+
+FormFactorRow FormFactors::row(uint32_t i) const {
+  if (!ok_[i]) return {};
+  switch (set_.method) {
+    case FormFactorMethod::Analytic: return analyticRow(i);
+    case FormFactorMethod::Hemicube: return hemicubeRow(i);
+    default: return monteCarloRow(i);
+  }
+}
+
+FormFactorRow FormFactors::analyticRow(uint32_t i) const {
+  FormFactorRow r;
+  const auto& t = s_.triangles[i];
+  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
+  const glm::vec3 n = normal_[i];
+  const int K = std::max(1, set_.analyticPoints);
+  std::vector<glm::vec3> xs(static_cast<size_t>(K));
+  SobolOwenStream pts(hash3(i, set_.seed, 0xf3u));
+  for (auto& x : xs) {
+    const glm::vec2 bc = uniformTriangle(pts.next());
+    const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
+    x = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
+  }
+  Rng rng(hash3(i, set_.seed, 0xf4u));
+  double total = 0;
+  uint64_t rays = 0;
+  for (uint32_t j = 0; j < uint32_t(s_.faceCount()); ++j) {
+    if (j == i || !ok_[j]) continue;
+    const auto& tj = s_.triangles[j];
+    const glm::dvec3 pa(s_.positions[tj.x]), pb(s_.positions[tj.y]), pc(s_.positions[tj.z]);
+    double F = 0;
+    for (const glm::vec3& x : xs) {
+      if (glm::dot(normal_[j], x - s_.positions[tj.x]) <= 0.f) continue;  // j faces away from x
+      const double f = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), pa, pb, pc);
+      if (f <= 0) continue;
+      if (!unoccluded_) {
+        const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
+        const glm::vec3 y = ub.x * s_.positions[tj.x] + ub.y * s_.positions[tj.y] + (1.f - ub.x - ub.y) * s_.positions[tj.z];
+        const glm::vec3 w = y - x;
+        const float len = glm::length(w);
+        Ray ray;
+        ray.o = x;
+        ray.d = w / len;
+        ray.tfar = len * (1.f - 1e-4f) - eps_;
+        ++rays;
+        if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
+      }
+      F += f;
+    }
+    F /= K;
+    if (F > 0) {
+      r.j.push_back(j);
+      r.F.push_back(float(F));
+      total += F;
+    }
+  }
+  rays_[i] += rays;
+  r.escaped = float(std::max(0.0, 1.0 - total));
+  return r;
+}
+
+bool pairwiseUnoccluded(const Scene& s) {
+  const auto ok = usableFaceMask(s);
+  double scale = 0;
+  for (const auto& p : s.positions) scale = std::max({scale, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
+  const double tol = 1e-5 * (scale > 0 ? scale : 1.0);
+  std::vector<uint8_t> used(s.vertexCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f]) used[s.triangles[f].x] = used[s.triangles[f].y] = used[s.triangles[f].z] = 1;
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const glm::dvec3 n = glm::normalize(glm::dvec3(faceNormalUnnormalized(s, f)));
+    const glm::dvec3 a(s.positions[s.triangles[f].x]);
+    for (size_t v = 0; v < s.vertexCount(); ++v)
+      if (used[v] && glm::dot(n, glm::dvec3(s.positions[v]) - a) < -tol) return false;  // early exit on the first
+  }
+  return true;
+}
+
+uint64_t FormFactors::raysCast() const {
+  uint64_t t = 0;
+  for (uint64_t r : rays_) t += r;
+  return t;
+}
+
+FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
+  FormFactorRow r;
+  const int N = set_.raysPerPatch;
+  const uint32_t seed = set_.seed;
+  const auto& t = s_.triangles[i];
+  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
+  const glm::vec3 n = normal_[i];
+  const Frame frame(n);
+  // Two independently scrambled 2D sequences (points, directions): padding.
+  SobolOwenStream pts(hash3(i, seed, 0xf1u)), dirs(hash3(i, seed, 0xf2u));
+  std::vector<uint32_t> hits;
+  hits.reserve(size_t(N));
+  int lost = 0;
+  Ray ray;
+  for (int k = 0; k < N; ++k) {
+    const glm::vec2 bc = uniformTriangle(pts.next());
+    // Keep the origin strictly inside the triangle, then lift it off the plane.
+    const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
+    ray.o = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
+    ray.d = frame.toWorld(cosineHemisphere(dirs.next()));
+    ray.tnear = 0.f;
+    ray.tfar = std::numeric_limits<float>::infinity();
+    const Hit h = caster_.intersect(ray);
+    if (h.valid() && h.face != i && glm::dot(ray.d, normal_[h.face]) < 0.f) hits.push_back(h.face);
+    else ++lost;
+  }
+  rays_[i] += uint64_t(N);
+  std::sort(hits.begin(), hits.end());
+  for (size_t k = 0; k < hits.size();) {
+    size_t e = k;
+    while (e < hits.size() && hits[e] == hits[k]) ++e;
+    r.j.push_back(hits[k]);
+    r.F.push_back(float(double(e - k) / N));
+    k = e;
+  }
+  r.escaped = float(double(lost) / N);
+  return r;
+}
+
+}  // namespace gi
