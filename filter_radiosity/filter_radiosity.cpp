@@ -1,5 +1,6 @@
 #include "filter_radiosity.h"
 
+#include "gi/output.h"
 #include "gi/radiosity.h"
 #include "gi/filters.h"
 #include "meshlab_bridge.h"
@@ -7,19 +8,31 @@
 using namespace gi;
 
 namespace {
-std::vector<ParamSpec> specs() { return filterSpecs(FilterKind::Radiosity); }
+FilterKind kindOf(int id) {
+  return id == FilterRadiosityPlugin::FP_FORM_FACTORS_OF_FACE ? FilterKind::FormFactorsOfFace : FilterKind::Radiosity;
+}
 }  // namespace
 
 FilterRadiosityPlugin::FilterRadiosityPlugin() {
-  typeList << FP_RADIOSITY;
+  typeList << FP_RADIOSITY << FP_FORM_FACTORS_OF_FACE;
   for (FilterIDType t : types()) actionList << new QAction(filterName(t), this);
 }
 
 QString FilterRadiosityPlugin::pluginName() const { return "FilterRadiosityGI"; }
 
-QString FilterRadiosityPlugin::filterName(FilterIDType) const { return "GI: Radiosity"; }
+QString FilterRadiosityPlugin::filterName(FilterIDType f) const {
+  return QString::fromStdString(filterDesc(kindOf(f)).meshlabName);
+}
 
-QString FilterRadiosityPlugin::filterInfo(FilterIDType) const {
+QString FilterRadiosityPlugin::filterInfo(FilterIDType f) const {
+  if (kindOf(f) == FilterKind::FormFactorsOfFace)
+    return "The <b>form factors</b> F<sub>ij</sub> from the selected face i to every other face j: the fraction of "
+           "the power leaving i (a Lambertian emitter) that arrives at j, visibility included. Written to face "
+           "<b>quality</b> (and grey face colour, the selected face red); vertex quality gets the area-weighted mean "
+           "of the incident faces. The log gives the row sum (1 in a closed room, less where light escapes) and the "
+           "<b>reciprocity</b> error |A<sub>i</sub> F<sub>ij</sub> - A<sub>j</sub> F<sub>ji</sub>| / A<sub>i</sub> "
+           "F<sub>ij</sub> over the strongest receivers. Compare the three methods (Monte Carlo rays, analytic "
+           "point-to-polygon, hemicube) on the same face to see their errors and artefacts.";
   return "<b>Radiosity</b> of diffuse (Lambertian) surfaces: the radiosity equation "
          "<i>B<sub>i</sub> = E<sub>i</sub> + &rho;<sub>i</sub> &sum;<sub>j</sub> F<sub>ij</sub> B<sub>j</sub></i> "
          "in RGB, with B the radiosity (W/m<sup>2</sup>), E the emitted radiosity, &rho; the reflectance and "
@@ -48,14 +61,27 @@ int FilterRadiosityPlugin::postCondition(QAction*) const {
   return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY;
 }
 
-void FilterRadiosityPlugin::initParameterSet(QAction*, MeshDocument& md, RichParameterList& par) {
-  ml::addParams(par, specs(), ml::documentDiagonal(md));
+void FilterRadiosityPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& par) {
+  ml::addParams(par, filterSpecs(kindOf(ID(a))), ml::documentDiagonal(md));
 }
 
 bool FilterRadiosityPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb) {
   auto logLine = [this](const std::string& s) { Log("%s", s.c_str()); };
+  if (kindOf(ID(a)) == FilterKind::FormFactorsOfFace) {
+    return ml::guarded(errorMessage, logLine, filterName(ID(a)), [&] {
+      ml::PreparedRun run = ml::prepare(md, par, filterSpecs(FilterKind::FormFactorsOfFace), false);
+      const Scene& s = run.bridge.scene;
+      const uint32_t face = chosenFace(run.values.getInt("face_index"), run.bridge.attrs.faceSelected, s.faceCount());
+      auto caster = makeEmbreeCaster(s);
+      const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(run.values), face);
+      const FormFactorOutput out = formFactorOutput(s, rep, face);
+      ml::writeFaceResults(run.bridge, out.faceF, out.faceColor);
+      ml::writeVertexResults(run.bridge, out.vertexF, {});
+      logLine(out.summary);
+    });
+  }
   return ml::guarded(errorMessage, logLine, filterName(ID(a)), [&] {
-    ml::PreparedRun run = ml::prepare(md, par, specs(), true);
+    ml::PreparedRun run = ml::prepare(md, par, filterSpecs(FilterKind::Radiosity), true);
     const RadiosityOptions opt = RadiosityOptions::fromParams(run.values);
     auto caster = makeEmbreeCaster(run.bridge.scene);
     RadiosityResult r = solveRadiosity(run.bridge.scene, *caster, opt, Progress(ml::progressFrom(cb)));

@@ -8,7 +8,7 @@ class FilterRadiosityPlugin : public QObject, public MeshFilterInterface {
   Q_INTERFACES(MeshFilterInterface)
 
  public:
-  enum { FP_RADIOSITY };
+  enum { FP_RADIOSITY, FP_FORM_FACTORS_OF_FACE };
   FilterRadiosityPlugin();
   QString pluginName() const override;
   QString filterName(FilterIDType filter) const override;

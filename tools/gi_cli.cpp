@@ -15,6 +15,7 @@
 #include "gi/ambient.h"
 #include "gi/direct.h"
 #include "gi/filters.h"
+#include "gi/form_factors.h"
 #include "gi/output.h"
 #include "gi/photon.h"
 #include "gi/pathtrace.h"
@@ -163,6 +164,22 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
       colors = greyColors(r.value);
       if (opt.bentNormals) extras.normals = r.bentNormal;
     }
+  } else if (kind == FilterKind::FormFactorsOfFace) {
+    if (v.getInt("face_index") < 0) throw std::invalid_argument("--face_index is needed on the command line (a file has no selection)");
+    const uint32_t face = chosenFace(v.getInt("face_index"), {}, mesh.scene.faceCount());
+    auto caster = makeEmbreeCaster(mesh.scene);
+    const FormFactorReport ffr = formFactorsOfFace(mesh.scene, *caster, formFactorSettings(v), face);
+    const FormFactorOutput fo = formFactorOutput(mesh.scene, ffr, face);
+    out.quality = fo.vertexF;
+    colors = greyColors(fo.vertexF);
+    mesh.attrs.faceQuality = fo.faceF;
+    mesh.attrs.faceColor.clear();
+    for (const auto& c : fo.faceColor) mesh.attrs.faceColor.push_back({c.r, c.g, c.b});
+    stats.add("row_sum", ffr.rowSum);
+    stats.add("lost", ffr.escaped);
+    stats.add("max_reciprocity_error", ffr.maxReciprocityError);
+    stats.add("seconds", ffr.seconds);
+    stats.note(fo.summary);
   } else if (kind == FilterKind::PathTracedReference) {
     // Cached by scene hash and parameters: computed once, reused by benchmarks.
     const std::string params = describe(specs, v);
@@ -290,7 +307,7 @@ int main(int argc, char** argv) {
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
   std::string filterName;
-  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference)")->required();
+  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)")->required();
   script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
@@ -306,7 +323,7 @@ int main(int argc, char** argv) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())
         if (f.cliName == filterName) d = &f;
-      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap, reference)");
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)");
       // Parameters after the filter name: --name value pairs, checked against the filter's table.
       const auto specs = filterSpecs(d->kind);
       const auto extras = script->remaining();

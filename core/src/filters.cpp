@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "gi/ambient.h"
+#include "gi/form_factors.h"
 #include "gi/direct.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
@@ -23,6 +24,8 @@ const std::vector<FilterDesc>& allFilters() {
       {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "photon-mapped radiosity from area emitters"},
       {FilterKind::PathTracedReference, "GI: Path Traced Reference", "reference",
        "per-vertex path-traced reference solution with error bars"},
+      {FilterKind::FormFactorsOfFace, "GI: Form Factors of Selected Face", "formfactors",
+       "form factors from one face to every other face (teaching, debugging)"},
   };
   return f;
 }
@@ -61,6 +64,15 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       add(lightingSceneSpecs());
       add(PhotonOptions::specs());
       add(displaySpecs());
+      break;
+    case FilterKind::FormFactorsOfFace:
+      s.push_back(geometrySceneSpecs().front());  // scene extent
+      s.push_back({"face_index", "Face",
+                   "The face whose form factors are computed: -1 = the one selected face (MeshLab), else its index "
+                   "in the scene (the command-line tool needs it).",
+                   ParamType::Int, -1, -1, 2147483647});
+      add(formFactorSpecs());
+      s.push_back(seedSpec("form-factor rays"));
       break;
     case FilterKind::PathTracedReference:
       add(lightingSceneSpecs());

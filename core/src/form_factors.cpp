@@ -5,7 +5,11 @@
 #include <limits>
 
 #include "gi/form_factor_analytic.h"
+#include "gi/run.h"
 #include "gi/sampling.h"
+
+#include <stdexcept>
+#include <string>
 
 namespace gi {
 
@@ -94,6 +98,74 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
   rays_[i] += rays;
   r.escaped = float(std::max(0.0, 1.0 - total));
   return r;
+}
+
+FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,
+                                   uint32_t face, int reciprocityChecks) {
+  if (face >= s.faceCount()) throw std::invalid_argument("face " + std::to_string(face) + " does not exist");
+  if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(face) + " is degenerate");
+  Timer timer;
+  const FormFactors ff(s, caster, settings);
+  FormFactorReport rep;
+  rep.row = ff.row(face);
+  for (float f : rep.row.F) rep.rowSum += f;
+  rep.escaped = rep.row.escaped;
+  std::vector<size_t> order(rep.row.j.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rep.row.F[a] > rep.row.F[b]; });
+  for (size_t k = 0; k < order.size() && int(k) < reciprocityChecks; ++k) {
+    const uint32_t j = rep.row.j[order[k]];
+    const FormFactorRow rj = ff.row(j);
+    double Fji = 0;
+    for (size_t m = 0; m < rj.j.size(); ++m)
+      if (rj.j[m] == face) Fji = rj.F[m];
+    const double lhs = ff.area(face) * rep.row.F[order[k]], rhs = ff.area(j) * Fji;
+    rep.maxReciprocityError = std::max(rep.maxReciprocityError, std::fabs(lhs - rhs) / lhs);
+    ++rep.reciprocityChecked;
+  }
+  rep.seconds = timer.seconds();
+  return rep;
+}
+
+std::vector<ParamSpec> formFactorSpecs() {
+  return {
+      {"form_factor_method", "Form factors",
+       "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
+       "cosine-weighted directions; the fraction that lands on patch j's front is F_ij (visibility included; cost "
+       "n x rays). Analytic point-to-polygon (Wallace et al. 1989): at a few points of each patch the exact "
+       "unoccluded factor to every other patch, times one visibility ray each (none in an empty convex room; cost "
+       "n^2). Hemicube (Cohen and Greenberg 1985): all patches rasterised onto a hemicube at each patch centre "
+       "with a depth buffer (cost n^2 x resolution; aliasing for small or distant patches). Auto: analytic up to "
+       "2,000 patches, else Monte Carlo. Light that leaves the scene or meets a back face is lost (absorbed).",
+       ParamType::Enum, 0, 0, 0, {"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
+      {"rays_per_patch", "Rays per patch (Monte Carlo)",
+       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N); the radiosity error "
+       "averages over many patches and falls faster.",
+       ParamType::Int, 1024, 16, 1 << 22},
+      {"analytic_points", "Points per patch (analytic)",
+       "Points on each patch where the analytic factors are evaluated and averaged.", ParamType::Int, 4, 1, 4096},
+      {"hemicube_resolution", "Hemicube resolution",
+       "Cells across the hemicube's top face (the sides have half as many rows).", ParamType::Int, 128, 4, 4096},
+  };
+}
+
+uint32_t chosenFace(int faceIndex, const std::vector<uint8_t>& selected, size_t faceCount) {
+  if (faceIndex >= 0) {
+    if (size_t(faceIndex) >= faceCount)
+      throw std::invalid_argument("face_index " + std::to_string(faceIndex) + " is beyond the " + std::to_string(faceCount) + " faces");
+    return uint32_t(faceIndex);
+  }
+  std::vector<uint32_t> sel;
+  for (size_t f = 0; f < selected.size(); ++f)
+    if (selected[f]) sel.push_back(uint32_t(f));
+  if (sel.size() != 1)
+    throw std::invalid_argument("select exactly one face (" + std::to_string(sel.size()) + " are selected), or give face_index");
+  return sel[0];
+}
+
+FormFactors::Settings formFactorSettings(const ParamValues& v) {
+  return {FormFactorMethod(v.getInt("form_factor_method")), v.getInt("rays_per_patch"), v.getInt("analytic_points"),
+          v.getInt("hemicube_resolution"), uint32_t(v.getInt("seed"))};
 }
 
 bool pairwiseUnoccluded(const Scene& s) {

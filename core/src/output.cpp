@@ -4,6 +4,9 @@
 #include <cmath>
 
 #include "gi/direct.h"
+#include "gi/form_factors.h"
+
+#include <cstdio>
 
 namespace gi {
 
@@ -33,6 +36,32 @@ std::vector<Rgb8> greyColors(const std::vector<float>& value) {
     c[i] = {b, b, b};
   }
   return c;
+}
+
+FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face) {
+  FormFactorOutput o;
+  o.faceF.assign(s.faceCount(), 0.f);
+  float maxF = 0;
+  for (size_t k = 0; k < rep.row.j.size(); ++k) {
+    o.faceF[rep.row.j[k]] = rep.row.F[k];
+    maxF = std::max(maxF, rep.row.F[k]);
+  }
+  std::vector<glm::vec3> f3(s.faceCount());
+  for (size_t f = 0; f < f3.size(); ++f) f3[f] = glm::vec3(o.faceF[f]);
+  for (const auto& v : faceToVertex(s, f3)) o.vertexF.push_back(v.x);
+  o.faceColor.resize(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const auto g = uint8_t(std::lround(255.f * (maxF > 0 ? std::sqrt(o.faceF[f] / maxF) : 0.f)));
+    o.faceColor[f] = f == face ? Rgb8{255, 0, 0} : Rgb8{g, g, g};
+  }
+  char b[256];
+  std::snprintf(b, sizeof b,
+                "GI: Form Factors of Selected Face: face %u, %zu faces reached, row sum %.6f, lost %.6f, max F %.6g, "
+                "reciprocity error max %.3g over the %d strongest receivers, %.3f s",
+                face, rep.row.j.size(), rep.rowSum, rep.escaped, double(maxF), rep.maxReciprocityError,
+                rep.reciprocityChecked, rep.seconds);
+  o.summary = b;
+  return o;
 }
 
 }  // namespace gi

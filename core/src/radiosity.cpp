@@ -15,24 +15,8 @@
 namespace gi {
 
 std::vector<ParamSpec> RadiosityOptions::specs() {
-  return {
-      {"form_factor_method", "Form factors",
-       "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
-       "cosine-weighted directions; the fraction that lands on patch j's front is F_ij (visibility included; cost "
-       "n x rays). Analytic point-to-polygon (Wallace et al. 1989): at a few points of each patch the exact "
-       "unoccluded factor to every other patch, times one visibility ray each (none in an empty convex room; cost "
-       "n^2). Hemicube (Cohen and Greenberg 1985): all patches rasterised onto a hemicube at each patch centre "
-       "with a depth buffer (cost n^2 x resolution; aliasing for small or distant patches). Auto: analytic up to "
-       "2,000 patches, else Monte Carlo. Light that leaves the scene or meets a back face is lost (absorbed).",
-       ParamType::Enum, 0, 0, 0, {"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
-      {"analytic_points", "Points per patch (analytic)",
-       "Points on each patch where the analytic factors are evaluated and averaged.", ParamType::Int, 4, 1, 4096},
-      {"hemicube_resolution", "Hemicube resolution",
-       "Cells across the hemicube's top face (the sides have half as many rows).", ParamType::Int, 128, 4, 4096},
-      {"rays_per_patch", "Rays per patch",
-       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N); the radiosity error "
-       "averages over many patches and falls faster.",
-       ParamType::Int, 1024, 16, 1 << 22},
+  std::vector<ParamSpec> s = formFactorSpecs();
+  const std::vector<ParamSpec> more = {
       {"light_samples", "Shadow rays per patch",
        "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to 256 "
        "emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter face, "
@@ -74,6 +58,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        1 << 20},
       seedSpec("form-factor rays"),
   };
+  s.insert(s.end(), more.begin(), more.end());
+  return s;
 }
 
 RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {

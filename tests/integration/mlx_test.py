@@ -226,6 +226,21 @@ def case_reference(c):
           "reference file holds B, H, standard errors and path counts")
 
 
+def case_formfactors(c):
+    box = os.path.join(c.meshes, "closed_box.ply")
+    out = os.path.join(c.tmp, "ff.ply")
+    log = c.server(box, c.script("ff", "formfactors", "--face_index", "5", "--form_factor_method", "Hemicube"), out,
+                   mask=("vq", "fq", "fc"))
+    m = re.search(r"row sum ([0-9.]+)", log)
+    check(m is not None and abs(float(m.group(1)) - 1.0) < 2e-3, "closed box: the row sums to 1 (%s)" % (m.group(1) if m else "?"))
+    check("reciprocity error" in log, "reciprocity error logged")
+    faces = read_ply(out)["face"]
+    check(faces[5]["red"] == 255 and faces[5]["green"] == 0, "the chosen face is marked red")
+    check(abs(sum(f["quality"] for f in faces) - 0) > 0 and max(f["quality"] for f in faces) < 1, "F_ij in face quality")
+    log = c.server(box, c.script("ff_sel", "formfactors"), expect_ok=False)
+    check("select exactly one face" in log, "no selection: clear reason")
+
+
 def case_bad_input(c):
     # A point cloud, an empty mesh, an invalid parameter, a scene without emitters.
     pc = os.path.join(c.tmp, "points.ply")
@@ -257,7 +272,7 @@ def case_dump(c):
     with open(dump, encoding="utf-8", errors="replace") as f:
         text = f.read()
     for name in ("GI: Ambient Occlusion", "GI: Ambient Obscurance", "GI: Sky Lighting", "GI: Radiosity", "GI: Photon Mapping",
-                 "GI: Path Traced Reference"):
+                 "GI: Path Traced Reference", "GI: Form Factors of Selected Face"):
         check(name in text, "meshlabserver -d lists '%s'" % name)
     for param in ("rays_per_vertex", "emitter_source", "photons", "sun_direction"):
         check(".mlx name: " + param in text, "meshlabserver -d lists parameter %s" % param)
@@ -289,7 +304,7 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "layers": case_layers, "reference": case_reference, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+CASES = {"cli": case_cli, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
          "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@
 
 namespace gi {
 
-enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping, PathTracedReference };
+enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping, PathTracedReference, FormFactorsOfFace };
 
 struct FilterDesc {
   FilterKind kind;

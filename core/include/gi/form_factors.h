@@ -16,6 +16,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/scene.h"
 
@@ -66,6 +67,25 @@ class FormFactors {
   std::vector<uint8_t> ok_;
   mutable std::vector<uint64_t> rays_;  // per patch, for the statistics
 };
+
+// One row for study (the "GI: Form Factors of Selected Face" filter): F from
+// face i to every other face, its sum, and the reciprocity A_i F_ij = A_j F_ji
+// checked against the rows of the receivers with the largest F_ij.
+struct FormFactorReport {
+  FormFactorRow row;
+  double rowSum = 0, escaped = 0;
+  double maxReciprocityError = 0;  // max |A_i F_ij - A_j F_ji| / (A_i F_ij) over the checked pairs
+  int reciprocityChecked = 0;
+  double seconds = 0;
+};
+FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,
+                                   uint32_t face, int reciprocityChecks = 16);
+std::vector<ParamSpec> formFactorSpecs();
+// The face a "face_index" parameter names: itself if >= 0, else the one
+// selected face (throws std::invalid_argument with a sentence otherwise).
+uint32_t chosenFace(int faceIndex, const std::vector<uint8_t>& selected, size_t faceCount);
+// Settings and face from the filter's parameters.
+FormFactors::Settings formFactorSettings(const ParamValues& v);  // method, rays, points, resolution (shared with the radiosity filter)
 
 // True when no face can block the view between two others: every vertex
 // lies on or in front of every face's plane (an empty convex room seen from

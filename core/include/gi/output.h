@@ -1,6 +1,7 @@
 // Per-vertex results into the common output convention (DESIGN.md §4):
 // quality = the physical scalar, colour = its display mapping.
 #pragma once
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -19,5 +20,15 @@ VertexOutput radiometricOutput(const Scene& s, const std::vector<glm::vec3>& rgb
 // Ambient occlusion / obscurance: quality = value in [0,1], colour = grey
 // value x 255 (the usual AO display, not sRGB-encoded).
 std::vector<Rgb8> greyColors(const std::vector<float>& value);
+
+struct FormFactorReport;
+// Form factors of one face as output: face values F_ij (grey, the face red),
+// vertex values (area-weighted mean of incident faces), and a log line.
+struct FormFactorOutput {
+  std::vector<float> faceF, vertexF;
+  std::vector<Rgb8> faceColor;
+  std::string summary;
+};
+FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face);
 
 }  // namespace gi
