@@ -1,6 +1,8 @@
 #include "gi/form_factors.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 #include <limits>
 
@@ -168,30 +170,11 @@ FormFactors::Settings formFactorSettings(const ParamValues& v) {
           v.getInt("hemicube_resolution"), uint32_t(v.getInt("seed"))};
 }
 
-bool pairwiseUnoccluded(const Scene& s) {
-  const auto ok = usableFaceMask(s);
-  double scale = 0;
-  for (const auto& p : s.positions) scale = std::max({scale, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
-  const double tol = 1e-5 * (scale > 0 ? scale : 1.0);
-  std::vector<uint8_t> used(s.vertexCount(), 0);
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f]) used[s.triangles[f].x] = used[s.triangles[f].y] = used[s.triangles[f].z] = 1;
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f]) continue;
-    const glm::dvec3 n = glm::normalize(glm::dvec3(faceNormalUnnormalized(s, f)));
-    const glm::dvec3 a(s.positions[s.triangles[f].x]);
-    for (size_t v = 0; v < s.vertexCount(); ++v)
-      if (used[v] && glm::dot(n, glm::dvec3(s.positions[v]) - a) < -tol) return false;  // early exit on the first
-  }
-  return true;
-}
-
 uint64_t FormFactors::raysCast() const {
   uint64_t t = 0;
   for (uint64_t r : rays_) t += r;
   return t;
 }
-
 FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   FormFactorRow r;
   const int N = set_.raysPerPatch;
@@ -229,6 +212,42 @@ FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   }
   r.escaped = float(double(lost) / N);
   return r;
+}
+
+bool pairwiseUnoccluded(const Scene& s) {
+  const auto ok = usableFaceMask(s);
+  double scale = 0;
+  for (const auto& p : s.positions) scale = std::max({scale, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
+  const double tol = 1e-5 * (scale > 0 ? scale : 1.0);
+  std::vector<uint32_t> used;
+  {
+    std::vector<uint8_t> u(s.vertexCount(), 0);
+    for (size_t f = 0; f < s.faceCount(); ++f)
+      if (ok[f]) u[s.triangles[f].x] = u[s.triangles[f].y] = u[s.triangles[f].z] = 1;
+    for (size_t v = 0; v < u.size(); ++v)
+      if (u[v]) used.push_back(uint32_t(v));
+  }
+  // Distinct planes only (a subdivided box has six), visited in a scattered
+  // order so that a non-convex scene fails on one of the first planes tried.
+  std::map<std::array<long long, 4>, std::pair<glm::dvec3, glm::dvec3>> planes;
+  for (size_t k = 0, n = s.faceCount(); k < n; ++k) {
+    const size_t f = (k * 2654435761ull) % n;
+    if (!ok[f]) continue;
+    const glm::dvec3 nn = glm::normalize(glm::dvec3(faceNormalUnnormalized(s, f)));
+    const glm::dvec3 a(s.positions[s.triangles[f].x]);
+    const std::array<long long, 4> key = {std::llround(nn.x * 1e6), std::llround(nn.y * 1e6), std::llround(nn.z * 1e6),
+                                          std::llround(glm::dot(nn, a) / tol)};
+    planes.emplace(key, std::make_pair(nn, a));
+    if (planes.size() * used.size() > 200000000ull) return false;  // too costly to prove: assume occlusion
+  }
+  std::vector<std::pair<glm::dvec3, glm::dvec3>> order;
+  for (const auto& kv : planes) order.push_back(kv.second);
+  for (size_t k = 0, n = order.size(); k < n; ++k) {
+    const auto& [nn, a] = order[(k * 2654435761ull) % n];
+    for (uint32_t v : used)
+      if (glm::dot(nn, glm::dvec3(s.positions[v]) - a) < -tol) return false;
+  }
+  return true;
 }
 
 }  // namespace gi

@@ -93,7 +93,9 @@ class DirectLight {
     for (size_t f = 0; f < s.faceCount(); ++f)
       if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
     analytic_ = emitters_.size() <= 256;
+    unoccluded_ = pairwiseUnoccluded(s);
   }
+  bool unoccluded() const { return unoccluded_; }
   bool empty() const { return lights_.empty(); }
   float eps() const { return eps_; }
   // Shadow rays per estimate() call.
@@ -118,7 +120,7 @@ class DirectLight {
       ray.o = x;
       ray.d = w / r;
       ray.tfar = r * (1.f - 1e-4f) - eps_;
-      if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
+      if (!unoccluded_ && ray.tfar > 0.f && caster_.occluded(ray)) continue;
       sum += F * glm::dvec3(s_.faceEmission(L));
     }
     return glm::vec3(sum);
@@ -130,7 +132,7 @@ class DirectLight {
   EmitterSampler lights_;
   float eps_;
   std::vector<uint32_t> emitters_;
-  bool analytic_ = true;
+  bool analytic_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
 
 }  // namespace
