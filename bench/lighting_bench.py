@@ -163,6 +163,15 @@ def main():
                 b.method(scene, mesh, ref, w, "radiosity, " + solver,
                          ["radiosity", "--solver", solver, "--rays_per_patch", str(rays), "--light_samples", str(light),
                           "--gather_rays", str(gather)], noise)
+        if scene == "cornell_1.5k":  # n^2 methods: the small box only
+            for pts in ([4] if a.quick else [1, 4, 16]):
+                b.method(scene, mesh, ref, w, "radiosity, analytic point-to-polygon",
+                         ["radiosity", "--form_factor_method", "Analytic point-to-polygon", "--analytic_points", str(pts),
+                          "--light_samples", "1024", "--gather_rays", "512"], noise)
+            for res in ([64] if a.quick else [64, 128, 256]):
+                b.method(scene, mesh, ref, w, "radiosity, hemicube",
+                         ["radiosity", "--form_factor_method", "Hemicube", "--hemicube_resolution", str(res),
+                          "--light_samples", "1024", "--gather_rays", "512"], noise)
         for photons in ([100000, 1000000] if a.quick else [100000, 300000, 1000000, 3000000]):
             b.method(scene, mesh, ref, w, "photon mapping (k=100)",
                      ["photonmap", "--photons", str(photons), "--k_nearest", "100"], noise)
