@@ -173,8 +173,13 @@ def main():
                          ["radiosity", "--form_factor_method", "Hemicube", "--hemicube_resolution", str(res),
                           "--light_samples", "1024", "--gather_rays", "512"], noise)
         for photons in ([100000, 1000000] if a.quick else [100000, 300000, 1000000, 3000000]):
-            b.method(scene, mesh, ref, w, "photon mapping (k=100)",
-                     ["photonmap", "--photons", str(photons), "--k_nearest", "100"], noise)
+            b.method(scene, mesh, ref, w, "photon mapping, photons only (k=100)",
+                     ["photonmap", "--photons", str(photons), "--k_nearest", "100", "--direct_light", "false"], noise)
+            b.method(scene, mesh, ref, w, "photon mapping, direct apart (k=100)",
+                     ["photonmap", "--photons", str(photons), "--k_nearest", "100", "--light_samples", "1024"], noise)
+            b.method(scene, mesh, ref, w, "photon mapping, final gather (k=100, 256 rays)",
+                     ["photonmap", "--photons", str(photons), "--k_nearest", "100", "--light_samples", "1024",
+                      "--final_gather", "true", "--gather_rays", "256"], noise)
     # Time and memory against the patch count (Gauss-Seidel, 1024 rays per patch).
     sizes = ["cornell_box", "cornell_box_10k"] + ([] if a.quick else ["cornell_box_100k"])
     scaling = []

@@ -5,6 +5,8 @@
 
 #include "gi/color.h"
 #include "gi/emitters.h"
+#include "gi/form_factor_analytic.h"
+#include "gi/form_factors.h"
 #include "gi/sampling.h"
 
 namespace gi {
@@ -107,5 +109,116 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable face got 0");
   return out;
 }
+
+namespace {
+
+// Direct irradiance from the emitters at points of the scene. With up to 256
+// emitter faces: the exact point-to-triangle factor to every emitter face
+// times the visibility of one shadow ray to a random point on it (Wallace et
+// al. 1989); with more: power-proportional point sampling.
+class DirectLight {
+ public:
+  DirectLight(const Scene& s, const RayCaster& c) : s_(s), caster_(c), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+    const auto ok = usableFaceMask(s);
+    for (size_t f = 0; f < s.faceCount(); ++f)
+      if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
+    analytic_ = emitters_.size() <= 256;
+    unoccluded_ = pairwiseUnoccluded(s);
+  }
+  bool unoccluded() const { return unoccluded_; }
+  bool empty() const { return lights_.empty(); }
+  float eps() const { return eps_; }
+  // Shadow rays per estimate() call.
+  int raysPerPoint() const { return analytic_ ? int(emitters_.size()) : 1; }
+
+  glm::vec3 estimate(const glm::vec3& x, const glm::vec3& n, SobolOwenStream& lsmp, Rng& rng, uint32_t skip) const {
+    if (!analytic_) {
+      const glm::vec2 uDir = lsmp.next();  // a second point of the same stream: decorrelated enough here
+      return sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, {rng.next(), rng.next()}, uDir, eps_);
+    }
+    glm::dvec3 sum(0.0);
+    for (uint32_t L : emitters_) {
+      if (L == skip) continue;
+      const auto& te = s_.triangles[L];
+      const glm::vec3 nL = faceNormalUnnormalized(s_, L);
+      if (glm::dot(nL, x - s_.positions[te.x]) <= 0.f) continue;  // behind the emitter: it emits one-sided
+      const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s_.positions[te.x]),
+                                                 glm::dvec3(s_.positions[te.y]), glm::dvec3(s_.positions[te.z]));
+      if (F <= 0) continue;
+      const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
+      const glm::vec3 y = ub.x * s_.positions[te.x] + ub.y * s_.positions[te.y] + (1.f - ub.x - ub.y) * s_.positions[te.z];
+      const glm::vec3 w = y - x;
+      const float r = glm::length(w);
+      Ray ray;
+      ray.o = x;
+      ray.d = w / r;
+      ray.tfar = r * (1.f - 1e-4f) - eps_;
+      if (!unoccluded_ && ray.tfar > 0.f && caster_.occluded(ray)) continue;
+      sum += F * glm::dvec3(s_.faceEmission(L));
+    }
+    return glm::vec3(sum);
+  }
+
+ private:
+  const Scene& s_;
+  const RayCaster& caster_;
+  EmitterSampler lights_;
+  float eps_;
+  std::vector<uint32_t> emitters_;
+  bool analytic_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
+};
+
+}  // namespace
+
+std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                             const Progress& progress) {
+  if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
+  std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
+  const DirectLight direct(s, caster);
+  if (direct.empty()) return H;
+  const auto ok = usableFaceMask(s);
+  const int points = std::max(1, lightSamples / direct.raysPerPoint());
+  parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!ok[i]) continue;
+      const auto& t = s.triangles[i];
+      const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
+      SobolOwenStream pts(hash3(uint32_t(i), seed, 0xd3u)), lsmp(hash3(uint32_t(i), seed, 0xd4u));
+      Rng rng(hash3(uint32_t(i), seed, 0xd5u));
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < points; ++k) {
+        const glm::vec2 bc = uniformTriangle(pts.next());
+        const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
+        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] +
+                            n * direct.eps();
+        sum += glm::dvec3(direct.estimate(x, n, lsmp, rng, uint32_t(i)));
+      }
+      H[i] = glm::vec3(sum / double(points));
+    }
+  });
+  return H;
+}
+
+std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                              const Progress& progress) {
+  const VertexMaterial mat = vertexMaterial(s);
+  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  const DirectLight direct(s, caster);
+  if (direct.empty()) return H;
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, direct.eps());
+  const int points = std::max(1, lightSamples / direct.raysPerPoint());
+  parallelBlocks(s.vertexCount(), progress, "direct light at vertices", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!mat.valid[i]) continue;
+      SobolOwenStream lsmp(hash3(uint32_t(i), seed, 0xd6u));
+      Rng rng(hash3(uint32_t(i), seed, 0xd7u));
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < points; ++k) sum += glm::dvec3(direct.estimate(origins[i], mat.n[i], lsmp, rng, kNoHit));
+      H[i] = glm::vec3(sum / double(points));
+    }
+  });
+  return H;
+}
+
 
 }  // namespace gi

@@ -36,6 +36,14 @@ struct VertexMaterial {
 };
 VertexMaterial vertexMaterial(const Scene& s);
 
+// Direct irradiance per face from the emitters (shadow rays, power sampling).
+std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                             const Progress& progress = Progress(nullptr));
+
+// The same at every vertex (used for the per-vertex output).
+std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                              const Progress& progress = Progress(nullptr));
+
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt,
                                const Progress& progress = Progress(nullptr));
 

@@ -43,4 +43,11 @@ class RayCaster;
 glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
                                  const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip = 0xffffffffu);
 
+// The same with multiple importance sampling (power heuristic): one light
+// sample and one cosine-weighted direction, whose emitter hits count too.
+// Bounded where the plain estimate is heavy-tailed (points on or next to an
+// emitter). s is the scene the sampler was built on.
+glm::vec3 sampleDirectIrradianceMIS(const EmitterSampler& lights, const Scene& s, const RayCaster& caster,
+                                    const glm::vec3& x, const glm::vec3& n, glm::vec2 uLight, glm::vec2 uDir, float eps);
+
 }  // namespace gi

@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/direct.h"
 #include "gi/form_factors.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
@@ -54,14 +55,6 @@ struct RadiosityResult {
 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                const Progress& progress = Progress(nullptr));
-
-// Direct irradiance per face from the emitters (shadow rays, power sampling).
-std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                             const Progress& progress = Progress(nullptr));
-
-// The same at every vertex (used for the per-vertex output).
-std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                              const Progress& progress = Progress(nullptr));
 
 // Solvers on precomputed rows and direct irradiance (exposed for tests).
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
