@@ -27,6 +27,10 @@ QString FilterPhotonMapPlugin::filterInfo(FilterIDType) const {
          "k nearest photons on the same side of the surface, <i>H &asymp; &sum; &Phi;<sub>p</sub> / (&pi; "
          "r<sub>k</sub><sup>2</sup>)</i>, and the radiosity is <i>B = E + &rho; H</i>. More photons: less noise; "
          "larger k: less noise but more blur.<br>"
+         "By default the <b>direct light</b> is computed apart at every vertex by light sampling with shadow rays "
+         "(soft shadows, no photon noise) and only photons that bounced at least once give the indirect light "
+         "(Jensen's split). The optional <b>final gather</b> reads the photon map where cosine-weighted rays from the "
+         "vertex land, which smooths the indirect light further.<br>"
          "Emitters, reflectance and output conventions are those of 'GI: Radiosity', so the two compare directly.";
 }
 
