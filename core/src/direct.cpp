@@ -1,6 +1,8 @@
 #include "gi/direct.h"
 
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -145,15 +147,9 @@ class DirectLight {
       const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s_.positions[te.x]),
                                                  glm::dvec3(s_.positions[te.y]), glm::dvec3(s_.positions[te.z]));
       if (F <= 0) continue;
-      const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
-      const glm::vec3 y = ub.x * s_.positions[te.x] + ub.y * s_.positions[te.y] + (1.f - ub.x - ub.y) * s_.positions[te.z];
-      const glm::vec3 w = y - x;
-      const float r = glm::length(w);
-      Ray ray;
-      ray.o = x;
-      ray.d = w / r;
-      ray.tfar = r * (1.f - 1e-4f) - eps_;
-      if (!unoccluded_ && ray.tfar > 0.f && caster_.occluded(ray)) continue;
+      if (!unoccluded_ &&
+          !visibleToRandomPoint(caster_, x, s_.positions[te.x], s_.positions[te.y], s_.positions[te.z], rng, eps_))
+        continue;
       sum += F * glm::dvec3(s_.faceEmission(L));
     }
     return glm::vec3(sum);
@@ -220,5 +216,35 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
   return H;
 }
 
+
+std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&)>& value) {
+  std::vector<glm::vec3> faceN(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f);
+  }
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(analyzeScene(s).rayEpsilon));
+  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t v = b; v < e; ++v) {
+      if (!mat.valid[v]) continue;
+      SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
+      const Frame frame(mat.n[v]);
+      glm::dvec3 sum(0.0);
+      Ray ray;
+      ray.o = origins[v];
+      for (int k = 0; k < rays; ++k) {
+        ray.d = frame.toWorld(cosineHemisphere(seq.next()));
+        ray.tfar = std::numeric_limits<float>::infinity();
+        const Hit h = caster.intersect(ray);
+        if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f)
+          sum += glm::dvec3(value(h.face, ray.o + ray.d * h.t));
+      }
+      H[v] = glm::vec3(sum / double(rays));
+    }
+  });
+  return H;
+}
 
 }  // namespace gi

@@ -77,16 +77,9 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
       const double f = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), pa, pb, pc);
       if (f <= 0) continue;
       if (!unoccluded_) {
-        const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
-        const glm::vec3 y = ub.x * s_.positions[tj.x] + ub.y * s_.positions[tj.y] + (1.f - ub.x - ub.y) * s_.positions[tj.z];
-        const glm::vec3 w = y - x;
-        const float len = glm::length(w);
-        Ray ray;
-        ray.o = x;
-        ray.d = w / len;
-        ray.tfar = len * (1.f - 1e-4f) - eps_;
         ++rays;
-        if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
+        if (!visibleToRandomPoint(caster_, x, s_.positions[tj.x], s_.positions[tj.y], s_.positions[tj.z], rng, eps_))
+          continue;
       }
       F += f;
     }

@@ -210,36 +210,25 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   std::vector<glm::vec3> Hd;
   if (opt.directLight) Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.5, 0.7));
   const double directSeconds = directTimer.seconds();
-  const float eps = float(analyzeScene(s).rayEpsilon);
-  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
     const glm::vec3 n = faceNormalUnnormalized(s, f);
     faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f);
   }
   Timer queryTimer;
-  parallelBlocks(nv, progress.sub(0.7, 1.0), gatherMap ? "final gather" : "density estimation", [&](size_t b, size_t e) {
+  // Final gather: cosine rays from each vertex; each hit's reflected radiosity rho H_photons.
+  std::vector<glm::vec3> gathered;
+  if (gatherMap)
+    gathered = finalGather(s, caster, mat, opt.gatherRays, opt.seed ^ 0x6au, [&](uint32_t f, const glm::vec3& y) {
+      return s.faceRho(f) * gatherMap->irradiance(y, faceN[f], opt.kNearest, r2max, nullptr);
+    });
+  parallelBlocks(nv, progress.sub(0.7, 1.0), "density estimation", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
       double err = 0;
       glm::vec3 H(0.f);
       if (gatherMap) {
-        // Final gather: cosine rays; each hit's reflected radiosity rho H_photons.
-        SobolOwenStream seq(hash3(uint32_t(i), opt.seed, 0x6au));
-        const Frame frame(mat.n[i]);
-        glm::dvec3 sum(0.0);
-        Ray ray;
-        ray.o = origins[i];
-        for (int k = 0; k < opt.gatherRays; ++k) {
-          ray.d = frame.toWorld(cosineHemisphere(seq.next()));
-          ray.tfar = std::numeric_limits<float>::infinity();
-          const Hit h = caster.intersect(ray);
-          if (!h.valid() || glm::dot(ray.d, faceN[h.face]) >= 0.f) continue;
-          const glm::vec3 y = ray.o + ray.d * h.t;
-          sum += glm::dvec3(s.faceRho(h.face) * gatherMap->irradiance(y, faceN[h.face], opt.kNearest, r2max, nullptr));
-        }
-        H = glm::vec3(sum / double(opt.gatherRays));
-      } else {
+        H = gathered[i];      } else {
         H = vertexMap.irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, &err);
       }
       if (opt.directLight) H += Hd[i];

@@ -321,33 +321,9 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed);
     std::vector<glm::vec3> Hi;
     if (opt.vertexOutput == RadiosityVertexOutput::FinalGather) {
-      Hi.assign(s.vertexCount(), glm::vec3(0.f));
-      std::vector<glm::vec3> R(res.B.size());
-      std::vector<glm::vec3> faceN(res.B.size());
-      for (size_t f = 0; f < R.size(); ++f) {
-        R[f] = res.Rgather[f];
-        const glm::vec3 n = faceNormalUnnormalized(s, f);
-        faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f);
-      }
-      const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(analyzeScene(s).rayEpsilon));
-      parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
-        for (size_t v = b; v < e; ++v) {
-          if (!mat.valid[v]) continue;
-          SobolOwenStream seq(hash3(uint32_t(v), opt.seed, 0xf9u));
-          const Frame frame(mat.n[v]);
-          glm::dvec3 sum(0.0);
-          Ray ray;
-          ray.o = origins[v];
-          for (int k = 0; k < opt.gatherRays; ++k) {
-            // Cosine-weighted: the irradiance estimate is the mean of the radiosity seen.
-            ray.d = frame.toWorld(cosineHemisphere(seq.next()));
-            ray.tfar = std::numeric_limits<float>::infinity();
-            const Hit h = caster.intersect(ray);
-            if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f) sum += glm::dvec3(R[h.face]);
-          }
-          Hi[v] = glm::vec3(sum / double(opt.gatherRays));
-        }
-      });
+      // Cosine-weighted: the irradiance estimate is the mean of the reflected radiosity seen.
+      Hi = finalGather(s, caster, mat, opt.gatherRays, opt.seed,
+                       [&res](uint32_t f, const glm::vec3&) { return res.Rgather[f]; });
       res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
     } else {
       Hi = faceToVertex(s, res.Hindirect);

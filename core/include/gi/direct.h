@@ -4,6 +4,7 @@
 // estimated by sampling emitter points in proportion to power, with shadow rays.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -43,6 +44,12 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
 // The same at every vertex (used for the per-vertex output).
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                               const Progress& progress = Progress(nullptr));
+
+// Final gather at every vertex: the mean over `rays` cosine-weighted rays of
+// value(face hit, point hit), for hits on a face's front (0 otherwise) — an
+// irradiance estimate when value is the radiosity leaving the hit point.
+std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&)>& value);
 
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt,
                                const Progress& progress = Progress(nullptr));

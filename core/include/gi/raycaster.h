@@ -50,6 +50,12 @@ class RayCaster {
   }
 };
 
+struct Rng;
+// Whether x sees a uniformly random point of triangle (a, b, c): one shadow
+// ray stopping short of the point (eps and a relative margin).
+bool visibleToRandomPoint(const RayCaster& caster, const glm::vec3& x, const glm::vec3& a, const glm::vec3& b,
+                          const glm::vec3& c, Rng& rng, float eps);
+
 enum class BatchMode { Single, Packet8, Stream };  // how batches reach Embree
 
 // Builds over the scene's usable faces (see usableFaceMask).
