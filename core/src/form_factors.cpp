@@ -21,10 +21,18 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
   area_.resize(s.faceCount());
   normal_.resize(s.faceCount());
   rays_.assign(s.faceCount(), 0);
+  farSkipped_.assign(s.faceCount(), 0);
+  centroid_.assign(s.faceCount(), glm::dvec3(0.0));
+  radius_.assign(s.faceCount(), 0.0);
   for (size_t f = 0; f < s.faceCount(); ++f) {
     area_[f] = ok_[f] ? faceArea(s, f) : 0.0;
     const glm::vec3 n = faceNormalUnnormalized(s, f);
     normal_[f] = ok_[f] ? glm::normalize(n) : glm::vec3(0.f);
+    const auto& t = s.triangles[f];
+    if (ok_[f]) {
+      centroid_[f] = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
+      for (int k = 0; k < 3; ++k) radius_[f] = std::max(radius_[f], glm::length(glm::dvec3(s.positions[t[k]]) - centroid_[f]));
+    }
   }
   if (set_.method == FormFactorMethod::Auto) {
     // Exact-per-point factors are affordable for small scenes (n^2 work);
@@ -34,6 +42,12 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
     set_.method = usable <= 2000 ? FormFactorMethod::Analytic : FormFactorMethod::MonteCarlo;
   }
   if (set_.method == FormFactorMethod::Analytic) unoccluded_ = pairwiseUnoccluded(s);
+}
+
+uint64_t FormFactors::farPairsSkipped() const {
+  uint64_t t = 0;
+  for (uint64_t r : farSkipped_) t += r;
+  return t;
 }
 
 double FormFactors::matrixBytesBound() const {
@@ -66,9 +80,13 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
   }
   Rng rng(hash3(i, set_.seed, 0xf4u));
   double total = 0;
-  uint64_t rays = 0;
+  uint64_t rays = 0, far = 0;
   for (uint32_t j = 0; j < uint32_t(s_.faceCount()); ++j) {
     if (j == i || !ok_[j]) continue;
+    // Negligible far pairs: F <= A_j / (pi d^2) for any point of i, with d a
+    // lower bound of the distance between the two triangles' bounding spheres.
+    const double d = glm::length(centroid_[i] - centroid_[j]) - radius_[i] - radius_[j];
+    if (d > 0 && area_[j] / (M_PI * d * d) < kNegligibleF) { ++far; continue; }
     const auto& tj = s_.triangles[j];
     const glm::dvec3 pa(s_.positions[tj.x]), pb(s_.positions[tj.y]), pc(s_.positions[tj.z]);
     double F = 0;
@@ -91,6 +109,7 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     }
   }
   rays_[i] += rays;
+  farSkipped_[i] += far;
   r.escaped = float(std::max(0.0, 1.0 - total));
   return r;
 }

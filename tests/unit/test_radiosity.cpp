@@ -335,3 +335,28 @@ TEST(FormFactors, PointToPolygonClosedForms) {
   EXPECT_GT(upper, 0.0);
   EXPECT_EQ(pointToTriangleFormFactor(x, n, {0, 0, -1}, {1, 0, -1}, {0, 1, -1}), 0.0);  // behind
 }
+
+// Negligible far pairs are skipped by a distance bound, without changing the
+// factors that matter: plates at distance 1 plus a copy 1,000 away (face
+// pairs across: F < 1e-8). Tolerance 5e-3: the ray offset, a fraction of the
+// now larger scene, lifts the sample points by 0.01.
+TEST(FormFactors, FarPairsSkipped) {
+  auto near = scenes::parallelPlates(1.0, 4);
+  Scene s = near.scene;
+  Scene far = test::transformed(near.scene, 1.0, glm::dvec3(1e3, 0, 0));
+  s.append(far);
+  auto caster = makeEmbreeCaster(s);
+  FormFactors ff(s, *caster, {FormFactorMethod::Analytic, 0, 8, 64, 0});
+  std::vector<FormFactorRow> rows(s.faceCount());
+  for (uint32_t i = 0; i < s.faceCount(); ++i) rows[i] = ff.row(i);
+  EXPECT_GE(ff.farPairsSkipped(), uint64_t(near.scene.faceCount()) * near.scene.faceCount());
+  const auto alone = allRows(near.scene, 0, 0, FormFactorMethod::Analytic, 8);
+  const size_t half = near.scene.faceCount() / 2;
+  double F = 0, Falone = 0, Aa = 0;
+  for (size_t i = 0; i < half; ++i) {
+    for (size_t k = 0; k < rows[i].j.size(); ++k) if (rows[i].j[k] >= half && rows[i].j[k] < 2 * half) F += faceArea(s, i) * rows[i].F[k];
+    for (size_t k = 0; k < alone[i].j.size(); ++k) if (alone[i].j[k] >= half) Falone += faceArea(s, i) * alone[i].F[k];
+    Aa += faceArea(s, i);
+  }
+  EXPECT_NEAR(F / Aa, Falone / Aa, 5e-3);
+}

@@ -48,6 +48,8 @@ class FormFactors {
   size_t patchCount() const { return area_.size(); }
   double area(uint32_t i) const { return area_[i]; }
   uint64_t raysCast() const;
+  uint64_t farPairsSkipped() const;  // analytic: pairs with F provably below kNegligibleF
+  static constexpr double kNegligibleF = 1e-7;
   FormFactorMethod method() const { return set_.method; }  // never Auto
   bool unoccluded() const { return unoccluded_; }            // visibility rays skipped
   // Upper bound of the bytes a full sparse matrix of these rows needs.
@@ -65,7 +67,10 @@ class FormFactors {
   std::vector<double> area_;
   std::vector<glm::vec3> normal_;
   std::vector<uint8_t> ok_;
-  mutable std::vector<uint64_t> rays_;  // per patch, for the statistics
+  mutable std::vector<uint64_t> rays_;        // per patch, for the statistics
+  mutable std::vector<uint64_t> farSkipped_;  // per patch, for the statistics
+  std::vector<glm::dvec3> centroid_;
+  std::vector<double> radius_;
 };
 
 // One row for study (the "GI: Form Factors of Selected Face" filter): F from
