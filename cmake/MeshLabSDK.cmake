@@ -23,8 +23,9 @@ target_compile_definitions(meshlab_common INTERFACE MESHLAB_SCALAR=float)
 target_link_libraries(meshlab_common INTERFACE "${MESHLAB_COMMON_LIB}"
   Qt5::Core Qt5::Gui Qt5::Widgets Qt5::OpenGL Qt5::Xml Qt5::XmlPatterns GLEW::GLEW OpenGL::GL)
 
-set(GI_PLUGIN_INSTALL_DIR "lib/${CMAKE_LIBRARY_ARCHITECTURE}/meshlab/plugins" CACHE STRING
-    "Plugin folder relative to the install prefix (Debian's MeshLab loads /usr/<this>)")
+# Debian's MeshLab loads plugins from <prefix of its binary>/lib/<arch>/meshlab/plugins,
+# i.e. /usr/lib/<arch>/meshlab/plugins: install there whatever CMAKE_INSTALL_PREFIX is.
+set(GI_PLUGIN_INSTALL_DIR "${MESHLAB_LIB_DIR}/plugins" CACHE PATH "Where MeshLab loads plugins from")
 
 # gi_add_plugin(name sources...): a MeshLab filter plugin module libname.so
 function(gi_add_plugin name)
