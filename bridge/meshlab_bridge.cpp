@@ -1,6 +1,8 @@
 #include "meshlab_bridge.h"
 
 #include <cmath>
+#include <memory>
+#include <utility>
 #include <stdexcept>
 
 #include <vcg/complex/algorithms/update/color.h>
@@ -226,7 +228,12 @@ void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor) {
 
 ProgressFn progressFrom(vcg::CallBackPos* cb) {
   if (!cb) return nullptr;
-  return [cb](int pct, const std::string& stage) {
+  // meshlabserver prints every call's message: pass on only new stages and
+  // steps of 5%, which is also all a progress bar needs.
+  auto last = std::make_shared<std::pair<int, std::string>>(-100, "");
+  return [cb, last](int pct, const std::string& stage) {
+    if (stage == last->second && pct < last->first + 5 && pct < 100) return true;
+    *last = {pct, stage};
     cb(pct, stage.c_str());
     return true;
   };

@@ -241,6 +241,25 @@ def case_formfactors(c):
     check("select exactly one face" in log, "no selection: clear reason")
 
 
+def case_examples(c):
+    # Every shipped example script runs in meshlabserver on the mesh it names.
+    root = os.path.dirname(c.meshes)
+    ex = os.path.join(root, "examples")
+    meshes = {"ambient_occlusion": "bunny", "ambient_occlusion_adaptive": "bunny", "obscurance_bunny": "bunny",
+              "sky_lighting": "floor_wall", "radiosity_cornell": "cornell_box", "radiosity_cornell_one_bounce": "cornell_box",
+              "photonmap_cornell": "cornell_box", "reference_cornell": "cornell_box", "form_factors_face0": "closed_box"}
+    scripts = sorted(f[:-4] for f in os.listdir(ex) if f.endswith(".mlx"))
+    for name in scripts:
+        mesh = os.path.join(c.meshes, meshes.get(name, "cornell_box") + ".ply")
+        out = os.path.join(c.tmp, name + ".ply")
+        if name == "radiosity_selected_faces":  # needs a selection: without one it must say so
+            log = c.server(mesh, os.path.join(ex, name + ".mlx"), out, expect_ok=False)
+            check("no emitters" in log, "%s without a selection explains itself" % name)
+            continue
+        c.server(mesh, os.path.join(ex, name + ".mlx"), out)
+        check(len(vertices(out)) > 0, "example %s runs" % name)
+
+
 def case_bad_input(c):
     # A point cloud, an empty mesh, an invalid parameter, a scene without emitters.
     pc = os.path.join(c.tmp, "points.ply")
@@ -304,7 +323,7 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
          "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Regenerates the example scripts with `gi script` (complete parameter lists,
+# as MeshLab 2020.09's meshlabserver needs). Run after changing a filter's
+# parameters; the meshlabserver_examples test runs every script.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+gi="${GI:-$root/build/tools/gi}"
+ex="$root/examples"
+m="$root/test_meshes"
+"$gi" script ao --rays_per_vertex 512 -o "$ex/ambient_occlusion.mlx"
+"$gi" script ao --target_error 0.005 --max_rays 8192 -o "$ex/ambient_occlusion_adaptive.mlx"
+"$gi" script obscurance --mesh "$m/bunny.ply" --max_distance 20% -o "$ex/obscurance_bunny.mlx"
+"$gi" script sky --sun_direction 0.4,1,0.3 --sun_angular_radius 2 -o "$ex/sky_lighting.mlx"
+"$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 -o "$ex/radiosity_cornell.mlx"
+"$gi" script radiosity --mesh "$m/cornell_box.ply" --bounces 1 --emitter_source 1 --vertex_output "Patch average" \
+  -o "$ex/radiosity_cornell_one_bounce.mlx"
+"$gi" script radiosity --mesh "$m/cornell_box.ply" -o "$ex/radiosity_selected_faces.mlx"
+"$gi" script photonmap --mesh "$m/cornell_box.ply" --emitter_source 1 --photons 1000000 --k_nearest 128 \
+  -o "$ex/photonmap_cornell.mlx"
+"$gi" script reference --mesh "$m/cornell_box.ply" --emitter_source 1 --target_relative_error 0.02 \
+  -o "$ex/reference_cornell.mlx"
+"$gi" script formfactors --face_index 0 --form_factor_method Hemicube -o "$ex/form_factors_face0.mlx"
+echo "examples written to $ex"
