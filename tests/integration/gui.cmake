@@ -29,4 +29,15 @@ else()
     PASS_REGULAR_EXPRESSION "gui_screenshot: FAIL: too little red and green in the screenshot"
     # the check retakes screenshots until it passes; for the control a few s will do
     ENVIRONMENT "GUI_RENDER_WAIT=6")
+
+  # A person's use of our filter: open a mesh, Filters -> Color Creation and
+  # Processing -> GI: Ambient Occlusion -> Apply; MeshLab must log our line.
+  add_test(NAME gui_apply_ambient_occlusion
+    COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/gui_screenshot.sh
+            ${GI_STAGE_DIR}/bin ${PROJECT_SOURCE_DIR}/test_meshes/bunny.ply ${CMAKE_BINARY_DIR}/gui_apply_ao.png)
+  set_tests_properties(gui_apply_ambient_occlusion PROPERTIES
+    TIMEOUT 180
+    LABELS gui
+    SKIP_RETURN_CODE 77
+    ENVIRONMENT "GUI_APPLY_AO=1")
 endif()

@@ -227,6 +227,33 @@ if not xr < xg:
 print(f"{msg}; red left of green (mean x {xr:.0f} < {xg:.0f})")
 PY
 )
+if [[ "${GUI_APPLY_AO:-0}" == 1 ]]; then
+  # Apply "GI: Ambient Occlusion" the way a person does: Filters menu ->
+  # Color Creation and Processing -> GI: Ambient Occlusion -> Apply. The
+  # keyboard walk relies on Debian's MeshLab 2020.09 menus (fixed order).
+  sleep 2
+  xdo mousemove 120 11 click 1; sleep 1
+  for _ in 1 2 3 4 5 6 7; do xdo key Down; done; sleep 0.3
+  xdo key Right; sleep 1
+  for _ in $(seq 1 15); do xdo key Down; done; sleep 0.3
+  xdo key Return; sleep 2
+  dlg=$(xdo search --onlyvisible --name '^GI: Ambient Occlusion$' | head -n 1)
+  [[ -n "$dlg" ]] || { timeout 30 import -window root "$out_png"; fail "the GI: Ambient Occlusion dialog did not open (screenshot: $out_png)"; }
+  # shellcheck disable=SC2034
+  WIDTH='' HEIGHT='' X='' Y='' SCREEN='' WINDOW=''
+  eval "$(xdo getwindowgeometry --shell "$dlg")"
+  xdo mousemove $((X + WIDTH * 3 / 4)) $((Y + HEIGHT - 15)) click 1  # the Apply button
+  for _ in $(seq 1 60); do
+    grep -q "Applied filter GI: Ambient Occlusion" "$tmp/meshlab.log" 2>/dev/null && break
+    sleep 0.5
+  done
+  sleep 2
+  timeout 30 import -window root "$out_png" || fail "import -window root failed"
+  grep -q "GI: Ambient Occlusion: vertices=" "$tmp/meshlab.log" || { ml_log; fail "no log line of GI: Ambient Occlusion (screenshot: $out_png)"; }
+  grep -q "Applied filter GI: Ambient Occlusion" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report the filter applied"; }
+  note "PASS: GI: Ambient Occlusion applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
+  exit 0
+fi
 if [[ "${GUI_NO_CHECK:-0}" == 1 ]]; then
   # Documentation screenshots (scripts/readme_images.sh): no colour check.
   sleep "${GUI_SETTLE:-4}"
