@@ -302,10 +302,5 @@ void writeRadiosity(PreparedRun& run, const std::vector<glm::vec3>& Bvertex, con
   if (bad) stats.note(std::to_string(bad) + " non-finite values written as 0");
 }
 
-void writeRadiometry(PreparedRun& run, VertexRadiometry& r) {
-  VertexOutput out = radiometricOutput(run.bridge.scene, r.B, run.values.getFloat("exposure"));
-  const size_t bad = writeVertexResults(run.bridge, out.quality, out.displayColors());
-  r.stats.add("exposure", out.exposure);
-  if (bad) r.stats.note(std::to_string(bad) + " non-finite values written as 0");
-}
+void writeRadiometry(PreparedRun& run, VertexRadiometry& r) { writeRadiosity(run, r.B, {}, false, r.stats); }
 }  // namespace gi::ml

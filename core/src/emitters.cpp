@@ -63,30 +63,29 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
   return L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea));
 }
 
+glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
+                         glm::vec2 u, float eps, uint64_t* rays) {
+  const auto L = lights.sample(u);
+  glm::vec3 w = L.p - x;
+  const float r2 = glm::dot(w, w);
+  if (!(r2 > 0.f)) return glm::vec3(0.f);
+  const float r = std::sqrt(r2);
+  w /= r;
+  const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
+  if (cx <= 0.f || ce <= 0.f) return glm::vec3(0.f);
+  Ray ray;
+  ray.o = x;
+  ray.d = w;
+  ray.tfar = r * (1.f - 1e-4f) - eps;
+  if (rays) ++*rays;
+  if (ray.tfar > 0.f && caster.occluded(ray)) return glm::vec3(0.f);
+  const float pdfL = L.pdfArea * r2 / ce;  // solid angle
+  return L.E * (0.318309886f * cx / pdfL) * powerHeuristic(pdfL, cx * 0.318309886f);
+}
+
 glm::vec3 sampleDirectIrradianceMIS(const EmitterSampler& lights, const Scene& s, const RayCaster& caster,
                                     const glm::vec3& x, const glm::vec3& n, glm::vec2 uLight, glm::vec2 uDir, float eps) {
-  auto power = [](float a, float b) { return a * a / (a * a + b * b); };
-  glm::vec3 H(0.f);
-  {
-    const auto L = lights.sample(uLight);
-    glm::vec3 w = L.p - x;
-    const float r2 = glm::dot(w, w);
-    if (r2 > 0.f) {
-      const float r = std::sqrt(r2);
-      w /= r;
-      const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
-      if (cx > 0.f && ce > 0.f) {
-        Ray ray;
-        ray.o = x;
-        ray.d = w;
-        ray.tfar = r * (1.f - 1e-4f) - eps;
-        if (ray.tfar <= 0.f || !caster.occluded(ray)) {
-          const float pdfL = L.pdfArea * r2 / ce;
-          H += L.E * (0.318309886f * cx / pdfL) * power(pdfL, cx * 0.318309886f);
-        }
-      }
-    }
-  }
+  glm::vec3 H = sampleLightMIS(lights, caster, x, n, uLight, eps);
   {
     const glm::vec3 w = Frame(n).toWorld(cosineHemisphere(uDir));
     const float cx = glm::dot(n, w);
@@ -101,7 +100,7 @@ glm::vec3 sampleDirectIrradianceMIS(const EmitterSampler& lights, const Scene& s
         const float cosY = -glm::dot(ng, w);
         if (cosY > 0.f && (E.r > 0.f || E.g > 0.f || E.b > 0.f)) {
           const float pdfL = lights.pdfArea(h.face) * h.t * h.t / cosY;
-          H += E * power(cx * 0.318309886f, pdfL);  // pi L_e cos / pdf_B = E, weighted
+          H += E * powerHeuristic(cx * 0.318309886f, pdfL);  // pi L_e cos / pdf_B = E, weighted
         }
       }
     }

@@ -70,8 +70,6 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
 
 namespace {
 
-inline float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
-
 class Tracer {
  public:
   Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
@@ -111,23 +109,8 @@ class Tracer {
     Ray ray;
     ray.o = x;
     if (!lights_.empty()) {
-      const auto L = lights_.sample({rng.next(), rng.next()});
-      glm::vec3 w = L.p - x;
-      const float r2 = glm::dot(w, w);
-      if (r2 > 0.f) {
-        const float r = std::sqrt(r2);
-        w /= r;
-        const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
-        if (cx > 0.f && ce > 0.f) {
-          ray.d = w;
-          ray.tfar = r * (1.f - 1e-4f) - eps_;
-          ++rays;
-          if (ray.tfar <= 0.f || !caster_.occluded(ray)) {
-            const float pdfL = L.pdfArea * r2 / ce;  // solid angle
-            H += L.E * 0.318309886f * cx / pdfL * powerHeuristic(pdfL, cx * 0.318309886f);
-          }
-        }
-      }
+      const glm::vec2 u{rng.next(), rng.next()};
+      H += sampleLightMIS(lights_, caster_, x, n, u, eps_, &rays);
     }
     if (hasSun_) {
       const glm::vec3 w = sunDisk_ ? Frame(o_.sunDirection).toWorld(uniformCone({rng.next(), rng.next()}, sunCos_))

@@ -43,6 +43,16 @@ class RayCaster;
 glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
                                  const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip = 0xffffffffu);
 
+// Multiple importance sampling, power heuristic (Veach 1997): the weight of a
+// sample drawn with density a against another strategy of density b.
+inline float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
+
+// One power-sampled emitter point's irradiance at x (unit normal n),
+// weighted for MIS against cosine-weighted direction sampling; 0 if the
+// shadow ray is blocked. Adds the shadow rays it casts to *rays.
+glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
+                         glm::vec2 u, float eps, uint64_t* rays = nullptr);
+
 // The same with multiple importance sampling (power heuristic): one light
 // sample and one cosine-weighted direction, whose emitter hits count too.
 // Bounded where the plain estimate is heavy-tailed (points on or next to an
