@@ -99,6 +99,7 @@ void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, doub
       case ParamType::Point:
         out.addParam(RichPoint3f(name, vcg::Point3f(s.defVec.x, s.defVec.y, s.defVec.z), label, help));
         break;
+      case ParamType::String: out.addParam(RichString(name, QString::fromStdString(s.defText), label, help)); break;
     }
   }
 }
@@ -125,6 +126,7 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
         v.set(s.name, glm::vec3(p[0], p[1], p[2]));
         break;
       }
+      case ParamType::String: v.set(s.name, in.getString(n).toStdString()); break;
     }
   }
   return v;
@@ -274,6 +276,13 @@ PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::v
   if (r.values.has("reflectance_source"))
     if (auto err = applySceneConventions(r.bridge.scene, r.bridge.attrs, r.values, withEmitters, &r.setupLog))
       throw std::invalid_argument(*err);
+  if (r.values.has("mirror_layers")) {
+    std::vector<LayerRange> layers;
+    for (const LayerPart& p : r.bridge.parts) layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
+    std::string log;
+    if (auto err = applyMaterials(r.bridge.scene, layers, r.values, &log)) throw std::invalid_argument(*err);
+    r.setupLog += "; " + log;
+  }
   r.report = analyzeScene(r.bridge.scene);
   if (r.report.usableFaces() == 0)
     throw std::invalid_argument("the mesh has no usable triangles (" + r.report.summary() + ")");

@@ -20,17 +20,24 @@ QString FilterPhotonMapPlugin::pluginName() const { return "FilterPhotonMapGI"; 
 QString FilterPhotonMapPlugin::filterName(FilterIDType) const { return "GI: Photon Mapping"; }
 
 QString FilterPhotonMapPlugin::filterInfo(FilterIDType) const {
-  return "<b>Photon mapping</b> (Jensen 1996). Pass 1: photons leave the emitters in proportion to their power "
-         "(cosine-distributed directions), bounce on diffuse surfaces with Russian roulette (survival probability = "
-         "the largest reflectance channel, power scaled by &rho;/p so the estimate stays unbiased), and are stored "
-         "where they land in a kd-tree (nanoflann). Pass 2: at every vertex the irradiance is estimated from the "
-         "k nearest photons on the same side of the surface, <i>H &asymp; &sum; &Phi;<sub>p</sub> / (&pi; "
-         "r<sub>k</sub><sup>2</sup>)</i>, and the radiosity is <i>B = E + &rho; H</i>. More photons: less noise; "
-         "larger k: less noise but more blur.<br>"
-         "By default the <b>direct light</b> is computed apart at every vertex by light sampling with shadow rays "
-         "(soft shadows, no photon noise) and only photons that bounced at least once give the indirect light "
-         "(Jensen's split). The optional <b>final gather</b> reads the photon map where cosine-weighted rays from the "
-         "vertex land, which smooths the indirect light further.<br>"
+  return "<b>Photon mapping</b> (Jensen 1996) carries the light radiosity cannot: <b>caustics</b>, light focused "
+         "by a mirror or glass onto a diffuse surface (paths L S+ D).<br>"
+         "<b>Pass 1</b>: photons leave the lights in proportion to their power (emitter faces, and an optional point "
+         "or spot light), bounce on diffuse surfaces with Russian roulette (survival = the largest reflectance "
+         "channel, power scaled by &rho;/p: unbiased), reflect on <b>mirrors</b> and reflect or refract through "
+         "<b>glass</b> (Fresnel reflectance, Snell's law, total internal reflection), and are stored where they land "
+         "on diffuse faces: photons that came through mirrors or glass only in the <b>caustic map</b>, those that "
+         "bounced off a diffuse surface before in the <b>global map</b> (kd-trees, nanoflann).<br>"
+         "<b>Pass 2</b>: at every vertex, <i>B = E + &rho; H</i> with the irradiance H from the direct light "
+         "(explicit light sampling with shadow rays: soft shadows), the caustic map (k nearest caustic photons, cone "
+         "filter) and the global map (k nearest, <i>H &asymp; &sum; &Phi;<sub>p</sub> / (&pi; r<sub>k</sub>"
+         "<sup>2</sup>)</i>), or a <b>final gather</b> that reads it where cosine rays from the vertex land. "
+         "<b>Progressive</b> photon mapping (Hachisuka et al. 2008) shoots passes of photons and shrinks a per-vertex "
+         "radius (alpha = 2/3) so the estimate converges.<br>"
+         "<b>Marking mirrors and glass</b>: load them as their own layers and name them (file name or Layer dialog "
+         "rename) to match 'Mirror layers' / 'Glass layers' (default: any name containing 'mirror' / 'glass'); set "
+         "'Scene extent' to all visible layers. Glass objects must be closed meshes with outward normals. Vertices "
+         "on mirrors and glass get no diffuse radiosity (0).<br>"
          "Emitters, reflectance and output conventions are those of 'GI: Radiosity', so the two compare directly.";
 }
 
@@ -49,7 +56,7 @@ bool FilterPhotonMapPlugin::applyFilter(QAction* a, MeshDocument& md, const Rich
   auto logLine = [this](const std::string& s) { Log("%s", s.c_str()); };
   return ml::guarded(errorMessage, logLine, filterName(ID(a)), [&] {
     ml::PreparedRun run = ml::prepare(md, par, specs(), true);
-    const PhotonOptions opt = PhotonOptions::fromParams(run.values);
+    const PhotonOptions opt = PhotonOptions::fromParams(run.values, run.bridge.scene.origin);
     auto caster = makeEmbreeCaster(run.bridge.scene);
     VertexRadiometry r = computePhotonMap(run.bridge.scene, *caster, opt, Progress(ml::progressFrom(cb)));
     ml::writeRadiometry(run, r);

@@ -351,4 +351,33 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   if (!os) failWrite(path, "writing failed (disk full?)");
 }
 
+void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
+  const size_t nf0 = into.scene.faceCount(), nv0 = into.scene.vertexCount();
+  const size_t nf1 = other.scene.faceCount(), nv1 = other.scene.vertexCount();
+  auto merge = [](auto& a, const auto& b, size_t n0, size_t n1, auto fill) {
+    if (a.empty() && b.empty()) return;
+    a.resize(n0, fill);
+    if (b.empty()) a.insert(a.end(), n1, fill);
+    else a.insert(a.end(), b.begin(), b.end());
+  };
+  merge(into.attrs.faceColor, other.attrs.faceColor, nf0, nf1, glm::u8vec3(188));
+  merge(into.attrs.vertexColor, other.attrs.vertexColor, nv0, nv1, glm::u8vec3(188));
+  merge(into.attrs.faceQuality, other.attrs.faceQuality, nf0, nf1, 0.f);
+  merge(into.attrs.faceSelected, other.attrs.faceSelected, nf0, nf1, uint8_t(0));
+  const bool normals = !into.scene.vertexNormals.empty() || !other.scene.vertexNormals.empty();
+  if (normals) {
+    // Missing normals of one part: computed from its faces.
+    if (into.scene.vertexNormals.empty()) into.scene.vertexNormals = computeVertexNormals(into.scene);
+  }
+  std::vector<glm::vec3> otherNormals = other.scene.vertexNormals;
+  if (normals && otherNormals.empty()) otherNormals = computeVertexNormals(other.scene);
+  const size_t tri0 = into.triangleToFace.empty() ? 0 : into.triangleToFace.back() + 1;
+  into.scene.append(other.scene);
+  if (normals) {
+    into.scene.vertexNormals.resize(nv0);
+    into.scene.vertexNormals.insert(into.scene.vertexNormals.end(), otherNormals.begin(), otherNormals.end());
+  }
+  for (uint32_t t : other.triangleToFace) into.triangleToFace.push_back(uint32_t(tri0 + t));
+}
+
 }  // namespace gi::io

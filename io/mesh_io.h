@@ -17,6 +17,10 @@ struct LoadedMesh {
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure.
 LoadedMesh loadMesh(const std::string& path);
 
+// Appends another mesh as a further part of one scene (attributes that only
+// one of them has are filled with defaults: grey 188 colours, quality 0).
+void appendMesh(LoadedMesh& into, const LoadedMesh& other);
+
 // Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and
 // "quality" (float, if given), faces with colour if attrs has face colours, and optionally
 // extra per-vertex float3 properties (e.g. bent normals as nx, ny, nz).

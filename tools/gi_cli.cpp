@@ -31,6 +31,7 @@ namespace {
 
 struct CommonArgs {
   std::string input, output, mesh, cacheDir, saveReference;
+  std::vector<std::string> layers;  // more files forming one scene with the input
   bool json = false, quiet = false;
   int threads = 0;
   std::map<std::string, std::string> raw;  // parameter texts as given
@@ -79,6 +80,7 @@ json valuesJson(const std::vector<ParamSpec>& specs, const ParamValues& v) {
         j[p.name] = {c.x, c.y, c.z};
         break;
       }
+      case ParamType::String: j[p.name] = v.getString(p.name); break;
     }
   }
   return j;
@@ -97,6 +99,7 @@ std::string defaultText(const ParamSpec& p) {
       return b;
     case ParamType::Direction:
     case ParamType::Point: std::snprintf(b, sizeof b, "%g,%g,%g", p.defVec.x, p.defVec.y, p.defVec.z); return b;
+    case ParamType::String: return "'" + p.defText + "'";
   }
   return "";
 }
@@ -112,7 +115,7 @@ void addParamOptions(CLI::App* sub, const std::vector<ParamSpec>& specs, CommonA
     }
     auto* opt = sub->add_option_function<std::string>(
         "--" + p.name, [&a, name = p.name](const std::string& t) { a.raw[name] = t; }, help);
-    opt->type_name(p.type == ParamType::Distance ? "LEN|PCT%" : p.type == ParamType::Bool ? "BOOL" : "VALUE");
+    opt->type_name(p.type == ParamType::Distance ? "LEN|PCT%" : p.type == ParamType::Bool ? "BOOL" : p.type == ParamType::String ? "TEXT" : "VALUE");
   }
 }
 
@@ -130,6 +133,14 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
   if (a.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(a.threads));
   Timer timer;
   io::LoadedMesh mesh = io::loadMesh(a.input);
+  // Layers as in MeshLab: named by file name, for the mirror/glass patterns.
+  auto baseName = [](const std::string& p) { const size_t k = p.find_last_of('/'); return k == std::string::npos ? p : p.substr(k + 1); };
+  std::vector<LayerRange> layers{{baseName(a.input), 0, mesh.scene.faceCount()}};
+  for (const std::string& file : a.layers) {
+    const size_t off = mesh.scene.faceCount();
+    io::appendMesh(mesh, io::loadMesh(file));
+    layers.push_back({baseName(file), off, mesh.scene.faceCount() - off});
+  }
   if (mesh.scene.faceCount() == 0)
     throw std::invalid_argument(a.input + " has no faces (a point cloud?): these filters need triangles");
   const SceneReport pre = analyzeScene(mesh.scene);
@@ -139,6 +150,11 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
   std::string setupLog;
   if (lighting || findSpec(specs, "reflectance_source"))
     if (auto err = applySceneConventions(mesh.scene, mesh.attrs, v, lighting, &setupLog)) throw std::invalid_argument(*err);
+  if (findSpec(specs, "mirror_layers")) {
+    std::string log;
+    if (auto err = applyMaterials(mesh.scene, layers, v, &log)) throw std::invalid_argument(*err);
+    setupLog += "; " + log;
+  }
   const SceneReport rep = analyzeScene(mesh.scene);
   if (rep.usableFaces() == 0) throw std::invalid_argument(a.input + " has no usable triangles (" + rep.summary() + ")");
   const Progress progress(stderrProgress(a.quiet));
@@ -218,7 +234,7 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
       B = r.Bvertex;
       faceB = r.B;
     } else {
-      VertexRadiometry r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v), progress);
+      VertexRadiometry r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v, mesh.scene.origin), progress);
       stats = r.stats;
       B = r.B;
     }
@@ -293,7 +309,9 @@ int main(int argc, char** argv) {
   for (const FilterDesc& d : allFilters()) {
     CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
     sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required();
-    sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality");
+    sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file)");
+    sub->add_option("--layer", a.layers, "another mesh file in the same scene, like a visible layer in MeshLab "
+                                         "(repeatable; its file name is its layer name)");
     sub->add_flag("--json", a.json, "print a machine-readable summary on stdout");
     sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");
     sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it");

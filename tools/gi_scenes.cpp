@@ -1,4 +1,5 @@
-// gi-scenes OUTDIR [NAME...]: writes the canonical test scenes as NAME.ply.
+// gi-scenes OUTDIR [NAME...]: writes the canonical test scenes as NAME.ply
+// (scenes of several layers, like caustic_cornell, as one file per layer).
 // Face colour = sRGB of rho, face quality = 1 on emitters (the inputs the
 // filters read); vertex colour shows rho, vertex quality is 0.
 #include <cstdio>
@@ -25,15 +26,17 @@ int main(int argc, char** argv) {
   try {
     std::filesystem::create_directories(dir);
     for (const auto& name : names) {
-      const gi::scenes::SceneFile sf = gi::scenes::byName(name);
-      const auto vertexRho = gi::faceToVertex(sf.scene, sf.scene.rho);
-      std::vector<gi::Rgb8> colour;
-      colour.reserve(vertexRho.size());
-      for (const auto& r : vertexRho) colour.push_back(gi::displayMap(r, 1.f));
-      const std::vector<float> quality(sf.scene.vertexCount(), 0.f);
-      const std::string path = (dir / (name + ".ply")).string();
-      gi::io::writePly(path, sf.scene, sf.attrs, quality, colour);
-      std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), sf.scene.vertexCount(), sf.scene.faceCount());
+      for (const auto& layer : gi::scenes::layersByName(name)) {
+        const gi::scenes::SceneFile& sf = layer.file;
+        const auto vertexRho = gi::faceToVertex(sf.scene, sf.scene.rho);
+        std::vector<gi::Rgb8> colour;
+        colour.reserve(vertexRho.size());
+        for (const auto& r : vertexRho) colour.push_back(gi::displayMap(r, 1.f));
+        const std::vector<float> quality(sf.scene.vertexCount(), 0.f);
+        const std::string path = (dir / layer.name).string();
+        gi::io::writePly(path, sf.scene, sf.attrs, quality, colour);
+        std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), sf.scene.vertexCount(), sf.scene.faceCount());
+      }
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gi-scenes: %s\n", e.what());

@@ -37,7 +37,8 @@ VertexMaterial vertexMaterial(const Scene& s) {
   std::vector<double> w(nv, 0.0);
   const auto ok = usableFaceMask(s);
   for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f]) continue;
+    // Mirror and glass faces carry no diffuse radiosity: vertices only on them are not valid.
+    if (!ok[f] || s.faceMaterial(f) != Material::Diffuse) continue;
     const double a = faceArea(s, f);
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = s.triangles[f][k];

@@ -62,6 +62,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       break;
     case FilterKind::PhotonMapping:
       add(lightingSceneSpecs());
+      add(materialSpecs());
       add(PhotonOptions::specs());
       add(displaySpecs());
       break;
@@ -76,6 +77,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       break;
     case FilterKind::PathTracedReference:
       add(lightingSceneSpecs());
+      add(materialSpecs());
       add(PathTraceOptions::specs());
       add(displaySpecs());
       break;
@@ -145,6 +147,9 @@ std::string mlxScript(const std::vector<ScriptStep>& steps, double diagonal) {
             << "\" " << n << "/>\n";
           break;
         }
+        case ParamType::String:
+          o << "  <Param type=\"RichString\" value=\"" << xmlEscape(st.values.getString(p.name)) << "\" " << n << "/>\n";
+          break;
       }
     }
     o << " </filter>\n";

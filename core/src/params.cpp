@@ -37,6 +37,7 @@ ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) 
       case ParamType::Color:
       case ParamType::Direction:
       case ParamType::Point: v.set(s.name, s.defVec); break;
+      case ParamType::String: v.set(s.name, s.defText); break;
     }
   }
   return v;
@@ -98,6 +99,10 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
             return "parameter '" + s.name + "' must be a finite position";
           break;
         }
+        case ParamType::String:
+          if (v.getString(s.name).find_first_of("\n\r\"<>&") != std::string::npos)
+            return "parameter '" + s.name + "' must be one line without the characters \" < > &";
+          break;
       }
     } catch (const std::bad_variant_access&) {
       return "parameter '" + s.name + "' has the wrong type";
@@ -126,6 +131,7 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
         o << num(c.x) << ',' << num(c.y) << ',' << num(c.z);
         break;
       }
+      case ParamType::String: o << '"' << v.getString(s.name) << '"'; break;
     }
   }
   return o.str();
@@ -200,6 +206,7 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         if (n.size() != 3) throw bad("expected x,y,z");
         return glm::vec3(float(n[0]), float(n[1]), float(n[2]));
       }
+      case ParamType::String: return text;
     }
   } catch (const std::invalid_argument& e) {
     if (std::string(e.what()).rfind("--", 0) == 0) throw;

@@ -9,6 +9,7 @@
 #include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/sampling.h"
+#include "gi/specular.h"
 
 namespace gi {
 
@@ -44,8 +45,15 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
        0.27, 0.0, 45},
       {"point_position", "Point light position", "Position of a point light (absolute coordinates).",
        ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
-      {"point_intensity", "Point light intensity (W/sr)", "Radiant intensity of the point light; 0 = none.",
+      {"point_intensity", "Point light intensity (W/sr)", "Radiant intensity of the point or spot light; 0 = none.",
        ParamType::Float, 0.0, 0.0, 1e12},
+      {"point_color", "Point light colour", "Colour of the point or spot light (sRGB).", ParamType::Color, 0, 0, 0, {},
+       glm::vec3(1.f)},
+      {"spot_direction", "Spot direction", "Axis of the spot light's cone.", ParamType::Direction, 0, 0, 0, {},
+       glm::vec3(0.f, -1.f, 0.f)},
+      {"spot_angle", "Spot half angle (deg)",
+       "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining every way.",
+       ParamType::Float, 180.0, 0.0, 180.0},
       seedSpec("paths"),
   };
 }
@@ -63,7 +71,9 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
   o.pointPosition = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
-  o.pointIntensity = glm::vec3(float(v.getFloat("point_intensity")));
+  o.pointIntensity = lin(v.getVec("point_color")) * float(v.getFloat("point_intensity"));
+  o.spotDirection = glm::normalize(v.getVec("spot_direction"));
+  o.spotAngleDeg = float(v.getFloat("spot_angle"));
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }
@@ -87,6 +97,7 @@ class Tracer {
     sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
     sunL_ = sunDisk_ ? o.sunIrradiance / omega : glm::vec3(0.f);
     hasPoint_ = luminance(o.pointIntensity) > 0.f;
+    cosSpot_ = std::cos(glm::radians(std::clamp(o.spotAngleDeg, 0.f, 180.f)));
     if (lights_.empty() && luminance(o.skyRadiance) <= 0.f && !hasSun_ && !hasPoint_)
       throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
                                   "quality), no sky, no sun and no point light");
@@ -132,7 +143,7 @@ class Tracer {
       const float r = std::sqrt(r2);
       w /= r;
       const float cx = glm::dot(n, w);
-      if (cx > 0.f && r2 > 0.f) {
+      if (cx > 0.f && r2 > 0.f && glm::dot(-w, o_.spotDirection) >= cosSpot_) {
         ray.d = w;
         ray.tfar = r * (1.f - 1e-4f);
         ++rays;
@@ -143,8 +154,11 @@ class Tracer {
   }
 
   // Radiance arriving at the ray's origin from direction w, sampled with
-  // solid-angle density pdfB (for the MIS weight of emitters it hits).
-  glm::vec3 radiance(const glm::vec3& o, const glm::vec3& w, float pdfB, int depth, Rng& rng, uint64_t& rays) const {
+  // solid-angle density pdfB (for the MIS weight of emitters it hits);
+  // afterSpecular: the direction came from a mirror or glass (a delta
+  // distribution next-event estimation cannot sample, so emitters count fully).
+  glm::vec3 radiance(const glm::vec3& o, const glm::vec3& w, float pdfB, int depth, Rng& rng, uint64_t& rays,
+                     bool afterSpecular = false) const {
     Ray ray;
     ray.o = o;
     ray.d = w;
@@ -152,20 +166,23 @@ class Tracer {
     const Hit h = caster_.intersect(ray);
     if (!h.valid()) {
       glm::vec3 L = o_.skyRadiance;
-      if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_) L += sunL_ * powerHeuristic(pdfB, sunPdf_);
+      if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
+        L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
       return L;
     }
     const glm::vec3 ng = faceN_[h.face];
+    const Material m = s_.faceMaterial(h.face);
+    if (isSpecular(m)) return specular(o + w * h.t, w, ng, h.face, m, depth, rng, rays);
     const float cosY = -glm::dot(ng, w);
     if (cosY <= 0.f) return glm::vec3(0.f);  // a back face: black, as in the radiosity filter
     glm::vec3 L(0.f);
     const glm::vec3 E = s_.faceEmission(h.face);
     if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
       const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
-      L += E * 0.318309886f * powerHeuristic(pdfB, pdfL);
+      L += E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL));
     }
     const glm::vec3 rho = s_.faceRho(h.face);
-    const float q = std::min(0.95f, std::max({rho.r, rho.g, rho.b}));
+    const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
     if (!(q > 0.f) || depth >= o_.maxDepth) return L;
     float scale = 1.f;
     if (depth >= 3) {  // Russian roulette
@@ -174,6 +191,22 @@ class Tracer {
     }
     const glm::vec3 y = o + w * h.t + ng * eps_;
     return L + rho * 0.318309886f * scale * irradiance(y, ng, depth + 1, rng, rays);
+  }
+
+  // A mirror or glass hit at x: continue in the sampled specular direction.
+  glm::vec3 specular(const glm::vec3& x, const glm::vec3& w, const glm::vec3& ng, uint32_t face, Material m, int depth,
+                     Rng& rng, uint64_t& rays) const {
+    if (depth >= o_.maxDepth) return glm::vec3(0.f);
+    const float ior = s_.ior.empty() ? 1.5f : s_.ior[face];
+    const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(face), ior, rng.next());
+    glm::vec3 weight = ev.weight * ev.radianceScale;
+    if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
+      const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
+      if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return glm::vec3(0.f);
+      weight /= q;
+    }
+    const glm::vec3 y = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
+    return weight * radiance(y, ev.d, 0.f, depth + 1, rng, rays, true);
   }
 
   const Scene& s_;
@@ -185,6 +218,7 @@ class Tracer {
   float sunCos_ = 1.f, sunPdf_ = 0.f;
   glm::vec3 sunL_{0.f};
   bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
+  float cosSpot_ = -1.f;
 };
 
 struct Accum {

@@ -66,6 +66,7 @@ uint64_t sceneHash(const Scene& s) {
     const glm::vec3 r = s.faceRho(f), e = s.faceEmission(f);
     const auto m = uint8_t(s.faceMaterial(f));
     mix(&r, sizeof r); mix(&e, sizeof e); mix(&m, 1);
+    if (s.faceMaterial(f) == Material::Glass) { const float n = s.ior.empty() ? 1.5f : s.ior[f]; mix(&n, sizeof n); }
   }
   return h;
 }

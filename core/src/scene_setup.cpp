@@ -1,7 +1,12 @@
 #include "gi/scene_setup.h"
 
+#include <fnmatch.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <sstream>
 
 namespace gi {
 
@@ -42,6 +47,93 @@ std::vector<ParamSpec> lightingSceneSpecs() {
                "default reproduces the Cornell box light of radiance (17, 12, 4): E = pi x 17 for red.",
                ParamType::Float, 53.407, 0.0, 1e12});
   return s;
+}
+
+std::vector<ParamSpec> materialSpecs() {
+  std::vector<ParamSpec> s;
+  ParamSpec mirror{"mirror_layers", "Mirror layers",
+                   "Layers that are perfect mirrors: comma-separated layer names as the Layer dialog shows them (the "
+                   "file name unless renamed; double-click a layer to rename it), with * matching any text, e.g. "
+                   "'mirror*, *.stl'. Case does not matter. Empty: no mirrors.",
+                   ParamType::String};
+  mirror.defText = "*mirror*";
+  s.push_back(mirror);
+  ParamSpec glass{"glass_layers", "Glass layers",
+                  "Layers made of glass (a smooth dielectric: Fresnel reflection, refraction, total internal "
+                  "reflection). Give each glass object as a closed mesh with outward normals. Same patterns as for "
+                  "mirrors; empty: no glass.",
+                  ParamType::String};
+  glass.defText = "*glass*";
+  s.push_back(glass);
+  s.push_back({"ior", "Index of refraction",
+               "Index of refraction of the glass (1.5: window glass, 1.33: water, 2.42: diamond; 1.0 makes the glass "
+               "vanish).",
+               ParamType::Float, 1.5, 1.0, 4.0});
+  s.push_back({"specular_color", "Mirror and glass colour",
+               "Reflectance of the mirrors and transmittance tint of the glass (sRGB; white = a perfect mirror and "
+               "clear glass).",
+               ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)});
+  return s;
+}
+
+bool matchesLayerPatterns(const std::string& name, const std::string& patterns) {
+  std::stringstream ss(patterns);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const size_t a = item.find_first_not_of(" \t"), b = item.find_last_not_of(" \t");
+    if (a == std::string::npos) continue;
+    if (fnmatch(item.substr(a, b - a + 1).c_str(), name.c_str(), FNM_CASEFOLD) == 0) return true;
+  }
+  return false;
+}
+
+std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange>& layers, const ParamValues& v,
+                                          std::string* log) {
+  const std::string mirrors = v.getString("mirror_layers"), glass = v.getString("glass_layers");
+  const float ior = float(v.getFloat("ior"));
+  if (!(ior >= 1.f)) return std::string("the index of refraction must be >= 1");
+  const glm::vec3 c = v.getVec("specular_color");
+  const glm::vec3 tint(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
+  const size_t nf = s.faceCount();
+  s.material.assign(nf, Material::Diffuse);
+  s.ior.assign(nf, ior);
+  std::string msg;
+  size_t keptEmitters = 0;
+  for (const LayerRange& l : layers) {
+    const bool m = matchesLayerPatterns(l.name, mirrors), g = matchesLayerPatterns(l.name, glass);
+    if (m && g) return "layer '" + l.name + "' matches both the mirror and the glass patterns";
+    if (!m && !g) continue;
+    const Material mat = m ? Material::Mirror : Material::Glass;
+    size_t count = 0;
+    for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f) {
+      if (luminance(s.faceEmission(f)) > 0.f) { ++keptEmitters; continue; }
+      s.material[f] = mat;
+      s.rho[f] = tint;  // the specular colour (may be 1: a perfect mirror)
+      ++count;
+    }
+    msg += std::string(msg.empty() ? "" : ", ") + "'" + l.name + "' " + (m ? "mirror" : "glass") + " (" +
+           std::to_string(count) + " faces)";
+    if (g) {  // a glass object should be closed: every edge shared by two of its faces
+      std::map<std::pair<uint32_t, uint32_t>, int> edges;
+      for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f)
+        for (int k = 0; k < 3; ++k) {
+          uint32_t a = s.triangles[f][k], b = s.triangles[f][(k + 1) % 3];
+          edges[{std::min(a, b), std::max(a, b)}]++;
+        }
+      const size_t open = size_t(std::count_if(edges.begin(), edges.end(), [](const auto& e) { return e.second != 2; }));
+      if (open) msg += " [not closed: " + std::to_string(open) + " border or non-manifold edges]";
+    }
+  }
+  if (msg.empty()) {
+    msg = "all surfaces diffuse (no layer matches the mirror or glass patterns)";
+  } else {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", ior);
+    msg = "specular: " + msg + ", index of refraction " + b;
+  }
+  if (keptEmitters) msg += "; " + std::to_string(keptEmitters) + " emitter faces in those layers stay diffuse emitters";
+  if (log) *log = msg;
+  return std::nullopt;
 }
 
 std::vector<ParamSpec> displaySpecs() {

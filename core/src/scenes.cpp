@@ -175,6 +175,63 @@ SceneFile cornellBox(double h) {
   return b.finish();
 }
 
+std::vector<NamedLayer> causticCornellLayers(double h, double hf, int sphereSubdiv) {
+  const glm::vec3 white(0.725f, 0.71f, 0.68f), red(0.63f, 0.065f, 0.05f), green(0.14f, 0.45f, 0.091f);
+  const glm::vec3 lightRho(0.78f), lightE = float(kPi) * glm::vec3(17.f, 12.f, 4.f);
+  const dvec3 inside(278.0, 274.4, 279.6);
+  Builder b;
+  auto wall = [&](dvec3 p0, dvec3 p1, dvec3 p2, dvec3 p3, const glm::vec3& r, double patch) {
+    dvec3 n = glm::cross(p2 - p0, p3 - p1);
+    if (glm::dot(n, inside - (p0 + p1 + p2 + p3) * 0.25) < 0.0) n = -n;
+    b.quadH(p0, p1, p2, p3, patch, n, r);
+  };
+  wall({552.8, 0, 0}, {0, 0, 0}, {0, 0, 559.2}, {549.6, 0, 559.2}, white, hf);                // floor
+  wall({549.6, 0, 559.2}, {0, 0, 559.2}, {0, 548.8, 559.2}, {556.0, 548.8, 559.2}, white, h);  // back
+  wall({0, 0, 559.2}, {0, 0, 0}, {0, 548.8, 0}, {0, 548.8, 559.2}, green, h);                   // x = 0
+  wall({552.8, 0, 0}, {549.6, 0, 559.2}, {556.0, 548.8, 559.2}, {556.0, 548.8, 0}, red, h);     // x ~ 556
+  const double xs[4] = {0.0, 213.0, 343.0, 556.0}, zs[4] = {0.0, 227.0, 332.0, 559.2}, yc = 548.8;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (i != 1 || k != 1)
+        wall({xs[i], yc, zs[k]}, {xs[i + 1], yc, zs[k]}, {xs[i + 1], yc, zs[k + 1]}, {xs[i], yc, zs[k + 1]}, white, h);
+  const double yl = 548.7;
+  b.quadH({343, yl, 227}, {343, yl, 332}, {213, yl, 332}, {213, yl, 227}, std::min(h, 26.0), {0, -1, 0}, lightRho, lightE);
+  std::vector<NamedLayer> out;
+  out.push_back({"caustic_cornell_box.ply", b.finish()});
+  // The glass sphere: outward normals (the glass is inside).
+  SceneFile ball = sphere(kGlassRadius, sphereSubdiv, false);
+  {
+    std::vector<dvec3> pts;
+    for (const auto& p : ball.scene.positions) pts.push_back(ball.scene.toWorld(p) + kGlassCentre);
+    Scene moved = Scene::fromAbsolute(pts, ball.scene.triangles);
+    moved.rho.assign(moved.faceCount(), glm::vec3(1.f));
+    moved.emission.assign(moved.faceCount(), glm::vec3(0.f));
+    ball.scene = std::move(moved);
+    refreshAttributes(ball);
+  }
+  out.push_back({"caustic_cornell_glass_sphere.ply", std::move(ball)});
+  Builder m;
+  m.quadH({330, 30, 558.7}, {500, 30, 558.7}, {500, 250, 558.7}, {330, 250, 558.7}, 20.0, {0, 0, -1}, glm::vec3(1.f));
+  out.push_back({"caustic_cornell_mirror.ply", m.finish()});
+  return out;
+}
+
+Scene causticCornell(double h, double hf, int sphereSubdiv, float ior) {
+  const auto layers = causticCornellLayers(h, hf, sphereSubdiv);
+  Scene s = layers[0].file.scene;
+  s.material.assign(s.faceCount(), Material::Diffuse);
+  s.ior.assign(s.faceCount(), ior);
+  const Material mats[3] = {Material::Diffuse, Material::Glass, Material::Mirror};
+  for (size_t k = 1; k < layers.size(); ++k) {
+    Scene part = layers[k].file.scene;
+    part.material.assign(part.faceCount(), mats[k]);
+    part.ior.assign(part.faceCount(), ior);
+    part.rho.assign(part.faceCount(), glm::vec3(1.f));
+    s.append(part);
+  }
+  return s;
+}
+
 SceneFile parallelPlates(double L, int n) {
   Builder b;
   const glm::vec3 black(0.f), E(1.f);
@@ -316,7 +373,14 @@ SceneFile cylindricalHole(double a, double h, int n) {
 
 std::vector<std::string> names() {
   return {"cornell_box", "cornell_box_fine", "parallel_plates", "perpendicular_plates", "furnace_sphere",
-          "closed_box",  "open_plane",       "floor_wall",      "bowl",                 "cylinder_hole"};
+          "closed_box",  "open_plane",       "floor_wall",      "bowl",                 "cylinder_hole",
+          "caustic_cornell"};
+}
+
+std::vector<NamedLayer> layersByName(const std::string& name) {
+  if (name == "caustic_cornell") return causticCornellLayers(50.0, 10.0, 5);
+  if (name == "caustic_cornell_coarse") return causticCornellLayers(50.0, 20.0, 5);  // benchmarks
+  return {{name + ".ply", byName(name)}};
 }
 
 SceneFile byName(const std::string& name) {
@@ -336,6 +400,8 @@ SceneFile byName(const std::string& name) {
   if (name == "floor_wall") return floorWithWall(4.0, 1.0, 20);
   if (name == "bowl") return hemisphericalBowl(1.0, 16);
   if (name == "cylinder_hole") return cylindricalHole(1.0, 1.0, 8);
+  if (name.rfind("caustic_cornell", 0) == 0)
+    throw std::invalid_argument("'" + name + "' has several layers (files): use layersByName");
   throw std::invalid_argument("unknown scene '" + name + "'");
 }
 

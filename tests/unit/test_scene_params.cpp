@@ -556,7 +556,7 @@ TEST(Filters, MlxScriptListsEveryParameterInOrder) {
       ASSERT_NE(q, std::string::npos) << s.name << " missing or out of order";
       const size_t ls = block.rfind("<Param ", q), le = block.find("/>", q);
       const std::string line = block.substr(ls, le - ls);
-      static const char* types[] = {"RichBool", "RichInt", "RichFloat", "RichAbsPerc", "RichEnum", "RichColor", "RichPoint3f", "RichPoint3f"};
+      static const char* types[] = {"RichBool", "RichInt", "RichFloat", "RichAbsPerc", "RichEnum", "RichColor", "RichPoint3f", "RichPoint3f", "RichString"};
       EXPECT_NE(line.find(std::string("type=\"") + types[int(s.type)] + "\""), std::string::npos) << line;
       if (s.type == gi::ParamType::Enum) {
         EXPECT_NE(line.find("enum_cardinality=\"" + std::to_string(s.choices.size()) + "\""), std::string::npos) << line;

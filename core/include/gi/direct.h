@@ -30,7 +30,8 @@ struct VertexRadiometry {
   RunStats stats;
 };
 
-// Per-vertex reflectance, emission and normal from the incident faces (area-weighted).
+// Per-vertex reflectance, emission and normal from the incident diffuse faces
+// (area-weighted); a vertex with none (isolated, or on mirror/glass only) is not valid.
 struct VertexMaterial {
   std::vector<glm::vec3> rho, E, n;
   std::vector<uint8_t> valid;

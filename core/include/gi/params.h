@@ -21,6 +21,7 @@ enum class ParamType {
   Color,      // sRGB in [0,1] (MeshLab colour picker / CLI "r,g,b" 0-255 or #rrggbb)
   Direction,  // a vector, normalised on use
   Point,      // a position (absolute coordinates)
+  String,     // free text (e.g. layer-name patterns)
 };
 
 struct ParamSpec {
@@ -32,9 +33,10 @@ struct ParamSpec {
   std::vector<std::string> choices;        // Enum
   glm::vec3 defVec{0.f};                   // Color, Direction
   bool meshlabOnly = false;                // e.g. layer choice (the CLI has one scene)
+  std::string defText;                     // String
 };
 
-using ParamValue = std::variant<bool, int, double, glm::vec3>;
+using ParamValue = std::variant<bool, int, double, glm::vec3, std::string>;
 
 class ParamValues {
  public:
@@ -44,6 +46,7 @@ class ParamValues {
   int getInt(const std::string& n) const { return std::get<int>(at(n)); }
   double getFloat(const std::string& n) const { return std::get<double>(at(n)); }
   glm::vec3 getVec(const std::string& n) const { return std::get<glm::vec3>(at(n)); }
+  const std::string& getString(const std::string& n) const { return std::get<std::string>(at(n)); }
   const std::map<std::string, ParamValue>& all() const { return v_; }
 
  private:

@@ -6,7 +6,11 @@
 // Russian roulette; at every diffuse vertex the lights are sampled too
 // (next-event estimation) and combined with the BSDF-sampled hits by multiple
 // importance sampling (power heuristic, Veach 1997). Lights: area emitters,
-// a uniform sky, a sun disk and a point light. Random numbers are
+// a uniform sky, a sun disk and a point or spot light. Mirror and glass faces
+// (gi/specular.h) are followed in their sampled specular direction; emitters
+// seen through them count fully (next-event estimation cannot sample them)
+// and shadow rays stop at them. Radiance is scaled by eta^2 across glass
+// (cancelling on paths that enter and leave). Random numbers are
 // independent per (vertex, sample, seed), so the reported standard error is
 // an honest Monte Carlo error bar and the result does not depend on threads.
 #pragma once
@@ -34,6 +38,8 @@ struct PathTraceOptions {
   float sunAngularRadiusDeg = 0.27f;
   glm::vec3 pointPosition{0.f};    // absolute coordinates
   glm::vec3 pointIntensity{0.f};   // W/sr
+  glm::vec3 spotDirection{0.f, -1.f, 0.f};
+  float spotAngleDeg = 180.f;      // half angle of a spot light's cone; 180 = point light
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

@@ -1,12 +1,22 @@
-// Photon mapping (Jensen 1996), first stage: photons emitted from the area
-// emitters in proportion to power, traced with Russian roulette through
-// diffuse surfaces and stored at every diffuse hit (global map, nanoflann
-// kd-tree). Per-vertex radiosity from the k nearest photons on the same side:
-//   B(x) = E(x) + rho(x) * sum_p Phi_p / (pi r_k^2)
-// (the irradiance density estimate with a uniform disk kernel). By default
-// the direct light is computed apart by light sampling and only photons that
-// bounced at least once are read (Jensen 1996's split); an optional final
-// gather reads the map where cosine rays from the vertex land.
+// Photon mapping (Jensen 1996) for the light paths radiosity cannot carry.
+// Photons leave the lights in proportion to power (area emitters; an optional
+// point or spot light), low-discrepancy in position and direction, and are
+// traced with Russian roulette through diffuse (Lambertian), mirror and glass
+// faces (gi/specular.h). Every diffuse hit is stored; by the path so far a
+// photon is
+//   direct   L D      (read only when the direct light is not computed apart),
+//   caustic  L S+ D   (the caustic map),
+//   indirect L ... D D (at least one diffuse bounce before: the global map).
+// Per-vertex radiosity B = E + rho H, with the irradiance H from
+//   - the direct light by explicit light sampling with shadow rays (default),
+//   - the caustic map: density estimate over the k nearest caustic photons on
+//     the same side with Jensen's cone filter (w = 1 - d / (1.1 r)),
+//   - the global map: uniform disk kernel, H ~ sum Phi / (pi r_k^2) over the
+//     k nearest, or a final gather that reads the map where cosine rays from
+//     the vertex land (following mirrors and glass on the way),
+//   - or, with progressive photon mapping (Hachisuka et al. 2008), per-vertex
+//     radius and flux statistics over passes of photons, the radius shrinking
+//     by alpha = 2/3, so that the estimate converges (bias and noise -> 0).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -22,29 +32,51 @@
 namespace gi {
 
 struct PhotonOptions {
-  int photons = 200000;       // emitted photon paths
-  int kNearest = 64;          // photons per estimate
-  double maxRadius = 0.0;     // 0 = unlimited; else gather radius cap
-  int maxDepth = 16;          // diffuse bounces before a path stops for sure
-  bool directLight = true;    // direct light by light sampling at vertices; photons for the indirect part
+  int photons = 200000;       // emitted photon paths (per pass when progressive)
+  int kNearest = 64;          // photons per global-map estimate
+  int causticK = 32;          // photons per caustic-map estimate
+  double maxRadius = 0.0;     // 0 = unlimited; else gather radius cap (absolute)
+  int maxDepth = 32;          // bounces (diffuse and specular) before a path stops for sure
+  bool directLight = true;    // direct light by light sampling at vertices; photons for the rest
   int lightSamples = 256;     // shadow rays per vertex for the direct light
-  bool finalGather = false;   // read the photon map where gather rays land instead of at the vertex
+  bool finalGather = false;   // read the global map where gather rays land instead of at the vertex
   int gatherRays = 64;
+  bool progressive = false;   // progressive photon mapping over `passes` passes
+  int passes = 16;
+  double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
+  glm::vec3 pointPosition{0.f};   // local coordinates
+  glm::vec3 pointIntensity{0.f};  // W/sr, RGB; 0 = no point light
+  glm::vec3 spotDirection{0.f, -1.f, 0.f};
+  float spotAngleDeg = 180.f;     // half angle of the cone; 180 = omnidirectional point light
   uint32_t seed = 0;
   static std::vector<ParamSpec> specs();
-  static PhotonOptions fromParams(const ParamValues& v);
+  static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
+
+enum PhotonPath : uint8_t { kDirectPhoton = 0, kCausticPhoton = 1, kIndirectPhoton = 2 };
 
 struct Photon {
   glm::vec3 p;      // position (local scene coordinates)
   glm::vec3 power;  // RGB flux, W
-  glm::vec3 n;      // unit normal of the surface side it arrived on
-  uint16_t depth;   // diffuse bounces before it arrived (0: straight from a light)
+  glm::i8vec3 n;    // normal of the surface side it arrived on, x 127
+  uint8_t path;     // PhotonPath
+  glm::vec3 normal() const { return glm::vec3(n) * (1.f / 127.f); }
 };
 
-// Traces the photons; deterministic for a seed, any thread count.
-std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                 const Progress& progress, RunStats& stats);
+struct PhotonTraceStats {
+  size_t emitted = 0, stored = 0, caustic = 0, direct = 0, indirect = 0;
+  size_t diffuseBounces = 0, specularBounces = 0, totalInternal = 0;
+  size_t lostAtMaxDepth = 0, escaped = 0;
+  size_t passes = 0;                             // calls of tracePhotons summed here
+  double storedPower = 0.0;                      // luminance, W, summed over passes
+  double emittedPower = 0.0;                     // luminance power of the lights, W
+  double lostPower = 0.0;                        // luminance still carried by paths cut at max depth
+};
+
+// Traces photons `first` .. `first + count - 1` of the seed's sequence (each
+// carrying 1/count of the power); deterministic for any thread count.
+std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
+                                 size_t count, const Progress& progress, PhotonTraceStats& stats);
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                   const Progress& progress = Progress(nullptr));

@@ -38,6 +38,24 @@ std::vector<ParamSpec> displaySpecs();
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
                                                  bool withEmitters, std::string* log = nullptr);
 
+// Mirror and glass (photon mapping and the reference): which layers are
+// specular, by name patterns, and their colour and index of refraction.
+std::vector<ParamSpec> materialSpecs();
+
+// A named range of faces of the scene: a MeshLab layer or an input file.
+struct LayerRange {
+  std::string name;
+  size_t faceOffset = 0, faceCount = 0;
+};
+// Marks the faces of layers whose name matches mirror_layers / glass_layers
+// (comma-separated shell patterns, case-insensitive) as Mirror / Glass with
+// the specular colour and index of refraction. Emitter faces stay diffuse.
+// Returns an error sentence for unusable settings; *log gets a summary.
+std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange>& layers, const ParamValues& v,
+                                          std::string* log = nullptr);
+// True if `name` matches one of the comma-separated patterns.
+bool matchesLayerPatterns(const std::string& name, const std::string& patterns);
+
 // Per-vertex results in the common output convention.
 struct VertexOutput {
   std::vector<float> quality;     // physical scalar (luminance, AO, ...)

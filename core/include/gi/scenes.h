@@ -45,6 +45,22 @@ SceneFile hemisphericalBowl(double radius, int n);
 // Patch edge a / n.
 SceneFile cylindricalHole(double a, double h, int n);
 
+// The caustic Cornell box: the box without its blocks (floor patches of
+// floorPatch), a glass sphere (radius 80 mm, centre kGlassCentre, icosphere
+// of 20 * 4^sphereSubdiv faces) and a mirror on the back wall (x 330..500,
+// y 30..250, z = 558.7, facing the room). Three layers, named as MeshLab would
+// name the shipped files: caustic_cornell_{box,glass_sphere,mirror}.ply.
+struct NamedLayer {
+  std::string name;
+  SceneFile file;
+};
+std::vector<NamedLayer> causticCornellLayers(double patchSize, double floorPatch, int sphereSubdiv);
+inline const glm::dvec3 kGlassCentre{185.0, 180.0, 200.0};
+inline constexpr double kGlassRadius = 80.0;
+// The layers in one scene with the materials applied (mirror_layers
+// '*mirror*', glass_layers '*glass*', the given index of refraction).
+Scene causticCornell(double patchSize, double floorPatch, int sphereSubdiv, float ior);
+
 // Sets uniform reflectance and emission on every face (and the attributes).
 void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E);
 
@@ -52,5 +68,8 @@ void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E);
 std::vector<std::string> names();
 // Throws std::invalid_argument for an unknown name.
 SceneFile byName(const std::string& name);
+// Scenes of several layers (files) by name, e.g. "caustic_cornell"; a
+// one-layer scene for the other names (layer name NAME.ply).
+std::vector<NamedLayer> layersByName(const std::string& name);
 
 }  // namespace gi::scenes

@@ -1,0 +1,38 @@
+// Internal parts of photon mapping shared by its sources.
+#pragma once
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/direct.h"
+#include "gi/photon.h"
+
+namespace gi {
+
+// Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
+// vertices as the measurement points: per vertex a radius R, an accumulated
+// photon count N and flux tau. After each pass of M new photons within R,
+//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) R'^2 / R^2,
+// and H = tau / (pi R^2 passes) (each pass's photons carry the full power / count).
+// The first radius is the distance to the k-th nearest photon of the first pass.
+struct ProgressiveResult {
+  std::vector<glm::vec3> H;
+  std::vector<double> noise;  // Poisson error estimate per vertex (luminance)
+  size_t verticesWithoutPhotons = 0;
+  double meanRadius = 0, meanCount = 0;
+  double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;
+  double peakBytes = 0;
+};
+ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
+                                       const VertexMaterial& mat, unsigned pathMask, const Progress& progress,
+                                       PhotonTraceStats& stats);
+
+// Final gather at every vertex through mirrors and glass: cosine-weighted rays
+// from origins[v] follow specular faces (up to 16 interactions) and, at the
+// first diffuse face, add value(face, point, its unit normal) if the ray hit its front (0 otherwise).
+std::vector<glm::vec3> specularFinalGather(
+    const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
+    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value);
+
+}  // namespace gi

@@ -1,0 +1,125 @@
+// Progressive photon mapping and the specular-aware final gather.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gi/color.h"
+#include "gi/sampling.h"
+#include "gi/specular.h"
+#include "photon_internal.h"
+#include "photon_map.h"
+
+namespace gi {
+
+ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
+                                       const VertexMaterial& mat, unsigned pathMask, const Progress& progress,
+                                       PhotonTraceStats& stats) {
+  const size_t nv = s.vertexCount();
+  ProgressiveResult r;
+  std::vector<float> R2(nv, 0.f);
+  std::vector<double> N(nv, 0.0);
+  std::vector<glm::dvec3> tau(nv, glm::dvec3(0.0));
+  const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
+  // Vertices where the first pass finds fewer than k photons within the cap
+  // start at the cap, or at 1% of the diagonal without one.
+  const float diag = float(analyzeScene(s).diagonal);
+  const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
+  const double alpha = opt.alpha;
+  const size_t count = size_t(opt.photons);
+  for (int pass = 0; pass < opt.passes; ++pass) {
+    const Progress pp = progress.sub(double(pass) / opt.passes, double(pass + 1) / opt.passes);
+    Timer tt;
+    std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.7), stats);
+    r.traceSeconds += tt.seconds();
+    Timer bt;
+    const PhotonMap map(photons, pathMask);
+    r.buildSeconds += bt.seconds();
+    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + map.memoryBytes()));
+    Timer qt;
+    parallelBlocks(nv, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1), [&](size_t b, size_t e) {
+      std::vector<std::pair<uint32_t, float>> scratch;
+      for (size_t i = b; i < e; ++i) {
+        if (!mat.valid[i]) continue;
+        if (pass == 0) {
+          const float k2 = map.kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
+          R2[i] = k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
+        }
+        glm::dvec3 flux;
+        size_t M = 0;
+        map.gather(s.positions[i], mat.n[i], R2[i], flux, M, scratch);
+        if (M == 0) continue;
+        const double ratio = (N[i] + alpha * double(M)) / (N[i] + double(M));
+        N[i] += alpha * double(M);
+        R2[i] = float(double(R2[i]) * ratio);
+        tau[i] = (tau[i] + flux) * ratio;
+      }
+    });
+    r.querySeconds += qt.seconds();
+  }
+  r.H.assign(nv, glm::vec3(0.f));
+  r.noise.assign(nv, 0.0);
+  double sumR = 0, sumN = 0;
+  size_t valid = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    if (!mat.valid[i]) continue;
+    ++valid;
+    sumR += std::sqrt(double(R2[i]));
+    sumN += N[i];
+    if (N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
+    const glm::dvec3 H = tau[i] / (M_PI * double(R2[i]) * opt.passes);
+    r.H[i] = glm::vec3(H);
+    // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
+    r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(N[i]);
+  }
+  r.meanRadius = valid ? sumR / double(valid) : 0.0;
+  r.meanCount = valid ? sumN / double(valid) : 0.0;
+  return r;
+}
+
+std::vector<glm::vec3> specularFinalGather(
+    const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
+    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value) {
+  std::vector<glm::vec3> faceN(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f, 0.f, 1.f);
+  }
+  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t v = b; v < e; ++v) {
+      if (!mat.valid[v]) continue;
+      SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
+      Rng rng(hash3(uint32_t(v), key, 0xfau));
+      const Frame frame(mat.n[v]);
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < rays; ++k) {
+        Ray ray;
+        ray.o = origins[v];
+        ray.d = frame.toWorld(cosineHemisphere(seq.next()));
+        glm::vec3 weight(1.f);
+        for (int bounce = 0; bounce < 16; ++bounce) {
+          const Hit h = caster.intersect(ray);
+          if (!h.valid()) break;
+          const glm::vec3 ng = faceN[h.face];
+          const glm::vec3 y = ray.o + ray.d * h.t;
+          const Material m = s.faceMaterial(h.face);
+          if (!isSpecular(m)) {
+            if (glm::dot(ray.d, ng) < 0.f) sum += glm::dvec3(weight * value(h.face, y, ng));
+            break;
+          }
+          const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
+          const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());
+          weight *= ev.weight * ev.radianceScale;
+          ray.o = y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+          ray.d = ev.d;
+          ray.tnear = 0.f;
+          ray.tfar = std::numeric_limits<float>::infinity();
+        }
+      }
+      H[v] = glm::vec3(sum / double(rays));
+    }
+  });
+  return H;
+}
+
+}  // namespace gi
