@@ -19,5 +19,11 @@ m="$root/test_meshes"
   -o "$ex/photonmap_cornell.mlx"
 "$gi" script reference --mesh "$m/cornell_box.ply" --emitter_source 1 --target_relative_error 0.02 \
   -o "$ex/reference_cornell.mlx"
+# The caustic Cornell box: open caustic_cornell_box.ply, caustic_cornell_glass_sphere.ply and
+# caustic_cornell_mirror.ply as three layers (the glass and the mirror are found by their names).
+"$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
+  --photons 1000000 --caustic_k 32 -o "$ex/photonmap_caustic.mlx"
+"$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
+  --photons 250000 --progressive true --passes 16 -o "$ex/photonmap_caustic_progressive.mlx"
 "$gi" script formfactors --face_index 0 --form_factor_method Hemicube -o "$ex/form_factors_face0.mlx"
 echo "examples written to $ex"

@@ -129,7 +129,7 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
   } else {
     char b[32];
     std::snprintf(b, sizeof b, "%g", ior);
-    msg = "specular: " + msg + ", index of refraction " + b;
+    msg = "specular: " + msg + ", index of refraction " + b + " (their own colours replaced by the mirror and glass colour)";
   }
   if (keptEmitters) msg += "; " + std::to_string(keptEmitters) + " emitter faces in those layers stay diffuse emitters";
   if (log) *log = msg;

@@ -30,10 +30,12 @@ class Ctx:
         subprocess.run([self.gi, "script", filt, "-o", path] + list(params), check=True)
         return path
 
-    def server(self, mesh, script, out=None, expect_ok=True, mask=("vc", "vq")):
-        cmd = [self.mlx_run, "-i", mesh]
+    def server(self, mesh, script, out=None, expect_ok=True, mask=("vc", "vq"), layer=None):
+        cmd = [self.mlx_run]
+        for m in (mesh if isinstance(mesh, list) else [mesh]):
+            cmd += ["-i", m]
         if out:
-            cmd += ["-o", out, "-m"] + list(mask)
+            cmd += ["-o", out] + (["-l", str(layer)] if layer is not None else []) + ["-m"] + list(mask)
         cmd += ["-s", script]
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
         log = p.stdout.decode("utf-8", "replace")
@@ -197,6 +199,51 @@ def case_photonmap(c):
     check(ceil["quality"] > 0.0, "indirect light reaches the ceiling (B = %.4f)" % ceil["quality"])
 
 
+def caustic_layers(c):
+    return [os.path.join(c.meshes, "caustic_cornell_%s.ply" % n) for n in ("box", "glass_sphere", "mirror")]
+
+
+# Light centre (278, 548.7, 279.5) through the glass sphere's centre (185, 180, 200), continued to the floor.
+CAUSTIC_FOCUS = (278 + (185 - 278) * 548.7 / 368.7, 0.0, 279.5 + (200 - 279.5) * 548.7 / 368.7)
+
+
+def case_caustic(c):
+    # Three layers (box, glass sphere, mirror) as one scene; the glass and the mirror are found by their
+    # layer names. The glass sphere focuses the light onto the floor where geometry says it must.
+    layers = caustic_layers(c)
+    out = os.path.join(c.tmp, "caustic.ply")
+    args = ["--mesh", layers[0], "--scene_extent", "All visible layers", "--emitter_source", "1", "--photons", "300000"]
+    log = c.server(layers, c.script("caustic", "photonmap", *args), out, layer=0)
+    check("'caustic_cornell_glass_sphere.ply' glass (20480 faces)" in log and "'caustic_cornell_mirror.ply' mirror" in log,
+          "the log names the glass and mirror layers")
+    m = re.search(r"photons_caustic_map=([0-9.e+]+)", log)
+    check(m is not None and float(m.group(1)) > 1000, "caustic map built (%s photons)" % (m.group(1) if m else "?"))
+    v = vertices(out)
+    focus, under_light = nearest(v, CAUSTIC_FOCUS)["quality"], nearest(v, (278, 0, 279.5))["quality"]
+    check(focus > 2 * under_light, "caustic at the predicted focus: B %.3f vs %.3f under the light" % (focus, under_light))
+    # Without glass (no layer matches): the sphere is a grey diffuse ball and its shadow is dark.
+    out2 = os.path.join(c.tmp, "no_glass.ply")
+    c.server(layers, c.script("noglass", "photonmap", *(args + ["--glass_layers", "none"])), out2, layer=0)
+    dark = nearest(vertices(out2), CAUSTIC_FOCUS)["quality"]
+    check(dark < 0.5 * under_light, "no glass, no caustic: B %.3f in the sphere's shadow" % dark)
+    # The CLI: --layer adds files as layers, named by file name.
+    import json
+    cli = os.path.join(c.tmp, "caustic_cli.ply")
+    p = subprocess.run([c.gi, "photonmap", layers[0], "--layer", layers[1], "--layer", layers[2], "--emitter_source", "1",
+                        "--photons", "300000", "-o", cli, "-q", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "gi photonmap with --layer runs")
+    j = json.loads(p.stdout)
+    check("glass (20480 faces)" in j["setup"] and j["stats"]["photons_caustic_map"] > 1000, "CLI: glass layer and caustic map")
+    vc = vertices(cli)
+    check(nearest(vc, CAUSTIC_FOCUS)["quality"] > 2 * under_light, "CLI: the same caustic")
+    # Progressive photon mapping from meshlabserver.
+    out3 = os.path.join(c.tmp, "ppm.ply")
+    log = c.server(layers, c.script("ppm", "photonmap", *(args[:-1] + ["100000", "--progressive", "true", "--passes", "4"])),
+                   out3, layer=0)
+    check("ppm_passes=4" in log and nearest(vertices(out3), CAUSTIC_FOCUS)["quality"] > 2 * under_light,
+          "progressive photon mapping: the caustic too")
+
+
 def case_reference(c):
     import json
     mesh = os.path.join(c.meshes, "cornell_box.ply")
@@ -251,6 +298,8 @@ def case_examples(c):
     scripts = sorted(f[:-4] for f in os.listdir(ex) if f.endswith(".mlx"))
     for name in scripts:
         mesh = os.path.join(c.meshes, meshes.get(name, "cornell_box") + ".ply")
+        if "caustic" in name:  # three layers
+            mesh = caustic_layers(c)
         out = os.path.join(c.tmp, name + ".ply")
         if name == "radiosity_selected_faces":  # needs a selection: without one it must say so
             log = c.server(mesh, os.path.join(ex, name + ".mlx"), out, expect_ok=False)
@@ -324,7 +373,7 @@ def case_cli(c):
 
 
 CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
-         "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
+         "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()

@@ -408,3 +408,27 @@ TEST(PhotonMap, GlassOfIndexOneVanishes) {
   EXPECT_NEAR(s1 / s0, 1.0, 0.02);
   EXPECT_LT(std::sqrt(d2 / double(n)), 0.06);
 }
+
+// Work the scene does not need is skipped and said: with rho = 0 everywhere
+// and no mirror or glass, the direct light is the whole answer and no photon
+// is traced; without specular faces there is no caustic map.
+TEST(PhotonMap, SkipsWhatTheSceneDoesNotNeed) {
+  auto sf = scenes::parallelPlates(1.0, 4);
+  auto caster = makeEmbreeCaster(sf.scene);
+  PhotonOptions o;
+  o.photons = 10000;
+  const VertexRadiometry r = computePhotonMap(sf.scene, *caster, o);
+  EXPECT_EQ(r.stats.get("photons_emitted", -1.0), -1.0);
+  bool said = false;
+  for (const auto& n : r.stats.notes) said |= n.find("no photons traced") != std::string::npos;
+  EXPECT_TRUE(said);
+  const size_t top = test::nearestVertex(sf.scene, {0, 0, 1});
+  EXPECT_NEAR(r.H[top].g, 0.2394, 0.005);  // point-to-square factor at the centre, 1 apart (direct light only)
+  auto box = scenes::cornellBox(100.0);
+  auto c2 = makeEmbreeCaster(box.scene);
+  const VertexRadiometry r2 = computePhotonMap(box.scene, *c2, o);
+  EXPECT_EQ(r2.stats.get("photons_caustic_map", -1.0), 0.0);
+  said = false;
+  for (const auto& n : r2.stats.notes) said |= n.find("no caustic map") != std::string::npos;
+  EXPECT_TRUE(said);
+}
