@@ -1,6 +1,7 @@
 // A kd-tree (nanoflann) over a subset of the photons and the density
 // estimates read from it. Internal to the photon-mapping sources.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -41,6 +42,8 @@ class PhotonMap {
     float d2[kMaxQuery];
     const float q[3] = {x.x, x.y, x.z};
     const size_t found = tree_->knnSearch(q, want, idx, d2);
+    float d2raw[kMaxQuery];
+    std::copy(d2, d2 + found, d2raw);
     int used = 0;
     float r2 = 0.f;
     const Photon* ph[kMaxQuery];
@@ -54,7 +57,13 @@ class PhotonMap {
       ++used;
     }
     if (used == 0) return glm::vec3(0.f);
-    if (used < k && r2max < HUGE_VALF) r2 = r2max;  // sparse region: the whole disk was searched
+    if (used < k) {
+      // Fewer than k on this side among the candidates: the density is that
+      // of the whole disk examined — up to r2max if the search reached past
+      // it, else up to the farthest candidate (the rest lay on other surfaces).
+      const bool exhausted = found < want || d2raw[found - 1] > r2max;
+      r2 = exhausted && r2max < HUGE_VALF ? r2max : d2raw[found - 1];
+    }
     r2 = std::max(r2, 1e-30f);
     const float r = std::sqrt(r2);
     glm::dvec3 sum(0.0);
