@@ -24,7 +24,9 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   Timer timer;
   MeshRefiner refiner(s);
   RadiosityOptions levelOpt = opt;
-  levelOpt.vertexOutput = RadiosityVertexOutput::PatchAverage;  // intermediate levels need patch values only
+  // Intermediate levels: direct light at the vertices, indirect interpolated (no gather rays).
+  if (levelOpt.vertexOutput == RadiosityVertexOutput::FinalGather)
+    levelOpt.vertexOutput = RadiosityVertexOutput::InterpolatedIndirect;
   const int levels = ro.maxDepth;
   auto stage = [&](int k) { return progress.sub(double(k) / (levels + 1), double(k + 1) / (levels + 1)); };
 
@@ -39,7 +41,7 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
     changed = false;
     const std::vector<float> V =
         ro.shadowThreshold < 1.0 ? emitterVisibility(sc, *rc, ro.visibilityRays, ro.seed) : std::vector<float>();
-    RefineMarks marks = markForRefinement(sc, res.B, V, refiner.mesh().depth, ro);
+    RefineMarks marks = markForRefinement(sc, res.B, res.Bvertex, V, refiner.mesh().depth, ro);
     const size_t n = sc.faceCount(), budget = size_t(ro.maxPatches);
     if (marks.faces.empty()) {
       why = "nothing left above the thresholds";
@@ -74,7 +76,7 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   }
   // The final solve on the refined mesh, with the vertex output asked for.
   const Scene& sc = refiner.mesh().scene;
-  if (changed || opt.vertexOutput != RadiosityVertexOutput::PatchAverage) {
+  if (changed || opt.vertexOutput != levelOpt.vertexOutput) {
     auto rc = caster(sc);
     res = solveRadiosity(sc, *rc, opt, stage(levels));
   }

@@ -89,6 +89,13 @@ struct MeshRefiner::Impl {
       p.redParents.push_back(parent);
       splitAll(parent.v);
     };
+    // Edges that already have a midpoint but are still edges of a face: left
+    // hanging when an undone green parent was red-split next to finer faces.
+    for (uint32_t f = 0; f < n; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t a = faces[f].v[k], b = faces[f].v[(k + 1) % 3];
+        if (midpoint.count(edgeKey(a, b))) splitEdge(a, b);
+      }
     for (uint32_t f : marked)
       if (f < n) mark(f);
     while (!work.empty()) {
@@ -157,7 +164,18 @@ struct MeshRefiner::Impl {
     }
     for (const Tri& t : p.redParents) red(t.v, t.src, t.depth);
     faces.swap(out);
-    publish();
+  }
+
+  // Red-splits `marked` and repeats the closure until no edge hangs (the
+  // children of an undone green parent can border faces split in the same
+  // pass: one more pass splits them in turn).
+  void refineAll(const std::vector<uint32_t>& marked) {
+    apply(plan(marked));
+    for (int pass = 0; pass < 64; ++pass) {
+      const Plan p = plan({});
+      if (p.split.empty()) break;
+      apply(p);
+    }
   }
 
   void publish() {
@@ -207,12 +225,15 @@ MeshRefiner& MeshRefiner::operator=(MeshRefiner&&) noexcept = default;
 const RefinedMesh& MeshRefiner::mesh() const { return impl_->mesh; }
 
 size_t MeshRefiner::faceCountAfter(const std::vector<uint32_t>& faces) const {
-  return impl_->countAfter(impl_->plan(faces));
+  Impl trial = *impl_;
+  trial.refineAll(faces);
+  return trial.faces.size();
 }
 
 size_t MeshRefiner::refine(const std::vector<uint32_t>& faces) {
   const size_t before = impl_->faces.size();
-  impl_->apply(impl_->plan(faces));
+  impl_->refineAll(faces);
+  impl_->publish();
   return impl_->faces.size() - before;
 }
 
@@ -250,8 +271,9 @@ std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, in
   return V;
 }
 
-RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<float>& visibility,
-                              const std::vector<uint8_t>& depth, const RefineOptions& opt) {
+RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<glm::vec3>& Bvertex,
+                              const std::vector<float>& visibility, const std::vector<uint8_t>& depth,
+                              const RefineOptions& opt) {
   const size_t n = s.faceCount();
   const auto ok = usableFaceMask(s);
   std::vector<double> A(n, 0.0), R(n, 0.0);
@@ -282,6 +304,17 @@ RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, c
       const double j = std::fabs(R[f] - R[g]) / std::max({R[f], R[g], floorR, 1e-30});
       jump[f] = std::max(jump[f], j);
       jump[g] = std::max(jump[g], j);
+    }
+  }
+  if (Bvertex.size() == s.vertexCount()) {
+    // The patch's mean against the mean of the linear interpolation of its
+    // corners' values (what is displayed): the interpolation error.
+    for (size_t f = 0; f < n; ++f) {
+      if (!ok[f]) continue;
+      const glm::vec3 E = s.faceEmission(f);
+      double corners = 0;
+      for (int k = 0; k < 3; ++k) corners += std::max(0.0, double(luminance(Bvertex[s.triangles[f][k]] - E))) / 3.0;
+      jump[f] = std::max(jump[f], std::fabs(R[f] - corners) / std::max({R[f], corners, floorR, 1e-30}));
     }
   }
   if (visibility.size() == s.vertexCount()) {

@@ -58,7 +58,8 @@ class MeshRefiner {
 };
 
 struct RefineOptions {
-  int maxDepth = 3;             // red splits per input face at most (levels of refinement)
+  int maxDepth = 3;             // levels; faces at this depth are not chosen (the conformity closure
+                                // may split a neighbour once more where input triangles differ in size)
   int maxPatches = 200000;      // never more faces than this
   double threshold = 0.1;       // relative jump of the reflected radiosity across an edge
   double shadowThreshold = 0.3; // difference of emitter visibility between a face's vertices
@@ -72,18 +73,22 @@ struct RefineOptions {
 // emitter faces the vertex. Deterministic per (vertex, ray, seed).
 std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, int rays, uint32_t seed);
 
-// Faces that need refinement, most needing first: across an edge between
-// faces less than creaseDegrees apart, |R_i - R_j| / max(R_i, R_j, 1% of the
-// area-weighted mean R) > threshold (R = luminance of B - E, the reflected
-// radiosity), or max - min of the vertices' emitter visibility >
+// Faces that need refinement, most needing first. B jumps: across an edge
+// between faces less than creaseDegrees apart, |R_i - R_j| / max(R_i, R_j,
+// 1% of the area-weighted mean R) > threshold (R = luminance of B - E, the
+// reflected radiosity); or, given per-vertex values (else pass {}), between
+// the patch's R and the mean of its corners' R (the error of the displayed
+// linear interpolation), with the same measure and threshold. Shadow
+// boundaries: max - min of the vertices' emitter visibility >
 // shadowThreshold. Priority = area x the larger excess ratio. Faces already
 // at maxDepth are left out.
 struct RefineMarks {
   std::vector<uint32_t> faces;  // by decreasing priority (ties: by index)
   size_t byJump = 0, byShadow = 0;
 };
-RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<float>& visibility,
-                              const std::vector<uint8_t>& depth, const RefineOptions& opt);
+RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<glm::vec3>& Bvertex,
+                              const std::vector<float>& visibility, const std::vector<uint8_t>& depth,
+                              const RefineOptions& opt);
 
 // The attributes of the input mesh carried to the refined one: face colour,
 // quality and selection from the source face; vertex colours of new vertices
