@@ -323,7 +323,59 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+def case_refine(c):
+    """GI: Radiosity with adaptive mesh refinement: the saved layer is the
+    refined mesh; the light, chosen by selection, stays selected, so a second
+    run in the same script finds it again."""
+    mesh = os.path.join(c.meshes, "cornell_box.ply")
+    n_in = len(read_ply(mesh)["face"])
+    fast = ["--mesh", mesh, "--emitter_source", "Selected faces", "--rays_per_patch", "256", "--light_samples", "64",
+            "--gather_rays", "32"]
+    first = open(c.script("ref1", "radiosity", *(fast + ["--refine", "true", "--refine_max_depth", "2"]))).read()
+    again = open(c.script("ref2", "radiosity", *fast)).read()
+    body = lambda t: t[t.index("<filter"):t.rindex("</filter>") + len("</filter>")]
+    select = (' <filter name="Select by Face Quality">\n'
+              '  <Param type="RichDynamicFloat" value="0.5" min="0" max="1" name="minQ"/>\n'
+              '  <Param type="RichDynamicFloat" value="1.5" min="0" max="2" name="maxQ"/>\n'
+              '  <Param type="RichBool" value="true" name="Inclusive"/>\n </filter>\n')
+    path = os.path.join(c.tmp, "refine.mlx")
+    with open(path, "w") as f:
+        f.write("<!DOCTYPE FilterScript>\n<FilterScript>\n" + select + " " + body(first) + "\n " + body(again) +
+                "\n</FilterScript>\n")
+    out = os.path.join(c.tmp, "refined.ply")
+    log = c.server(mesh, path, out, mask=("vc", "vq", "fc", "fq"))
+    runs = re.findall(r"(\d+) emitter faces", log)
+    check(len(runs) >= 2 and int(runs[0]) == 12, "first run: the 12 selected light faces emit (%s)" % runs)
+    check(int(runs[-1]) > 12, "second run on the refined mesh: the light's refined faces are still selected (%s)" % runs[-1])
+    check("refinement stopped" in log and "faces refined" in log, "the log reports the refinement levels")
+    ply = read_ply(out)
+    v, faces = ply["vertex"], ply["face"]
+    check(len(faces) > n_in, "the saved layer is refined: %d faces from %d" % (len(faces), n_in))
+    check(all(math.isfinite(r["quality"]) for r in v), "finite vertex quality everywhere")
+    light = [r for r in v if r["y"] > 548 and 213 < r["x"] < 343 and 227 < r["z"] < 332]
+    floor = nearest(v, (400, 0, 150))
+    check(light and min(r["quality"] for r in light) > 10 * floor["quality"],
+          "the light still emits (B >= %.1f on %d light vertices, floor %.2f)" %
+          (min(r["quality"] for r in light) if light else 0, len(light), floor["quality"]))
+    check(sum(1 for f in faces if f["quality"] > 0.5) > 12, "face quality (the light's mark) carried to its refined faces")
+    # The CLI writes the refined mesh too, and it can be lit again.
+    cli = os.path.join(c.tmp, "refined_cli.ply")
+    p = subprocess.run([c.gi, "radiosity", mesh, "-o", cli, "--json", "--emitter_source", "1", "--rays_per_patch", "256",
+                        "--refine", "true", "--refine_max_depth", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    check(p.returncode == 0, "gi radiosity --refine true runs")
+    import json
+    j = json.loads(p.stdout)
+    n_cli = len(read_ply(cli)["face"])
+    check(n_cli > n_in and n_cli == int(j["stats"]["refined_patches"]),
+          "CLI output is the refined mesh (%d faces, stats %d)" % (n_cli, j["stats"]["refined_patches"]))
+    p = subprocess.run([c.gi, "radiosity", cli, "-q", "--json", "--emitter_source", "1", "--rays_per_patch", "64"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0 and json.loads(p.stdout)["scene"]["emitter_faces"] > 12,
+          "the refined file lights again: its light faces kept their quality")
+
+
+CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
          "photonmap": case_photonmap, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":
