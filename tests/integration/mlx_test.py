@@ -358,6 +358,38 @@ def case_refine(c):
           "the light still emits (B >= %.1f on %d light vertices, floor %.2f)" %
           (min(r["quality"] for r in light) if light else 0, len(light), floor["quality"]))
     check(sum(1 for f in faces if f["quality"] > 0.5) > 12, "face quality (the light's mark) carried to its refined faces")
+    # Two layers, all visible: the ceiling with the light (layer 0) and the rest (layer 1); each is replaced
+    # by its own refined part and receives its result.
+    box = read_ply(mesh)
+    bv, bf = box["vertex"], box["face"]
+    paths = []
+    for name, top in (("top", True), ("rest", False)):
+        faces = [t for t in bf if all(bv[i]["y"] > 548 for i in t["vertex_indices"]) == top]
+        used = sorted({i for t in faces for i in t["vertex_indices"]})
+        remap = {o: n for n, o in enumerate(used)}
+        path = os.path.join(c.tmp, name + ".ply")
+        with open(path, "w") as fh:
+            fh.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face %d\nproperty list uchar int vertex_indices\nproperty float quality\nend_header\n"
+                     % (len(used), len(faces)))
+            for i in used:
+                fh.write("%r %r %r\n" % (bv[i]["x"], bv[i]["y"], bv[i]["z"]))
+            for t in faces:
+                fh.write("3 %s %r\n" % (" ".join(str(remap[i]) for i in t["vertex_indices"]), t["quality"]))
+        paths.append((path, len(faces)))
+    two = c.script("ref_layers", "radiosity", "--mesh", mesh, "--scene_extent", "All visible layers", "--emitter_source",
+                   "1", "--rays_per_patch", "128", "--light_samples", "64", "--gather_rays", "16", "--refine", "true",
+                   "--refine_max_depth", "1")
+    for layer, (path, n) in enumerate(paths):
+        out = os.path.join(c.tmp, "ref_layer%d.ply" % layer)
+        p = subprocess.run([c.mlx_run, "-i", paths[0][0], "-i", paths[1][0], "-o", out, "-l", str(layer), "-m", "vq", "fq",
+                            "-s", two], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+        if p.returncode != 0:
+            fail("meshlabserver failed:\n" + p.stdout.decode("utf-8", "replace")[-2000:])
+        ply = read_ply(out)
+        q = [r["quality"] for r in ply["vertex"]]
+        check(len(ply["face"]) > n and all(math.isfinite(x) for x in q) and max(q) > 0,
+              "layer %d refined on its own (%d faces from %d) and lit (max B %.2f)" % (layer, len(ply["face"]), n, max(q)))
     # The CLI writes the refined mesh too, and it can be lit again.
     cli = os.path.join(c.tmp, "refined_cli.ply")
     p = subprocess.run([c.gi, "radiosity", mesh, "-o", cli, "--json", "--emitter_source", "1", "--rays_per_patch", "256",
