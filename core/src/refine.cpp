@@ -45,6 +45,7 @@ struct MeshRefiner::Impl {
   std::vector<glm::uvec2> parents;
   std::vector<Tri> greenParents;                 // by green id
   std::unordered_map<EdgeKey, uint32_t> midpoint;  // edge -> its midpoint vertex
+  std::vector<uint8_t> srcValid;  // per input face: indices in range (others are never split)
   RefinedMesh mesh;
 
   // The closure: which current faces are red-split, which green pairs are
@@ -76,8 +77,9 @@ struct MeshRefiner::Impl {
     auto splitAll = [&](const glm::uvec3& v) {
       for (int k = 0; k < 3; ++k) splitEdge(v[k], v[(k + 1) % 3]);
     };
+    auto valid = [&](uint32_t f) { return srcValid[faces[f].src] != 0; };
     auto mark = [&](uint32_t f) {
-      if (p.red[f] || p.removed[f]) return;
+      if (p.red[f] || p.removed[f] || !valid(f)) return;
       if (faces[f].green == kNotGreen) {
         p.red[f] = 1;
         splitAll(faces[f].v);
@@ -154,7 +156,10 @@ struct MeshRefiner::Impl {
       int k1 = -1, count = 0;
       for (int k = 0; k < 3; ++k)
         if (p.split.count(edgeKey(F.v[k], F.v[(k + 1) % 3]))) { ++count; k1 = k; }
-      if (count == 0) { out.push_back(F); continue; }
+      if (count == 0 || !srcValid[F.src]) {
+        out.push_back(F);
+        continue;
+      }
       // count == 1 on a red-born face: bisect it (green) from the split edge's midpoint.
       const uint32_t a = F.v[k1], b = F.v[(k1 + 1) % 3], c = F.v[(k1 + 2) % 3], m = mid(a, b);
       const int32_t id = int32_t(greenParents.size());
@@ -214,6 +219,8 @@ MeshRefiner::MeshRefiner(const Scene& input) : impl_(std::make_unique<Impl>()) {
   if (input.vertexNormals.size() == input.positions.size()) d.normals = input.vertexNormals;
   d.parents.resize(input.positions.size());
   for (uint32_t v = 0; v < input.positions.size(); ++v) d.parents[v] = glm::uvec2(v, v);
+  const size_t nv = input.positions.size();
+  for (const auto& t : input.triangles) d.srcValid.push_back(t.x < nv && t.y < nv && t.z < nv ? 1 : 0);
   d.faces.resize(input.triangles.size());
   for (uint32_t f = 0; f < input.triangles.size(); ++f) d.faces[f] = {input.triangles[f], f, 0, kNotGreen};
   d.publish();

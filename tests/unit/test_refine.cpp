@@ -376,3 +376,26 @@ TEST(Refine, BudgetAndDepthRespectedAndDeterministic) {
   EXPECT_EQ(one.result.Bvertex, two.result.Bvertex);
   EXPECT_EQ(one.result.B, two.result.B);
 }
+
+TEST(Refine, BadFacesDoNotBreakIt) {
+  // A face with an index out of range and a degenerate one beside marked faces:
+  // left alone, no crash; the rest refines as usual.
+  scenes::SceneFile plane = scenes::openPlane(1.0, 2);
+  Scene s = plane.scene;
+  const uint32_t nv = uint32_t(s.vertexCount());
+  s.triangles.push_back({0, 1, nv + 5});
+  s.triangles.push_back({0, 1, 1});
+  s.rho.resize(s.triangles.size(), glm::vec3(0.5f));
+  MeshRefiner r(s);
+  std::vector<uint32_t> all(s.faceCount());
+  for (uint32_t f = 0; f < all.size(); ++f) all[f] = f;
+  r.refine(all);
+  r.refine(all);
+  const RefinedMesh& m = r.mesh();
+  EXPECT_EQ(std::count(m.sourceFace.begin(), m.sourceFace.end(), uint32_t(s.faceCount() - 2)), 1);
+  for (size_t f = 0; f < m.scene.faceCount(); ++f) {
+    if (m.sourceFace[f] == s.faceCount() - 2) continue;
+    for (int k = 0; k < 3; ++k) EXPECT_LT(m.scene.triangles[f][k], m.scene.vertexCount());
+  }
+  EXPECT_GT(m.scene.faceCount(), 4 * plane.scene.faceCount());
+}
