@@ -358,6 +358,21 @@ def case_refine(c):
           "the light still emits (B >= %.1f on %d light vertices, floor %.2f)" %
           (min(r["quality"] for r in light) if light else 0, len(light), floor["quality"]))
     check(sum(1 for f in faces if f["quality"] > 0.5) > 12, "face quality (the light's mark) carried to its refined faces")
+    def border_length(p):
+        pv, pf = p["vertex"], p["face"]
+        used = {}
+        for f in pf:
+            t = f["vertex_indices"]
+            for k in range(3):
+                e = (min(t[k], t[(k + 1) % 3]), max(t[k], t[(k + 1) % 3]))
+                used[e] = used.get(e, 0) + 1
+        return sum(math.dist([pv[a][x] for x in "xyz"], [pv[b][x] for x in "xyz"]) for (a, b), n in used.items() if n == 1)
+    lin, lout = border_length(read_ply(mesh)), border_length(ply)
+    check(abs(lout - lin) < 1e-4 * lin, "no T-junctions: the border length stays %.1f (now %.1f)" % (lin, lout))
+    colours_in = {(f["red"], f["green"], f["blue"]) for f in read_ply(mesh)["face"]}
+    colours_out = {(f["red"], f["green"], f["blue"]) for f in faces}
+    check(colours_out <= colours_in and len(colours_out) == len(colours_in),
+          "face colours (the reflectance) carried from the source faces (%d colours)" % len(colours_out))
     # Two layers, all visible: the ceiling with the light (layer 0) and the rest (layer 1); each is replaced
     # by its own refined part and receives its result.
     box = read_ply(mesh)
