@@ -7,6 +7,12 @@ Error: RMS over the non-emitting vertices of (B - B_ref), weighted by vertex
 area, relative to the reference's area-weighted mean B. The reference's own
 error bars (relative standard error 1% per vertex) are reported beside it.
 
+Also: radiosity with adaptive mesh refinement (error on the input's
+vertices, which the refined mesh keeps first and in order); the analytic and
+hemicube form factors on the 10k-patch box (full run only); and time / peak
+memory of the beyond-budget path (a 1 MB memory budget: progressive
+refinement with form-factor rows computed on the fly) against the patch count.
+
 Writes results/lighting_bench.{json,csv,md,png}.
 usage: python3 bench/lighting_bench.py [--build build] [--quick]
 """
@@ -121,7 +127,8 @@ class Bench:
         for _ in range(self.repeats):
             j = json.loads(run([self.gi] + args + [mesh, "-o", out, "-q", "--json", "--emitter_source", "1"]))
             times.append(j["stats"]["seconds"])
-        B = [r["quality"] for r in read_ply(out)["vertex"]]
+        # A refined mesh keeps the input's vertices first, in order.
+        B = [r["quality"] for r in read_ply(out)["vertex"]][:len(ref)]
         row = {"scene": scene, "method": label, "args": " ".join(args[1:]), "seconds": sorted(times)[len(times) // 2],
                "relative_rms_error": self.error(B, ref, w[0]), "relative_rms_error_interior": self.error(B, ref, w[1])}
         # Without the reference's own noise (independent errors add in quadrature).
@@ -163,6 +170,20 @@ def main():
                 b.method(scene, mesh, ref, w, "radiosity, " + solver,
                          ["radiosity", "--solver", solver, "--rays_per_patch", str(rays), "--light_samples", str(light),
                           "--gather_rays", str(gather)], noise)
+        if scene == "cornell_1.5k":
+            for depth in ([1] if a.quick else [1, 2, 3]):
+                b.method(scene, mesh, ref, w, "radiosity, adaptive refinement",
+                         ["radiosity", "--refine", "true", "--refine_max_depth", str(depth), "--light_samples", "1024",
+                          "--gather_rays", "512"], noise)
+        if scene == "cornell_10k":  # n^2 methods at 10k patches: fewer settings
+            for pts in [1, 4]:
+                b.method(scene, mesh, ref, w, "radiosity, analytic point-to-polygon",
+                         ["radiosity", "--form_factor_method", "Analytic point-to-polygon", "--analytic_points", str(pts),
+                          "--light_samples", "1024", "--gather_rays", "512"], noise)
+            for res in [64, 128]:
+                b.method(scene, mesh, ref, w, "radiosity, hemicube",
+                         ["radiosity", "--form_factor_method", "Hemicube", "--hemicube_resolution", str(res),
+                          "--light_samples", "1024", "--gather_rays", "512"], noise)
         if scene == "cornell_1.5k":  # n^2 methods: the small box only
             for pts in ([4] if a.quick else [1, 4, 16]):
                 b.method(scene, mesh, ref, w, "radiosity, analytic point-to-polygon",
@@ -190,15 +211,22 @@ def main():
         patches = read_ply(mesh)["face"]
         wall, rss = run_measured([b.gi, "radiosity", mesh, "-q", "--emitter_source", "1", "--rays_per_patch", "1024",
                                   "-o", os.path.join(b.tmp, "s.ply")])
-        scaling.append({"patches": len(patches), "wall_seconds": wall, "peak_rss_mb": rss})
-        print("scaling: %7d patches  %7.2f s  %7.1f MB" % (len(patches), wall, rss), flush=True)
+        # Beyond the budget: progressive refinement, rows on the fly (memory linear in patches).
+        wall_b, rss_b = run_measured([b.gi, "radiosity", mesh, "-q", "--emitter_source", "1", "--rays_per_patch", "1024",
+                                      "--memory_budget_mb", "1", "-o", os.path.join(b.tmp, "s.ply")])
+        scaling.append({"patches": len(patches), "wall_seconds": wall, "peak_rss_mb": rss,
+                        "beyond_budget_wall_seconds": wall_b, "beyond_budget_peak_rss_mb": rss_b})
+        print("scaling: %7d patches  %7.2f s  %7.1f MB; beyond the budget (rows on the fly) %7.2f s  %7.1f MB" % (
+            len(patches), wall, rss, wall_b, rss_b), flush=True)
     xs = [math.log(r["patches"]) for r in scaling]
     def slope(key):
         ys = [math.log(r[key]) for r in scaling]
         mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
         return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
     result = {"rows": b.rows, "references": refinfo, "scaling": scaling,
-              "scaling_time_slope": slope("wall_seconds"), "scaling_memory_slope": slope("peak_rss_mb")}
+              "scaling_time_slope": slope("wall_seconds"), "scaling_memory_slope": slope("peak_rss_mb"),
+              "beyond_budget_time_slope": slope("beyond_budget_wall_seconds"),
+              "beyond_budget_memory_slope": slope("beyond_budget_peak_rss_mb")}
     with open(os.path.join(a.out, "lighting_bench.json"), "w") as f:
         json.dump(result, f, indent=1)
     with open(os.path.join(a.out, "lighting_bench.csv"), "w", newline="") as f:
@@ -211,11 +239,14 @@ def main():
         lines.append("| %s | %s | %s | %.3f | %.4f | %.4f | %.4f |" % (
             r["scene"], r["method"], r["args"], r["seconds"], r["relative_rms_error"], r["relative_rms_error_interior"],
             r["interior_error_minus_reference_noise"]))
-    lines += ["", "| patches | time (s) | peak RSS (MB) |", "|---|---|---|"]
+    lines += ["", "| patches | time (s) | peak RSS (MB) | beyond budget: time (s) | peak RSS (MB) |", "|---|---|---|---|---|"]
     for r in scaling:
-        lines.append("| %d | %.2f | %.1f |" % (r["patches"], r["wall_seconds"], r["peak_rss_mb"]))
+        lines.append("| %d | %.2f | %.1f | %.2f | %.1f |" % (r["patches"], r["wall_seconds"], r["peak_rss_mb"],
+                                                         r["beyond_budget_wall_seconds"], r["beyond_budget_peak_rss_mb"]))
     lines.append("")
-    lines.append("log-log slopes against patches: time %.2f, memory %.2f" % (result["scaling_time_slope"], result["scaling_memory_slope"]))
+    lines.append("log-log slopes against patches: time %.2f, memory %.2f; beyond the budget: time %.2f, memory %.2f" % (
+        result["scaling_time_slope"], result["scaling_memory_slope"], result["beyond_budget_time_slope"],
+        result["beyond_budget_memory_slope"]))
     for s, info in refinfo.items():
         lines.append("reference %s: %d paths, %.1f s, mean relative standard error %.4f (%s)" % (
             s, info["paths"], info["seconds"], info["mean_relative_std_error"], info["file"]))

@@ -10,6 +10,7 @@
 #include <common/interfaces.h>
 
 #include "gi/params.h"
+#include "gi/refine.h"
 #include "gi/run.h"
 #include "gi/scene.h"
 #include "gi/scene_setup.h"
@@ -54,6 +55,16 @@ void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const s
 void writeVertexScalarAttribute(BridgeScene& b, const std::string& name, const std::vector<float>& v);
 // Multiplies existing vertex colours by a factor in [0,1] (AO "multiply colour").
 void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor);
+
+// Replaces each layer's geometry by its part of `m`, a refinement of
+// b.scene (faces whose sourceFace lies in the layer's face range): old
+// vertices stay, new ones are appended (position, normal, colour and quality
+// interpolated), faces keep colour, quality and selection of their source
+// face; topology, face normals and bounding box are updated. Then b (scene,
+// attributes, parts) is indexed as toScene would index the new layers, and
+// Bvertex / Bface (given on m.scene) are permuted to match. (mesh_replace.cpp)
+void replaceWithRefined(BridgeScene& b, const RefinedMesh& m, std::vector<glm::vec3>& Bvertex,
+                        std::vector<glm::vec3>& Bface);
 
 // MeshLab progress callback -> engine progress (cancellation not supported by 2020.09's cb).
 ProgressFn progressFrom(vcg::CallBackPos* cb);

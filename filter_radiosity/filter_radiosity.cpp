@@ -49,7 +49,12 @@ QString FilterRadiosityPlugin::filterInfo(FilterIDType f) const {
          "<b>Emitters</b>: select the light's faces, or give them a face quality above a threshold. "
          "<b>Reflectance</b>: face colour, else vertex colour, else a constant (sRGB converted to linear).<br>"
          "Output: vertex <b>quality</b> = luminance of B (W/m<sup>2</sup>); vertex <b>colour</b> = "
-         "sRGB(exposure &times; B). Every layer of the scene receives its result.";
+         "sRGB(exposure &times; B). Every layer of the scene receives its result.<br>"
+         "<b>Adaptive mesh refinement</b> (optional, 'refine'): solve, split the patches where the reflected "
+         "radiosity jumps across an edge or differs from its corners' values, or where a shadow boundary crosses "
+         "(the vertices see the lights differently), solve again, up to a depth or a patch budget. Red-green "
+         "subdivision keeps the mesh free of T-junctions. The refined mesh replaces the layer's geometry; faces keep "
+         "their colour, quality and selection, so the filter can be applied again.";
 }
 
 MeshFilterInterface::FilterClass FilterRadiosityPlugin::getClass(QAction*) {
@@ -57,8 +62,12 @@ MeshFilterInterface::FilterClass FilterRadiosityPlugin::getClass(QAction*) {
 }
 MeshFilterInterface::FILTER_ARITY FilterRadiosityPlugin::filterArity(QAction*) const { return VARIABLE; }
 int FilterRadiosityPlugin::getPreConditions(QAction*) const { return MeshModel::MM_NONE; }
-int FilterRadiosityPlugin::postCondition(QAction*) const {
-  return MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY;
+int FilterRadiosityPlugin::postCondition(QAction* a) const {
+  const int results = MeshModel::MM_VERTCOLOR | MeshModel::MM_VERTQUALITY | MeshModel::MM_FACECOLOR | MeshModel::MM_FACEQUALITY;
+  // postCondition cannot see the parameters: GI: Radiosity may refine the
+  // mesh (parameter 'refine'), so MeshLab must refresh geometry and topology.
+  if (a && ID(a) == FP_RADIOSITY) return results | MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE;
+  return results;
 }
 
 void FilterRadiosityPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& par) {
@@ -83,8 +92,16 @@ bool FilterRadiosityPlugin::applyFilter(QAction* a, MeshDocument& md, const Rich
   return ml::guarded(errorMessage, logLine, filterName(ID(a)), [&] {
     ml::PreparedRun run = ml::prepare(md, par, filterSpecs(FilterKind::Radiosity), true);
     const RadiosityOptions opt = RadiosityOptions::fromParams(run.values);
-    auto caster = makeEmbreeCaster(run.bridge.scene);
-    RadiosityResult r = solveRadiosity(run.bridge.scene, *caster, opt, Progress(ml::progressFrom(cb)));
+    RadiosityResult r;
+    if (opt.refine) {
+      // The refined mesh replaces the layers' geometry, then receives the results.
+      AdaptiveRadiosity ar = solveRadiosityAdaptive(run.bridge.scene, opt, Progress(ml::progressFrom(cb)));
+      r = std::move(ar.result);
+      ml::replaceWithRefined(run.bridge, ar.mesh, r.Bvertex, r.B);
+    } else {
+      auto caster = makeEmbreeCaster(run.bridge.scene);
+      r = solveRadiosity(run.bridge.scene, *caster, opt, Progress(ml::progressFrom(cb)));
+    }
     ml::writeRadiosity(run, r.Bvertex, r.B, run.values.getBool("face_output"), r.stats);
     logLine(run.report.summary() + "; " + run.setupLog);
     logLine(r.stats.line("GI: Radiosity"));

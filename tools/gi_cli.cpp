@@ -226,14 +226,24 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
     colors = out.displayColors();
     stats.add("exposure", out.exposure);
   } else {
-    auto caster = makeEmbreeCaster(mesh.scene);
     std::vector<glm::vec3> B, faceB;
-    if (kind == FilterKind::Radiosity) {
-      RadiosityResult r = solveRadiosity(mesh.scene, *caster, RadiosityOptions::fromParams(v), progress);
+    const RadiosityOptions ropt = kind == FilterKind::Radiosity ? RadiosityOptions::fromParams(v) : RadiosityOptions();
+    if (kind == FilterKind::Radiosity && ropt.refine) {
+      // The refined mesh is what gets written: attributes follow the source faces.
+      AdaptiveRadiosity r = solveRadiosityAdaptive(mesh.scene, ropt, progress);
+      mesh.attrs = refineAttributes(mesh.attrs, r.mesh);
+      mesh.scene = std::move(r.mesh.scene);
+      stats = r.result.stats;
+      B = r.result.Bvertex;
+      faceB = r.result.B;
+    } else if (kind == FilterKind::Radiosity) {
+      auto caster = makeEmbreeCaster(mesh.scene);
+      RadiosityResult r = solveRadiosity(mesh.scene, *caster, ropt, progress);
       stats = r.stats;
       B = r.Bvertex;
       faceB = r.B;
     } else {
+      auto caster = makeEmbreeCaster(mesh.scene);
       VertexRadiometry r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v, mesh.scene.origin), progress);
       stats = r.stats;
       B = r.B;

@@ -57,6 +57,30 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "Rays per vertex for the final gather of the indirect light (cosine-weighted).", ParamType::Int, 256, 1,
        1 << 20},
       seedSpec("form-factor rays"),
+      {"refine", "Adaptive mesh refinement",
+       "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
+       "midpoints where its reflected radiosity jumps across an edge (staircase artefacts) or where a shadow "
+       "boundary crosses it (its vertices see the lights differently: shadow leaks); neighbours are bisected or "
+       "split too, so the mesh stays free of T-junctions (red-green refinement). The refined mesh replaces the "
+       "layer's geometry (faces keep colour, quality and selection). Off: the geometry is never changed.",
+       ParamType::Bool, 0},
+      {"refine_max_depth", "Refinement: maximum depth",
+       "Levels of refinement: each level splits the marked patches once (a patch of depth d is 4^d times smaller "
+       "than its original triangle) and solves again, so the cost grows with the levels.",
+       ParamType::Int, 3, 1, 12},
+      {"refine_max_patches", "Refinement: patch budget",
+       "Never more patches than this; when a level would exceed it, the patches that need refinement most "
+       "(largest jump or visibility difference times area) are split first.",
+       ParamType::Int, 200000, 1, 100000000},
+      {"refine_threshold", "Refinement: radiosity jump",
+       "Split the two patches on either side of an edge when their reflected radiosity differs by more than this "
+       "fraction of the larger one (ignoring differences below 1% of the scene's mean). Smaller: more patches. "
+       "Edges sharper than 30 degrees are not tested: B jumps there for real.",
+       ParamType::Float, 0.1, 1e-4, 100.0},
+      {"refine_shadow_threshold", "Refinement: shadow boundary",
+       "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) differs "
+       "by more than this between two of its vertices: a shadow boundary crosses it. 1 turns this test off.",
+       ParamType::Float, 0.3, 0.0, 1.0},
   };
   s.insert(s.end(), more.begin(), more.end());
   return s;
@@ -77,6 +101,12 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.seed = uint32_t(v.getInt("seed"));
   o.vertexOutput = RadiosityVertexOutput(v.getInt("vertex_output"));
   o.gatherRays = v.getInt("gather_rays");
+  o.refine = v.getBool("refine");
+  o.refinement.maxDepth = v.getInt("refine_max_depth");
+  o.refinement.maxPatches = v.getInt("refine_max_patches");
+  o.refinement.threshold = v.getFloat("refine_threshold");
+  o.refinement.shadowThreshold = v.getFloat("refine_shadow_threshold");
+  o.refinement.seed = o.seed;
   return o;
 }
 

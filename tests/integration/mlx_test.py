@@ -372,7 +372,106 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
-CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity,
+def case_refine(c):
+    """GI: Radiosity with adaptive mesh refinement: the saved layer is the
+    refined mesh; the light, chosen by selection, stays selected, so a second
+    run in the same script finds it again."""
+    mesh = os.path.join(c.meshes, "cornell_box.ply")
+    n_in = len(read_ply(mesh)["face"])
+    fast = ["--mesh", mesh, "--emitter_source", "Selected faces", "--rays_per_patch", "256", "--light_samples", "64",
+            "--gather_rays", "32"]
+    first = open(c.script("ref1", "radiosity", *(fast + ["--refine", "true", "--refine_max_depth", "2"]))).read()
+    again = open(c.script("ref2", "radiosity", *fast)).read()
+    body = lambda t: t[t.index("<filter"):t.rindex("</filter>") + len("</filter>")]
+    select = (' <filter name="Select by Face Quality">\n'
+              '  <Param type="RichDynamicFloat" value="0.5" min="0" max="1" name="minQ"/>\n'
+              '  <Param type="RichDynamicFloat" value="1.5" min="0" max="2" name="maxQ"/>\n'
+              '  <Param type="RichBool" value="true" name="Inclusive"/>\n </filter>\n')
+    path = os.path.join(c.tmp, "refine.mlx")
+    with open(path, "w") as f:
+        f.write("<!DOCTYPE FilterScript>\n<FilterScript>\n" + select + " " + body(first) + "\n " + body(again) +
+                "\n</FilterScript>\n")
+    out = os.path.join(c.tmp, "refined.ply")
+    log = c.server(mesh, path, out, mask=("vc", "vq", "fc", "fq"))
+    runs = re.findall(r"(\d+) emitter faces", log)
+    check(len(runs) >= 2 and int(runs[0]) == 12, "first run: the 12 selected light faces emit (%s)" % runs)
+    check(int(runs[-1]) > 12, "second run on the refined mesh: the light's refined faces are still selected (%s)" % runs[-1])
+    check("refinement stopped" in log and "faces refined" in log, "the log reports the refinement levels")
+    ply = read_ply(out)
+    v, faces = ply["vertex"], ply["face"]
+    check(len(faces) > n_in, "the saved layer is refined: %d faces from %d" % (len(faces), n_in))
+    check(all(math.isfinite(r["quality"]) for r in v), "finite vertex quality everywhere")
+    light = [r for r in v if r["y"] > 548 and 213 < r["x"] < 343 and 227 < r["z"] < 332]
+    floor = nearest(v, (400, 0, 150))
+    check(light and min(r["quality"] for r in light) > 10 * floor["quality"],
+          "the light still emits (B >= %.1f on %d light vertices, floor %.2f)" %
+          (min(r["quality"] for r in light) if light else 0, len(light), floor["quality"]))
+    check(sum(1 for f in faces if f["quality"] > 0.5) > 12, "face quality (the light's mark) carried to its refined faces")
+    def border_length(p):
+        pv, pf = p["vertex"], p["face"]
+        used = {}
+        for f in pf:
+            t = f["vertex_indices"]
+            for k in range(3):
+                e = (min(t[k], t[(k + 1) % 3]), max(t[k], t[(k + 1) % 3]))
+                used[e] = used.get(e, 0) + 1
+        return sum(math.dist([pv[a][x] for x in "xyz"], [pv[b][x] for x in "xyz"]) for (a, b), n in used.items() if n == 1)
+    lin, lout = border_length(read_ply(mesh)), border_length(ply)
+    check(abs(lout - lin) < 1e-4 * lin, "no T-junctions: the border length stays %.1f (now %.1f)" % (lin, lout))
+    colours_in = {(f["red"], f["green"], f["blue"]) for f in read_ply(mesh)["face"]}
+    colours_out = {(f["red"], f["green"], f["blue"]) for f in faces}
+    check(colours_out <= colours_in and len(colours_out) == len(colours_in),
+          "face colours (the reflectance) carried from the source faces (%d colours)" % len(colours_out))
+    # Two layers, all visible: the ceiling with the light (layer 0) and the rest (layer 1); each is replaced
+    # by its own refined part and receives its result.
+    box = read_ply(mesh)
+    bv, bf = box["vertex"], box["face"]
+    paths = []
+    for name, top in (("top", True), ("rest", False)):
+        faces = [t for t in bf if all(bv[i]["y"] > 548 for i in t["vertex_indices"]) == top]
+        used = sorted({i for t in faces for i in t["vertex_indices"]})
+        remap = {o: n for n, o in enumerate(used)}
+        path = os.path.join(c.tmp, name + ".ply")
+        with open(path, "w") as fh:
+            fh.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element face %d\nproperty list uchar int vertex_indices\nproperty float quality\nend_header\n"
+                     % (len(used), len(faces)))
+            for i in used:
+                fh.write("%r %r %r\n" % (bv[i]["x"], bv[i]["y"], bv[i]["z"]))
+            for t in faces:
+                fh.write("3 %s %r\n" % (" ".join(str(remap[i]) for i in t["vertex_indices"]), t["quality"]))
+        paths.append((path, len(faces)))
+    two = c.script("ref_layers", "radiosity", "--mesh", mesh, "--scene_extent", "All visible layers", "--emitter_source",
+                   "1", "--rays_per_patch", "128", "--light_samples", "64", "--gather_rays", "16", "--refine", "true",
+                   "--refine_max_depth", "1")
+    for layer, (path, n) in enumerate(paths):
+        out = os.path.join(c.tmp, "ref_layer%d.ply" % layer)
+        p = subprocess.run([c.mlx_run, "-i", paths[0][0], "-i", paths[1][0], "-o", out, "-l", str(layer), "-m", "vq", "fq",
+                            "-s", two], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+        if p.returncode != 0:
+            fail("meshlabserver failed:\n" + p.stdout.decode("utf-8", "replace")[-2000:])
+        ply = read_ply(out)
+        q = [r["quality"] for r in ply["vertex"]]
+        check(len(ply["face"]) > n and all(math.isfinite(x) for x in q) and max(q) > 0,
+              "layer %d refined on its own (%d faces from %d) and lit (max B %.2f)" % (layer, len(ply["face"]), n, max(q)))
+    # The CLI writes the refined mesh too, and it can be lit again.
+    cli = os.path.join(c.tmp, "refined_cli.ply")
+    p = subprocess.run([c.gi, "radiosity", mesh, "-o", cli, "--json", "--emitter_source", "1", "--rays_per_patch", "256",
+                        "--refine", "true", "--refine_max_depth", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    check(p.returncode == 0, "gi radiosity --refine true runs")
+    import json
+    j = json.loads(p.stdout)
+    n_cli = len(read_ply(cli)["face"])
+    check(n_cli > n_in and n_cli == int(j["stats"]["refined_patches"]),
+          "CLI output is the refined mesh (%d faces, stats %d)" % (n_cli, j["stats"]["refined_patches"]))
+    p = subprocess.run([c.gi, "radiosity", cli, "-q", "--json", "--emitter_source", "1", "--rays_per_patch", "64"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0 and json.loads(p.stdout)["scene"]["emitter_faces"] > 12,
+          "the refined file lights again: its light faces kept their quality")
+
+
+CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
          "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump}
 
 if __name__ == "__main__":

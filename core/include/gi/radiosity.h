@@ -8,6 +8,8 @@
 // with the most unshot power). Rows are sparse; only hit patches are stored.
 #pragma once
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -16,6 +18,7 @@
 #include "gi/form_factors.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
+#include "gi/refine.h"
 #include "gi/run.h"
 #include "gi/scene.h"
 
@@ -38,6 +41,8 @@ struct RadiosityOptions {
   uint32_t seed = 0;
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
+  bool refine = false;            // adaptive mesh refinement (solveRadiosityAdaptive)
+  RefineOptions refinement;       // its limits and thresholds
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
@@ -60,5 +65,21 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress);
+
+// Adaptive mesh refinement (refine.h): solve, mark the faces where the
+// reflected radiosity jumps across an edge or a shadow boundary crosses,
+// red-green subdivide them, solve again; up to refinement.maxDepth levels or
+// refinement.maxPatches faces. Intermediate solves use patch averages at the
+// vertices (their vertex values are not needed); the last one uses
+// opt.vertexOutput. The stats say per level how many faces were refined and
+// why refinement stopped. Deterministic for any thread count.
+struct AdaptiveRadiosity {
+  RefinedMesh mesh;        // the refined scene and where each face came from
+  RadiosityResult result;  // on mesh.scene
+};
+using CasterFactory = std::function<std::unique_ptr<RayCaster>(const Scene&)>;
+AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt,
+                                         const Progress& progress = Progress(nullptr),
+                                         const CasterFactory& makeCaster = nullptr);
 
 }  // namespace gi

@@ -1,0 +1,92 @@
+// Adaptive mesh refinement around the radiosity solver: solve -> mark ->
+// subdivide -> solve again (Cohen, Greenberg, Immel and Brock 1986 refine
+// where B varies; Heckbert 1992 and Lischinski et al. 1992 where shadow
+// boundaries cross patches).
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "gi/radiosity.h"
+
+namespace gi {
+
+namespace {
+std::string level(int k) { return "level " + std::to_string(k); }
+}  // namespace
+
+AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
+                                         const CasterFactory& makeCaster) {
+  const RefineOptions& ro = opt.refinement;
+  if (ro.maxDepth < 0) throw std::invalid_argument("refine_max_depth must be >= 0");
+  if (ro.maxPatches < 1) throw std::invalid_argument("refine_max_patches must be >= 1");
+  if (!(ro.threshold > 0)) throw std::invalid_argument("refine_threshold must be > 0");
+  const CasterFactory caster = makeCaster ? makeCaster : [](const Scene& sc) { return makeEmbreeCaster(sc); };
+  Timer timer;
+  MeshRefiner refiner(s);
+  RadiosityOptions levelOpt = opt;
+  // Intermediate levels: direct light at the vertices, indirect interpolated (no gather rays).
+  if (levelOpt.vertexOutput == RadiosityVertexOutput::FinalGather)
+    levelOpt.vertexOutput = RadiosityVertexOutput::InterpolatedIndirect;
+  const int levels = ro.maxDepth;
+  auto stage = [&](int k) { return progress.sub(double(k) / (levels + 1), double(k + 1) / (levels + 1)); };
+
+  std::vector<std::string> log;
+  std::string why = "maximum depth " + std::to_string(ro.maxDepth) + " reached";
+  RadiosityResult res;
+  bool changed = true;  // since the last solve
+  for (int k = 0; k < levels; ++k) {
+    const Scene& sc = refiner.mesh().scene;
+    auto rc = caster(sc);
+    res = solveRadiosity(sc, *rc, levelOpt, stage(k));
+    changed = false;
+    const std::vector<float> V =
+        ro.shadowThreshold < 1.0 ? emitterVisibility(sc, *rc, ro.visibilityRays, ro.seed) : std::vector<float>();
+    RefineMarks marks = markForRefinement(sc, res.B, res.Bvertex, V, refiner.mesh().depth, ro);
+    const size_t n = sc.faceCount(), budget = size_t(ro.maxPatches);
+    if (marks.faces.empty()) {
+      why = "nothing left above the thresholds";
+      break;
+    }
+    // Within the budget: the most needing faces first; shrink the marked
+    // prefix until the conforming closure fits.
+    size_t take = marks.faces.size(), after = refiner.faceCountAfter(marks.faces);
+    for (int tries = 0; after > budget && take > 0 && tries < 40; ++tries) {
+      const double room = n < budget ? double(budget - n) : 0.0;
+      const size_t shrunk = size_t(double(take) * room / double(after - n) * 0.9);
+      take = std::min(take - 1, shrunk);
+      after = refiner.faceCountAfter({marks.faces.begin(), marks.faces.begin() + long(take)});
+    }
+    if (after > budget || take == 0) {
+      why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(marks.faces.size()) +
+            " faces still above the thresholds)";
+      break;
+    }
+    const size_t wanted = marks.faces.size();
+    marks.faces.resize(take);
+    refiner.refine(marks.faces);
+    changed = true;
+    log.push_back(level(k + 1) + ": " + std::to_string(take) + " faces refined (" + std::to_string(marks.byJump) +
+                  " by B jump, " + std::to_string(marks.byShadow) + " by shadow boundary), " + std::to_string(n) +
+                  " -> " + std::to_string(refiner.mesh().scene.faceCount()) + " patches");
+    if (take < wanted) {  // the budget cut this level short: the next could add only a handful
+      why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(wanted - take) +
+            " faces above the thresholds left unrefined)";
+      break;
+    }
+  }
+  // The final solve on the refined mesh, with the vertex output asked for.
+  const Scene& sc = refiner.mesh().scene;
+  if (changed || opt.vertexOutput != levelOpt.vertexOutput) {
+    auto rc = caster(sc);
+    res = solveRadiosity(sc, *rc, opt, stage(levels));
+  }
+  for (const auto& l : log) res.stats.note(l);
+  res.stats.note("refinement stopped: " + why);
+  res.stats.add("refine_levels", double(log.size()));
+  res.stats.add("input_patches", double(s.faceCount()));
+  res.stats.add("refined_patches", double(sc.faceCount()));
+  res.stats.add("refine_total_seconds", timer.seconds());
+  return {refiner.mesh(), std::move(res)};
+}
+
+}  // namespace gi
