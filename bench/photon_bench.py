@@ -139,9 +139,13 @@ def main():
         photons = [100000, 1000000] if q else [100000, 300000, 1000000, 3000000]
         for n in photons:
             b.run_method(scene, "photon mapping", "photonmap", ["--photons", str(n), "--light_samples", "1024"], ref, regions, "pm")
-        for passes in ([4] if q else [2, 8, 32]):
-            b.run_method(scene, "progressive photon mapping (250k per pass)", "photonmap",
-                         ["--photons", "250000", "--progressive", "true", "--passes", str(passes), "--light_samples", "1024"],
+        if not q:
+            b.run_method(scene, "photon mapping, k = 512", "photonmap",
+                         ["--photons", "3000000", "--k_nearest", "512", "--caustic_k", "512", "--light_samples", "1024"],
+                         ref, regions, "pm_k512")
+        for passes in ([4] if q else [4, 16, 64, 128]):
+            b.run_method(scene, "progressive photon mapping (50k per pass)", "photonmap",
+                         ["--photons", "50000", "--progressive", "true", "--passes", str(passes), "--light_samples", "1024"],
                          ref, regions, "ppm")
         if scene == "cornell_box":
             for n in ([300000] if q else [300000, 1000000]):
@@ -155,7 +159,7 @@ def main():
     equal = []
     pt = [(r["seconds"], r["error_caustic"]) for r in b.rows if r["scene"] == "caustic_cornell" and r["tag"] == "pt"]
     for r in b.rows:
-        if r["scene"] == "caustic_cornell" and r["tag"] in ("pm", "ppm"):
+        if r["scene"] == "caustic_cornell" and r["tag"] in ("pm", "pm_k512", "ppm"):
             e_pt = loglog_at(pt, r["seconds"])
             equal.append({"method": r["method"], "args": r["args"], "seconds": r["seconds"], "error_pm": r["error_caustic"],
                           "error_pt_at_equal_time": e_pt, "ratio_pt_over_pm": e_pt / r["error_caustic"]})

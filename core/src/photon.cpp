@@ -28,8 +28,14 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        ParamType::Int, 64, 1, 512},
       {"caustic_k", "Photons per caustic estimate",
        "k for the caustic map (photons that reached a diffuse surface through mirrors or glass only). Its cone "
-       "filter (Jensen 1996) keeps caustic edges sharp; smaller k: sharper and noisier.",
-       ParamType::Int, 32, 1, 512},
+       "filter (Jensen 1996) keeps caustic edges sharp; smaller k: sharper and noisier (the relative noise is "
+       "about 1 / sqrt(k)).",
+       ParamType::Int, 128, 1, 512},
+      {"caustic_projection", "Aim caustic photons at mirrors and glass",
+       "Shoot the caustic photons only towards the mirror and glass objects (Jensen's projection maps: from each "
+       "light point, directions in the cones their bounding spheres subtend), so that small specular objects get "
+       "many caustic photons. Off: the caustic map keeps the global photons that happened to pass through them.",
+       ParamType::Bool, 1},
       {"max_radius", "Maximum gather radius",
        "Photons farther than this from a vertex are ignored (0 = no limit); vertices with no photon within it get "
        "only their direct light. Absolute or % of the bbox diagonal.",
@@ -83,6 +89,7 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
   o.photons = v.getInt("photons");
   o.kNearest = v.getInt("k_nearest");
   o.causticK = v.getInt("caustic_k");
+  o.causticProjection = v.getBool("caustic_projection");
   o.maxRadius = v.getFloat("max_radius");
   o.maxDepth = v.getInt("max_depth");
   o.directLight = v.getBool("direct_light");
@@ -157,6 +164,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   // diffuse interreflection (rho > 0); with the direct light apart and
   // neither, there is nothing for them to do.
   const bool needPhotons = !opt.directLight || specular || anyDiffuseReflection(s);
+  const bool projection = opt.directLight && specular && opt.causticProjection;  // caustic photons aimed at mirrors and glass
   const float r2max = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
 
   Timer directTimer;
@@ -181,7 +189,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (EmitterSampler(s).empty() && !(luminance(opt.pointIntensity) > 0.f))
       throw std::invalid_argument("the scene has no light: no emitter faces and no point or spot light");
   } else if (opt.progressive) {
-    ProgressiveResult pr = progressivePhotonMap(s, caster, opt, mat, vertexPaths, progress.sub(0.15, 1.0), ts);
+    ProgressiveResult pr = progressivePhotonMap(s, caster, opt, mat, vertexPaths, projection, progress.sub(0.15, 1.0), ts);
     Hphot = std::move(pr.H);
     noise = std::move(pr.noise);
     noPhotonVertices = pr.verticesWithoutPhotons;
@@ -195,19 +203,22 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (opt.finalGather) st.note("final gather not used: progressive photon mapping estimates all photon light");
   } else {
     Timer traceTimer;
-    std::vector<Photon> photons = tracePhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.55), ts);
+    std::vector<Photon> photons = tracePhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts);
+    // Caustic photons (L S+ D) have their own map, shot by projection towards
+    // the mirrors and glass, whenever the direct light is apart; otherwise
+    // one map holds every photon.
+    std::vector<Photon> causticPhotons;
+    if (projection) causticPhotons = traceCausticPhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
     const double traceSeconds = traceTimer.seconds();
     Timer buildTimer;
-    // Caustic photons (L S+ D) have their own map whenever the direct light
-    // is apart; otherwise one map holds every photon.
-    const bool causticMap = opt.directLight && ts.caustic > 0;
     const unsigned globalPaths = opt.directLight ? (1u << kIndirectPhoton) : 7u;
     PhotonMap global(photons, globalPaths);
     std::unique_ptr<PhotonMap> caustics, all;
-    if (causticMap) caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
+    if (projection && !causticPhotons.empty()) caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton);
+    else if (opt.directLight && !projection && ts.caustic > 0) caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
     if (opt.directLight && opt.finalGather) all = std::make_unique<PhotonMap>(photons, 7u);
     const double buildSeconds = buildTimer.seconds();
-    size_t mapBytes = photons.capacity() * sizeof(Photon) + global.memoryBytes();
+    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon) + global.memoryBytes();
     if (caustics) mapBytes += caustics->memoryBytes();
     if (all) mapBytes += all->memoryBytes();
     Timer queryTimer;
@@ -258,8 +269,14 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   }
   if (needPhotons) {
     st.add("photons_emitted", double(ts.emitted));
+    if (projection) {
+      st.add("caustic_photons_aimed", double(ts.causticEmitted));
+      st.add("caustic_photons_stored", double(ts.causticStored));
+      st.note("caustic photons aimed at the mirrors and glass (projection): " +
+              std::to_string(ts.causticEmitted - ts.causticMissed) + " of " + std::to_string(ts.causticEmitted) +
+              " hit them first");
+    }
     st.add("photons_stored", double(ts.stored));
-    st.add("photons_caustic", double(ts.caustic));
     st.add("diffuse_bounces", double(ts.diffuseBounces));
     st.add("specular_bounces", double(ts.specularBounces));
     st.add("total_internal_reflections", double(ts.totalInternal));

@@ -16,6 +16,8 @@ namespace gi {
 //   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) R'^2 / R^2,
 // and H = tau / (pi R^2 passes) (each pass's photons carry the full power / count).
 // The first radius is the distance to the k-th nearest photon of the first pass.
+// With `projection`, each pass's caustic photons come from traceCausticPhotons
+// (those of the global pass are dropped).
 struct ProgressiveResult {
   std::vector<glm::vec3> H;
   std::vector<double> noise;  // Poisson error estimate per vertex (luminance)
@@ -25,8 +27,8 @@ struct ProgressiveResult {
   double peakBytes = 0;
 };
 ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                       const VertexMaterial& mat, unsigned pathMask, const Progress& progress,
-                                       PhotonTraceStats& stats);
+                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
+                                       const Progress& progress, PhotonTraceStats& stats);
 
 // Final gather at every vertex through mirrors and glass: cosine-weighted rays
 // from origins[v] follow specular faces (up to 16 interactions) and, at the

@@ -81,23 +81,6 @@ class PhotonMap {
     return glm::vec3(sum / area);
   }
 
-  // Flux and count of the photons within sqrt(r2) of x on the same side (PPM).
-  void gather(const glm::vec3& x, const glm::vec3& n, float r2, glm::dvec3& flux, size_t& count,
-              std::vector<std::pair<uint32_t, float>>& scratch) const {
-    flux = glm::dvec3(0.0);
-    count = 0;
-    if (size() == 0) return;
-    const float q[3] = {x.x, x.y, x.z};
-    scratch.clear();
-    tree_->radiusSearch(q, r2, scratch, nanoflann::SearchParams(32, 0.f, false));
-    for (const auto& it : scratch) {
-      const Photon& p = cloud_.all[cloud_.idx[it.first]];
-      if (glm::dot(p.normal(), n) < 0.5f) continue;
-      flux += glm::dvec3(p.power);
-      ++count;
-    }
-  }
-
   // Distance^2 to the k-th nearest photon on the same side (HUGE_VALF if fewer).
   float kthRadius2(const glm::vec3& x, const glm::vec3& n, int k) const {
     if (size() == 0) return HUGE_VALF;

@@ -2,18 +2,20 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "gi/color.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
 #include "photon_internal.h"
+#include "photon_grid.h"
 #include "photon_map.h"
 
 namespace gi {
 
 ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                       const VertexMaterial& mat, unsigned pathMask, const Progress& progress,
-                                       PhotonTraceStats& stats) {
+                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
+                                       const Progress& progress, PhotonTraceStats& stats) {
   const size_t nv = s.vertexCount();
   ProgressiveResult r;
   std::vector<float> R2(nv, 0.f);
@@ -29,24 +31,51 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   for (int pass = 0; pass < opt.passes; ++pass) {
     const Progress pp = progress.sub(double(pass) / opt.passes, double(pass + 1) / opt.passes);
     Timer tt;
-    std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.7), stats);
+    std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats);
+    if (projection) {
+      photons.erase(std::remove_if(photons.begin(), photons.end(), [](const Photon& p) { return p.path == kCausticPhoton; }),
+                    photons.end());
+      const auto c = traceCausticPhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
+      photons.insert(photons.end(), c.begin(), c.end());
+    }
     r.traceSeconds += tt.seconds();
     Timer bt;
-    const PhotonMap map(photons, pathMask);
-    r.buildSeconds += bt.seconds();
-    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + map.memoryBytes()));
-    Timer qt;
-    parallelBlocks(nv, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1), [&](size_t b, size_t e) {
-      std::vector<std::pair<uint32_t, float>> scratch;
-      for (size_t i = b; i < e; ++i) {
-        if (!mat.valid[i]) continue;
-        if (pass == 0) {
-          const float k2 = map.kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
+    // Pass 1 needs the k nearest photons (the first radii): a kd-tree. Later
+    // passes only gather within each vertex's radius: a grid whose cells are
+    // the 90th percentile of the radii (most gathers visit 27 cells).
+    std::unique_ptr<PhotonMap> map;
+    if (pass == 0) {
+      map = std::make_unique<PhotonMap>(photons, pathMask);
+      parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          if (!mat.valid[i]) continue;
+          const float k2 = map->kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
           R2[i] = k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
         }
+      });
+    }
+    std::vector<float> radii;
+    for (size_t i = 0; i < nv; ++i)
+      if (mat.valid[i]) radii.push_back(R2[i]);
+    float cell = std::sqrt(r2fallback);
+    if (!radii.empty()) {
+      const size_t q = radii.size() * 9 / 10;
+      std::nth_element(radii.begin(), radii.begin() + q, radii.end());
+      cell = std::max(std::sqrt(radii[q]), 1e-6f * diag);
+    }
+    const PhotonGrid grid(photons, pathMask, cell);
+    r.buildSeconds += bt.seconds();
+    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
+                                               (map ? map->memoryBytes() : 0)));
+    map.reset();
+    std::vector<Photon>().swap(photons);
+    Timer qt;
+    parallelBlocks(nv, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        if (!mat.valid[i]) continue;
         glm::dvec3 flux;
         size_t M = 0;
-        map.gather(s.positions[i], mat.n[i], R2[i], flux, M, scratch);
+        grid.gather(s.positions[i], mat.n[i], R2[i], flux, M);
         if (M == 0) continue;
         const double ratio = (N[i] + alpha * double(M)) / (N[i] + double(M));
         N[i] += alpha * double(M);

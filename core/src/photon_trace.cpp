@@ -32,30 +32,40 @@ class PhotonLights {
   }
   bool empty() const { return !(total_ > 0.0); }
   double totalPower() const { return total_; }
-  struct Emission {
-    glm::vec3 o, d, power, n;  // n: the emitting face's normal (0 for the point light)
+  // A point on a light: the origin of a photon, before its direction is drawn.
+  struct LightPoint {
+    glm::vec3 o, n;   // n: the emitting face's normal (0 for the point light)
+    glm::vec3 L;      // radiance E / pi of an area emitter, or the intensity I of the point light
+    float pdf;        // pdf of the choice: area density x face choice, or the point light's probability
+    bool point;
   };
-  // u: 4 numbers in [0,1); photon power for `count` photons in total.
-  Emission sample(glm::vec2 u0, glm::vec2 u1, double count) const {
-    Emission e;
+  LightPoint samplePoint(glm::vec2 u0) const {
     const double pPoint = pointPower_ / total_;
-    if (u0.x < pPoint) {
-      const glm::vec2 ur{float(std::min(0.99999994, u0.x / pPoint)), u0.y};
-      e.o = o_.pointPosition;
-      e.d = Frame(spotFrame_).toWorld(uniformCone(ur, float(cosSpot_)));
-      // Flux per photon: I * solid angle / (p_choice * count).
-      const float omega = float(2.0 * M_PI * (1.0 - cosSpot_));
-      e.power = o_.pointIntensity * omega / float(pPoint * count);
-      e.n = glm::vec3(0.f);
-      return e;
-    }
+    if (u0.x < pPoint) return {o_.pointPosition, glm::vec3(0.f), o_.pointIntensity, float(pPoint), true};
     const float ux = float(std::min(0.99999994, (u0.x - pPoint) / (1.0 - pPoint)));
     const auto L = area_.sample({ux, u0.y});
-    e.o = L.p;
-    e.n = L.n;
-    e.d = Frame(L.n).toWorld(cosineHemisphere(u1));
-    // Flux of one photon: E A / (p_face N) = E / (pdfArea N).
-    e.power = L.E / (L.pdfArea * float((1.0 - pPoint) * count));
+    return {L.p, L.n, L.E * float(M_1_PI), L.pdfArea * float(1.0 - pPoint), false};
+  }
+  // Whether the point or spot light shines towards d.
+  bool inSpot(const glm::vec3& d) const { return glm::dot(d, spotFrame_) >= float(cosSpot_); }
+
+  struct Emission {
+    glm::vec3 o, d, power, n;
+  };
+  // The global photons: cosine-distributed from area emitters, uniform in the
+  // spot's cone; photon power for `count` photons in total.
+  Emission sample(glm::vec2 u0, glm::vec2 u1, double count) const {
+    const LightPoint lp = samplePoint(u0);
+    Emission e{lp.o, {}, {}, lp.n};
+    if (lp.point) {
+      // Flux per photon: I * solid angle / (p_choice * count).
+      e.d = Frame(spotFrame_).toWorld(uniformCone(u1, float(cosSpot_)));
+      e.power = lp.L * float(2.0 * M_PI * (1.0 - cosSpot_)) / float(lp.pdf * count);
+    } else {
+      // L cos / (pdf_A * (cos / pi) * count) = pi L / (pdf_A count).
+      e.d = Frame(lp.n).toWorld(cosineHemisphere(u1));
+      e.power = lp.L * float(M_PI) / float(lp.pdf * count);
+    }
     return e;
   }
 
@@ -172,6 +182,165 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   stats.emitted += count;
   stats.emittedPower = lights.totalPower();
   ++stats.passes;
+  return all;
+}
+
+namespace {
+
+// Bounding spheres of the connected groups of mirror and glass faces.
+struct SpecularTarget {
+  glm::vec3 c;
+  float r;
+};
+std::vector<SpecularTarget> specularTargets(const Scene& s) {
+  std::vector<uint32_t> parent(s.vertexCount());
+  for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  auto find = [&](uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f] && isSpecular(s.faceMaterial(f)))
+      for (int k = 1; k < 3; ++k) parent[find(s.triangles[f][k])] = find(s.triangles[f][0]);
+  std::vector<int> group(s.vertexCount(), -1);
+  std::vector<glm::vec3> lo, hi;
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f] || !isSpecular(s.faceMaterial(f))) continue;
+    const uint32_t root = find(s.triangles[f][0]);
+    if (group[root] < 0) {
+      group[root] = int(lo.size());
+      lo.push_back(glm::vec3(HUGE_VALF));
+      hi.push_back(glm::vec3(-HUGE_VALF));
+    }
+    for (int k = 0; k < 3; ++k) {
+      lo[size_t(group[root])] = glm::min(lo[size_t(group[root])], s.positions[s.triangles[f][k]]);
+      hi[size_t(group[root])] = glm::max(hi[size_t(group[root])], s.positions[s.triangles[f][k]]);
+    }
+  }
+  std::vector<SpecularTarget> out;
+  for (size_t g = 0; g < lo.size(); ++g) {
+    const glm::vec3 c = 0.5f * (lo[g] + hi[g]);
+    out.push_back({c, glm::length(hi[g] - lo[g]) * 0.5f * 1.001f + 1e-6f});
+  }
+  return out;
+}
+
+// A direction from o towards one of the targets' spheres: the sphere chosen
+// in proportion to the solid angle of its cone, the direction uniform in the
+// cone; pdf = (number of cones containing it) / (sum of the cones' solid
+// angles). False (and nothing drawn) if o lies inside a sphere.
+bool aimAtTargets(const std::vector<SpecularTarget>& targets, const glm::vec3& o, glm::vec2 u, glm::vec3& d, float& pdf) {
+  thread_local std::vector<float> omega, cosMax;
+  omega.resize(targets.size());
+  cosMax.resize(targets.size());
+  float total = 0.f;
+  for (size_t t = 0; t < targets.size(); ++t) {
+    const float l = glm::length(targets[t].c - o);
+    if (l <= targets[t].r) return false;
+    cosMax[t] = std::sqrt(std::max(0.f, 1.f - (targets[t].r / l) * (targets[t].r / l)));
+    omega[t] = 2.f * float(M_PI) * (1.f - cosMax[t]);
+    total += omega[t];
+  }
+  float acc = 0.f;
+  size_t t = 0;
+  for (; t + 1 < targets.size() && u.x * total >= acc + omega[t]; ++t) acc += omega[t];
+  u.x = std::clamp((u.x * total - acc) / omega[t], 0.f, 0.99999994f);
+  d = Frame(glm::normalize(targets[t].c - o)).toWorld(uniformCone(u, cosMax[t]));
+  pdf = 0.f;
+  for (size_t k = 0; k < targets.size(); ++k) {
+    const glm::vec3 a = targets[k].c - o;
+    if (glm::dot(d, a) / glm::length(a) >= cosMax[k]) pdf += 1.f / total;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
+                                        size_t count, const Progress& progress, PhotonTraceStats& stats) {
+  const PhotonLights lights(s, opt);
+  const std::vector<SpecularTarget> targets = specularTargets(s);
+  if (lights.empty() || targets.empty()) return {};
+  const float eps = float(analyzeScene(s).rayEpsilon);
+  std::vector<glm::vec3> faceN(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    const float l = glm::length(n);
+    faceN[f] = l > 0.f ? n / l : glm::vec3(0.f, 0.f, 1.f);
+  }
+  constexpr size_t kBlock = 4096;
+  const size_t nBlocks = (count + kBlock - 1) / kBlock;
+  std::vector<std::vector<Photon>> blocks(nBlocks);
+  std::vector<size_t> specular(nBlocks, 0), missed(nBlocks, 0);
+  const uint32_t kPos = hash32(opt.seed ^ 0xca57u), kDir = hash32(opt.seed ^ 0xca58u);
+  parallelBlocks(nBlocks, progress, "tracing caustic photons", [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) {
+      for (size_t i = b * kBlock; i < std::min(count, (b + 1) * kBlock); ++i) {
+        const uint32_t index = uint32_t(first + i);
+        const auto lp = lights.samplePoint(sobolOwen2D(index, kPos));
+        glm::vec2 u = sobolOwen2D(index, kDir);
+        Ray ray;
+        ray.o = lp.o + lp.n * eps;
+        glm::vec3 power;
+        glm::vec3 d;
+        float pdfW = 0.f;
+        if (!aimAtTargets(targets, lp.o, u, d, pdfW)) {
+          // The light point lies within a target's sphere: every direction
+          // may reach it; draw them as the global photons do.
+          const auto e = lights.sample(sobolOwen2D(index, kPos), u, double(count));
+          d = e.d;
+          power = e.power;
+        } else if (lp.point) {
+          if (!lights.inSpot(d)) continue;
+          power = lp.L / (lp.pdf * pdfW * float(count));
+        } else {
+          const float c = glm::dot(d, lp.n);
+          if (c <= 0.f) continue;
+          power = lp.L * c / (lp.pdf * pdfW * float(count));
+        }
+        ray.d = d;
+        Rng rng(hash3(index, opt.seed, 0xc5u));
+        bool viaSpecular = false;
+        for (int depth = 0; depth < opt.maxDepth; ++depth) {
+          const Hit h = caster.intersect(ray);
+          if (!h.valid()) break;
+          const Material m = s.faceMaterial(h.face);
+          const glm::vec3 x = ray.o + ray.d * h.t, ng = faceN[h.face];
+          if (!isSpecular(m)) {
+            // L S+ D: stored at the first diffuse front face. A first hit on a
+            // diffuse face is not a caustic path: the global photons carry it.
+            if (viaSpecular && glm::dot(ng, ray.d) < 0.f) blocks[b].push_back({x, power, packNormal(ng), kCausticPhoton});
+            if (!viaSpecular) ++missed[b];
+            break;
+          }
+          const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
+          const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());
+          const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
+          if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) break;
+          power *= ev.weight / q;
+          viaSpecular = true;
+          ++specular[b];
+          ray.o = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+          ray.d = ev.d;
+          ray.tnear = 0.f;
+          ray.tfar = std::numeric_limits<float>::infinity();
+        }
+      }
+    }
+  });
+  std::vector<Photon> all;
+  size_t total = 0;
+  for (const auto& b : blocks) total += b.size();
+  all.reserve(total);
+  for (size_t b = 0; b < nBlocks; ++b) {
+    all.insert(all.end(), blocks[b].begin(), blocks[b].end());
+    std::vector<Photon>().swap(blocks[b]);
+    stats.specularBounces += specular[b];
+    stats.causticMissed += missed[b];
+  }
+  stats.causticEmitted += count;
+  stats.causticStored += all.size();
   return all;
 }
 
