@@ -9,12 +9,13 @@
 #include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/sampling.h"
+#include "gi/scene_setup.h"
 #include "gi/specular.h"
 
 namespace gi {
 
 std::vector<ParamSpec> PathTraceOptions::specs() {
-  return {
+  std::vector<ParamSpec> out = {
       {"samples_per_vertex", "Paths per vertex",
        "Paths traced from each vertex when no target error is set. The error falls as 1/sqrt(N) (independent "
        "random numbers: the reported standard error is an honest error bar).",
@@ -43,19 +44,10 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
        ParamType::Float, 0.0, 0.0, 1e9},
       {"sun_angular_radius", "Sun angular radius (deg)", "0 gives a sharp directional light.", ParamType::Float,
        0.27, 0.0, 45},
-      {"point_position", "Point light position", "Position of a point light (absolute coordinates).",
-       ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
-      {"point_intensity", "Point light intensity (W/sr)", "Radiant intensity of the point or spot light; 0 = none.",
-       ParamType::Float, 0.0, 0.0, 1e12},
-      {"point_color", "Point light colour", "Colour of the point or spot light (sRGB).", ParamType::Color, 0, 0, 0, {},
-       glm::vec3(1.f)},
-      {"spot_direction", "Spot direction", "Axis of the spot light's cone.", ParamType::Direction, 0, 0, 0, {},
-       glm::vec3(0.f, -1.f, 0.f)},
-      {"spot_angle", "Spot half angle (deg)",
-       "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining every way.",
-       ParamType::Float, 180.0, 0.0, 180.0},
-      seedSpec("paths"),
   };
+  for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
+  out.push_back(seedSpec("paths"));
+  return out;
 }
 
 PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::dvec3& origin) {
@@ -70,10 +62,11 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.sunDirection = glm::normalize(v.getVec("sun_direction"));
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
-  o.pointPosition = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
-  o.pointIntensity = lin(v.getVec("point_color")) * float(v.getFloat("point_intensity"));
-  o.spotDirection = glm::normalize(v.getVec("spot_direction"));
-  o.spotAngleDeg = float(v.getFloat("spot_angle"));
+  const PointLight pl = pointLightFromParams(v, origin);
+  o.pointPosition = pl.position;
+  o.pointIntensity = pl.intensity;
+  o.spotDirection = pl.spotDirection;
+  o.spotAngleDeg = pl.spotAngleDeg;
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }

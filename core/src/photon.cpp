@@ -10,6 +10,7 @@
 #include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/sampling.h"
+#include "gi/scene_setup.h"
 #include "gi/specular.h"
 #include "photon_map.h"
 #include "photon_internal.h"
@@ -17,7 +18,7 @@
 namespace gi {
 
 std::vector<ParamSpec> PhotonOptions::specs() {
-  return {
+  std::vector<ParamSpec> out = {
       {"photons", "Photons emitted",
        "Number of photon paths shot from the lights (in proportion to their power); per pass when progressive. More "
        "photons: less noise and blur; memory grows linearly (about 32 bytes per stored photon, 2-4 stored per path).",
@@ -66,22 +67,10 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        "Paths end after this many bounces, diffuse or specular (Russian roulette ends most much earlier; the power "
        "still carried by cut paths is logged).",
        ParamType::Int, 32, 1, 1000},
-      {"point_position", "Point light position", "Position of an optional point or spot light (absolute coordinates).",
-       ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
-      {"point_intensity", "Point light intensity (W/sr)",
-       "Radiant intensity of the point or spot light; 0 = none. Its power is 4 pi I (point) or 2 pi (1 - cos a) I "
-       "(spot of half angle a).",
-       ParamType::Float, 0.0, 0.0, 1e12},
-      {"point_color", "Point light colour", "Colour of the point or spot light (sRGB).", ParamType::Color, 0, 0, 0, {},
-       glm::vec3(1.f)},
-      {"spot_direction", "Spot direction", "Axis of the spot light's cone.", ParamType::Direction, 0, 0, 0, {},
-       glm::vec3(0.f, -1.f, 0.f)},
-      {"spot_angle", "Spot half angle (deg)",
-       "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining every "
-       "way.",
-       ParamType::Float, 180.0, 0.0, 180.0},
-      seedSpec("photon paths"),
   };
+  for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
+  out.push_back(seedSpec("photon paths"));
+  return out;
 }
 
 PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& origin) {
@@ -98,11 +87,11 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
   o.gatherRays = v.getInt("gather_rays");
   o.progressive = v.getBool("progressive");
   o.passes = v.getInt("passes");
-  o.pointPosition = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
-  const glm::vec3 c = v.getVec("point_color");
-  o.pointIntensity = float(v.getFloat("point_intensity")) * glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
-  o.spotDirection = glm::normalize(v.getVec("spot_direction"));
-  o.spotAngleDeg = float(v.getFloat("spot_angle"));
+  const PointLight pl = pointLightFromParams(v, origin);
+  o.pointPosition = pl.position;
+  o.pointIntensity = pl.intensity;
+  o.spotDirection = pl.spotDirection;
+  o.spotAngleDeg = pl.spotAngleDeg;
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }

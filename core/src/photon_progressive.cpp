@@ -108,11 +108,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
     uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value) {
-  std::vector<glm::vec3> faceN(s.faceCount());
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
-    faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f, 0.f, 1.f);
-  }
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {

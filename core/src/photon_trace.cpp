@@ -18,6 +18,25 @@ glm::i8vec3 packNormal(const glm::vec3& n) {
   return glm::i8vec3(int8_t(std::lround(n.x * 127.f)), int8_t(std::lround(n.y * 127.f)), int8_t(std::lround(n.z * 127.f)));
 }
 
+// A photon meets a mirror or glass face (unit normal ng) at x: its new
+// direction and power, with Russian roulette on the tint (a white mirror or
+// clear glass always passes); the ray starts again on the side it leaves by.
+// False if the photon is absorbed.
+bool specularStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::vec3& x, float eps, Rng& rng, Ray& ray,
+                  glm::vec3& power, size_t& totalInternal) {
+  const float ior = s.ior.empty() ? 1.5f : s.ior[face];
+  const SpecularEvent ev = scatterSpecular(s.faceMaterial(face), ray.d, ng, s.faceRho(face), ior, rng.next());
+  totalInternal += ev.totalInternal;
+  const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
+  if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return false;
+  power *= ev.weight / q;
+  ray.o = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+  ray.d = ev.d;
+  ray.tnear = 0.f;
+  ray.tfar = std::numeric_limits<float>::infinity();
+  return true;
+}
+
 // The lights photons leave from: the area emitters and an optional point or
 // spot light, chosen in proportion to their (luminance) power.
 class PhotonLights {
@@ -85,12 +104,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
     throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality) "
                                 "and no point or spot light");
   const float eps = float(analyzeScene(s).rayEpsilon);
-  std::vector<glm::vec3> faceN(s.faceCount());
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
-    const float l = glm::length(n);
-    faceN[f] = l > 0.f ? n / l : glm::vec3(0.f, 0.f, 1.f);
-  }
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   // Fixed-size blocks, concatenated in order: the result is independent of threads.
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
@@ -118,39 +132,27 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           const glm::vec3 x = ray.o + ray.d * h.t;
           const Material m = s.faceMaterial(h.face);
           const glm::vec3 ng = faceN[h.face];
-          glm::vec3 newDir;
-          glm::vec3 side = glm::dot(ng, ray.d) > 0.f ? -ng : ng;  // the side the photon arrived on
           if (isSpecular(m)) {
-            const glm::vec3 tint = s.faceRho(h.face);
-            const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
-            const SpecularEvent ev = scatterSpecular(m, ray.d, ng, tint, ior, rng.next());
-            st.totalInternal += ev.totalInternal;
-            // Russian roulette on the tint (a white mirror or clear glass always survives).
-            const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
-            if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) break;
-            power *= ev.weight / q;
-            newDir = ev.d;
+            if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, st.totalInternal)) break;
             ++st.specularBounces;
             viaSpecular = true;
-            side = glm::dot(newDir, ng) > 0.f ? ng : -ng;  // leave on the side of the new direction
-          } else {
-            // Diffuse faces are one-sided, as in the radiosity filter and the
-            // reference: the back of a face is black.
-            if (glm::dot(ng, ray.d) > 0.f) break;
-            const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
-            out.push_back({x, power, packNormal(side), path});
-            st.storedPower += luminance(power);
-            (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
-            const glm::vec3 rho = s.faceRho(h.face);
-            const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
-            if (!(q > 0.f) || rng.next() >= q) break;  // Russian roulette: absorbed
-            power *= rho / q;
-            newDir = Frame(side).toWorld(cosineHemisphere({rng.next(), rng.next()}));
-            ++diffuse;
-            ++st.diffuseBounces;
+            continue;
           }
-          ray.o = x + side * eps;
-          ray.d = newDir;
+          // Diffuse faces are one-sided, as in the radiosity filter and the
+          // reference: the back of a face is black.
+          if (glm::dot(ng, ray.d) > 0.f) break;
+          const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
+          out.push_back({x, power, packNormal(ng), path});
+          st.storedPower += luminance(power);
+          (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
+          const glm::vec3 rho = s.faceRho(h.face);
+          const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
+          if (!(q > 0.f) || rng.next() >= q) break;  // Russian roulette: absorbed
+          power *= rho / q;
+          ++diffuse;
+          ++st.diffuseBounces;
+          ray.o = x + ng * eps;
+          ray.d = Frame(ng).toWorld(cosineHemisphere({rng.next(), rng.next()}));
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
         }
@@ -263,12 +265,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   const std::vector<SpecularTarget> targets = specularTargets(s);
   if (lights.empty() || targets.empty()) return {};
   const float eps = float(analyzeScene(s).rayEpsilon);
-  std::vector<glm::vec3> faceN(s.faceCount());
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
-    const float l = glm::length(n);
-    faceN[f] = l > 0.f ? n / l : glm::vec3(0.f, 0.f, 1.f);
-  }
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
   std::vector<std::vector<Photon>> blocks(nBlocks);
@@ -314,17 +311,10 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
             if (!viaSpecular) ++missed[b];
             break;
           }
-          const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
-          const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());
-          const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
-          if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) break;
-          power *= ev.weight / q;
+          size_t tir = 0;
+          if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, tir)) break;
           viaSpecular = true;
           ++specular[b];
-          ray.o = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
-          ray.d = ev.d;
-          ray.tnear = 0.f;
-          ray.tfar = std::numeric_limits<float>::infinity();
         }
       }
     }

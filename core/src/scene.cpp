@@ -78,6 +78,16 @@ glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f) {
   return glm::vec3(glm::cross(b - a, c - a));
 }
 
+std::vector<glm::vec3> unitFaceNormals(const Scene& s) {
+  std::vector<glm::vec3> n(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 m = faceNormalUnnormalized(s, f);
+    const float l = glm::length(m);
+    n[f] = l > 0.f ? m / l : glm::vec3(0.f, 0.f, 1.f);
+  }
+  return n;
+}
+
 double faceArea(const Scene& s, size_t f) {
   const auto& t = s.triangles[f];
   glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);

@@ -76,6 +76,35 @@ std::vector<ParamSpec> materialSpecs() {
   return s;
 }
 
+std::vector<ParamSpec> pointLightSpecs() {
+  return {
+      {"point_position", "Point light position", "Position of an optional point or spot light (absolute coordinates).",
+       ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
+      {"point_intensity", "Point light intensity (W/sr)",
+       "Radiant intensity of the point or spot light; 0 = none. Its power is 4 pi I (point) or 2 pi (1 - cos a) I "
+       "(spot of half angle a).",
+       ParamType::Float, 0.0, 0.0, 1e12},
+      {"point_color", "Point light colour", "Colour of the point or spot light (sRGB).", ParamType::Color, 0, 0, 0, {},
+       glm::vec3(1.f)},
+      {"spot_direction", "Spot direction", "Axis of the spot light's cone.", ParamType::Direction, 0, 0, 0, {},
+       glm::vec3(0.f, -1.f, 0.f)},
+      {"spot_angle", "Spot half angle (deg)",
+       "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining every "
+       "way.",
+       ParamType::Float, 180.0, 0.0, 180.0},
+  };
+}
+
+PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& origin) {
+  PointLight p;
+  p.position = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
+  const glm::vec3 c = v.getVec("point_color");
+  p.intensity = float(v.getFloat("point_intensity")) * glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
+  p.spotDirection = glm::normalize(v.getVec("spot_direction"));
+  p.spotAngleDeg = float(v.getFloat("spot_angle"));
+  return p;
+}
+
 bool matchesLayerPatterns(const std::string& name, const std::string& patterns) {
   std::stringstream ss(patterns);
   std::string item;

@@ -46,6 +46,8 @@ uint64_t sceneHash(const Scene& s);
 // Geometry helpers (local coordinates).
 glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f);  // cross product, |n| = 2 * area
 double faceArea(const Scene& s, size_t f);
+// Unit face normals (winding order); +z for degenerate faces.
+std::vector<glm::vec3> unitFaceNormals(const Scene& s);
 // Angle-weighted vertex normals from the faces; zero vector for isolated vertices.
 std::vector<glm::vec3> computeVertexNormals(const Scene& s);
 

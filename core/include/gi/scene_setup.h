@@ -42,6 +42,16 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
 // specular, by name patterns, and their colour and index of refraction.
 std::vector<ParamSpec> materialSpecs();
 
+// An optional point or spot light (photon mapping and the reference).
+struct PointLight {
+  glm::vec3 position{0.f};          // local scene coordinates
+  glm::vec3 intensity{0.f};         // W/sr, linear RGB; 0 = none
+  glm::vec3 spotDirection{0.f, -1.f, 0.f};
+  float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light
+};
+std::vector<ParamSpec> pointLightSpecs();
+PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
+
 // A named range of faces of the scene: a MeshLab layer or an input file.
 struct LayerRange {
   std::string name;
