@@ -139,12 +139,44 @@ class Bench:
             flush=True)
 
 
+def plot(rows, refinfo, scenes, path):
+    """Error versus time per scene; one colour per method in every panel."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    methods = sorted({r["method"] for r in rows})
+    colour = {m: "C%d" % (i % 10) for i, m in enumerate(methods)}
+    marker = {m: "os^vD"[i // 10] for i, m in enumerate(methods)}
+    fig, axes = plt.subplots(1, len(scenes), figsize=(6.5 * len(scenes), 5.2))
+    axes = axes if len(scenes) > 1 else [axes]
+    for ax, scene in zip(axes, scenes):
+        for m in methods:
+            pts = sorted((r["seconds"], r["relative_rms_error_interior"]) for r in rows if r["scene"] == scene and r["method"] == m)
+            if pts:
+                ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker[m] + "-", color=colour[m], label=m)
+        ax.axhline(refinfo[scene]["relative_noise_interior"], color="grey", ls="--", lw=0.7,
+                   label="the reference's own noise")
+        ax.set_title(scene)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel("relative RMS error vs path-traced reference (interior vertices)")
+        ax.grid(True, which="both", lw=0.3)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--replot", action="store_true", help="only redraw the plot from results/lighting_bench.json")
     a = ap.parse_args()
+    if a.replot:
+        with open(os.path.join(a.out, "lighting_bench.json")) as f:
+            r = json.load(f)
+        plot(r["rows"], r["references"], list(r["references"]), os.path.join(a.out, "lighting_bench.png"))
+        return
     os.makedirs(a.out, exist_ok=True)
     b = Bench(a.build, a.out, 1 if a.quick else 3)
     scenes = {"cornell_1.5k": "cornell_box"} if a.quick else {"cornell_1.5k": "cornell_box", "cornell_10k": "cornell_box_10k"}
@@ -252,24 +284,7 @@ def main():
             s, info["paths"], info["seconds"], info["mean_relative_std_error"], info["file"]))
     with open(os.path.join(a.out, "lighting_bench.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.6))
-    axes = axes if len(scenes) > 1 else [axes]
-    for ax, scene in zip(axes, scenes):
-        for m in sorted({r["method"] for r in b.rows if r["scene"] == scene}):
-            pts = sorted((r["seconds"], r["relative_rms_error_interior"]) for r in b.rows if r["scene"] == scene and r["method"] == m)
-            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=m)
-        ax.axhline(refinfo[scene]["relative_noise_interior"], color="grey", ls="--", lw=0.7,
-                   label="the reference's own noise")
-        ax.set_title(scene)
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("relative RMS error vs path-traced reference (interior vertices)")
-        ax.grid(True, which="both", lw=0.3)
-    axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "lighting_bench.png"), dpi=110)
+    plot(b.rows, refinfo, list(scenes), os.path.join(a.out, "lighting_bench.png"))
     print("\n".join(lines))
 
 
