@@ -124,7 +124,12 @@ def main():
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--report", action="store_true", help="only rewrite the tables and plot from results/photon_bench.json")
     a = ap.parse_args()
+    if a.report:
+        with open(os.path.join(a.out, "photon_bench.json")) as f:
+            report(json.load(f), a.out)
+        return
     os.makedirs(a.out, exist_ok=True)
     b = Bench(a.build, a.out, 1 if a.quick else 3)
     q = a.quick
@@ -155,14 +160,6 @@ def main():
         # The peer: the path tracer itself (an independent seed), at growing path counts.
         for spp in ([16, 128] if q else [16, 64, 256, 1024, 4096]):
             b.run_method(scene, "path tracer", "reference", ["--samples_per_vertex", str(spp), "--seed", "1"], ref, regions, "pt")
-    # Equal-time error ratio on the caustic region: the path tracer's error at each photon-mapping time.
-    equal = []
-    pt = [(r["seconds"], r["error_caustic"]) for r in b.rows if r["scene"] == "caustic_cornell" and r["tag"] == "pt"]
-    for r in b.rows:
-        if r["scene"] == "caustic_cornell" and r["tag"] in ("pm", "pm_k512", "ppm"):
-            e_pt = loglog_at(pt, r["seconds"])
-            equal.append({"method": r["method"], "args": r["args"], "seconds": r["seconds"], "error_pm": r["error_caustic"],
-                          "error_pt_at_equal_time": e_pt, "ratio_pt_over_pm": e_pt / r["error_caustic"]})
     # 10M photons: time, peak memory, photon memory.
     big = {}
     if not q:
@@ -175,17 +172,39 @@ def main():
                "photons_stored": j["stats"]["photons_stored"], "photons_per_second": j["stats"]["photons_per_second"],
                "kdtree_build_seconds": j["stats"]["kdtree_build_seconds"]}
         print("10M photons: %.1f s, peak RSS %.0f MB, photon maps %.0f MB" % (wall, rss, big["photon_memory_mb"]), flush=True)
-    result = {"rows": b.rows, "references": refs, "equal_time": equal, "ten_million": big, "focus": FOCUS}
-    with open(os.path.join(a.out, "photon_bench.json"), "w") as f:
+    report({"rows": b.rows, "references": refs, "ten_million": big, "focus": FOCUS}, a.out)
+
+
+def equal_time(rows):
+    """On the caustic region, per photon-mapping run: the path tracer's error at the same time, and the
+    time it needs for the same error (both by log-log interpolation of its runs, extrapolated at the ends)."""
+    pt = [(r["seconds"], r["error_caustic"]) for r in rows if r["scene"] == "caustic_cornell" and r["tag"] == "pt"]
+    inv = [(e, t) for t, e in pt]
+    out = []
+    for r in rows:
+        if r["scene"] == "caustic_cornell" and r["tag"] in ("pm", "pm_k512", "ppm"):
+            e_pt = loglog_at(pt, r["seconds"])
+            t_pt = loglog_at(inv, r["error_caustic"])
+            out.append({"method": r["method"], "args": r["args"], "seconds": r["seconds"], "error_pm": r["error_caustic"],
+                        "error_pt_at_equal_time": e_pt, "ratio_pt_over_pm": e_pt / r["error_caustic"],
+                        "pt_seconds_to_same_error": t_pt, "time_ratio": t_pt / r["seconds"]})
+    return out
+
+
+def report(result, outdir):
+    """Writes photon_bench.{json,csv,md,png} from the measured rows."""
+    b_rows, refs, big = result["rows"], result["references"], result["ten_million"]
+    equal = result["equal_time"] = equal_time(b_rows)
+    with open(os.path.join(outdir, "photon_bench.json"), "w") as f:
         json.dump(result, f, indent=1)
-    keys = sorted({k for r in b.rows for k in r})
-    with open(os.path.join(a.out, "photon_bench.csv"), "w", newline="") as f:
+    keys = sorted({k for r in b_rows for k in r})
+    with open(os.path.join(outdir, "photon_bench.csv"), "w", newline="") as f:
         wr = csv.DictWriter(f, fieldnames=keys)
         wr.writeheader()
-        wr.writerows(b.rows)
+        wr.writerows(b_rows)
     lines = ["| scene | method | settings | time (s) | error, caustic region | error, interior vertices | interior minus ref. noise | photons/s | kd-tree build (s) | query (s) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for r in b.rows:
+    for r in b_rows:
         lines.append("| %s | %s | %s | %.2f | %s | %.4f | %.4f | %s | %s | %s |" % (
             r["scene"], r["method"], r["args"], r["seconds"],
             "%.4f" % r["error_caustic"] if "error_caustic" in r else "", r["error_interior"],
@@ -193,10 +212,12 @@ def main():
             "%.2fM" % (r["photons_per_second"] / 1e6) if "photons_per_second" in r else "",
             "%.3f" % r["kdtree_build_seconds"] if "kdtree_build_seconds" in r else "",
             "%.3f" % r["query_seconds"] if "query_seconds" in r else ""))
-    lines += ["", "| caustic region: method | settings | time (s) | error | path tracer's error at equal time | ratio |", "|---|---|---|---|---|---|"]
+    lines += ["", "| caustic region: method | settings | time (s) | error | path tracer's error at equal time | error ratio | path tracer's time to the same error (s) | time ratio |",
+              "|---|---|---|---|---|---|---|---|"]
     for e in equal:
-        lines.append("| %s | %s | %.2f | %.4f | %.4f | %.1f |" % (e["method"], e["args"], e["seconds"], e["error_pm"],
-                                                                  e["error_pt_at_equal_time"], e["ratio_pt_over_pm"]))
+        lines.append("| %s | %s | %.2f | %.4f | %.4f | %.1f | %.1f | %.1f |" % (
+            e["method"], e["args"], e["seconds"], e["error_pm"], e["error_pt_at_equal_time"], e["ratio_pt_over_pm"],
+            e["pt_seconds_to_same_error"], e["time_ratio"]))
     if big:
         lines += ["", "10M photons on the caustic box: %.1f s, peak RSS %.0f MB (photon maps %.0f MB, %.1fM stored), %.2fM photons/s" % (
             big["wall_seconds"], big["peak_rss_mb"], big["photon_memory_mb"], big["photons_stored"] / 1e6,
@@ -204,17 +225,20 @@ def main():
     for s, info in refs.items():
         lines.append("reference %s: %d paths, %.1f s, mean relative standard error %.4f (%s)" % (
             s, info["paths"], info["seconds"], info["mean_relative_std_error"], info["file"]))
-    with open(os.path.join(a.out, "photon_bench.md"), "w") as f:
+    with open(os.path.join(outdir, "photon_bench.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
+    methods = sorted({r["method"] for r in b_rows})
+    colour = {m: "C%d" % (i % 10) for i, m in enumerate(methods)}
     for ax, (scene, region) in zip(axes, [("cornell_box", "interior"), ("caustic_cornell", "caustic")]):
-        for m in sorted({r["method"] for r in b.rows if r["scene"] == scene}):
-            pts = sorted((r["seconds"], r["error_" + region]) for r in b.rows if r["scene"] == scene and r["method"] == m)
-            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=m)
-        noise = [r["reference_noise_" + region] for r in b.rows if r["scene"] == scene][0]
+        for m in methods:
+            pts = sorted((r["seconds"], r["error_" + region]) for r in b_rows if r["scene"] == scene and r["method"] == m)
+            if pts:
+                ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", color=colour[m], label=m)
+        noise = [r["reference_noise_" + region] for r in b_rows if r["scene"] == scene][0]
         ax.axhline(noise, color="grey", ls="--", lw=0.7, label="the reference's own noise")
         ax.set_title("%s (%s vertices)" % (scene, region))
         ax.set_xlabel("time (s)")
@@ -222,7 +246,7 @@ def main():
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(os.path.join(a.out, "photon_bench.png"), dpi=110)
+    fig.savefig(os.path.join(outdir, "photon_bench.png"), dpi=110)
     print("\n".join(lines))
 
 
