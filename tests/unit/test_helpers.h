@@ -1,8 +1,12 @@
 // Small helpers shared by the engine tests.
 #pragma once
 #include <cmath>
+#include <algorithm>
+#include <array>
 #include <functional>
 #include <limits>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -37,6 +41,41 @@ inline double rms(const std::vector<float>& a, const std::vector<float>& b) {
   double s = 0;
   for (size_t i = 0; i < a.size(); ++i) s += double(a[i] - b[i]) * double(a[i] - b[i]);
   return std::sqrt(s / double(a.size()));
+}
+
+// 1 for vertices on a mesh border (an edge used by one face).
+inline std::vector<uint8_t> borderVertices(const Scene& s) {
+  std::map<std::pair<uint32_t, uint32_t>, int> edgeUse;
+  for (const auto& t : s.triangles)
+    for (int k = 0; k < 3; ++k) ++edgeUse[std::minmax(t[k], t[(k + 1) % 3])];
+  std::vector<uint8_t> border(s.vertexCount(), 0);
+  for (const auto& [e, n] : edgeUse)
+    if (n == 1) border[e.first] = border[e.second] = 1;
+  return border;
+}
+
+// Walls of a box scene: faces grouped by (normal, reflectance), skipping
+// emitters and faces touching a mesh border (creases, the rim of a light,
+// where per-vertex values and patch averages legitimately differ). Per
+// group: area and the area-weighted sums of two per-face values a and b.
+inline std::map<std::string, std::array<double, 3>> wallSums(const Scene& s, const std::function<double(size_t)>& a,
+                                                              const std::function<double(size_t)>& b) {
+  const std::vector<uint8_t> border = borderVertices(s);
+  std::map<std::string, std::array<double, 3>> groups;
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const auto& t = s.triangles[f];
+    if (s.faceEmission(f).r > 0 || border[t.x] || border[t.y] || border[t.z]) continue;
+    const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
+    const std::string key = std::to_string(int(std::lround(n.x * 10))) + "," + std::to_string(int(std::lround(n.y * 10))) +
+                            "," + std::to_string(int(std::lround(n.z * 10))) + "," +
+                            std::to_string(int(s.faceRho(f).r * 100));
+    const double area = faceArea(s, f);
+    auto& g = groups[key];
+    g[0] += area;
+    g[1] += area * a(f);
+    g[2] += area * b(f);
+  }
+  return groups;
 }
 
 }  // namespace gi::test

@@ -169,30 +169,13 @@ TEST(PathTracer, AgreesWithRadiosityOnCornellBox) {
   ro.tolerance = 1e-7;
   const auto rad = solveRadiosity(s, *caster, ro);
   const auto pt = trace(s, 256);
-  // Group faces by (rho, normal): each group is one wall or block side.
-  auto key = [&](size_t f) {
-    const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
-    return std::to_string(int(std::lround(n.x * 10))) + "," + std::to_string(int(std::lround(n.y * 10))) + "," +
-           std::to_string(int(std::lround(n.z * 10))) + "," + std::to_string(int(s.faceRho(f).r * 100));
-  };
-  std::map<std::pair<uint32_t, uint32_t>, int> edgeUse;
-  for (const auto& t : s.triangles)
-    for (int k = 0; k < 3; ++k) ++edgeUse[std::minmax(t[k], t[(k + 1) % 3])];
-  std::vector<uint8_t> border(s.vertexCount(), 0);
-  for (const auto& [e, n] : edgeUse)
-    if (n == 1) border[e.first] = border[e.second] = 1;
-  std::map<std::string, std::array<double, 3>> groups;  // area, radiosity, path tracer
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    const auto& t = s.triangles[f];
-    if (s.faceEmission(f).r > 0 || border[t.x] || border[t.y] || border[t.z]) continue;
-    const double a = faceArea(s, f);
-    double ptB = 0;
-    for (int k = 0; k < 3; ++k) ptB += luminance(pt.B[s.triangles[f][k]]) / 3;
-    auto& g = groups[key(f)];
-    g[0] += a;
-    g[1] += a * luminance(rad.B[f]);
-    g[2] += a * ptB;
-  }
+  const auto groups = test::wallSums(
+      s, [&](size_t f) { return double(luminance(rad.B[f])); },
+      [&](size_t f) {
+        double ptB = 0;
+        for (int k = 0; k < 3; ++k) ptB += luminance(pt.B[s.triangles[f][k]]) / 3;
+        return ptB;
+      });
   int compared = 0;
   for (const auto& [k, g] : groups) {
     if (g[0] < 5e3) continue;  // ignore tiny groups (mm^2)
@@ -203,6 +186,7 @@ TEST(PathTracer, AgreesWithRadiosityOnCornellBox) {
   // Per-vertex output against the path tracer at vertices off the borders:
   // the final gather beats interpolating the patches, which beats the plain
   // patch average (the error of each printed as a test property).
+  const std::vector<uint8_t> border = test::borderVertices(s);
   auto vertexError = [&](RadiosityVertexOutput mode) {
     RadiosityOptions o = ro;
     o.vertexOutput = mode;
