@@ -6,6 +6,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <tbb/parallel_invoke.h>
+
 #include "gi/color.h"
 #include "gi/direct.h"
 #include "gi/emitters.h"
@@ -201,11 +203,20 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     const double traceSeconds = traceTimer.seconds();
     Timer buildTimer;
     const unsigned globalPaths = opt.directLight ? (1u << kIndirectPhoton) : 7u;
-    PhotonMap global(photons, globalPaths);
-    std::unique_ptr<PhotonMap> caustics, all;
-    if (projection && !causticPhotons.empty()) caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton);
-    else if (opt.directLight && !projection && ts.caustic > 0) caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
-    if (opt.directLight && opt.finalGather) all = std::make_unique<PhotonMap>(photons, 7u);
+    // The (single-threaded) kd-tree builds run side by side.
+    std::unique_ptr<PhotonMap> globalMap, caustics, all;
+    tbb::parallel_invoke(
+        [&] { globalMap = std::make_unique<PhotonMap>(photons, globalPaths); },
+        [&] {
+          if (projection && !causticPhotons.empty())
+            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton);
+          else if (opt.directLight && !projection && ts.caustic > 0)
+            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
+        },
+        [&] {
+          if (opt.directLight && opt.finalGather) all = std::make_unique<PhotonMap>(photons, 7u);
+        });
+    const PhotonMap& global = *globalMap;
     const double buildSeconds = buildTimer.seconds();
     size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon) + global.memoryBytes();
     if (caustics) mapBytes += caustics->memoryBytes();

@@ -24,12 +24,17 @@ class PhotonMap {
   PhotonMap(const std::vector<Photon>& all, unsigned pathMask) : cloud_{all, {}} {
     for (uint32_t i = 0; i < all.size(); ++i)
       if (pathMask & (1u << all[i].path)) cloud_.idx.push_back(i);
-    tree_ = std::make_unique<Tree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    // Positions copied together: the build reads them many times over.
+    cloud_.pts.resize(cloud_.idx.size());
+    for (size_t k = 0; k < cloud_.idx.size(); ++k) cloud_.pts[k] = all[cloud_.idx[k]].p;
+    tree_ = std::make_unique<Tree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree_->buildIndex();
   }
   size_t size() const { return cloud_.idx.size(); }
   // Index and tree; the photons themselves belong to the caller's vector.
-  size_t memoryBytes() const { return cloud_.idx.capacity() * sizeof(uint32_t) + tree_->usedMemory(*tree_); }
+  size_t memoryBytes() const {
+    return cloud_.idx.capacity() * sizeof(uint32_t) + cloud_.pts.capacity() * sizeof(glm::vec3) + tree_->usedMemory(*tree_);
+  }
 
   // Irradiance at x (unit normal n) from the k nearest photons on the same
   // side within sqrt(r2max). *noise gets the Poisson standard error.
@@ -102,8 +107,9 @@ class PhotonMap {
   struct Cloud {
     const std::vector<Photon>& all;
     std::vector<uint32_t> idx;
+    std::vector<glm::vec3> pts;  // positions of idx, contiguous
     size_t kdtree_get_point_count() const { return idx.size(); }
-    float kdtree_get_pt(size_t i, size_t d) const { return all[idx[i]].p[int(d)]; }
+    float kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
     template <class B> bool kdtree_get_bbox(B&) const { return false; }
   };
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
