@@ -1,6 +1,7 @@
 #include "gi/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -163,6 +164,23 @@ SceneReport analyzeScene(const Scene& s) {
     }
   }
   for (size_t i = 0; i < nv; ++i) r.isolatedVertices += (finite[i] && !used[i]) ? 1 : 0;
+  // Duplicated faces: the same three corner positions (in any order) as an
+  // earlier usable face. Coplanar copies hide each other at random in ray
+  // casting, so exact energy accounting does not hold for them.
+  {
+    std::vector<std::array<float, 9>> keys;
+    keys.reserve(r.faces);
+    for (size_t f = 0; f < r.faces; ++f) {
+      if (!ok[f]) continue;
+      std::array<glm::vec3, 3> c = {s.positions[s.triangles[f].x], s.positions[s.triangles[f].y], s.positions[s.triangles[f].z]};
+      std::sort(c.begin(), c.end(), [](const glm::vec3& a, const glm::vec3& b) {
+        return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+      });
+      keys.push_back({c[0].x, c[0].y, c[0].z, c[1].x, c[1].y, c[1].z, c[2].x, c[2].y, c[2].z});
+    }
+    std::sort(keys.begin(), keys.end());
+    for (size_t k = 1; k < keys.size(); ++k) r.duplicateFaces += keys[k] == keys[k - 1] ? 1 : 0;
+  }
   if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; r.diagonal = glm::length(hi - lo); }
   // Ray offsets: a small fraction of the scene size, and never below the float
   // resolution of the largest local coordinate (positions are centred).
@@ -181,6 +199,9 @@ std::string SceneReport::summary() const {
                 "%zu NaN/Inf vertices, %zu isolated vertices; %zu emitter faces; bbox diagonal %.6g",
                 vertices, faces, usableFaces(), degenerateFaces, invalidFaces, facesOnNonFinite, nonFiniteVertices,
                 isolatedVertices, emitterFaces, diagonal);
+  if (duplicateFaces)
+    return std::string(buf) + "; " + std::to_string(duplicateFaces) +
+           " duplicated faces (coplanar copies shadow each other at random: remove them for exact results)";
   return buf;
 }
 
