@@ -23,7 +23,7 @@ std::vector<ParamSpec> PhotonOptions::specs() {
   std::vector<ParamSpec> out = {
       {"photons", "Photons emitted",
        "Number of photon paths shot from the lights (in proportion to their power); per pass when progressive. More "
-       "photons: less noise and blur; memory grows linearly (about 32 bytes per stored photon, 2-4 stored per path).",
+       "photons: less noise and blur; memory grows linearly (about 50 bytes per stored photon with its kd-tree, 1-4 stored per path).",
        ParamType::Int, 200000, 1, 100000000},
       {"k_nearest", "Photons per estimate",
        "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side of the "
