@@ -14,7 +14,7 @@ m="$root/test_meshes"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 -o "$ex/radiosity_cornell.mlx"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --bounces 1 --emitter_source 1 --vertex_output "Patch average" \
   -o "$ex/radiosity_cornell_one_bounce.mlx"
-"$gi" script radiosity --mesh "$m/cornell_box.ply" -o "$ex/radiosity_selected_faces.mlx"
+"$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source "Selected faces" -o "$ex/radiosity_selected_faces.mlx"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 --refine true --refine_max_depth 2 \
   -o "$ex/radiosity_cornell_refined.mlx"
 "$gi" script photonmap --mesh "$m/cornell_box.ply" --emitter_source 1 --photons 1000000 --k_nearest 128 \

@@ -34,8 +34,9 @@ std::vector<ParamSpec> lightingSceneSpecs() {
   s.push_back({"emitter_source", "Emitters",
                "Which faces emit light. 'Selected faces': select the light in MeshLab (or with a selection filter in "
                "a script). 'Face quality above threshold': faces whose quality exceeds the threshold below. "
-               "'None': only for scenes lit otherwise.",
-               ParamType::Enum, 0, 0, 0, {"Selected faces", "Face quality above threshold", "None"}});
+               "'None': only for scenes lit otherwise. 'Auto' (the default): the selected faces if any face is "
+               "selected, else the faces with quality above the threshold (the log says which).",
+               ParamType::Enum, 3, 0, 0, {"Selected faces", "Face quality above threshold", "None", "Auto"}});
   s.push_back({"emitter_quality_threshold", "Emitter quality threshold",
                "With 'Face quality above threshold', faces with quality strictly above this value emit.",
                ParamType::Float, 0.5, -1e30, 1e30});
@@ -213,10 +214,17 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
     const glm::vec3 E = float(v.getFloat("emitter_intensity")) * glm::vec3(srgbToLinear(col.r), srgbToLinear(col.g), srgbToLinear(col.b));
     s.emission.assign(nf, glm::vec3(0.f));
     size_t count = 0;
-    if (es == EmitterSource::SelectedFaces && a.faceSelected.size() == nf) {
+    const bool anySelected = a.faceSelected.size() == nf &&
+                             std::any_of(a.faceSelected.begin(), a.faceSelected.end(), [](uint8_t x) { return x != 0; });
+    const EmitterSource chosen = es != EmitterSource::Auto ? es
+                                 : anySelected        ? EmitterSource::SelectedFaces
+                                                      : EmitterSource::QualityAbove;
+    if (es == EmitterSource::Auto)
+      msg += std::string("; emitters: ") + (anySelected ? "the selected faces" : "faces with quality above the threshold (nothing selected)");
+    if (chosen == EmitterSource::SelectedFaces && a.faceSelected.size() == nf) {
       for (size_t f = 0; f < nf; ++f)
         if (a.faceSelected[f]) { s.emission[f] = E; ++count; }
-    } else if (es == EmitterSource::QualityAbove && a.faceQuality.size() == nf) {
+    } else if (chosen == EmitterSource::QualityAbove && a.faceQuality.size() == nf) {
       const float th = float(v.getFloat("emitter_quality_threshold"));
       for (size_t f = 0; f < nf; ++f)
         if (a.faceQuality[f] > th) { s.emission[f] = E; ++count; }

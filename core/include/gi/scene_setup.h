@@ -23,7 +23,7 @@ struct MeshAttributes {
   std::vector<uint8_t> faceSelected;
 };
 
-enum class EmitterSource { SelectedFaces = 0, QualityAbove = 1, None = 2 };
+enum class EmitterSource { SelectedFaces = 0, QualityAbove = 1, None = 2, Auto = 3 };
 enum class ReflectanceSource { Auto = 0, FaceColor = 1, VertexColor = 2, Constant = 3 };
 
 // Scene parameters shared by radiosity, photon mapping and the reference.
