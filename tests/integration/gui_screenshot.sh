@@ -34,7 +34,9 @@
 # about 5 s, a failing one about 35 s).
 #
 # Environment knobs: GUI_NO_CHECK=1 (just take the screenshot), GUI_TIMEOUT, GUI_MIN_FRACTION, GUI_RENDER_WAIT (seconds to keep
-# re-taking screenshots until the check passes, default 30), PYTHON.
+# re-taking screenshots until the check passes, default 30), PYTHON, GUI_SCREEN_HEIGHT (default 1024);
+# GUI_APPLY_AO=1 or GUI_APPLY_FILTER=name with GUI_APPLY_DOWNS=its place in Color Creation and Processing
+# (GUI_MENU_PEEK=1: screenshot that submenu and stop) and GUI_APPLY_LOG=text its log line must hold.
 #
 # MeshLab 2020.09 quirks handled here:
 #  * it keeps state in ~/.config/VCG/MeshLab_64bit_fp.conf (a loaded-mesh counter,
@@ -62,7 +64,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 timeout_s=${GUI_TIMEOUT:-140}
 min_fraction=${GUI_MIN_FRACTION:-0.02}
 render_wait=${GUI_RENDER_WAIT:-30}
-width=1280 height=1024
+width=1280 height=${GUI_SCREEN_HEIGHT:-1024}
 t0=$SECONDS
 
 for tool in Xvfb xdotool import convert xdpyinfo timeout; do
@@ -227,31 +229,34 @@ if not xr < xg:
 print(f"{msg}; red left of green (mean x {xr:.0f} < {xg:.0f})")
 PY
 )
-if [[ "${GUI_APPLY_AO:-0}" == 1 ]]; then
-  # Apply "GI: Ambient Occlusion" the way a person does: Filters menu ->
-  # Color Creation and Processing -> GI: Ambient Occlusion -> Apply. The
-  # keyboard walk relies on Debian's MeshLab 2020.09 menus (fixed order).
+apply_name=${GUI_APPLY_FILTER:-} apply_downs=${GUI_APPLY_DOWNS:-15}
+[[ "${GUI_APPLY_AO:-0}" == 1 ]] && apply_name="GI: Ambient Occlusion" apply_downs=15
+if [[ -n "$apply_name" ]]; then
+  # Apply a filter the way a person does: Filters menu -> Color Creation and
+  # Processing -> the filter (the apply_downs-th entry) -> Apply. The keyboard
+  # walk relies on Debian's MeshLab 2020.09 menus (fixed order).
   sleep 2
   xdo mousemove 120 11 click 1; sleep 1
   for _ in 1 2 3 4 5 6 7; do xdo key Down; done; sleep 0.3
   xdo key Right; sleep 1
-  for _ in $(seq 1 15); do xdo key Down; done; sleep 0.3
+  if [[ "${GUI_MENU_PEEK:-0}" == 1 ]]; then timeout 30 import -window root "$out_png"; note "menu screenshot $out_png"; exit 0; fi
+  for _ in $(seq 1 "$apply_downs"); do xdo key Down; done; sleep 0.3
   xdo key Return; sleep 2
-  dlg=$(xdo search --onlyvisible --name '^GI: Ambient Occlusion$' | head -n 1)
-  [[ -n "$dlg" ]] || { timeout 30 import -window root "$out_png"; fail "the GI: Ambient Occlusion dialog did not open (screenshot: $out_png)"; }
+  dlg=$(xdo search --onlyvisible --name "^$apply_name\$" | head -n 1)
+  [[ -n "$dlg" ]] || { timeout 30 import -window root "$out_png"; fail "the $apply_name dialog did not open (screenshot: $out_png)"; }
   # shellcheck disable=SC2034
   WIDTH='' HEIGHT='' X='' Y='' SCREEN='' WINDOW=''
   eval "$(xdo getwindowgeometry --shell "$dlg")"
   xdo mousemove $((X + WIDTH * 3 / 4)) $((Y + HEIGHT - 15)) click 1  # the Apply button
-  for _ in $(seq 1 60); do
-    grep -q "Applied filter GI: Ambient Occlusion" "$tmp/meshlab.log" 2>/dev/null && break
+  for _ in $(seq 1 120); do
+    grep -q "Applied filter $apply_name" "$tmp/meshlab.log" 2>/dev/null && break
     sleep 0.5
   done
   sleep 2
   timeout 30 import -window root "$out_png" || fail "import -window root failed"
-  grep -q "GI: Ambient Occlusion: vertices=" "$tmp/meshlab.log" || { ml_log; fail "no log line of GI: Ambient Occlusion (screenshot: $out_png)"; }
-  grep -q "Applied filter GI: Ambient Occlusion" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report the filter applied"; }
-  note "PASS: GI: Ambient Occlusion applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
+  grep -q "Applied filter $apply_name" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report $apply_name applied (screenshot: $out_png)"; }
+  grep -q "${GUI_APPLY_LOG:-$apply_name: vertices=}" "$tmp/meshlab.log" || { ml_log; fail "no log line of $apply_name (screenshot: $out_png)"; }
+  note "PASS: $apply_name applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
   exit 0
 fi
 if [[ "${GUI_NO_CHECK:-0}" == 1 ]]; then
