@@ -320,7 +320,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_std_error", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
-  if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable face got 0");
+  if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
   return res;
 }
 
