@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -113,7 +114,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   return out;
 }
 
-namespace {
+namespace detail {
 
 // Direct irradiance from the emitters at points of the scene. With up to 256
 // emitter faces: the exact point-to-triangle factor to every emitter face
@@ -165,7 +166,18 @@ class DirectLight {
   bool analytic_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
 
-}  // namespace
+}  // namespace detail
+
+using detail::DirectLight;
+
+DirectLightAt::DirectLightAt(const Scene& s, const RayCaster& caster) : impl_(std::make_unique<DirectLight>(s, caster)) {}
+DirectLightAt::~DirectLightAt() = default;
+glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const {
+  if (impl_->empty()) return glm::vec3(0.f);
+  SobolOwenStream lsmp(hash3(key, 0xd8u, 0x5au));
+  Rng rng(hash3(key, 0xd9u, 0x5bu));
+  return impl_->estimate(x + n * impl_->eps(), n, lsmp, rng, kNoHit);
+}
 
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                              const Progress& progress) {
@@ -219,7 +231,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&)>& value) {
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value) {
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
     const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -240,7 +252,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
         ray.tfar = std::numeric_limits<float>::infinity();
         const Hit h = caster.intersect(ray);
         if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f)
-          sum += glm::dvec3(value(h.face, ray.o + ray.d * h.t));
+          sum += glm::dvec3(value(h.face, ray.o + ray.d * h.t, h.t));
       }
       H[v] = glm::vec3(sum / double(rays));
     }

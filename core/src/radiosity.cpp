@@ -1,6 +1,8 @@
 #include "gi/radiosity.h"
 
 #include <algorithm>
+#include <cstring>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
@@ -352,9 +354,28 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     std::vector<glm::vec3> Hi;
     if (opt.vertexOutput == RadiosityVertexOutput::FinalGather) {
       // Cosine-weighted: the irradiance estimate is the mean of the reflected radiosity seen.
-      Hi = finalGather(s, caster, mat, opt.gatherRays, opt.seed,
-                       [&res](uint32_t f, const glm::vec3&) { return res.Rgather[f]; });
+      // Near hits (within two patch edges) see the patch up close, where its
+      // average hides how the direct light varies across it (the shadow of an
+      // object standing on it, a shadow edge): there the direct light is
+      // evaluated at the hit point itself and the patch's indirect light
+      // added (a two-level gather). Only for the converged solution: with a
+      // fixed bounce count the patch values are what the count asks for.
+      const bool refineNear = opt.bounces < 0;
+      const DirectLightAt directAt(s, caster);
+      const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+      std::vector<float> nearT(s.faceCount());
+      for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
+      std::atomic<uint64_t> nearHits{0};
+      Hi = finalGather(s, caster, mat, opt.gatherRays, opt.seed, [&](uint32_t f, const glm::vec3& y, float t) {
+        if (!refineNear || t > nearT[f]) return res.Rgather[f];
+        nearHits.fetch_add(1, std::memory_order_relaxed);
+        uint32_t bits[3];
+        std::memcpy(bits, &y, sizeof bits);
+        const uint32_t key = hash3(bits[0] ^ opt.seed, bits[1], bits[2] ^ f);
+        return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
+      });
       res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
+      if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
     } else {
       Hi = faceToVertex(s, res.Hindirect);
     }

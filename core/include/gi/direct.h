@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -47,10 +48,28 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
                                               const Progress& progress = Progress(nullptr));
 
 // Final gather at every vertex: the mean over `rays` cosine-weighted rays of
-// value(face hit, point hit), for hits on a face's front (0 otherwise) — an
-// irradiance estimate when value is the radiosity leaving the hit point.
+// value(face hit, point hit, distance), for hits on a face's front (0
+// otherwise) — an irradiance estimate when value is the radiosity leaving
+// the hit point.
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&)>& value);
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value);
+
+namespace detail {
+class DirectLight;
+}
+// The direct light at any point: one estimate of the estimator the vertices
+// use (every emitter's exact factor with a shadow ray each for up to 256
+// emitter faces, else an MIS light sample), random numbers keyed by `key`.
+class DirectLightAt {
+ public:
+  DirectLightAt(const Scene& s, const RayCaster& caster);
+  ~DirectLightAt();
+  // x on a face, n its unit normal (the lit side); the ray origin is lifted by the scene's offset.
+  glm::vec3 operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const;
+
+ private:
+  std::unique_ptr<detail::DirectLight> impl_;
+};
 
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt,
                                const Progress& progress = Progress(nullptr));
