@@ -122,11 +122,13 @@ namespace detail {
 // al. 1989); with more: power-proportional point sampling.
 class DirectLight {
  public:
-  DirectLight(const Scene& s, const RayCaster& c) : s_(s), caster_(c), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+  // sampled: always power-proportional MIS light samples (one shadow ray each).
+  DirectLight(const Scene& s, const RayCaster& c, bool sampled = false)
+      : s_(s), caster_(c), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
     const auto ok = usableFaceMask(s);
     for (size_t f = 0; f < s.faceCount(); ++f)
       if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
-    analytic_ = emitters_.size() <= 256;
+    analytic_ = !sampled && emitters_.size() <= 256;
     unoccluded_ = pairwiseUnoccluded(s);
   }
   bool unoccluded() const { return unoccluded_; }
@@ -170,13 +172,16 @@ class DirectLight {
 
 using detail::DirectLight;
 
-DirectLightAt::DirectLightAt(const Scene& s, const RayCaster& caster) : impl_(std::make_unique<DirectLight>(s, caster)) {}
+DirectLightAt::DirectLightAt(const Scene& s, const RayCaster& caster, int samples)
+    : impl_(std::make_unique<DirectLight>(s, caster, true)), samples_(std::max(1, samples)) {}
 DirectLightAt::~DirectLightAt() = default;
 glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const {
   if (impl_->empty()) return glm::vec3(0.f);
   SobolOwenStream lsmp(hash3(key, 0xd8u, 0x5au));
   Rng rng(hash3(key, 0xd9u, 0x5bu));
-  return impl_->estimate(x + n * impl_->eps(), n, lsmp, rng, kNoHit);
+  glm::vec3 sum(0.f);
+  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, lsmp, rng, kNoHit);
+  return sum / float(samples_);
 }
 
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,

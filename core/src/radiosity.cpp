@@ -361,7 +361,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
       // added (a two-level gather). Only for the converged solution: with a
       // fixed bounce count the patch values are what the count asks for.
       const bool refineNear = opt.bounces < 0;
-      const DirectLightAt directAt(s, caster);
+      const DirectLightAt directAt(s, caster, 4);
       const std::vector<glm::vec3> faceN = unitFaceNormals(s);
       std::vector<float> nearT(s.faceCount());
       for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));

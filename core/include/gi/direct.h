@@ -57,18 +57,20 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
 namespace detail {
 class DirectLight;
 }
-// The direct light at any point: one estimate of the estimator the vertices
-// use (every emitter's exact factor with a shadow ray each for up to 256
-// emitter faces, else an MIS light sample), random numbers keyed by `key`.
+// The direct light at any point by `samples` power-proportional light
+// samples combined with cosine-weighted directions by MIS (one shadow ray
+// each: cheap where many points each need a rough value), random numbers
+// keyed by `key`.
 class DirectLightAt {
  public:
-  DirectLightAt(const Scene& s, const RayCaster& caster);
+  DirectLightAt(const Scene& s, const RayCaster& caster, int samples);
   ~DirectLightAt();
   // x on a face, n its unit normal (the lit side); the ray origin is lifted by the scene's offset.
   glm::vec3 operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const;
 
  private:
   std::unique_ptr<detail::DirectLight> impl_;
+  int samples_ = 1;
 };
 
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt,
