@@ -124,7 +124,7 @@ class DirectLight {
  public:
   // sampled: always power-proportional MIS light samples (one shadow ray each).
   DirectLight(const Scene& s, const RayCaster& c, bool sampled = false)
-      : s_(s), caster_(c), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+      : s_(s), caster_(c), lights_(s), eps_(float(sceneScale(s).rayEpsilon)) {
     const auto ok = usableFaceMask(s);
     for (size_t f = 0; f < s.faceCount(); ++f)
       if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
@@ -242,7 +242,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
     const glm::vec3 n = faceNormalUnnormalized(s, f);
     faceN[f] = glm::length(n) > 0.f ? glm::normalize(n) : glm::vec3(0.f);
   }
-  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(analyzeScene(s).rayEpsilon));
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {

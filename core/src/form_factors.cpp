@@ -16,7 +16,7 @@
 namespace gi {
 
 FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings)
-    : s_(s), caster_(caster), set_(settings), eps_(float(analyzeScene(s).rayEpsilon)) {
+    : s_(s), caster_(caster), set_(settings), eps_(float(sceneScale(s).rayEpsilon)) {
   ok_ = usableFaceMask(s);
   area_.resize(s.faceCount());
   normal_.resize(s.faceCount());

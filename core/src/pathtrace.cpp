@@ -76,7 +76,7 @@ namespace {
 class Tracer {
  public:
   Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
-      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(analyzeScene(s).rayEpsilon)) {
+      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)) {
     faceN_.resize(s.faceCount());
     for (size_t f = 0; f < s.faceCount(); ++f) {
       const glm::vec3 n = faceNormalUnnormalized(s, f);

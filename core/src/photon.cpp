@@ -148,7 +148,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   RunStats& st = out.stats;
   const VertexMaterial mat = vertexMaterial(s);
   const size_t nv = s.vertexCount();
-  const float eps = float(analyzeScene(s).rayEpsilon);
+  const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
   const bool specular = anySpecular(s);
   // What the scene needs: photons carry caustics (specular faces) and

@@ -24,7 +24,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
   // Vertices where the first pass finds fewer than k photons within the cap
   // start at the cap, or at 1% of the diagonal without one.
-  const float diag = float(analyzeScene(s).diagonal);
+  const float diag = float(sceneScale(s).diagonal);
   const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
   const double alpha = opt.alpha;
   const size_t count = size_t(opt.photons);

@@ -103,7 +103,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   if (lights.empty())
     throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality) "
                                 "and no point or spot light");
-  const float eps = float(analyzeScene(s).rayEpsilon);
+  const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   // Fixed-size blocks, concatenated in order: the result is independent of threads.
   constexpr size_t kBlock = 4096;
@@ -264,7 +264,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   const PhotonLights lights(s, opt);
   const std::vector<SpecularTarget> targets = specularTargets(s);
   if (lights.empty() || targets.empty()) return {};
-  const float eps = float(analyzeScene(s).rayEpsilon);
+  const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;

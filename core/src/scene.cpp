@@ -181,15 +181,29 @@ SceneReport analyzeScene(const Scene& s) {
     std::sort(keys.begin(), keys.end());
     for (size_t k = 1; k < keys.size(); ++k) r.duplicateFaces += keys[k] == keys[k - 1] ? 1 : 0;
   }
-  if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; r.diagonal = glm::length(hi - lo); }
+  if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; }
+  const SceneScale sc = sceneScale(s);
+  r.diagonal = sc.diagonal;
+  r.rayEpsilon = sc.rayEpsilon;
+  return r;
+}
+
+SceneScale sceneScale(const Scene& s) {
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  double maxAbs = 0.0;
+  for (const glm::vec3& p : s.positions) {
+    if (!finite3(p)) continue;
+    lo = glm::min(lo, s.toWorld(p));
+    hi = glm::max(hi, s.toWorld(p));
+    maxAbs = std::max({maxAbs, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
+  }
+  SceneScale sc;
+  if (lo.x <= hi.x) sc.diagonal = glm::length(hi - lo);
   // Ray offsets: a small fraction of the scene size, and never below the float
   // resolution of the largest local coordinate (positions are centred).
-  double maxAbs = 0.0;
-  for (size_t i = 0; i < nv; ++i)
-    if (finite[i]) maxAbs = std::max({maxAbs, double(std::fabs(s.positions[i].x)), double(std::fabs(s.positions[i].y)), double(std::fabs(s.positions[i].z))});
-  r.rayEpsilon = std::max(r.diagonal * 1e-5, maxAbs * 64.0 * 1.19e-7);
-  if (r.rayEpsilon == 0.0) r.rayEpsilon = 1e-6;
-  return r;
+  sc.rayEpsilon = std::max(sc.diagonal * 1e-5, maxAbs * 64.0 * 1.19e-7);
+  if (sc.rayEpsilon == 0.0) sc.rayEpsilon = 1e-6;
+  return sc;
 }
 
 std::string SceneReport::summary() const {

@@ -70,6 +70,13 @@ struct SceneReport {
 
 // Counts every defect and computes the scale used for ray offsets.
 SceneReport analyzeScene(const Scene& s);
+// Only the scale (one pass over the vertices): what the algorithms need for
+// their ray offsets, without the defect counts of a full report.
+struct SceneScale {
+  double diagonal = 0.0;    // bbox diagonal over finite vertices
+  double rayEpsilon = 0.0;  // offset for ray origins (local units)
+};
+SceneScale sceneScale(const Scene& s);
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
 
