@@ -44,6 +44,25 @@ EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
   return smp;
 }
 
+bool PointLight::on() const { return luminance(intensity) > 0.f; }
+float PointLight::cosSpot() const { return std::cos(glm::radians(std::clamp(spotAngleDeg, 0.f, 180.f))); }
+
+glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n) {
+  if (!L.on()) return glm::vec3(0.f);
+  glm::vec3 w = L.position - x;
+  const float r2 = glm::dot(w, w);
+  if (!(r2 > 0.f)) return glm::vec3(0.f);
+  const float r = std::sqrt(r2);
+  w /= r;
+  const float cx = glm::dot(n, w);
+  if (cx <= 0.f || !L.shinesTowards(-w)) return glm::vec3(0.f);
+  Ray ray;
+  ray.o = x;
+  ray.d = w;
+  ray.tfar = r * (1.f - 1e-4f);
+  return caster.occluded(ray) ? glm::vec3(0.f) : L.intensity * cx / r2;
+}
+
 glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
                                  const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip) {
   const auto L = lights.sample(u);

@@ -62,11 +62,7 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.sunDirection = glm::normalize(v.getVec("sun_direction"));
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
-  const PointLight pl = pointLightFromParams(v, origin);
-  o.pointPosition = pl.position;
-  o.pointIntensity = pl.intensity;
-  o.spotDirection = pl.spotDirection;
-  o.spotAngleDeg = pl.spotAngleDeg;
+  o.point = pointLightFromParams(v, origin);
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }
@@ -89,8 +85,7 @@ class Tracer {
     sunDisk_ = hasSun_ && o.sunAngularRadiusDeg > 0.f;
     sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
     sunL_ = sunDisk_ ? o.sunIrradiance / omega : glm::vec3(0.f);
-    hasPoint_ = luminance(o.pointIntensity) > 0.f;
-    cosSpot_ = std::cos(glm::radians(std::clamp(o.spotAngleDeg, 0.f, 180.f)));
+    hasPoint_ = o.point.on();
     if (lights_.empty() && luminance(o.skyRadiance) <= 0.f && !hasSun_ && !hasPoint_)
       throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
                                   "quality), no sky, no sun and no point light");
@@ -131,17 +126,8 @@ class Tracer {
       }
     }
     if (hasPoint_) {
-      glm::vec3 w = o_.pointPosition - x;
-      const float r2 = glm::dot(w, w);
-      const float r = std::sqrt(r2);
-      w /= r;
-      const float cx = glm::dot(n, w);
-      if (cx > 0.f && r2 > 0.f && glm::dot(-w, o_.spotDirection) >= cosSpot_) {
-        ray.d = w;
-        ray.tfar = r * (1.f - 1e-4f);
-        ++rays;
-        if (!caster_.occluded(ray)) H += o_.pointIntensity * cx / r2;
-      }
+      ++rays;
+      H += pointLightIrradiance(o_.point, caster_, x, n);
     }
     return H;
   }
@@ -211,7 +197,6 @@ class Tracer {
   float sunCos_ = 1.f, sunPdf_ = 0.f;
   glm::vec3 sunL_{0.f};
   bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
-  float cosSpot_ = -1.f;
 };
 
 struct Accum {

@@ -89,11 +89,7 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
   o.gatherRays = v.getInt("gather_rays");
   o.progressive = v.getBool("progressive");
   o.passes = v.getInt("passes");
-  const PointLight pl = pointLightFromParams(v, origin);
-  o.pointPosition = pl.position;
-  o.pointIntensity = pl.intensity;
-  o.spotDirection = pl.spotDirection;
-  o.spotAngleDeg = pl.spotAngleDeg;
+  o.point = pointLightFromParams(v, origin);
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }
@@ -113,27 +109,13 @@ bool anyDiffuseReflection(const Scene& s) {
 }
 
 // Irradiance from the point or spot light at every vertex (one shadow ray each).
-std::vector<glm::vec3> pointLightIrradiance(const Scene& s, const RayCaster& caster, const PhotonOptions& o,
+std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& caster, const PointLight& L,
                                             const VertexMaterial& mat, const std::vector<glm::vec3>& origins) {
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
-  if (!(luminance(o.pointIntensity) > 0.f)) return H;
-  const float cosSpot = std::cos(glm::radians(std::clamp(o.spotAngleDeg, 0.f, 180.f)));
+  if (!L.on()) return H;
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (!mat.valid[i]) continue;
-      glm::vec3 w = o.pointPosition - origins[i];
-      const float r2 = glm::dot(w, w);
-      if (!(r2 > 0.f)) continue;
-      const float r = std::sqrt(r2);
-      w /= r;
-      const float cx = glm::dot(mat.n[i], w);
-      if (cx <= 0.f || glm::dot(-w, o.spotDirection) < cosSpot) continue;
-      Ray ray;
-      ray.o = origins[i];
-      ray.d = w;
-      ray.tfar = r * (1.f - 1e-4f);
-      if (!caster.occluded(ray)) H[i] = o.pointIntensity * cx / r2;
-    }
+    for (size_t i = b; i < e; ++i)
+      if (mat.valid[i]) H[i] = pointLightIrradiance(L, caster, origins[i], mat.n[i]);
   });
   return H;
 }
@@ -162,7 +144,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   std::vector<glm::vec3> Hd(nv, glm::vec3(0.f));
   if (opt.directLight) {
     Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.15));
-    const auto Hp = pointLightIrradiance(s, caster, opt, mat, origins);
+    const auto Hp = pointLightAtVertices(s, caster, opt.point, mat, origins);
     for (size_t i = 0; i < nv; ++i) Hd[i] += Hp[i];
   }
   const double directSeconds = directTimer.seconds();
@@ -177,7 +159,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.note("no photons traced: the direct light is computed apart and nothing reflects it (rho = 0 everywhere, no "
             "mirror or glass)");
     // Still fail clearly without any light.
-    if (EmitterSampler(s).empty() && !(luminance(opt.pointIntensity) > 0.f))
+    if (EmitterSampler(s).empty() && !opt.point.on())
       throw std::invalid_argument("the scene has no light: no emitter faces and no point or spot light");
   } else if (opt.progressive) {
     ProgressiveResult pr = progressivePhotonMap(s, caster, opt, mat, vertexPaths, projection, progress.sub(0.15, 1.0), ts);

@@ -42,12 +42,12 @@ bool specularStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm:
 class PhotonLights {
  public:
   PhotonLights(const Scene& s, const PhotonOptions& o) : area_(s), o_(o) {
-    cosSpot_ = std::cos(glm::radians(std::clamp(o.spotAngleDeg, 0.f, 180.f)));
+    cosSpot_ = o.point.cosSpot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
-    pointPower_ = double(luminance(o.pointIntensity)) * 2.0 * M_PI * (1.0 - cosSpot_);
+    pointPower_ = double(luminance(o.point.intensity)) * 2.0 * M_PI * (1.0 - cosSpot_);
     if (!(pointPower_ > 0.0)) pointPower_ = 0.0;
     total_ = area_.totalPower() + pointPower_;
-    spotFrame_ = glm::length(o.spotDirection) > 0.f ? glm::normalize(o.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
+    spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
   }
   bool empty() const { return !(total_ > 0.0); }
   double totalPower() const { return total_; }
@@ -60,7 +60,7 @@ class PhotonLights {
   };
   LightPoint samplePoint(glm::vec2 u0) const {
     const double pPoint = pointPower_ / total_;
-    if (u0.x < pPoint) return {o_.pointPosition, glm::vec3(0.f), o_.pointIntensity, float(pPoint), true};
+    if (u0.x < pPoint) return {o_.point.position, glm::vec3(0.f), o_.point.intensity, float(pPoint), true};
     const float ux = float(std::min(0.99999994, (u0.x - pPoint) / (1.0 - pPoint)));
     const auto L = area_.sample({ux, u0.y});
     return {L.p, L.n, L.E * float(M_1_PI), L.pdfArea * float(1.0 - pPoint), false};

@@ -101,8 +101,8 @@ TEST(PathTracer, PointLightAndSun) {
   s.rho.assign(s.faceCount(), glm::vec3(0.f));
   s.emission.clear();
   PathTraceOptions o;
-  o.pointPosition = glm::vec3(glm::dvec3(0.3, -0.2, 1.5) - s.origin);
-  o.pointIntensity = glm::vec3(2.f);
+  o.point.position = glm::vec3(glm::dvec3(0.3, -0.2, 1.5) - s.origin);
+  o.point.intensity = glm::vec3(2.f);
   const auto r = trace(s, 4, o);
   for (size_t i = 0; i < s.vertexCount(); ++i) {
     const glm::dvec3 p = s.toWorld(s.positions[i]);

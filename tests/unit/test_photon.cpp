@@ -448,8 +448,8 @@ TEST(PhotonMap, PointAndSpotLights) {
   auto caster = makeEmbreeCaster(sf.scene);
   const float I = 3.f, h = 1.f;
   PhotonOptions o;
-  o.pointPosition = glm::vec3(glm::dvec3(0, 0, h) - sf.scene.origin);
-  o.pointIntensity = glm::vec3(I);
+  o.point.position = glm::vec3(glm::dvec3(0, 0, h) - sf.scene.origin);
+  o.point.intensity = glm::vec3(I);
   o.photons = 2000000;
   o.kNearest = 400;
   o.maxRadius = 0.05;
@@ -464,8 +464,8 @@ TEST(PhotonMap, PointAndSpotLights) {
   const VertexRadiometry direct = computePhotonMap(sf.scene, *caster, o);
   EXPECT_NEAR(direct.H[centre].g, I / (h * h), 1e-3);
   EXPECT_NEAR(direct.H[off].g, I * cosOff / 2.0, 1e-3);
-  o.spotDirection = glm::vec3(0, 0, -1);
-  o.spotAngleDeg = 20.f;
+  o.point.spotDirection = glm::vec3(0, 0, -1);
+  o.point.spotAngleDeg = 20.f;
   const VertexRadiometry spot = computePhotonMap(sf.scene, *caster, o);
   EXPECT_NEAR(spot.H[centre].g, I / (h * h), 1e-3);
   EXPECT_EQ(spot.H[off].g, 0.f);

@@ -37,6 +37,20 @@ class EmitterSampler {
 
 class RayCaster;
 
+// An optional point or spot light (photon mapping and the reference).
+struct PointLight {
+  glm::vec3 position{0.f};          // local scene coordinates
+  glm::vec3 intensity{0.f};         // W/sr, linear RGB; 0 = none
+  glm::vec3 spotDirection{0.f, -1.f, 0.f};
+  float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light
+  bool on() const;
+  float cosSpot() const;            // cosine of the half angle
+  bool shinesTowards(const glm::vec3& d) const { return glm::dot(d, spotDirection) >= cosSpot(); }
+};
+// Irradiance I cos / r^2 from the point light at x (unit normal n), 0 if the
+// shadow ray is blocked or x lies outside the spot's cone.
+glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n);
+
 // One-sample estimate of the direct irradiance at x (unit normal n) from the
 // emitters: a power-sampled emitter point y, E_y cos(x) cos(y) / (pi r^2 pdf)
 // if the shadow ray x -> y is free, else 0. Points on face `skip` are ignored.

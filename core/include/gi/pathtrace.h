@@ -19,6 +19,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/emitters.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
@@ -36,10 +37,7 @@ struct PathTraceOptions {
   glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
-  glm::vec3 pointPosition{0.f};    // absolute coordinates
-  glm::vec3 pointIntensity{0.f};   // W/sr
-  glm::vec3 spotDirection{0.f, -1.f, 0.f};
-  float spotAngleDeg = 180.f;      // half angle of a spot light's cone; 180 = point light
+  PointLight point;                // optional point or spot light (local coordinates)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

@@ -24,6 +24,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/direct.h"
+#include "gi/emitters.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
@@ -45,10 +46,7 @@ struct PhotonOptions {
   bool progressive = false;   // progressive photon mapping over `passes` passes
   int passes = 16;
   double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
-  glm::vec3 pointPosition{0.f};   // local coordinates
-  glm::vec3 pointIntensity{0.f};  // W/sr, RGB; 0 = no point light
-  glm::vec3 spotDirection{0.f, -1.f, 0.f};
-  float spotAngleDeg = 180.f;     // half angle of the cone; 180 = omnidirectional point light
+  PointLight point;           // optional point or spot light (local coordinates)
   uint32_t seed = 0;
   static std::vector<ParamSpec> specs();
   static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/color.h"
+#include "gi/emitters.h"
 #include "gi/params.h"
 #include "gi/scene.h"
 
@@ -42,13 +43,7 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
 // specular, by name patterns, and their colour and index of refraction.
 std::vector<ParamSpec> materialSpecs();
 
-// An optional point or spot light (photon mapping and the reference).
-struct PointLight {
-  glm::vec3 position{0.f};          // local scene coordinates
-  glm::vec3 intensity{0.f};         // W/sr, linear RGB; 0 = none
-  glm::vec3 spotDirection{0.f, -1.f, 0.f};
-  float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light
-};
+// The optional point or spot light's parameters (photon mapping and the reference).
 std::vector<ParamSpec> pointLightSpecs();
 PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 
