@@ -275,6 +275,7 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
                   {"emitter_faces", rep.emitterFaces}, {"diagonal", rep.diagonal}};
     j["stats"] = statsJson(stats);
     j["notes"] = stats.notes;
+    j["warnings"] = stats.warnings;
     if (!setupLog.empty()) j["setup"] = setupLog;
     std::cout << j.dump(2) << std::endl;
   } else if (!a.quiet) {

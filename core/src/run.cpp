@@ -24,6 +24,7 @@ std::string RunStats::line(const std::string& title) const {
     s += buf;
     first = false;
   }
+  for (const auto& w : warnings) s += "; WARNING: " + w;
   for (const auto& n : notes) s += "; " + n;
   return s;
 }

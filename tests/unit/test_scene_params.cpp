@@ -16,6 +16,7 @@
 #include "gi/color.h"
 #include "gi/filters.h"
 #include "gi/params.h"
+#include "gi/run.h"
 #include "gi/scene.h"
 
 namespace {
@@ -593,3 +594,11 @@ TEST(Filters, MlxScriptListsEveryParameterInOrder) {
 }
 
 }  // namespace
+
+TEST(RunStats, LineShowsWarningsBeforeNotes) {
+  gi::RunStats st;
+  st.add("rays", 10);
+  st.note("skipped nothing");
+  st.warn("not converged");
+  EXPECT_EQ(st.line("T"), "T: rays=10; WARNING: not converged; skipped nothing");
+}

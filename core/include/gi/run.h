@@ -21,8 +21,13 @@ struct Cancelled : std::runtime_error {
 struct RunStats {
   std::vector<std::pair<std::string, double>> numbers;  // in insertion order
   std::vector<std::string> notes;                        // what was skipped and why, etc.
+  // A parameter or a scene that makes the result unreliable (not converged,
+  // a gather radius below the photon spacing, ...): shown first in the log
+  // line as "WARNING: ..." and listed apart in the CLI's JSON.
+  std::vector<std::string> warnings;
   void add(const std::string& key, double v) { numbers.emplace_back(key, v); }
   void note(const std::string& s) { notes.push_back(s); }
+  void warn(const std::string& s) { warnings.push_back(s); }
   double get(const std::string& key, double fallback = 0.0) const;
   std::string line(const std::string& title) const;  // "title: k=v, ...; notes"
 };
