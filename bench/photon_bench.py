@@ -26,7 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "integration"))
-from lighting_bench import lum, run, run_measured, vertex_weights  # noqa: E402
+from lighting_bench import lum, reference_arrays, run, run_measured, vertex_weights  # noqa: E402
 from plyread import read_ply  # noqa: E402
 
 MESHES = os.path.join(ROOT, "test_meshes")
@@ -60,6 +60,7 @@ class Bench:
         path = [n for n in j["notes"] if "cached" in n][0].split(" ")[-1]
         with open(path) as f:
             ref = json.load(f)
+        ref = reference_arrays(ref)
         ref["wall_seconds_this_run"] = time.perf_counter() - t0
         ref["file"] = os.path.relpath(path, ROOT)
         return ref
@@ -105,6 +106,7 @@ class Bench:
         main = "caustic" if "caustic" in regions else "interior"
         print("%-16s %-40s %-44s %8.3f s  error %s %.4f" % (scene, label, row["args"][:44], row["seconds"], main,
                                                             row["error_" + main]), flush=True)
+
 
 
 def loglog_at(pts, t):

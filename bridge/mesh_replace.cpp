@@ -1,7 +1,7 @@
 // The refined mesh back into MeshLab: each layer's faces are replaced by its
 // part of the refined mesh, new vertices are appended (old vertices and their
 // attributes stay), and the bridge is re-indexed as toScene would index the
-// new layers, so the ordinary write-back functions work unchanged.
+// new layers, so the write-back works unchanged.
 #include "meshlab_bridge.h"  // first: MeshLab's mesh types before vcg's algorithms
 
 #include <algorithm>
@@ -26,10 +26,11 @@ vcg::Color4b mixColors(const vcg::Color4b& a, const vcg::Color4b& b) {
 
 }  // namespace
 
-void replaceWithRefined(BridgeScene& b, const RefinedMesh& m, std::vector<glm::vec3>& Bvertex,
-                        std::vector<glm::vec3>& Bface) {
+RefinedOrder replaceWithRefined(BridgeScene& b, const RefinedMesh& m) {
   const size_t nv = m.scene.vertexCount(), nf = m.scene.faceCount();
-  if (m.inputVertices != b.scene.vertexCount() || Bvertex.size() != nv || Bface.size() != nf)
+  size_t inputVertices = 0;
+  for (const LayerPart& p : b.parts) inputVertices += p.vertexCount;
+  if (m.inputVertices != inputVertices)
     throw std::logic_error("refined mesh does not match the layers");
   // Which part each refined vertex and face belongs to (parts share no vertex).
   std::vector<int> partOfVertex(nv, -1);
@@ -126,37 +127,10 @@ void replaceWithRefined(BridgeScene& b, const RefinedMesh& m, std::vector<glm::v
   }
   if (vertexOrder.size() != nv || faceOrder.size() != nf) throw std::logic_error("refined mesh not covered by the layers");
 
-  // The scene, attributes and results in the new order.
-  std::vector<uint32_t> newIndex(nv);
-  for (size_t i = 0; i < nv; ++i) newIndex[vertexOrder[i]] = uint32_t(i);
-  const MeshAttributes refinedAttrs = refineAttributes(b.attrs, m);
-  Scene s;
-  s.origin = m.scene.origin;
-  MeshAttributes a;
-  std::vector<glm::vec3> Bv(nv), Bf(nf);
-  for (size_t i = 0; i < nv; ++i) {
-    s.positions.push_back(m.scene.positions[vertexOrder[i]]);
-    if (!m.scene.vertexNormals.empty()) s.vertexNormals.push_back(m.scene.vertexNormals[vertexOrder[i]]);
-    if (!refinedAttrs.vertexColor.empty()) a.vertexColor.push_back(refinedAttrs.vertexColor[vertexOrder[i]]);
-    Bv[i] = Bvertex[vertexOrder[i]];
-  }
-  for (size_t i = 0; i < nf; ++i) {
-    const uint32_t f = faceOrder[i];
-    const glm::uvec3 t = m.scene.triangles[f];
-    s.triangles.push_back({newIndex[t.x], newIndex[t.y], newIndex[t.z]});
-    if (!m.scene.rho.empty()) s.rho.push_back(m.scene.rho[f]);
-    if (!m.scene.emission.empty()) s.emission.push_back(m.scene.emission[f]);
-    if (!m.scene.material.empty()) s.material.push_back(m.scene.material[f]);
-    if (!m.scene.ior.empty()) s.ior.push_back(m.scene.ior[f]);
-    if (!refinedAttrs.faceColor.empty()) a.faceColor.push_back(refinedAttrs.faceColor[f]);
-    if (!refinedAttrs.faceQuality.empty()) a.faceQuality.push_back(refinedAttrs.faceQuality[f]);
-    if (!refinedAttrs.faceSelected.empty()) a.faceSelected.push_back(refinedAttrs.faceSelected[f]);
-    Bf[i] = Bface[f];
-  }
-  b.scene = std::move(s);
-  b.attrs = std::move(a);
-  Bvertex.swap(Bv);
-  Bface.swap(Bf);
+  // The layers' old attributes no longer match: what toScene would read now is in the layers.
+  b.scene = Scene();
+  b.attrs = MeshAttributes();
+  return {std::move(vertexOrder), std::move(faceOrder)};
 }
 
 }  // namespace gi::ml

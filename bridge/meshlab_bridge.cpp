@@ -5,6 +5,8 @@
 #include <utility>
 #include <stdexcept>
 
+#include <QCoreApplication>
+
 #include <vcg/complex/algorithms/update/color.h>
 
 namespace gi::ml {
@@ -140,90 +142,55 @@ double documentDiagonal(MeshDocument& md) {
   return d > 0 && std::isfinite(d) ? d : 1.0;
 }
 
-size_t writeVertexResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors) {
-  size_t bad = 0;
+void writeResult(BridgeScene& b, FilterResult& r) {
+  if (r.refined) {
+    const RefinedOrder order = replaceWithRefined(b, *r.refined);
+    r.reorder(order.vertex, order.face);
+  }
+  int vmask = 0;
+  if (!r.vertexQuality.empty()) vmask |= MeshModel::MM_VERTQUALITY;
+  if (!r.vertexColor.empty()) vmask |= MeshModel::MM_VERTCOLOR;
+  if (!r.vertexNormal.empty()) vmask |= MeshModel::MM_VERTNORMAL;
+  for (LayerPart& p : b.parts) p.mm->updateDataMask(vmask);
   for (LayerPart& p : b.parts) {
-    int mask = int(MeshModel::MM_VERTQUALITY) | (colors.empty() ? 0 : int(MeshModel::MM_VERTCOLOR));
-    p.mm->updateDataMask(mask);
-    CMeshO& m = p.mm->cm;
-    for (size_t i = 0; i < m.vert.size(); ++i) {
-      const int s = p.sceneVertex[i];
-      if (s < 0) continue;
-      float q = quality[size_t(s)];
-      if (!std::isfinite(q)) { q = 0.f; ++bad; }
-      m.vert[i].Q() = q;
-      if (!colors.empty()) {
-        const Rgb8 c = colors[size_t(s)];
-        m.vert[i].C() = vcg::Color4b(c.r, c.g, c.b, 255);
+    for (size_t i = 0; i < p.mm->cm.vert.size(); ++i) {
+      if (p.sceneVertex[i] < 0) continue;
+      const size_t s = size_t(p.sceneVertex[i]);
+      CVertexO& v = p.mm->cm.vert[i];
+      if (!r.vertexQuality.empty()) v.Q() = r.vertexQuality[s];
+      if (!r.vertexColor.empty()) v.C() = vcg::Color4b(r.vertexColor[s].r, r.vertexColor[s].g, r.vertexColor[s].b, 255);
+      if (!r.vertexNormal.empty()) v.N() = Point3m(r.vertexNormal[s].x, r.vertexNormal[s].y, r.vertexNormal[s].z);
+    }
+  }
+  if (!r.faceQuality.empty() || !r.faceColor.empty()) {
+    for (LayerPart& p : b.parts) {
+      p.mm->updateDataMask((r.faceQuality.empty() ? 0 : int(MeshModel::MM_FACEQUALITY)) |
+                           (r.faceColor.empty() ? 0 : int(MeshModel::MM_FACECOLOR)));
+      CMeshO& m = p.mm->cm;
+      size_t k = p.faceOffset;
+      for (size_t i = 0; i < m.face.size(); ++i) {
+        if (m.face[i].IsD()) continue;
+        if (!r.faceQuality.empty()) m.face[i].Q() = r.faceQuality[k];
+        if (!r.faceColor.empty()) m.face[i].C() = vcg::Color4b(r.faceColor[k].r, r.faceColor[k].g, r.faceColor[k].b, 255);
+        ++k;
       }
     }
   }
-  return bad;
-}
-
-size_t writeFaceResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors) {
-  size_t bad = 0;
-  for (LayerPart& p : b.parts) {
-    p.mm->updateDataMask(int(MeshModel::MM_FACEQUALITY) | int(MeshModel::MM_FACECOLOR));
-    CMeshO& m = p.mm->cm;
-    size_t k = p.faceOffset;
-    for (size_t i = 0; i < m.face.size(); ++i) {
-      if (m.face[i].IsD()) continue;
-      float q = quality[k];
-      if (!std::isfinite(q)) { q = 0.f; ++bad; }
-      m.face[i].Q() = q;
-      const Rgb8 c = colors[k];
-      m.face[i].C() = vcg::Color4b(c.r, c.g, c.b, 255);
-      ++k;
-    }
-  }
-  return bad;
-}
-
-void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v, bool alsoNormals) {
-  for (LayerPart& p : b.parts) {
-    CMeshO& m = p.mm->cm;
-    auto h = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<Point3m>(m, name);
-    if (alsoNormals) p.mm->updateDataMask(MeshModel::MM_VERTNORMAL);
-    for (size_t i = 0; i < m.vert.size(); ++i) {
-      const int s = p.sceneVertex[i];
-      if (s < 0) continue;
-      glm::vec3 x = v[size_t(s)];
-      if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) x = glm::vec3(0.f);
-      h[m.vert[i]] = Point3m(x.x, x.y, x.z);
-      if (alsoNormals) m.vert[i].N() = Point3m(x.x, x.y, x.z);
-    }
-  }
-}
-
-void writeVertexScalarAttribute(BridgeScene& b, const std::string& name, const std::vector<float>& v) {
-  for (LayerPart& p : b.parts) {
-    CMeshO& m = p.mm->cm;
-    auto h = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<Scalarm>(m, name);
-    for (size_t i = 0; i < m.vert.size(); ++i) {
-      const int s = p.sceneVertex[i];
-      if (s < 0) continue;
-      const float x = v[size_t(s)];
-      h[m.vert[i]] = std::isfinite(x) ? x : 0.f;
-    }
-  }
-}
-
-void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor) {
-  for (LayerPart& p : b.parts) {
-    const bool had = p.mm->hasDataMask(MeshModel::MM_VERTCOLOR);
-    p.mm->updateDataMask(MeshModel::MM_VERTCOLOR);
-    CMeshO& m = p.mm->cm;
-    for (size_t i = 0; i < m.vert.size(); ++i) {
-      const int s = p.sceneVertex[i];
-      if (s < 0) continue;
-      float f = factor[size_t(s)];
-      if (!std::isfinite(f)) f = 0.f;
-      vcg::Color4b c = had ? m.vert[i].C() : vcg::Color4b(255, 255, 255, 255);
-      // Scale in linear light, then re-encode.
-      glm::vec3 lin = srgb8ToLinear(c[0], c[1], c[2]) * f;
-      Rgb8 o = displayMap(lin, 1.f);
-      m.vert[i].C() = vcg::Color4b(o.r, o.g, o.b, c[3]);
+  for (const VertexAttribute& a : r.attributes) {
+    for (LayerPart& p : b.parts) {
+      CMeshO& m = p.mm->cm;
+      if (a.components == 3) {
+        auto h = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<Point3m>(m, a.name);
+        for (size_t i = 0; i < m.vert.size(); ++i)
+          if (p.sceneVertex[i] >= 0) {
+            const float* x = &a.values[size_t(p.sceneVertex[i]) * 3];
+            h[m.vert[i]] = Point3m(x[0], x[1], x[2]);
+          }
+      } else {
+        auto h = vcg::tri::Allocator<CMeshO>::GetPerVertexAttribute<Scalarm>(m, a.name);
+        for (size_t i = 0; i < m.vert.size(); ++i)
+          if (p.sceneVertex[i] >= 0) h[m.vert[i]] = a.values[size_t(p.sceneVertex[i])];
+      }
     }
   }
 }
@@ -233,10 +200,13 @@ ProgressFn progressFrom(vcg::CallBackPos* cb) {
   // meshlabserver prints every call's message: pass on only new stages and
   // steps of 5%, which is also all a progress bar needs.
   auto last = std::make_shared<std::pair<int, std::string>>(-100, "");
-  return [cb, last](int pct, const std::string& stage) {
+  // meshlabserver prints each label as it comes, without a separator.
+  const bool server = QCoreApplication::applicationFilePath().endsWith("meshlabserver");
+  return [cb, last, server](int pct, const std::string& stage) {
     if (stage == last->second && pct < last->first + 5 && pct < 100) return true;
     *last = {pct, stage};
-    cb(pct, stage.c_str());
+    const std::string label = server ? stage + " " + std::to_string(pct) + "%\n" : stage;
+    cb(pct, label.c_str());
     return true;
   };
 }
@@ -265,51 +235,15 @@ bool guarded(QString& errorMessage, const std::function<void(const std::string&)
 
 namespace gi::ml {
 
-PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::vector<ParamSpec>& specs,
-                    bool withEmitters) {
-  PreparedRun r;
-  r.values = readParams(par, specs);
-  const double diag = documentDiagonal(md);
-  if (auto err = validate(specs, r.values, diag)) throw std::invalid_argument(*err);
-  const int extent = r.values.has("scene_extent") ? r.values.getInt("scene_extent") : 0;
-  r.bridge = toScene(participatingLayers(md, extent));
-  if (r.values.has("reflectance_source"))
-    if (auto err = applySceneConventions(r.bridge.scene, r.bridge.attrs, r.values, withEmitters, &r.setupLog))
-      throw std::invalid_argument(*err);
-  if (r.values.has("mirror_layers")) {
-    std::vector<LayerRange> layers;
-    for (const LayerPart& p : r.bridge.parts) layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
-    std::string log;
-    if (auto err = applyMaterials(r.bridge.scene, layers, r.values, &log)) throw std::invalid_argument(*err);
-    r.setupLog += "; " + log;
-  }
-  r.report = analyzeScene(r.bridge.scene);
-  if (r.report.usableFaces() == 0)
-    throw std::invalid_argument("the mesh has no usable triangles (" + r.report.summary() + ")");
-  return r;
+FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b) {
+  FilterInput in;
+  in.values = readParams(par, filterSpecs(kind));
+  const int extent = in.values.has("scene_extent") ? in.values.getInt("scene_extent") : 0;
+  b = toScene(participatingLayers(md, extent));
+  in.scene = std::move(b.scene);  // the bridge keeps the layers' indexing, the engine the geometry
+  in.attrs = b.attrs;
+  for (const LayerPart& p : b.parts) in.layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
+  return in;
 }
 
-
-}  // namespace gi::ml
-
-#include "gi/direct.h"
-#include "gi/output.h"
-
-namespace gi::ml {
-void writeRadiosity(PreparedRun& run, const std::vector<glm::vec3>& Bvertex, const std::vector<glm::vec3>& Bface,
-                    bool faces, RunStats& stats) {
-  VertexOutput out = radiometricOutput(run.bridge.scene, Bvertex, run.values.getFloat("exposure"));
-  size_t bad = writeVertexResults(run.bridge, out.quality, out.displayColors());
-  if (faces) {
-    VertexOutput f;
-    f.rgb = Bface;
-    f.exposure = out.exposure;
-    for (const auto& b : Bface) f.quality.push_back(luminance(b));
-    bad += writeFaceResults(run.bridge, f.quality, f.displayColors());
-  }
-  stats.add("exposure", out.exposure);
-  if (bad) stats.note(std::to_string(bad) + " non-finite values written as 0");
-}
-
-void writeRadiometry(PreparedRun& run, VertexRadiometry& r) { writeRadiosity(run, r.B, {}, false, r.stats); }
 }  // namespace gi::ml

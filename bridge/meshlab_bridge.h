@@ -9,6 +9,8 @@
 
 #include <common/interfaces.h>
 
+#include "gi/filter_run.h"
+#include "gi/filters.h"
 #include "gi/params.h"
 #include "gi/refine.h"
 #include "gi/run.h"
@@ -43,30 +45,26 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
 // Diagonal of the layers' bounding boxes (current layer or all visible ones).
 double documentDiagonal(MeshDocument& md);
 
-// Writes quality and colour to every vertex of every part (non-finite values
-// become 0 and are counted in the return value). Colour is skipped if empty.
-size_t writeVertexResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors);
-// The same per face (scene face order).
-size_t writeFaceResults(BridgeScene& b, const std::vector<float>& quality, const std::vector<Rgb8>& colors);
-// Per-vertex Point3m attribute `name` (e.g. "BentNormal"), optionally into the normals too.
-void writeVertexVectorAttribute(BridgeScene& b, const std::string& name, const std::vector<glm::vec3>& v,
-                                bool alsoNormals);
-// Per-vertex scalar attribute `name` (e.g. "StdError").
-void writeVertexScalarAttribute(BridgeScene& b, const std::string& name, const std::vector<float>& v);
-// Multiplies existing vertex colours by a factor in [0,1] (AO "multiply colour").
-void multiplyVertexColors(BridgeScene& b, const std::vector<float>& factor);
+// Writes a filter's result into the layers, after any refined geometry has
+// replaced theirs: quality, colour, normals, face values and per-vertex
+// attributes (Scalarm or Point3m), each only when the result has it.
+void writeResult(BridgeScene& b, FilterResult& r);
 
 // Replaces each layer's geometry by its part of `m`, a refinement of
 // b.scene (faces whose sourceFace lies in the layer's face range): old
 // vertices stay, new ones are appended (position, normal, colour and quality
 // interpolated), faces keep colour, quality and selection of their source
 // face; topology, face normals and bounding box are updated. Then b (scene,
-// attributes, parts) is indexed as toScene would index the new layers, and
-// Bvertex / Bface (given on m.scene) are permuted to match. (mesh_replace.cpp)
-void replaceWithRefined(BridgeScene& b, const RefinedMesh& m, std::vector<glm::vec3>& Bvertex,
-                        std::vector<glm::vec3>& Bface);
+// attributes, parts) is indexed as toScene would index the new layers.
+// Returns, per new scene vertex and face, its index in m.scene. (mesh_replace.cpp)
+struct RefinedOrder {
+  std::vector<uint32_t> vertex, face;
+};
+RefinedOrder replaceWithRefined(BridgeScene& b, const RefinedMesh& m);
 
-// MeshLab progress callback -> engine progress (cancellation not supported by 2020.09's cb).
+// MeshLab progress callback -> engine progress (cancellation not supported by
+// 2020.09's cb). meshlabserver prints the labels back to back, so there each
+// ends with a newline.
 ProgressFn progressFrom(vcg::CallBackPos* cb);
 
 // Runs `body`; converts engine exceptions into errorMessage + a log line + false.
@@ -78,26 +76,8 @@ bool guarded(QString& errorMessage, const std::function<void(const std::string&)
 
 namespace gi::ml {
 
-// Everything a filter does before its algorithm: parameters read and
-// validated, layers gathered into a scene, scene conventions applied.
-struct PreparedRun {
-  ParamValues values;
-  BridgeScene bridge;
-  SceneReport report;
-  std::string setupLog;  // reflectance / emitters summary
-};
-PreparedRun prepare(MeshDocument& md, const RichParameterList& par, const std::vector<ParamSpec>& specs,
-                    bool withEmitters);
+// The filter's input from the document: its parameters, the participating
+// layers (scene extent) as one scene with their names.
+FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b);
 
-}  // namespace gi::ml
-
-namespace gi {
-struct VertexRadiometry;
-}
-namespace gi::ml {
-// Writes B as quality (luminance) and display colour; adds the exposure to the stats.
-void writeRadiometry(PreparedRun& run, VertexRadiometry& r);
-// Per-vertex radiosity and, optionally, per-face radiosity with the same exposure.
-void writeRadiosity(PreparedRun& run, const std::vector<glm::vec3>& Bvertex, const std::vector<glm::vec3>& Bface,
-                    bool faces, RunStats& stats);
 }  // namespace gi::ml

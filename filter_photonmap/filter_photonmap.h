@@ -1,22 +1,14 @@
-// MeshLab adapter for the engine's radiosity (gi/photon.h). No algorithm code here.
+// MeshLab plugin offering the engine's photon mapping: the filters the catalogue
+// (gi/filters.h) lists under "filter_photonmap". No algorithm and no filter-specific
+// code here: gi::ml::GiFilterPlugin does the MeshLab side for every plugin.
 #pragma once
-#include <common/interfaces.h>
+#include "gi_plugin.h"
 
-class FilterPhotonMapPlugin : public QObject, public MeshFilterInterface {
+class FilterPhotonMapPlugin : public QObject, public gi::ml::GiFilterPlugin {
   Q_OBJECT
   MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
   Q_INTERFACES(MeshFilterInterface)
 
  public:
-  enum { FP_PHOTON_MAPPING };
-  FilterPhotonMapPlugin();
-  QString pluginName() const override;
-  QString filterName(FilterIDType filter) const override;
-  QString filterInfo(FilterIDType filter) const override;
-  FilterClass getClass(QAction* a) override;
-  FILTER_ARITY filterArity(QAction*) const override;
-  int getPreConditions(QAction*) const override;
-  int postCondition(QAction*) const override;
-  void initParameterSet(QAction* a, MeshDocument& md, RichParameterList& par) override;
-  bool applyFilter(QAction* a, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb) override;
+  FilterPhotonMapPlugin() : GiFilterPlugin("filter_photonmap") { createActions(this); }
 };

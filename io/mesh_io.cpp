@@ -308,6 +308,7 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   check(attrs.faceColor.size(), nf, "face colours");
   check(attrs.faceQuality.size(), nf, "face qualities");
   if (vertexColor.empty()) check(attrs.vertexColor.size(), nv, "vertex colours");
+  for (const VertexAttribute& a : extras.attributes) check(a.values.size(), nv * size_t(a.components), a.name.c_str());
   if (nv > uint32_t(INT32_MAX)) failWrite(path, "too many vertices for int indices");
 
   const bool hasN = !extras.normals.empty(), hasQ = !vertexQuality.empty();
@@ -319,6 +320,11 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   if (hasN) h << "property float nx\nproperty float ny\nproperty float nz\n";
   if (hasC) h << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   if (hasQ) h << "property float quality\n";
+  for (const VertexAttribute& a : extras.attributes) {
+    if (a.components == 1) h << "property float " << a.name << "\n";
+    else
+      for (const char* c : {"_x", "_y", "_z"}) h << "property float " << a.name << c << "\n";
+  }
   h << "element face " << nf << "\nproperty list uchar int vertex_indices\n";
   if (hasFC) h << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   if (hasFQ) h << "property float quality\n";
@@ -337,6 +343,8 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
       else w.u8(attrs.vertexColor[i].r), w.u8(attrs.vertexColor[i].g), w.u8(attrs.vertexColor[i].b);
     }
     if (hasQ) w.f32(vertexQuality[i]);
+    for (const VertexAttribute& a : extras.attributes)
+      for (int c = 0; c < a.components; ++c) w.f32(a.values[i * size_t(a.components) + size_t(c)]);
   }
   for (size_t f = 0; f < nf; ++f) {
     const auto& t = s.triangles[f];

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "gi/filter_run.h"
 #include "gi/scene.h"
 #include "gi/scene_setup.h"
 
@@ -22,10 +23,12 @@ LoadedMesh loadMesh(const std::string& path);
 void appendMesh(LoadedMesh& into, const LoadedMesh& other);
 
 // Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and
-// "quality" (float, if given), faces with colour if attrs has face colours, and optionally
-// extra per-vertex float3 properties (e.g. bent normals as nx, ny, nz).
+// "quality" (float, if given), faces with colour and quality if attrs has them,
+// and optionally normals and named per-vertex attributes (a scalar as
+// "property float NAME", a vector as NAME_x, NAME_y, NAME_z).
 struct PlyExtras {
   std::vector<glm::vec3> normals;  // written as nx, ny, nz if not empty
+  std::vector<VertexAttribute> attributes;
 };
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
               const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,

@@ -12,17 +12,12 @@
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
-#include "gi/ambient.h"
-#include "gi/direct.h"
+#include "gi/filter_run.h"
 #include "gi/filters.h"
-#include "gi/form_factors.h"
-#include "gi/output.h"
-#include "gi/photon.h"
-#include "gi/pathtrace.h"
-#include "gi/radiosity.h"
+#include "gi/refine.h"
 #include "gi/scene_setup.h"
 #include "mesh_io.h"
-#include "reference.h"
+#include "result_file.h"
 
 using namespace gi;
 using json = nlohmann::json;
@@ -30,7 +25,7 @@ using json = nlohmann::json;
 namespace {
 
 struct CommonArgs {
-  std::string input, output, mesh, cacheDir, saveReference;
+  std::string input, output, mesh, cacheDir, saveResult;
   std::vector<std::string> layers;  // more files forming one scene with the input
   bool json = false, quiet = false;
   int threads = 0;
@@ -126,7 +121,10 @@ ParamValues resolve(const std::vector<ParamSpec>& specs, const CommonArgs& a, do
   return v;
 }
 
-int runFilter(FilterKind kind, const CommonArgs& a) {
+// Loads the input (and --layer files) as one scene, runs the filter through
+// gi::runFilter (or reuses a cached result of the same prepared scene and
+// parameters), writes the PLY and prints the log or the JSON summary.
+int runCommand(FilterKind kind, const CommonArgs& a) {
   const auto specs = filterSpecs(kind);
   const FilterDesc& desc = filterDesc(kind);
   std::unique_ptr<tbb::global_control> threads;
@@ -135,152 +133,77 @@ int runFilter(FilterKind kind, const CommonArgs& a) {
   io::LoadedMesh mesh = io::loadMesh(a.input);
   // Layers as in MeshLab: named by file name, for the mirror/glass patterns.
   auto baseName = [](const std::string& p) { const size_t k = p.find_last_of('/'); return k == std::string::npos ? p : p.substr(k + 1); };
-  std::vector<LayerRange> layers{{baseName(a.input), 0, mesh.scene.faceCount()}};
+  FilterInput in;
+  in.layers.push_back({baseName(a.input), 0, mesh.scene.faceCount()});
   for (const std::string& file : a.layers) {
     const size_t off = mesh.scene.faceCount();
     io::appendMesh(mesh, io::loadMesh(file));
-    layers.push_back({baseName(file), off, mesh.scene.faceCount() - off});
+    in.layers.push_back({baseName(file), off, mesh.scene.faceCount() - off});
   }
-  if (mesh.scene.faceCount() == 0)
-    throw std::invalid_argument(a.input + " has no faces (a point cloud?): these filters need triangles");
-  const SceneReport pre = analyzeScene(mesh.scene);
-  ParamValues v = resolve(specs, a, pre.diagonal);
-  const bool lighting = kind == FilterKind::Radiosity || kind == FilterKind::PhotonMapping ||
-                        kind == FilterKind::PathTracedReference;
-  std::string setupLog;
-  if (lighting || findSpec(specs, "reflectance_source"))
-    if (auto err = applySceneConventions(mesh.scene, mesh.attrs, v, lighting, &setupLog)) throw std::invalid_argument(*err);
-  if (findSpec(specs, "mirror_layers")) {
-    std::string log;
-    if (auto err = applyMaterials(mesh.scene, layers, v, &log)) throw std::invalid_argument(*err);
-    setupLog += "; " + log;
-  }
-  const SceneReport rep = analyzeScene(mesh.scene);
-  if (rep.usableFaces() == 0) throw std::invalid_argument(a.input + " has no usable triangles (" + rep.summary() + ")");
-  const Progress progress(stderrProgress(a.quiet));
+  const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);  // written back unchanged
+  mesh.scene.vertexNormals.clear();
+  in.values = resolve(specs, a, analyzeScene(mesh.scene).diagonal);
+  in.scene = std::move(mesh.scene);
+  in.attrs = mesh.attrs;
 
-  VertexOutput out;
-  std::vector<Rgb8> colors;
-  RunStats stats;
-  io::PlyExtras extras;
-  if (kind == FilterKind::AmbientOcclusion || kind == FilterKind::AmbientObscurance || kind == FilterKind::SkyLighting) {
-    const AmbientMode mode = kind == FilterKind::AmbientOcclusion ? AmbientMode::Occlusion
-                             : kind == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
-                                                                     : AmbientMode::Sky;
-    const AmbientOptions opt = AmbientOptions::fromParams(mode, v);
-    auto caster = makeEmbreeCaster(mesh.scene, opt.batch);
-    AmbientResult r = computeAmbient(mesh.scene, *caster, opt, progress);
-    stats = r.stats;
-    if (mode == AmbientMode::Sky) {
-      out = radiometricOutput(mesh.scene, r.rgb, v.getFloat("exposure"));
-      colors = out.displayColors();
-      stats.add("exposure", out.exposure);
-    } else {
-      out.quality = r.value;
-      colors = greyColors(r.value);
-      if (opt.bentNormals) extras.normals = r.bentNormal;
-    }
-  } else if (kind == FilterKind::FormFactorsOfFace) {
-    if (v.getInt("face_index") < 0) throw std::invalid_argument("--face_index is needed on the command line (a file has no selection)");
-    const uint32_t face = chosenFace(v.getInt("face_index"), {}, mesh.scene.faceCount());
-    auto caster = makeEmbreeCaster(mesh.scene);
-    const FormFactorReport ffr = formFactorsOfFace(mesh.scene, *caster, formFactorSettings(v), face);
-    const FormFactorOutput fo = formFactorOutput(mesh.scene, ffr, face);
-    out.quality = fo.vertexF;
-    colors = greyColors(fo.vertexF);
-    mesh.attrs.faceQuality = fo.faceF;
-    mesh.attrs.faceColor.clear();
-    for (const auto& c : fo.faceColor) mesh.attrs.faceColor.push_back({c.r, c.g, c.b});
-    stats.add("row_sum", ffr.rowSum);
-    stats.add("lost", ffr.escaped);
-    stats.add("max_reciprocity_error", ffr.maxReciprocityError);
-    stats.add("seconds", ffr.seconds);
-    stats.note(fo.summary);
-  } else if (kind == FilterKind::PathTracedReference) {
-    // Cached by scene hash and parameters: computed once, reused by benchmarks.
-    const std::string params = describe(specs, v);
-    const uint64_t hash = sceneHash(mesh.scene);
-    const std::string cached = a.cacheDir.empty() ? "" : io::referenceCachePath(a.cacheDir, a.input, hash, params);
-    io::ReferenceFile ref;
-    bool reused = false;
-    if (!cached.empty() && std::ifstream(cached)) {
-      ref = io::readReference(cached);
-      reused = ref.sceneHash == hash && ref.parameters == params && ref.B.size() == mesh.scene.vertexCount();
-    }
+  const Progress progress(stderrProgress(a.quiet));
+  FilterResult r = prepareFilter(kind, in);
+  const io::ResultKey key{desc.cliName, a.input, sceneHash(in.scene), describe(specs, in.values)};
+  const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
+  bool reused = false;
+  if (!cached.empty() && std::ifstream(cached)) {
+    FilterResult stored = r;
+    const io::ResultKey k = io::readResultFile(cached, stored);
+    reused = k.filter == key.filter && k.sceneHash == key.sceneHash && k.parameters == key.parameters &&
+             stored.vertexQuality.size() == in.scene.vertexCount();
     if (reused) {
-      stats.add("vertices", double(ref.B.size()));
-      stats.add("reference_seconds", ref.seconds);
-      stats.note("reused the cached reference " + cached);
-    } else {
-      auto caster = makeEmbreeCaster(mesh.scene);
-      PathTraceResult r = pathTrace(mesh.scene, *caster, PathTraceOptions::fromParams(v, mesh.scene.origin), progress);
-      stats = r.stats;
-      ref = {a.input, hash, params, r.stats.get("seconds"), r.B, r.H, r.stdError, r.stdErrorH, r.samples};
-      if (!cached.empty()) {
-        io::writeReference(cached, ref);
-        stats.note("cached as " + cached);
-      }
+      r = std::move(stored);
+      r.stats.note("reused the cached result " + cached);
     }
-    if (!a.saveReference.empty()) io::writeReference(a.saveReference, ref);
-    out = radiometricOutput(mesh.scene, ref.B, v.getFloat("exposure"));
-    colors = out.displayColors();
-    stats.add("exposure", out.exposure);
-  } else {
-    std::vector<glm::vec3> B, faceB;
-    const RadiosityOptions ropt = kind == FilterKind::Radiosity ? RadiosityOptions::fromParams(v) : RadiosityOptions();
-    if (kind == FilterKind::Radiosity && ropt.refine) {
-      // The refined mesh is what gets written: attributes follow the source faces.
-      AdaptiveRadiosity r = solveRadiosityAdaptive(mesh.scene, ropt, progress);
-      mesh.attrs = refineAttributes(mesh.attrs, r.mesh);
-      mesh.scene = std::move(r.mesh.scene);
-      stats = r.result.stats;
-      B = r.result.Bvertex;
-      faceB = r.result.B;
-    } else if (kind == FilterKind::Radiosity) {
-      auto caster = makeEmbreeCaster(mesh.scene);
-      RadiosityResult r = solveRadiosity(mesh.scene, *caster, ropt, progress);
-      stats = r.stats;
-      B = r.Bvertex;
-      faceB = r.B;
-    } else {
-      auto caster = makeEmbreeCaster(mesh.scene);
-      VertexRadiometry r = computePhotonMap(mesh.scene, *caster, PhotonOptions::fromParams(v, mesh.scene.origin), progress);
-      stats = r.stats;
-      B = r.B;
-    }
-    out = radiometricOutput(mesh.scene, B, v.getFloat("exposure"));
-    if (!faceB.empty() && v.getBool("face_output")) {  // patches' radiosity as face colour and quality
-      mesh.attrs.faceColor.clear();
-      mesh.attrs.faceQuality.clear();
-      for (const auto& b : faceB) {
-        const Rgb8 c = displayMap(b, out.exposure);
-        mesh.attrs.faceColor.push_back({c.r, c.g, c.b});
-        mesh.attrs.faceQuality.push_back(luminance(b));
-      }
-    }
-    colors = out.displayColors();
-    stats.add("exposure", out.exposure);
   }
-  if (!a.output.empty()) io::writePly(a.output, mesh.scene, mesh.attrs, out.quality, colors, extras);
-  stats.add("total_seconds", timer.seconds());
+  if (!reused) {
+    computeFilter(kind, in, r, progress);
+    if (!cached.empty() && !r.refined) {
+      io::writeResultFile(cached, key, r);
+      r.stats.note("cached as " + cached);
+    }
+  }
+  if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
+
+  // The output: the input mesh (or its refinement) with the result's
+  // properties; what the result leaves alone keeps the input's values.
+  const Scene& out = r.refined ? r.refined->scene : in.scene;
+  MeshAttributes attrs = r.refined ? refineAttributes(mesh.attrs, *r.refined) : mesh.attrs;
+  if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
+  if (!r.faceColor.empty()) {
+    attrs.faceColor.clear();
+    for (const Rgb8& c : r.faceColor) attrs.faceColor.push_back({c.r, c.g, c.b});
+  }
+  io::PlyExtras extras;
+  extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
+  extras.attributes = r.attributes;
+  if (!a.output.empty()) io::writePly(a.output, out, attrs, r.vertexQuality, r.vertexColor, extras);
+  r.stats.add("total_seconds", timer.seconds());
+  const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {
+    const SceneReport& rep = r.report;
     json j;
     j["filter"] = desc.meshlabName;
     j["input"] = a.input;
     if (!a.output.empty()) j["output"] = a.output;
-    j["parameters"] = valuesJson(specs, v);
+    j["parameters"] = valuesJson(specs, in.values);
     j["scene"] = {{"vertices", rep.vertices}, {"faces", rep.faces}, {"usable_faces", rep.usableFaces()},
                   {"degenerate_faces", rep.degenerateFaces}, {"invalid_faces", rep.invalidFaces},
                   {"nonfinite_vertices", rep.nonFiniteVertices}, {"isolated_vertices", rep.isolatedVertices},
                   {"emitter_faces", rep.emitterFaces}, {"diagonal", rep.diagonal}};
-    j["stats"] = statsJson(stats);
-    j["notes"] = stats.notes;
-    j["warnings"] = stats.warnings;
-    if (!setupLog.empty()) j["setup"] = setupLog;
+    j["stats"] = statsJson(r.stats);
+    j["notes"] = r.stats.notes;
+    j["warnings"] = r.stats.warnings;
+    if (!r.setupLog.empty()) j["setup"] = r.setupLog;
+    j["log"] = lines;
     std::cout << j.dump(2) << std::endl;
   } else if (!a.quiet) {
-    std::cerr << rep.summary() << (setupLog.empty() ? "" : "; " + setupLog) << "\n";
-    std::cerr << stats.line(desc.meshlabName) << "\n";
+    for (const std::string& l : lines) std::cerr << l << "\n";
     if (!a.output.empty()) std::cerr << "wrote " << a.output << "\n";
   }
   return 0;
@@ -327,11 +250,10 @@ int main(int argc, char** argv) {
     sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");
     sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it");
     addParamOptions(sub, filterSpecs(d.kind), a, false);
-    if (d.kind == FilterKind::PathTracedReference) {
-      sub->add_option("--cache", a.cacheDir, "folder of cached references: reuse one computed with the same scene and "
-                                             "parameters, or store the new one there");
-      sub->add_option("--save-reference", a.saveReference, "also write the reference (JSON: B, H, standard errors, paths)");
-    }
+    sub->add_option("--cache", a.cacheDir, "folder of cached results: reuse one computed with the same scene and "
+                                           "parameters, or store the new one there (e.g. a slow reference)");
+    sub->add_option("--save-result", a.saveResult, "also write the whole result as JSON (quality, colours, attributes "
+                                                   "such as Radiosity, StdError, Paths; statistics)");
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
@@ -347,7 +269,7 @@ int main(int argc, char** argv) {
   }
   try {
     for (auto& [sub, kind] : subs)
-      if (sub->parsed()) return runFilter(kind, a);
+      if (sub->parsed()) return runCommand(kind, a);
     if (script->parsed()) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())

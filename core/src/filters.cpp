@@ -15,27 +15,6 @@
 
 namespace gi {
 
-const std::vector<FilterDesc>& allFilters() {
-  static const std::vector<FilterDesc> f = {
-      {FilterKind::AmbientOcclusion, "GI: Ambient Occlusion", "ao", "per-vertex cosine-weighted ambient occlusion"},
-      {FilterKind::AmbientObscurance, "GI: Ambient Obscurance", "obscurance", "per-vertex ambient obscurance"},
-      {FilterKind::SkyLighting, "GI: Sky Lighting", "sky", "per-vertex irradiance from a uniform sky and a sun"},
-      {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "the radiosity method: form factors and a solver"},
-      {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "photon-mapped radiosity from area emitters"},
-      {FilterKind::PathTracedReference, "GI: Path Traced Reference", "reference",
-       "per-vertex path-traced reference solution with error bars"},
-      {FilterKind::FormFactorsOfFace, "GI: Form Factors of Selected Face", "formfactors",
-       "form factors from one face to every other face (teaching, debugging)"},
-  };
-  return f;
-}
-
-const FilterDesc& filterDesc(FilterKind k) {
-  for (const auto& d : allFilters())
-    if (d.kind == k) return d;
-  throw std::logic_error("unknown filter");
-}
-
 std::vector<ParamSpec> filterSpecs(FilterKind k) {
   std::vector<ParamSpec> s;
   auto add = [&s](const std::vector<ParamSpec>& more) { s.insert(s.end(), more.begin(), more.end()); };

@@ -264,13 +264,15 @@ def case_reference(c):
     diff = max(abs(a["quality"] - b["quality"]) / max(1e-6, b["quality"]) for a, b in zip(v, w) if b["quality"] > 1e-3)
     check(diff < 1e-3, "meshlabserver and CLI agree (max relative difference %.2g)" % diff)
     j2 = json.loads(subprocess.run(args, stdout=subprocess.PIPE, check=True).stdout)
-    check(any("reused the cached reference" in n for n in j2["notes"]) and "rays" not in j2["stats"],
+    check(any("reused the cached result" in n for n in j2["notes"]) and j2["stats"]["rays"] == j1["stats"]["rays"],
           "second run reuses the cached reference")
     files = os.listdir(cache)
     with open(os.path.join(cache, files[0])) as f:
         ref = json.load(f)
-    check(ref["format"] == "gi-reference" and len(ref["std_error_B"]) == len(v) and min(ref["samples"]) >= 64,
-          "reference file holds B, H, standard errors and path counts")
+    at = ref["attributes"]
+    check(ref["format"] == "gi-result" and len(at["StdError"]["values"]) == len(v) and min(at["Paths"]["values"]) >= 64
+          and len(at["Radiosity"]["values"]) == 3 * len(v) and len(at["Irradiance"]["values"]) == 3 * len(v),
+          "result file holds B, H, standard errors and path counts")
 
 
 def case_formfactors(c):

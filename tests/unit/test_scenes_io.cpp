@@ -13,7 +13,7 @@
 
 #include "gi/scenes.h"
 #include "mesh_io.h"
-#include "reference.h"
+#include "result_file.h"
 
 namespace fs = std::filesystem;
 using gi::scenes::SceneFile;
@@ -389,34 +389,50 @@ TEST(ScenesIo, CommittedTestMeshesMatchTheGenerators) {
   }
 }
 
-// Reference files: a round trip keeps every array; the cache path depends on
-// the scene hash and the parameters; a damaged file is a clear error.
-TEST(ReferenceFile, RoundTripAndCacheKey) {
-  gi::io::ReferenceFile r;
-  r.mesh = "m.ply";
-  r.sceneHash = 0x0123456789abcdefull;
-  r.parameters = "samples_per_vertex=64";
-  r.seconds = 1.5;
-  r.B = {{1, 2, 3}, {4, 5, 6}};
-  r.H = {{0.5f, 0.25f, 0.125f}, {0, 0, 0}};
-  r.stdErrorB = {0.1f, 0.2f};
-  r.stdErrorH = {0.01f, 0.02f};
-  r.samples = {64, 128};
-  const std::string path = ::testing::TempDir() + "ref_roundtrip.giref.json";
-  gi::io::writeReference(path, r);
-  const auto q = gi::io::readReference(path);
-  EXPECT_EQ(q.sceneHash, r.sceneHash);
-  EXPECT_EQ(q.parameters, r.parameters);
-  EXPECT_EQ(q.B, r.B);
-  EXPECT_EQ(q.H, r.H);
-  EXPECT_EQ(q.stdErrorB, r.stdErrorB);
-  EXPECT_EQ(q.samples, r.samples);
-  const auto a = gi::io::referenceCachePath("d", "x/m.ply", 1, "p=1");
-  EXPECT_NE(a, gi::io::referenceCachePath("d", "x/m.ply", 2, "p=1"));
-  EXPECT_NE(a, gi::io::referenceCachePath("d", "x/m.ply", 1, "p=2"));
-  EXPECT_EQ(a.rfind("d/m-", 0), 0u);
-  { std::ofstream(path) << "{\"format\": \"gi-reference\", \"version\": 1}"; }
-  EXPECT_THROW(gi::io::readReference(path), std::runtime_error);
+// Result files: a round trip keeps every array bit for bit; the cache path
+// depends on the filter, the scene hash and the parameters; a damaged file is
+// a clear error.
+TEST(ResultFile, RoundTripAndCacheKey) {
+  gi::FilterResult r;
+  r.vertexQuality = {0.1f, 1.f / 3.f};
+  r.vertexColor = {{1, 2, 3}, {250, 251, 252}};
+  r.faceQuality = {7.f};
+  r.faceColor = {{9, 8, 7}};
+  r.attributes.push_back({"Radiosity", 3, {1, 2, 3, 4, 5, 6.000001f}});
+  r.attributes.push_back({"Paths", 1, {64, 128}});
+  r.stats.add("seconds", 1.5);
+  r.stats.note("a note");
+  r.stats.warn("a warning");
+  const gi::io::ResultKey key{"reference", "m.ply", 0x0123456789abcdefull, "samples_per_vertex=64"};
+  const std::string path = ::testing::TempDir() + "roundtrip.giresult.json";
+  gi::io::writeResultFile(path, key, r);
+  gi::FilterResult q;
+  const auto k = gi::io::readResultFile(path, q);
+  EXPECT_EQ(k.sceneHash, key.sceneHash);
+  EXPECT_EQ(k.parameters, key.parameters);
+  EXPECT_EQ(k.filter, key.filter);
+  EXPECT_EQ(q.vertexQuality, r.vertexQuality);
+  EXPECT_EQ(q.faceQuality, r.faceQuality);
+  ASSERT_EQ(q.vertexColor.size(), 2u);
+  EXPECT_EQ(q.vertexColor[1].b, 252);
+  ASSERT_NE(q.attribute("Radiosity"), nullptr);
+  EXPECT_EQ(q.attribute("Radiosity")->values, r.attributes[0].values);
+  EXPECT_EQ(q.attribute("Paths")->components, 1);
+  EXPECT_EQ(q.stats.get("seconds"), 1.5);
+  EXPECT_EQ(q.stats.warnings, r.stats.warnings);
+  const auto a = gi::io::resultCachePath("d", key);
+  auto other = key;
+  other.sceneHash = 2;
+  EXPECT_NE(a, gi::io::resultCachePath("d", other));
+  other = key;
+  other.parameters = "p=2";
+  EXPECT_NE(a, gi::io::resultCachePath("d", other));
+  other = key;
+  other.filter = "photonmap";
+  EXPECT_NE(a, gi::io::resultCachePath("d", other));
+  EXPECT_EQ(a.rfind("d/m-reference-", 0), 0u);
+  { std::ofstream(path) << "{\"format\": \"gi-result\", \"version\": 1}"; }
+  EXPECT_THROW(gi::io::readResultFile(path, q), std::runtime_error);
   // The scene hash sees geometry and materials.
   auto sf = gi::scenes::openPlane(1.0, 2);
   const uint64_t h0 = gi::sceneHash(sf.scene);

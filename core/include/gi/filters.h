@@ -1,6 +1,9 @@
-// The catalogue of filters: MeshLab name, CLI subcommand and the full
-// parameter list in dialog order. MeshLab 2020.09's meshlabserver needs every
-// parameter of a filter in a script, in this order: mlxScript writes them.
+// The catalogue of filters: for each, its MeshLab name, CLI subcommand,
+// plugin, description (MeshLab's filterInfo, the CLI's help), what it writes
+// and the full parameter list in dialog order. Front ends take every filter
+// from here (docs/design.md, "Adding a filter"). MeshLab 2020.09's
+// meshlabserver needs every parameter of a filter in a script, in this order:
+// mlxScript writes them.
 #pragma once
 #include <string>
 #include <vector>
@@ -11,15 +14,30 @@ namespace gi {
 
 enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping, PathTracedReference, FormFactorsOfFace };
 
+// What a filter may change in the mesh (MeshLab's postCondition, the PLY the CLI writes).
+enum FilterWrites : unsigned {
+  WritesVertexQuality = 1u << 0,
+  WritesVertexColor = 1u << 1,
+  WritesVertexNormal = 1u << 2,
+  WritesFaceQuality = 1u << 3,
+  WritesFaceColor = 1u << 4,
+  WritesGeometry = 1u << 5,  // the mesh may be refined (new vertices and faces)
+};
+
 struct FilterDesc {
   FilterKind kind;
   std::string meshlabName;  // exact filter name (scripts depend on it)
   std::string cliName;      // subcommand of the command-line tool
-  std::string summary;      // one line
+  std::string plugin;       // the MeshLab plugin that offers it (e.g. "filter_ambient")
+  std::string summary;      // one line (CLI help)
+  std::string info;         // MeshLab's filterInfo: what it computes and how (HTML)
+  unsigned writes = 0;      // FilterWrites bits
 };
 
 const std::vector<FilterDesc>& allFilters();
 const FilterDesc& filterDesc(FilterKind k);
+// The filters of one plugin, in catalogue order.
+std::vector<FilterKind> pluginFilters(const std::string& plugin);
 std::vector<ParamSpec> filterSpecs(FilterKind k);
 
 // A complete .mlx script applying the filters with the given values (e.g.

@@ -1,0 +1,79 @@
+// One way to run a filter, whatever the front end. The MeshLab plugins, the
+// command-line tool and the tests hand the same FilterInput (the scene of all
+// layers, their attributes and names, the parameter values) to runFilter and
+// get one FilterResult back; they only read and write data. So a filter
+// behaves the same in MeshLab, in meshlabserver scripts and in `gi`, and a new
+// filter added to the catalogue (gi/filters.h) appears in all of them at once.
+//
+// Steps, the same for every filter:
+//   1. validate the parameter values against the filter's table;
+//   2. apply the scene conventions (reflectance, emitters, mirror and glass
+//      layers: docs/design.md, "Conventions");
+//   3. run the algorithm;
+//   4. map the physical result to the output convention (quality = the
+//      physical scalar, colour = its display mapping) and check that nothing
+//      non-finite leaves the engine.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gi/color.h"
+#include "gi/filters.h"
+#include "gi/params.h"
+#include "gi/refine.h"
+#include "gi/run.h"
+#include "gi/scene.h"
+#include "gi/scene_setup.h"
+
+namespace gi {
+
+struct FilterInput {
+  Scene scene;                     // all layers as one scene (vertex normals are not used: see docs/design.md)
+  MeshAttributes attrs;            // colours, face quality and selection, as the meshes carry them
+  std::vector<LayerRange> layers;  // layer names and face ranges, in scene order
+  ParamValues values;              // every parameter of the filter's table (distances absolute)
+};
+
+// A per-vertex attribute: MeshLab stores it as a named per-vertex attribute
+// (Scalarm or Point3m), the command-line tool as PLY vertex properties.
+struct VertexAttribute {
+  std::string name;           // e.g. "BentNormal", "StdError", "Radiosity"
+  int components = 1;         // 1 (scalar) or 3 (vector)
+  std::vector<float> values;  // vertexCount x components
+};
+
+struct FilterResult {
+  // Per vertex / face of the output scene (the input's, or `refined->scene`);
+  // an empty array leaves that property of the mesh as it was.
+  std::vector<float> vertexQuality;
+  std::vector<Rgb8> vertexColor;
+  std::vector<glm::vec3> vertexNormal;  // only when a parameter asks to replace the normals
+  std::vector<float> faceQuality;
+  std::vector<Rgb8> faceColor;
+  std::vector<VertexAttribute> attributes;
+  std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
+
+  SceneReport report;    // the scene the algorithm saw (after the conventions)
+  std::string setupLog;  // reflectance, emitters, materials: what the conventions chose
+  RunStats stats;        // the algorithm's numbers, notes and warnings
+
+  const VertexAttribute* attribute(const std::string& name) const;
+  // The two log lines every front end prints: the scene and what was computed.
+  std::vector<std::string> logLines(const std::string& title) const;
+  // Reorders the per-vertex and per-face arrays: new index i takes old index order[i].
+  void reorder(const std::vector<uint32_t>& vertexOrder, const std::vector<uint32_t>& faceOrder);
+};
+
+// Runs filter `kind` on `in` (its scene takes the conventions' reflectance,
+// emission and materials). Throws std::invalid_argument with one sentence
+// for unusable input or parameters, gi::Cancelled if progress asks to stop.
+FilterResult runFilter(FilterKind kind, FilterInput& in, const Progress& progress = Progress(nullptr));
+
+// runFilter in two halves, for a front end that may reuse a stored result of
+// the same prepared scene: steps 1-2 (the result holds the scene report and
+// the set-up log), then steps 3-4.
+FilterResult prepareFilter(FilterKind kind, FilterInput& in);
+void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress = Progress(nullptr));
+
+}  // namespace gi

@@ -1,0 +1,251 @@
+#include "gi/filter_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+#include <stdexcept>
+#include <string>
+
+#include "gi/ambient.h"
+#include "gi/direct.h"
+#include "gi/form_factors.h"
+#include "gi/output.h"
+#include "gi/pathtrace.h"
+#include "gi/photon.h"
+#include "gi/radiosity.h"
+
+namespace gi {
+
+namespace {
+
+bool needsEmitters(FilterKind k) {
+  return k == FilterKind::Radiosity || k == FilterKind::PhotonMapping || k == FilterKind::PathTracedReference;
+}
+
+VertexAttribute scalarAttribute(const std::string& name, const std::vector<float>& v) { return {name, 1, v}; }
+
+VertexAttribute vectorAttribute(const std::string& name, const std::vector<glm::vec3>& v) {
+  VertexAttribute a{name, 3, {}};
+  a.values.reserve(v.size() * 3);
+  for (const glm::vec3& x : v) a.values.insert(a.values.end(), {x.x, x.y, x.z});
+  return a;
+}
+
+// Validation, the scene conventions and the scene report: steps 1 and 2.
+void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
+  if (in.scene.faceCount() == 0)
+    throw std::invalid_argument(in.scene.vertexCount() == 0
+                                    ? "the mesh is empty"
+                                    : "the mesh has no faces (a point cloud?): these filters need triangles");
+  // Vertex normals come from the triangles in every front end (docs/design.md, "Conventions").
+  in.scene.vertexNormals.clear();
+  const std::vector<ParamSpec> specs = filterSpecs(kind);
+  const double diagonal = analyzeScene(in.scene).diagonal;
+  if (auto err = validate(specs, in.values, diagonal)) throw std::invalid_argument(*err);
+  const ParamValues& v = in.values;
+  if (v.has("reflectance_source"))
+    if (auto err = applySceneConventions(in.scene, in.attrs, v, needsEmitters(kind), &res.setupLog))
+      throw std::invalid_argument(*err);
+  if (v.has("mirror_layers")) {
+    std::string log;
+    if (auto err = applyMaterials(in.scene, in.layers, v, &log)) throw std::invalid_argument(*err);
+    res.setupLog += (res.setupLog.empty() ? "" : "; ") + log;
+  }
+  res.report = analyzeScene(in.scene);
+  if (res.report.usableFaces() == 0)
+    throw std::invalid_argument("the mesh has no usable triangles (" + res.report.summary() + ")");
+}
+
+// Radiometric output (quality = luminance, colour = display mapping) and the
+// linear RGB value as the attribute "Radiosity" (what a later pass, such as
+// a ray-traced view, reads back from the mesh).
+void radiometric(FilterResult& res, const Scene& s, const std::vector<glm::vec3>& B, double exposure,
+                 const std::string& attribute) {
+  const VertexOutput out = radiometricOutput(s, B, exposure);
+  res.vertexQuality = out.quality;
+  res.vertexColor = out.displayColors();
+  res.attributes.push_back(vectorAttribute(attribute, B));
+  res.stats.add("exposure", out.exposure);
+}
+
+void faceRadiometric(FilterResult& res, const std::vector<glm::vec3>& Bface) {
+  VertexOutput f;
+  f.rgb = Bface;
+  f.exposure = float(res.stats.get("exposure", 1.0));
+  for (const glm::vec3& b : Bface) f.quality.push_back(luminance(b));
+  res.faceQuality = f.quality;
+  res.faceColor = f.displayColors();
+}
+
+// Multiplies sRGB vertex colours (white where the mesh has none) by a factor in linear light.
+std::vector<Rgb8> multiplyColors(const std::vector<glm::u8vec3>& colors, const std::vector<float>& factor) {
+  std::vector<Rgb8> out(factor.size());
+  for (size_t i = 0; i < factor.size(); ++i) {
+    const glm::u8vec3 c = i < colors.size() ? colors[i] : glm::u8vec3(255);
+    const float f = std::isfinite(factor[i]) ? factor[i] : 0.f;
+    out[i] = displayMap(srgb8ToLinear(c.r, c.g, c.b) * f, 1.f);
+  }
+  return out;
+}
+
+void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress) {
+  const AmbientMode mode = kind == FilterKind::AmbientOcclusion    ? AmbientMode::Occlusion
+                           : kind == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
+                                                                   : AmbientMode::Sky;
+  const ParamValues& v = in.values;
+  const AmbientOptions opt = AmbientOptions::fromParams(mode, v);
+  const auto caster = makeEmbreeCaster(in.scene, opt.batch);
+  AmbientResult r = computeAmbient(in.scene, *caster, opt, progress);
+  res.stats = std::move(r.stats);
+  if (mode == AmbientMode::Sky) {
+    radiometric(res, in.scene, r.rgb, v.getFloat("exposure"), "Irradiance");
+  } else {
+    res.vertexQuality = r.value;
+    const auto mapping = AOColorMapping(mode == AmbientMode::Occlusion ? v.getInt("color_mapping") : 0);
+    if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(r.value);
+    else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, r.value);
+    if (opt.bentNormals) {
+      res.attributes.push_back(vectorAttribute("BentNormal", r.bentNormal));
+      if (v.getBool("bent_normals_to_vertex_normals")) res.vertexNormal = r.bentNormal;
+    }
+  }
+  res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+}
+
+void runFormFactors(FilterInput& in, FilterResult& res) {
+  const Scene& s = in.scene;
+  const uint32_t face = chosenFace(in.values.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const auto caster = makeEmbreeCaster(s);
+  const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(in.values), face);
+  FormFactorOutput out = formFactorOutput(s, rep, face);
+  res.vertexQuality = std::move(out.vertexF);
+  res.faceQuality = std::move(out.faceF);
+  res.faceColor = std::move(out.faceColor);
+  res.stats.add("face", double(face));
+  res.stats.add("row_sum", rep.rowSum);
+  res.stats.add("lost", rep.escaped);
+  res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
+  res.stats.add("seconds", rep.seconds);
+  res.stats.note(out.summary);
+}
+
+void runReference(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const auto caster = makeEmbreeCaster(in.scene);
+  PathTraceResult r = pathTrace(in.scene, *caster, PathTraceOptions::fromParams(in.values, in.scene.origin), progress);
+  res.stats = std::move(r.stats);
+  radiometric(res, in.scene, r.B, in.values.getFloat("exposure"), "Radiosity");
+  res.attributes.push_back(vectorAttribute("Irradiance", r.H));
+  res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+  res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
+  res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
+}
+
+void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const RadiosityOptions opt = RadiosityOptions::fromParams(in.values);
+  RadiosityResult r;
+  const Scene* out = &in.scene;
+  if (opt.refine) {
+    AdaptiveRadiosity ar = solveRadiosityAdaptive(in.scene, opt, progress);
+    r = std::move(ar.result);
+    res.refined = std::move(ar.mesh);
+    out = &res.refined->scene;
+  } else {
+    const auto caster = makeEmbreeCaster(in.scene);
+    r = solveRadiosity(in.scene, *caster, opt, progress);
+  }
+  res.stats = std::move(r.stats);
+  radiometric(res, *out, r.Bvertex, in.values.getFloat("exposure"), "Radiosity");
+  if (in.values.getBool("face_output")) faceRadiometric(res, r.B);
+}
+
+void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const auto caster = makeEmbreeCaster(in.scene);
+  VertexRadiometry r = computePhotonMap(in.scene, *caster, PhotonOptions::fromParams(in.values, in.scene.origin), progress);
+  res.stats = std::move(r.stats);
+  radiometric(res, in.scene, r.B, in.values.getFloat("exposure"), "Radiosity");
+  if (r.stdError.size() == r.B.size()) res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+}
+
+// Step 4: every array has the output scene's size and nothing non-finite
+// leaves the engine (a NaN in MeshLab's quality breaks its colour ramps).
+void finish(FilterResult& res, const Scene& out) {
+  const size_t nv = out.vertexCount(), nf = out.faceCount();
+  auto sized = [](size_t n, size_t want, const char* what) {
+    if (n != 0 && n != want) throw std::logic_error(std::string("filter result: wrong number of ") + what);
+  };
+  sized(res.vertexQuality.size(), nv, "vertex qualities");
+  sized(res.vertexColor.size(), nv, "vertex colours");
+  sized(res.vertexNormal.size(), nv, "vertex normals");
+  sized(res.faceQuality.size(), nf, "face qualities");
+  sized(res.faceColor.size(), nf, "face colours");
+  size_t bad = 0;
+  auto clean = [&bad](float& x) {
+    if (!std::isfinite(x)) x = 0.f, ++bad;
+  };
+  for (float& q : res.vertexQuality) clean(q);
+  for (float& q : res.faceQuality) clean(q);
+  for (glm::vec3& n : res.vertexNormal) clean(n.x), clean(n.y), clean(n.z);
+  res.attributes.erase(std::remove_if(res.attributes.begin(), res.attributes.end(),
+                                      [](const VertexAttribute& a) { return a.values.empty(); }),
+                       res.attributes.end());
+  for (VertexAttribute& a : res.attributes) {
+    sized(a.values.size(), nv * size_t(a.components), a.name.c_str());
+    for (float& x : a.values) clean(x);
+  }
+  if (bad) res.stats.warn(std::to_string(bad) + " non-finite values were written as 0");
+}
+
+}  // namespace
+
+const VertexAttribute* FilterResult::attribute(const std::string& name) const {
+  for (const auto& a : attributes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+std::vector<std::string> FilterResult::logLines(const std::string& title) const {
+  return {report.summary() + (setupLog.empty() ? "" : "; " + setupLog), stats.line(title)};
+}
+
+void FilterResult::reorder(const std::vector<uint32_t>& vertexOrder, const std::vector<uint32_t>& faceOrder) {
+  auto permute = [](auto& a, const std::vector<uint32_t>& order, size_t components) {
+    if (a.empty()) return;
+    auto b = a;
+    for (size_t i = 0; i < order.size(); ++i)
+      for (size_t c = 0; c < components; ++c) b[i * components + c] = a[order[i] * components + c];
+    a.swap(b);
+  };
+  permute(vertexQuality, vertexOrder, 1);
+  permute(vertexColor, vertexOrder, 1);
+  permute(vertexNormal, vertexOrder, 1);
+  permute(faceQuality, faceOrder, 1);
+  permute(faceColor, faceOrder, 1);
+  for (VertexAttribute& a : attributes) permute(a.values, vertexOrder, size_t(a.components));
+}
+
+FilterResult prepareFilter(FilterKind kind, FilterInput& in) {
+  FilterResult res;
+  prepare(kind, in, res);
+  return res;
+}
+
+FilterResult runFilter(FilterKind kind, FilterInput& in, const Progress& progress) {
+  FilterResult res = prepareFilter(kind, in);
+  computeFilter(kind, in, res, progress);
+  return res;
+}
+
+void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress) {
+  switch (kind) {
+    case FilterKind::AmbientOcclusion:
+    case FilterKind::AmbientObscurance:
+    case FilterKind::SkyLighting: runAmbient(kind, in, res, progress); break;
+    case FilterKind::FormFactorsOfFace: runFormFactors(in, res); break;
+    case FilterKind::PathTracedReference: runReference(in, res, progress); break;
+    case FilterKind::Radiosity: runRadiosity(in, res, progress); break;
+    case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
+  }
+  finish(res, res.refined ? res.refined->scene : in.scene);
+}
+
+}  // namespace gi
