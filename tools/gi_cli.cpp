@@ -209,6 +209,29 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   return 0;
 }
 
+int listFilters(bool asJson) {
+  json all = json::array();
+  for (const FilterDesc& d : allFilters()) {
+    if (!asJson) {
+      std::printf("%-12s '%s' (%s): %s\n", d.cliName.c_str(), d.meshlabName.c_str(), d.plugin.c_str(), d.summary.c_str());
+      continue;
+    }
+    json params = json::array();
+    for (const ParamSpec& p : filterSpecs(d.kind))
+      params.push_back({{"name", p.name}, {"label", p.label}, {"default", defaultText(p)}, {"meshlab_only", p.meshlabOnly}});
+    json writes = json::array();
+    const std::pair<unsigned, const char*> bits[] = {
+        {WritesVertexQuality, "vertex_quality"}, {WritesVertexColor, "vertex_color"}, {WritesVertexNormal, "vertex_normal"},
+        {WritesFaceQuality, "face_quality"},     {WritesFaceColor, "face_color"},     {WritesGeometry, "geometry"}};
+    for (const auto& [bit, name] : bits)
+      if (d.writes & bit) writes.push_back(name);
+    all.push_back({{"cli", d.cliName}, {"meshlab", d.meshlabName}, {"plugin", d.plugin}, {"summary", d.summary},
+                   {"writes", writes}, {"parameters", params}});
+  }
+  if (asJson) std::cout << all.dump(2) << std::endl;
+  return 0;
+}
+
 int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   double diag = 1.0;
   if (!a.mesh.empty()) {
@@ -262,6 +285,8 @@ int main(int argc, char** argv) {
   script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
+  CLI::App* list = app.add_subcommand("filters", "list the filters (the catalogue MeshLab's plugins and this tool share)");
+  list->add_flag("--json", a.json, "as JSON: names, plugin, description, what each writes, parameters");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -270,6 +295,7 @@ int main(int argc, char** argv) {
   try {
     for (auto& [sub, kind] : subs)
       if (sub->parsed()) return runCommand(kind, a);
+    if (list->parsed()) return listFilters(a.json);
     if (script->parsed()) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())

@@ -40,6 +40,12 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   // Vertex normals come from the triangles in every front end (docs/design.md, "Conventions").
   in.scene.vertexNormals.clear();
   const std::vector<ParamSpec> specs = filterSpecs(kind);
+  // MeshLab holds RichFloat and RichAbsPerc values in single precision: the
+  // command-line tool's doubles are rounded the same way, so that both front
+  // ends compute with the same numbers.
+  for (const ParamSpec& p : specs)
+    if ((p.type == ParamType::Float || p.type == ParamType::Distance) && in.values.has(p.name))
+      in.values.set(p.name, double(float(in.values.getFloat(p.name))));
   const double diagonal = analyzeScene(in.scene).diagonal;
   if (auto err = validate(specs, in.values, diagonal)) throw std::invalid_argument(*err);
   const ParamValues& v = in.values;

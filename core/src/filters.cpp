@@ -78,9 +78,11 @@ static std::string xmlEscape(const std::string& t) {
   return o;
 }
 
+// MeshLab reads script values as float: 9 significant digits give back exactly
+// the float the engine rounds the value to (gi::runFilter).
 static std::string fnum(double x) {
   char b[64];
-  std::snprintf(b, sizeof b, "%.9g", x);
+  std::snprintf(b, sizeof b, "%.9g", double(float(x)));
   return b;
 }
 
