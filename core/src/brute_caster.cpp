@@ -49,19 +49,6 @@ class BruteForceCaster final : public RayCaster {
 
 }  // namespace
 
-bool visibleToRandomPoint(const RayCaster& caster, const glm::vec3& x, const glm::vec3& a, const glm::vec3& b,
-                          const glm::vec3& c, Rng& rng, float eps) {
-  const glm::vec2 ub = uniformTriangle({rng.next(), rng.next()});
-  const glm::vec3 w = ub.x * a + ub.y * b + (1.f - ub.x - ub.y) * c - x;
-  const float len = glm::length(w);
-  if (!(len > 0.f)) return true;
-  Ray ray;
-  ray.o = x;
-  ray.d = w / len;
-  ray.tfar = len * (1.f - 1e-4f) - eps;
-  return ray.tfar <= 0.f || !caster.occluded(ray);
-}
-
 std::unique_ptr<RayCaster> makeBruteForceCaster(const Scene& s) { return std::make_unique<BruteForceCaster>(s); }
 
 }  // namespace gi

@@ -14,23 +14,6 @@
 
 namespace gi {
 
-std::vector<ParamSpec> DirectOptions::specs() {
-  return {
-      {"light_samples", "Shadow rays per vertex",
-       "Points sampled on the emitters (in proportion to their power) for each vertex, each with a shadow ray. "
-       "More samples give smoother soft shadows; the error falls as about N^-1/2 to N^-3/4.",
-       ParamType::Int, 64, 1, 1 << 20},
-      seedSpec("sampling sequences"),
-  };
-}
-
-DirectOptions DirectOptions::fromParams(const ParamValues& v) {
-  DirectOptions o;
-  o.lightSamples = v.getInt("light_samples");
-  o.seed = uint32_t(v.getInt("seed"));
-  return o;
-}
-
 VertexMaterial vertexMaterial(const Scene& s) {
   const size_t nv = s.vertexCount();
   VertexMaterial m;

@@ -20,8 +20,6 @@ namespace gi {
 struct DirectOptions {
   int lightSamples = 64;  // shadow rays per vertex
   uint32_t seed = 0;
-  static std::vector<ParamSpec> specs();
-  static DirectOptions fromParams(const ParamValues& v);
 };
 
 struct VertexRadiometry {

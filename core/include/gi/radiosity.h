@@ -1,11 +1,12 @@
 // The radiosity method over the triangles of a scene (Goral et al. 1984;
 // Cohen and Greenberg 1985):
 //   B_i = E_i + rho_i sum_j F_ij B_j          (RGB, W/m^2)
-// with form factors F_ij estimated by Monte Carlo ray casting from each patch
-// (cosine-weighted hemisphere directions from stratified points on the
-// patch: F_ij ~ (rays from i hitting j's front) / N) and solved by Jacobi,
+// with form factors F_ij by one of three methods (gi/form_factors.h: Monte
+// Carlo rays from each patch, the analytic point-to-polygon factor, or a
+// hemicube), the direct light apart (gi/direct.h), solved by Jacobi,
 // Gauss-Seidel or progressive refinement (Cohen et al. 1988: shoot the patch
-// with the most unshot power). Rows are sparse; only hit patches are stored.
+// with the most unshot power). Rows are sparse; only non-zero factors are
+// stored, or computed on the fly beyond the memory budget.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -49,7 +50,7 @@ struct RadiosityOptions {
 
 struct RadiosityResult {
   std::vector<glm::vec3> B;         // per face
-  std::vector<glm::vec3> Bvertex;   // per vertex (see RadiosityOptions::vertexDirect)
+  std::vector<glm::vec3> Bvertex;   // per vertex (see RadiosityOptions::vertexOutput)
   std::vector<glm::vec3> Rgather;   // per face: reflected radiosity the vertices gather from
   std::vector<glm::vec3> Hindirect; // per face: irradiance from Rgather
   int iterations = 0;
