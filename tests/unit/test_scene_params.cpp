@@ -602,3 +602,19 @@ TEST(RunStats, LineShowsWarningsBeforeNotes) {
   st.warn("not converged");
   EXPECT_EQ(st.line("T"), "T: rays=10; WARNING: not converged; skipped nothing");
 }
+
+// An enumeration's table gives its dialog choices, log names and values by
+// one list: index <-> value both ways, out-of-range choices refused.
+TEST(EnumTable, ChoicesLogNamesAndValuesFromOneList) {
+  enum class Fruit { Pear = 7, Apple = 3 };
+  static constexpr auto table = gi::makeEnumTable<Fruit>(gi::EnumChoice<Fruit>{Fruit::Pear, "A pear", "pear"},
+                                                         gi::EnumChoice<Fruit>{Fruit::Apple, "An apple", "apple"});
+  EXPECT_EQ(table.choices(), (std::vector<std::string>{"A pear", "An apple"}));
+  EXPECT_EQ(table.index(Fruit::Apple), 1);
+  EXPECT_STREQ(table.logName(Fruit::Pear), "pear");
+  gi::ParamValues v;
+  v.set("fruit", 1);
+  EXPECT_EQ(table.get(v, "fruit"), Fruit::Apple);
+  v.set("fruit", 2);
+  EXPECT_THROW(table.get(v, "fruit"), std::invalid_argument);
+}

@@ -2,8 +2,10 @@
 // table per algorithm gives name, help, default, range and validation, so the
 // two front ends cannot drift apart.
 #pragma once
+#include <array>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -64,6 +66,41 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v);
 // an enum's name or index). Throws std::invalid_argument with a sentence.
 ParamValue parseValue(const ParamSpec& spec, const std::string& text, double diagonal);
 const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name);
+
+// One table per enumeration: each value with the choice the dialog shows (and
+// scripts and the CLI accept) and the short name the log uses, so that the
+// three cannot drift apart. A value's dialog index is its place in the table.
+template <class E>
+struct EnumChoice {
+  E value;
+  const char* choice;  // dialog, .mlx and CLI
+  const char* log;     // log lines
+};
+template <class E, size_t N>
+struct EnumTable {
+  std::array<EnumChoice<E>, N> entries;
+  std::vector<std::string> choices() const {
+    std::vector<std::string> c;
+    for (const auto& e : entries) c.push_back(e.choice);
+    return c;
+  }
+  int index(E v) const {
+    for (size_t i = 0; i < N; ++i)
+      if (entries[i].value == v) return int(i);
+    throw std::logic_error("enumeration value missing from its table");
+  }
+  E at(int i) const {
+    if (i < 0 || size_t(i) >= N) throw std::invalid_argument("choice " + std::to_string(i) + " does not exist");
+    return entries[size_t(i)].value;
+  }
+  const char* logName(E v) const { return entries[size_t(index(v))].log; }
+  // The value of enumeration parameter `name` in v.
+  E get(const ParamValues& v, const std::string& name) const { return at(v.getInt(name)); }
+};
+template <class E, class... C>
+constexpr EnumTable<E, sizeof...(C)> makeEnumTable(C... c) {
+  return {{{c...}}};
+}
 // The "seed" parameter every stochastic filter has; `what` names what it seeds.
 ParamSpec seedSpec(const std::string& what);
 
