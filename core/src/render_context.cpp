@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "gi/color.h"
 #include "gi/specular.h"
@@ -72,6 +73,30 @@ Context::Context(const Scene& s, const RayCaster& c, const RenderOptions& o, con
       areaLights_.emplace_back();
     }
     areaLights_[size_t(group[root])].faces.push_back(uint32_t(f));
+  }
+  for (AreaLight& l : areaLights_) {
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge -> uses
+    std::vector<uint32_t> verts;
+    double area = 0.0;
+    l.E = s.faceEmission(l.faces[0]);
+    for (const uint32_t f : l.faces) {
+      const auto& t = s.triangles[f];
+      l.uniform = l.uniform && s.faceEmission(f) == l.E;
+      for (int k = 0; k < 3; ++k) {
+        ++edges[{t[k], t[(k + 1) % 3]}];
+        verts.push_back(t[k]);
+      }
+      const double a = faceArea(s, f);
+      l.centroid += a * (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
+      area += a;
+    }
+    l.centroid /= area;
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    for (const uint32_t v : verts) l.corners.push_back(glm::dvec3(s.positions[v]));
+    for (const auto& [e, n] : edges)
+      if (!edges.count({e.second, e.first}))
+        for (int k = 0; k < n; ++k) l.boundary.push_back({glm::dvec3(s.positions[e.first]), glm::dvec3(s.positions[e.second])});
   }
 }
 

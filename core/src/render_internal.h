@@ -125,6 +125,15 @@ class Context {
 
   struct AreaLight {
     std::vector<uint32_t> faces;
+    // With one emission over the light, the sum of its faces' contour
+    // integrals is the integral over its boundary (inner edges cancel)
+    // whenever no face is clipped: x in front of every face and every
+    // corner in front of x (Stokes). Boundary edges directed as the faces wind.
+    bool uniform = true;
+    glm::vec3 E{0.f};
+    std::vector<glm::dvec3> corners;
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> boundary;
+    glm::dvec3 centroid{0.0};  // area-weighted
   };
 
   const Scene& s_;

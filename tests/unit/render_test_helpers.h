@@ -21,7 +21,9 @@ struct SceneBuilder {
   void tri(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, glm::vec3 r, glm::vec3 e, Material m,
            float roughness = 0.2f) {
     const uint32_t i = uint32_t(pts.size());
-    pts.insert(pts.end(), {a, b, c});
+    pts.push_back(a);
+    pts.push_back(b);
+    pts.push_back(c);
     tris.push_back({i, i + 1, i + 2});
     rho.push_back(r);
     E.push_back(e);

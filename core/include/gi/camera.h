@@ -22,7 +22,7 @@ namespace gi {
 // Extrinsics.Tra() — NOT the negated TranslationVector of MeshLab's XML
 // files) and the rotation whose rows are the camera's x (right), y (up) and
 // z axes in world coordinates, z pointing backwards (the camera looks along
-// -row 2, as in OpenGL). Intrinsics: focal length and pixel size in mm, the
+// -row 2, as in OpenGL; vcg's Shot::GetViewDir() returns row 2 itself). Intrinsics: focal length and pixel size in mm, the
 // principal point and the viewport in pixels, viewport y pointing up.
 struct ShotData {
   double viewpoint[3] = {0, 0, 0};
