@@ -100,8 +100,9 @@ glm::vec3 Context::traceSampled(Ray ray, const SurfacePoint* first, Sampler& smp
         ++diffuseVertices;
         const int nL = diffuseVertices == 1 ? o_.lightSamples : 1;
         const Bsdf b = bsdfAt(sp, -ray.d);
-        L += beta * nextEvent(sp.x, sp.n, b, smp, c, nL);
-        if (twoPass) L += beta * twoPassIndirect(sp, rho, smp, c);
+        glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL);
+        if (twoPass) Ld = glm::max(Ld + twoPassIndirect(sp, rho, smp, c), glm::vec3(0.f));  // see render_twopass.cpp
+        L += beta * Ld;
         const bool wanted = path && (o_.maxDiffuseBounces < 0 || diffuseVertices <= o_.maxDiffuseBounces);
         const bool goOn = wanted && depth < o_.maxDepth;
         if (wanted && !goOn) ++c.cutAtMaxDepth;

@@ -78,7 +78,7 @@ struct Bsdf {
 // The first pass's data for the two-pass mode (render_twopass.cpp).
 struct TwoPassData {
   std::vector<glm::vec3> R;         // reflected radiosity B - E per vertex (>= 0)
-  std::vector<glm::vec3> indirect;  // its indirect part (DirectIndirect, Caustics), >= 0
+  std::vector<glm::vec3> indirect;  // its indirect part (DirectIndirect, Caustics); noise may make it < 0
   std::vector<Photon> causticPhotons;
   std::unique_ptr<PhotonMap> caustics;  // null: none; refers to causticPhotons (so this never moves)
   float r2max = HUGE_VALF;

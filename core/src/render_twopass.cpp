@@ -3,7 +3,7 @@
 // Jensen 1996, "Global Illumination using Photon Maps", the rendering pass):
 // the per-vertex radiosity B split into what the eye pass recomputes and
 // what it reads from the mesh.
-//   R        = B - E                      reflected radiosity (Map, FinalGather)
+//   R        = B - E (>= 0)               reflected radiosity (Map, FinalGather)
 //   indirect = B - Bdirect [- rho Hc]     the part due to light that bounced on a
 //                                         diffuse surface first (DirectIndirect,
 //                                         Caustics), where Bdirect = E + rho H_direct
@@ -11,8 +11,10 @@
 //                                         the vertex (removed when the first pass
 //                                         has caustics, since the eye pass reads
 //                                         them from the map at the hit point).
-// Differences of noisy estimates can dip below 0: they are clamped channel
-// by channel and counted in the log.
+// The indirect part is a difference of noisy estimates and may dip below 0
+// at some vertices: it is kept as it is (clamping zero-mean noise would
+// bias it upwards); the eye pass keeps the diffuse radiance of a hit >= 0,
+// and the log counts such vertices.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -62,14 +64,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
   checkPerVertex(o.firstPassB, nv, "the first pass's radiosity");
   const VertexMaterial mat = vertexMaterial(s);
   tp.R.resize(nv);
-  size_t clamped = 0;
-  auto clampAt0 = [&clamped](glm::vec3 v) {
-    bool neg = false;
-    for (int k = 0; k < 3; ++k)
-      if (v[k] < 0.f) { v[k] = 0.f; neg = true; }
-    clamped += neg;
-    return v;
-  };
+  size_t negative = 0;
   for (size_t i = 0; i < nv; ++i) tp.R[i] = glm::max(o.firstPassB[i] - mat.E[i], glm::vec3(0.f));
   const bool wantCaustics = o.twoPass == TwoPassDiffuse::Caustics || o.twoPass == TwoPassDiffuse::FinalGather;
   if (wantCaustics && anySpecularFace(s)) {
@@ -117,15 +112,18 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
       glm::vec3 ind = o.firstPassB[i] - Bd[i];
       if (removeCaustics && mat.valid[i])
         ind -= mat.rho[i] * tp.caustics->irradiance(s.positions[i], mat.n[i], o.causticK, tp.r2max, PhotonKernel::Cone);
-      tp.indirect[i] = clampAt0(ind);
+      tp.indirect[i] = ind;
+      negative += mat.valid[i] && (ind.r < 0.f || ind.g < 0.f || ind.b < 0.f);
     }
     if (removeCaustics) stats.note("the first pass's caustics replaced by the caustic map read at the hit points");
   }
-  stats.add("first_pass_vertices_clamped", double(clamped));
-  if (clamped > nv / 10)
-    stats.warn(std::to_string(clamped) + " of " + std::to_string(nv) +
-               " vertices had a negative indirect part (first pass noisier than its direct part, or computed "
-               "with other lights): clamped to 0");
+  if (!tp.indirect.empty()) {
+    stats.add("first_pass_negative_indirect_vertices", double(negative));
+    if (negative > nv / 10)
+      stats.warn(std::to_string(negative) + " of " + std::to_string(nv) +
+                 " vertices have a negative indirect part (B below its direct part: a first pass noisier than "
+                 "the direct estimate, or computed with other lights or materials)");
+  }
 }
 
 }  // namespace gi::eye

@@ -318,6 +318,68 @@ TEST(RenderModes, TwoPassDirectPlusStoredIndirectInFurnace) {
   }
 }
 
+// Jensen's rendering pass: the floor under a floating glass cube gets no
+// direct light (the shadow rays stop at the glass), only the caustic of the
+// light refracted through the cube. The two-pass mode reads it from its
+// caustic photon map at each hit, on top of the first pass (photon mapping)
+// for the rest; the path-traced mode finds it by paths. Over a window of
+// the floor inside the caustic, the two images' means agree within 4
+// combined standard errors: the path tracer's from its pixels, the map's
+// ~ the Poisson error 1 / sqrt(photons in the window) of its photon count
+// (k-nearest estimates over a window average ~ window / (pi r_k^2) = M / k
+// nearly independent estimates each of relative error 1 / sqrt(k)).
+TEST(RenderModes, TwoPassCausticsMatchPathTraced) {
+  SceneBuilder b;
+  b.quad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, 16);
+  b.quad({-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}, glm::vec3(0.f), glm::vec3(10.f));
+  b.box({-0.4, 0.5, -0.4}, {0.4, 1.1, 0.4}, glm::vec3(1.f), glm::vec3(0.f), Material::Glass, false);
+  const Scene s = b.build();
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions po;
+  po.photons = 100000;
+  const VertexRadiometry first = computePhotonMap(s, *caster, po);
+  RenderOptions o;
+  o.camera = Camera::lookAt({0, 0.45, -2.5}, {0, 0, 0}, {0, 1, 0}, 12, 48, 36);
+  o.mode = RenderMode::TwoPass;
+  o.twoPass = TwoPassDiffuse::Caustics;
+  o.samplesPerPixel = 16;
+  o.causticPhotons = 100000;
+  o.firstPassB = first.B;
+  const RenderResult tp = render(s, *caster, o);
+  o.mode = RenderMode::PathTraced;
+  o.samplesPerPixel = 256;
+  const RenderResult pt = render(s, *caster, o);
+  // The window: pixels whose centre ray meets the floor within |x|, |z| <
+  // 0.15, where every line to the light crosses the glass: no direct light.
+  const double w = 0.15;
+  double a = 0, bsum = 0, va = 0, vb = 0;
+  int n = 0;
+  for (int j = 0; j < 36; ++j)
+    for (int i = 0; i < 48; ++i) {
+      const Ray r = o.camera.ray({i + 0.5f, j + 0.5f}, {0.5f, 0.5f}, {0, 0, 0});
+      if (r.d.y >= 0.f) continue;
+      const glm::dvec3 x = glm::dvec3(r.o) + glm::dvec3(r.d) * (-double(r.o.y) / r.d.y);
+      if (std::fabs(x.x) > w || std::fabs(x.z) > w) continue;
+      const size_t p = size_t(j) * 48 + size_t(i);
+      a += luminance(tp.image.px[p]);
+      bsum += luminance(pt.image.px[p]);
+      va += double(tp.stdError[p]) * tp.stdError[p];
+      vb += double(pt.stdError[p]) * pt.stdError[p];
+      ++n;
+    }
+  ASSERT_GT(n, 40);
+  // Photons in the window: the stored caustic photons spread over the cube's
+  // 0.8 x 0.8 shadow (uniformly enough for an error estimate).
+  const double stored = tp.stats.get("caustic_photons_stored");
+  ASSERT_GT(stored, 50000.0);
+  const double inWindow = stored * (2 * w) * (2 * w) / (0.8 * 0.8);
+  const double sigmaMap = a / n / std::sqrt(inWindow);
+  const double sigma = std::sqrt(va / (double(n) * n) + vb / (double(n) * n) + sigmaMap * sigmaMap);
+  EXPECT_NEAR(a / n, bsum / n, 4 * sigma) << "two-pass " << a / n << " path traced " << bsum / n;
+  // Without the caustic map the window is nearly dark: the test measures the caustic.
+  EXPECT_GT(a / n, 0.5 * luminance(glm::vec3(10.f)) * 0.5 / M_PI * 0.1);
+}
+
 // Rendering is bit-identical for any number of threads.
 TEST(RenderModes, DeterministicAcrossThreads) {
   const Scene s = roomA().build();
