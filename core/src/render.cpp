@@ -147,7 +147,7 @@ void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o
 // For each vertex, the radiance it sends towards the camera: an eye ray
 // arriving at the vertex (visible or not) from the camera's side, shaded
 // with the vertex normal (a smooth surface's reflection) on the incident
-// face seen most frontally.
+// face seen most frontally; 0 for vertices facing away from the camera.
 std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, const Context& ctx,
                                       const Progress& progress, Tally& tally) {
   const size_t nv = s.vertexCount();
@@ -179,6 +179,10 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
       sp.x = s.positions[v];
       sp.face = best;
       sp.n = glm::dot(vn[v], faceN[best]) > 0.5f ? glm::normalize(vn[v]) : faceN[best];
+      // Facing away: nothing leaves it towards the camera on its outer side
+      // (a glass vertex would start an eye ray inside the glass, beyond the
+      // critical angle where no light can come from).
+      if (!(glm::dot(sp.n, toCam) > 0.f)) continue;
       const auto& t = s.triangles[best];
       sp.u = t.y == v ? 1.f : 0.f;
       sp.v = t.z == v ? 1.f : 0.f;

@@ -21,7 +21,6 @@
 
 #include "gi/color.h"
 #include "gi/specular.h"
-#include "photon_map.h"
 #include "render_internal.h"
 
 namespace gi::eye {
@@ -134,9 +133,7 @@ glm::vec3 Context::traceSampled(Ray ray, const SurfacePoint* first, Sampler& smp
 
 glm::vec3 Context::twoPassIndirect(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const {
   glm::vec3 L(0.f);
-  const PhotonMap* caustics = tp_->caustics.get();
-  if (o_.twoPass != TwoPassDiffuse::DirectIndirect && caustics)
-    L += rho * kInvPi * caustics->irradiance(sp.x, sp.n, o_.causticK, tp_->r2max, PhotonKernel::Cone);
+  if (o_.twoPass != TwoPassDiffuse::DirectIndirect) L += rho * kInvPi * tp_->caustic(sp.x, sp.n, o_.causticK);
   if (o_.twoPass == TwoPassDiffuse::FinalGather) L += rho * kInvPi * finalGather(sp, smp, c);
   else L += interpolate(tp_->indirect, sp) * kInvPi;
   return L;

@@ -16,8 +16,6 @@
 
 namespace gi {
 
-class PhotonMap;
-
 namespace eye {
 
 // The numbers of one pixel (or vertex) sample. QMC: consecutive 2D draws
@@ -75,13 +73,29 @@ struct Bsdf {
   bool sample(glm::vec2 u, glm::vec3& wi, glm::vec3& weight, float& pdf) const;
 };
 
+// Caustic photons and their density estimate (render_caustics.cpp).
+class CausticMap {
+ public:
+  explicit CausticMap(std::vector<Photon> photons);
+  ~CausticMap();
+  size_t size() const;
+  // Irradiance at x (unit normal n) from the k nearest photons on n's side within sqrt(r2max).
+  glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // The first pass's data for the two-pass mode (render_twopass.cpp).
 struct TwoPassData {
   std::vector<glm::vec3> R;         // reflected radiosity B - E per vertex (>= 0)
   std::vector<glm::vec3> indirect;  // its indirect part (DirectIndirect, Caustics); noise may make it < 0
-  std::vector<Photon> causticPhotons;
-  std::unique_ptr<PhotonMap> caustics;  // null: none; refers to causticPhotons (so this never moves)
+  std::unique_ptr<CausticMap> caustics;  // null: none (no mirror or glass, or not asked for)
   float r2max = HUGE_VALF;
+  glm::vec3 caustic(const glm::vec3& x, const glm::vec3& n, int k) const {
+    return caustics ? caustics->irradiance(x, n, k, r2max) : glm::vec3(0.f);
+  }
   TwoPassData();
   TwoPassData(const TwoPassData&) = delete;
   TwoPassData& operator=(const TwoPassData&) = delete;

@@ -22,7 +22,6 @@
 #include "gi/color.h"
 #include "gi/direct.h"
 #include "gi/specular.h"
-#include "photon_map.h"
 #include "render_internal.h"
 
 namespace gi::eye {
@@ -75,13 +74,14 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.point = o.point;
     po.seed = o.seed;
     PhotonTraceStats ts;
-    tp.causticPhotons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
-    if (!tp.causticPhotons.empty()) tp.caustics = std::make_unique<PhotonMap>(tp.causticPhotons, 1u << kCausticPhoton);
+    std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+    const size_t stored = photons.size();
     tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
+    if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons));
     stats.add("caustic_photons_aimed", double(ts.causticEmitted));
-    stats.add("caustic_photons_stored", double(tp.causticPhotons.size()));
+    stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
-    if (tp.causticPhotons.empty()) stats.note("no caustic photon reached a diffuse surface through mirrors or glass");
+    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors or glass");
   } else if (wantCaustics) {
     stats.note("no caustic map: the scene has no mirror or glass faces");
   }
@@ -111,7 +111,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     for (size_t i = 0; i < nv; ++i) {
       glm::vec3 ind = o.firstPassB[i] - Bd[i];
       if (removeCaustics && mat.valid[i])
-        ind -= mat.rho[i] * tp.caustics->irradiance(s.positions[i], mat.n[i], o.causticK, tp.r2max, PhotonKernel::Cone);
+        ind -= mat.rho[i] * tp.caustic(s.positions[i], mat.n[i], o.causticK);
       tp.indirect[i] = ind;
       negative += mat.valid[i] && (ind.r < 0.f || ind.g < 0.f || ind.b < 0.f);
     }

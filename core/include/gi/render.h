@@ -99,8 +99,9 @@ struct RenderResult {
   Image image;                     // radiance, W / (m^2 sr), linear RGB
   std::vector<float> stdError;     // per pixel: standard error of the luminance from the sample variance
                                    // (an honest error bar for PathTraced; QMC modes: conservative)
-  std::vector<uint8_t> seesEmitter;  // per pixel: the centre ray hits an emitting face (for auto exposure)
-  std::vector<glm::vec3> vertexRadiance;  // per vertex, towards the camera (if asked), W / (m^2 sr)
+  std::vector<uint8_t> seesEmitter;  // per pixel: its first sample's eye ray hits an emitter (for auto exposure)
+  std::vector<glm::vec3> vertexRadiance;  // per vertex, towards the camera (if asked), W / (m^2 sr);
+                                          // 0 where the vertex normal faces away from the camera
   RunStats stats;
 };
 
