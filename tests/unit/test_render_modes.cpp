@@ -330,7 +330,7 @@ TEST(RenderModes, TwoPassDirectPlusStoredIndirectInFurnace) {
 // nearly independent estimates each of relative error 1 / sqrt(k)).
 TEST(RenderModes, TwoPassCausticsMatchPathTraced) {
   SceneBuilder b;
-  b.quad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, 16);
+  b.quad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, 40);
   b.quad({-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}, glm::vec3(0.f), glm::vec3(10.f));
   b.box({-0.4, 0.5, -0.4}, {0.4, 1.1, 0.4}, glm::vec3(1.f), glm::vec3(0.f), Material::Glass, false);
   const Scene s = b.build();
@@ -343,7 +343,10 @@ TEST(RenderModes, TwoPassCausticsMatchPathTraced) {
   o.mode = RenderMode::TwoPass;
   o.twoPass = TwoPassDiffuse::Caustics;
   o.samplesPerPixel = 16;
-  o.causticPhotons = 100000;
+  // The first pass's caustic photons and k: its caustics at the vertices are
+  // then exactly those the eye pass takes out (same photons, same estimate).
+  o.causticPhotons = po.photons;
+  o.causticK = po.causticK;
   o.firstPassB = first.B;
   const RenderResult tp = render(s, *caster, o);
   o.mode = RenderMode::PathTraced;
@@ -375,7 +378,11 @@ TEST(RenderModes, TwoPassCausticsMatchPathTraced) {
   const double inWindow = stored * (2 * w) * (2 * w) / (0.8 * 0.8);
   const double sigmaMap = a / n / std::sqrt(inWindow);
   const double sigma = std::sqrt(va / (double(n) * n) + vb / (double(n) * n) + sigmaMap * sigmaMap);
-  EXPECT_NEAR(a / n, bsum / n, 4 * sigma) << "two-pass " << a / n << " path traced " << bsum / n;
+  // Plus 3% for the bias of k-nearest density estimates at finite photon
+  // counts (consistent, not unbiased): over seeds 0-3 and 100k-400k photons
+  // the window's two-pass and first-pass-alone means stayed within 2.5% of
+  // the path-traced one. A caustic 15% too weak or 10% too strong fails.
+  EXPECT_NEAR(a / n, bsum / n, 4 * sigma + 0.03 * bsum / n) << "two-pass " << a / n << " path traced " << bsum / n;
   // Without the caustic map the window is nearly dark: the test measures the caustic.
   EXPECT_GT(a / n, 0.5 * luminance(glm::vec3(10.f)) * 0.5 / M_PI * 0.1);
 }
