@@ -88,16 +88,19 @@ std::vector<ParamSpec> RenderOptions::specs() {
                ParamType::Bool, 1});
   s.push_back({"caustic_photons", "Caustic photons",
                "Photons aimed at the mirrors and glass for the caustic map (two-pass). More: sharper and less noisy "
-               "caustics; about 50 bytes each once stored.",
+               "caustics; about 50 bytes each once stored. With the photon-mapping filter's 'Photons emitted', "
+               "'Photons per caustic estimate', 'Maximum gather radius' and seed, the caustics its first pass "
+               "stored at the vertices are exactly those taken out (same photons, same estimate).",
                ParamType::Int, 200000, 1, 100000000});
   s.push_back({"caustic_k", "Photons per caustic estimate",
                "Nearest caustic photons read at each hit point (cone filter, Jensen 1996): smaller k is sharper and "
                "noisier (relative noise about 1/sqrt(k)).",
-               ParamType::Int, 64, 1, 512});
+               ParamType::Int, 128, 1, 512});
   s.push_back({"caustic_max_radius", "Caustic gather radius",
                "Caustic photons farther than this from a hit point are not read (0 = no limit): keeps caustics from "
-               "bleeding into the dark around them. Absolute or % of the bbox diagonal.",
-               ParamType::Distance, 0.02, 0.0, 1.0});
+               "bleeding into the dark around them, and makes the search cheap far from them. Absolute or % of the "
+               "bbox diagonal.",
+               ParamType::Distance, 0.05, 0.0, 1.0});
   s.push_back({"gather_rays", "Final-gather rays",
                "Rays per diffuse hit (and per eye ray) for the final gather: cosine-distributed, through mirrors and "
                "glass, reading the first pass's reflected radiosity where they land.",

@@ -72,8 +72,10 @@ struct RenderOptions {
   TwoPassDiffuse twoPass = TwoPassDiffuse::Caustics;
   bool firstPassHasCaustics = true;
   int causticPhotons = 200000;  // caustic photons shot (projection towards mirrors and glass)
-  int causticK = 64;
+  int causticK = 128;
   double causticMaxRadius = 0;  // absolute; 0 = unlimited
+  // (With the first pass's photons, caustic k, gather radius and seed, its
+  // vertex caustics are exactly those the eye pass takes out.)
   int gatherRays = 16;          // final-gather rays per eye-path diffuse hit
   bool renderImage = true;
   bool vertexRadiance = false;  // also the radiance each vertex sends towards the camera
