@@ -13,7 +13,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config dpkg-dev
   meshlab qtbase5-dev libqt5opengl5-dev libqt5xmlpatterns5-dev libglew-dev libeigen3-dev
   libembree-dev libglm-dev libopenmesh-dev libtbb-dev libnanoflann-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libpng-dev
   xvfb xauth imagemagick xdotool x11-utils
   python3 python3-numpy python3-matplotlib
 )

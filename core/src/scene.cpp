@@ -33,11 +33,13 @@ size_t Scene::append(const Scene& o) {
   // Per-face arrays become explicit as soon as one part has them.
   const bool anyRho = !rho.empty() || !o.rho.empty(), anyE = !emission.empty() || !o.emission.empty();
   const bool anyMat = !material.empty() || !o.material.empty(), anyIor = !ior.empty() || !o.ior.empty();
+  const bool anyRough = !roughness.empty() || !o.roughness.empty();
   const bool anyN = !vertexNormals.empty() || !o.vertexNormals.empty();
   if (anyRho) fillTo(rho, fOff, glm::vec3(0.5f));
   if (anyE) fillTo(emission, fOff, glm::vec3(0.f));
   if (anyMat) fillTo(material, fOff, Material::Diffuse);
   if (anyIor) fillTo(ior, fOff, 1.5f);
+  if (anyRough) fillTo(roughness, fOff, 0.2f);
   if (anyN) fillTo(vertexNormals, vOff, glm::vec3(0.f));
   const glm::dvec3 shift = o.origin - origin;
   for (const auto& p : o.positions) positions.push_back(glm::vec3(glm::dvec3(p) + shift));
@@ -47,6 +49,7 @@ size_t Scene::append(const Scene& o) {
     if (anyE) emission.push_back(o.faceEmission(f));
     if (anyMat) material.push_back(o.faceMaterial(f));
     if (anyIor) ior.push_back(o.ior.empty() ? 1.5f : o.ior[f]);
+    if (anyRough) roughness.push_back(o.faceRoughness(f));
   }
   if (anyN) {
     if (o.vertexNormals.empty()) vertexNormals.resize(positions.size(), glm::vec3(0.f));
@@ -68,6 +71,7 @@ uint64_t sceneHash(const Scene& s) {
     const auto m = uint8_t(s.faceMaterial(f));
     mix(&r, sizeof r); mix(&e, sizeof e); mix(&m, 1);
     if (s.faceMaterial(f) == Material::Glass) { const float n = s.ior.empty() ? 1.5f : s.ior[f]; mix(&n, sizeof n); }
+    if (s.faceMaterial(f) == Material::Glossy) { const float a = s.faceRoughness(f); mix(&a, sizeof a); }
   }
   return h;
 }

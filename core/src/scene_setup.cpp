@@ -77,6 +77,23 @@ std::vector<ParamSpec> materialSpecs() {
   return s;
 }
 
+std::vector<ParamSpec> glossySpecs() {
+  ParamSpec layers{"glossy_layers", "Glossy layers",
+                   "Layers with a glossy (rough metal) surface: a GGX microfacet reflector (Walter et al. 2007) that "
+                   "blurs reflections more as its roughness grows. Same patterns as for mirrors; empty: none.",
+                   ParamType::String};
+  layers.defText = "*glossy*";
+  return {layers,
+          {"glossy_roughness", "Glossy roughness (alpha)",
+           "Width alpha of the GGX distribution of microfacet normals: 0.01 nearly a mirror, 0.1 polished, 0.3 "
+           "brushed, 1 very rough (the reflected highlight spreads over roughly alpha radians).",
+           ParamType::Float, 0.2, 0.001, 1.0},
+          {"glossy_color", "Glossy colour",
+           "Reflectance of the glossy surfaces at normal incidence (F0 of Schlick's Fresnel term, sRGB); towards "
+           "grazing angles every colour tends to white. White: no light absorbed by the microfacets.",
+           ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)}};
+}
+
 std::vector<ParamSpec> pointLightSpecs() {
   return {
       {"point_position", "Point light position", "Position of an optional point or spot light (absolute coordinates).",
@@ -129,19 +146,25 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
   s.ior.assign(nf, ior);
   std::string msg;
   size_t keptEmitters = 0;
+  // Glossy layers only where the caller offers them (glossySpecs).
+  const bool withGlossy = v.has("glossy_layers");
+  if (withGlossy) s.roughness.assign(nf, float(v.getFloat("glossy_roughness")));
   for (const LayerRange& l : layers) {
     const bool m = matchesLayerPatterns(l.name, mirrors), g = matchesLayerPatterns(l.name, glass);
-    if (m && g) return "layer '" + l.name + "' matches both the mirror and the glass patterns";
-    if (!m && !g) continue;
-    const Material mat = m ? Material::Mirror : Material::Glass;
+    const bool gl = withGlossy && matchesLayerPatterns(l.name, v.getString("glossy_layers"));
+    if (int(m) + int(g) + int(gl) > 1) return "layer '" + l.name + "' matches more than one of the mirror, glass and glossy patterns";
+    if (!m && !g && !gl) continue;
+    const Material mat = m ? Material::Mirror : g ? Material::Glass : Material::Glossy;
+    const glm::vec3 c2 = gl ? v.getVec("glossy_color") : glm::vec3(0.f);
+    const glm::vec3 colour = gl ? glm::vec3(srgbToLinear(c2.r), srgbToLinear(c2.g), srgbToLinear(c2.b)) : tint;
     size_t count = 0;
     for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f) {
       if (luminance(s.faceEmission(f)) > 0.f) { ++keptEmitters; continue; }
       s.material[f] = mat;
-      s.rho[f] = tint;  // the specular colour (may be 1: a perfect mirror)
+      s.rho[f] = colour;  // the specular colour (may be 1: a perfect mirror)
       ++count;
     }
-    msg += std::string(msg.empty() ? "" : ", ") + "'" + l.name + "' " + (m ? "mirror" : "glass") + " (" +
+    msg += std::string(msg.empty() ? "" : ", ") + "'" + l.name + "' " + (m ? "mirror" : g ? "glass" : "glossy") + " (" +
            std::to_string(count) + " faces)";
     if (g) {  // a glass object should be closed: every edge shared by two of its faces
       std::map<std::pair<uint32_t, uint32_t>, int> edges;

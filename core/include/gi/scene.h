@@ -8,7 +8,9 @@
 
 namespace gi {
 
-enum class Material : uint8_t { Diffuse = 0, Mirror = 1, Glass = 2 };
+// Glossy: the GGX microfacet reflector of gi/glossy.h (roughness per face,
+// specular colour in rho); only the ray tracer (gi/render.h) shades it so far.
+enum class Material : uint8_t { Diffuse = 0, Mirror = 1, Glass = 2, Glossy = 3 };
 
 // Positions are stored relative to `origin` (double), so that meshes far from
 // the coordinate origin (offsets of 1e6) keep full float precision in the
@@ -22,12 +24,14 @@ struct Scene {
   std::vector<glm::vec3> emission;        // per-face emitted radiosity E, W/m^2 (empty: none)
   std::vector<Material> material;         // per face (empty: all diffuse)
   std::vector<float> ior;                 // per face index of refraction for Glass (empty: 1.5)
+  std::vector<float> roughness;           // per face GGX alpha for Glossy (empty: 0.2)
 
   size_t vertexCount() const { return positions.size(); }
   size_t faceCount() const { return triangles.size(); }
   glm::vec3 faceRho(size_t f) const { return rho.empty() ? glm::vec3(0.5f) : rho[f]; }
   glm::vec3 faceEmission(size_t f) const { return emission.empty() ? glm::vec3(0.f) : emission[f]; }
   Material faceMaterial(size_t f) const { return material.empty() ? Material::Diffuse : material[f]; }
+  float faceRoughness(size_t f) const { return roughness.empty() ? 0.2f : roughness[f]; }
   bool hasEmitters() const;
 
   // Absolute <-> local coordinates.

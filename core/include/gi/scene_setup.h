@@ -43,6 +43,11 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
 // specular, by name patterns, and their colour and index of refraction.
 std::vector<ParamSpec> materialSpecs();
 
+// Glossy layers (the ray tracer): name patterns, GGX roughness and specular
+// colour. Apart from materialSpecs so that filters without glossy shading do
+// not offer it; applyMaterials reads them when present.
+std::vector<ParamSpec> glossySpecs();
+
 // The optional point or spot light's parameters (photon mapping and the reference).
 std::vector<ParamSpec> pointLightSpecs();
 PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
@@ -54,7 +59,9 @@ struct LayerRange {
 };
 // Marks the faces of layers whose name matches mirror_layers / glass_layers
 // (comma-separated shell patterns, case-insensitive) as Mirror / Glass with
-// the specular colour and index of refraction. Emitter faces stay diffuse.
+// the specular colour and index of refraction, and, if `v` has the
+// glossySpecs parameters, those matching glossy_layers as Glossy (colour and
+// roughness from them). Emitter faces stay diffuse.
 // Returns an error sentence for unusable settings; *log gets a summary.
 std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange>& layers, const ParamValues& v,
                                           std::string* log = nullptr);

@@ -1,0 +1,279 @@
+// The eye pass's driver: tiles of pixels in parallel, primary rays of a tile
+// cast together (one coherent batch per sample index), per-pixel means and
+// sample variances, the optional per-vertex radiance towards the camera, and
+// the log line.
+#include "gi/render.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "gi/color.h"
+#include "render_internal.h"
+
+namespace gi {
+
+const char* renderModeName(RenderMode m) {
+  switch (m) {
+    case RenderMode::Whitted: return "Whitted";
+    case RenderMode::Distributed: return "Distributed";
+    case RenderMode::TwoPass: return "Two-pass";
+    case RenderMode::PathTraced: return "Path traced";
+  }
+  return "?";
+}
+
+namespace {
+
+using eye::Context;
+using eye::Counts;
+using eye::Sampler;
+using eye::SurfacePoint;
+
+constexpr int kTile = 16;
+
+void validate(const RenderOptions& o) {
+  if (int(o.mode) < 0 || int(o.mode) > 3) throw std::invalid_argument("unknown render mode");
+  if (o.samplesPerPixel < 1) throw std::invalid_argument("samples_per_pixel must be >= 1");
+  if (o.maxDepth < 0) throw std::invalid_argument("max_depth must be >= 0");
+  if (o.maxDiffuseBounces < -1) throw std::invalid_argument("max_diffuse_bounces must be >= -1 (-1: no limit)");
+  if (o.lightSamples < 1 || o.gatherRays < 1) throw std::invalid_argument("light_samples and gather_rays must be >= 1");
+  if (o.causticPhotons < 1 || o.causticK < 1 || o.causticK > 512)
+    throw std::invalid_argument("caustic_photons must be >= 1 and caustic_k in [1, 512]");
+  if (!(o.whittedMinWeight >= 0.f && o.whittedMinWeight <= 1.f))
+    throw std::invalid_argument("whitted_min_weight must lie in [0, 1]");
+  if (!o.renderImage && !o.vertexRadiance) throw std::invalid_argument("neither an image nor vertex radiance was asked for");
+}
+
+bool finite3(const glm::vec3& v) { return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b); }
+
+// One sample of the radiance along `ray`, whose first surface point is sp.
+glm::vec3 sampleRadiance(const Context& ctx, RenderMode mode, const Ray& ray, const SurfacePoint& sp, Sampler& smp,
+                         Counts& c, uint64_t& nonFinite) {
+  const glm::vec3 L = mode == RenderMode::Whitted ? ctx.traceWhitted(ray, &sp, c) : ctx.traceSampled(ray, &sp, smp, c);
+  if (finite3(L)) return L;
+  ++nonFinite;
+  return glm::vec3(0.f);
+}
+
+struct Tally {
+  Counts counts;
+  uint64_t nonFinite = 0;
+};
+
+void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o, const Context& ctx,
+                 const Progress& progress, RenderResult& res, Tally& tally) {
+  const Camera& cam = o.camera;
+  const int W = cam.width(), H = cam.height();
+  res.image = Image(W, H);
+  res.stdError.assign(res.image.px.size(), 0.f);
+  res.seesEmitter.assign(res.image.px.size(), 0);
+  const int tx = (W + kTile - 1) / kTile, ty = (H + kTile - 1) / kTile;
+  const size_t nTiles = size_t(tx) * size_t(ty);
+  std::vector<Tally> tileTally(nTiles);
+  const bool qmc = o.mode != RenderMode::PathTraced;
+  const uint32_t salt = 0x5e11u + uint32_t(o.mode);
+  const int spp = o.samplesPerPixel;
+  auto renderTile = [&](size_t t) {
+    const int x0 = int(t % size_t(tx)) * kTile, y0 = int(t / size_t(tx)) * kTile;
+    const int x1 = std::min(W, x0 + kTile), y1 = std::min(H, y0 + kTile);
+    const size_t n = size_t(x1 - x0) * size_t(y1 - y0);
+    std::vector<Ray> rays(n);
+    std::vector<Hit> hits(n);
+    std::vector<Sampler> smp;
+    smp.reserve(n);
+    std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
+    std::vector<double> sl(n, 0.0), sl2(n, 0.0);
+    Tally& tl = tileTally[t];
+    for (int k = 0; k < spp; ++k) {
+      // The tile's primary rays for sample k, cast as one batch (packets).
+      smp.clear();
+      size_t i = 0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x, ++i) {
+          const uint32_t pixel = uint32_t(y) * uint32_t(W) + uint32_t(x);
+          smp.emplace_back(hash3(pixel, o.seed, salt), uint32_t(k), qmc);
+          const glm::vec2 u = smp[i].next2D(), lens = smp[i].next2D();
+          rays[i] = cam.ray({float(x) + u.x, float(y) + u.y}, lens, s.origin);
+        }
+      caster.intersectBatch(rays.data(), n, hits.data());
+      tl.counts.primary += n;
+      i = 0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x, ++i) {
+          const SurfacePoint sp = ctx.surfaceAt(rays[i], hits[i]);
+          if (k == 0 && sp.valid() && ctx.emits(sp.face) && glm::dot(sp.n, rays[i].d) < 0.f)
+            res.seesEmitter[size_t(y) * size_t(W) + size_t(x)] = 1;
+          const glm::vec3 L = sampleRadiance(ctx, o.mode, rays[i], sp, smp[i], tl.counts, tl.nonFinite);
+          sum[i] += glm::dvec3(L);
+          const double l = luminance(L);
+          sl[i] += l;
+          sl2[i] += l * l;
+        }
+    }
+    size_t i = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x, ++i) {
+        const size_t p = size_t(y) * size_t(W) + size_t(x);
+        res.image.px[p] = glm::vec3(sum[i] / double(spp));
+        if (spp > 1) {
+          const double m = sl[i] / spp, var = std::max(0.0, (sl2[i] - spp * m * m) / (spp - 1));
+          res.stdError[p] = float(std::sqrt(var / spp));
+        }
+      }
+  };
+  // Slices of tiles between progress reports (MeshLab's callback runs on this thread only).
+  const size_t threads = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const size_t slice = std::max<size_t>(4 * threads, nTiles / 50);
+  progress.report(0.0, "tracing eye rays");
+  for (size_t b0 = 0; b0 < nTiles; b0 += slice) {
+    const size_t b1 = std::min(nTiles, b0 + slice);
+    tbb::parallel_for(tbb::blocked_range<size_t>(b0, b1, 1), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t t = r.begin(); t != r.end(); ++t) renderTile(t);
+    });
+    progress.report(double(b1) / double(nTiles), "tracing eye rays");
+  }
+  for (const Tally& t : tileTally) {
+    tally.counts.add(t.counts);
+    tally.nonFinite += t.nonFinite;
+  }
+}
+
+// For each vertex, the radiance it sends towards the camera: an eye ray
+// arriving at the vertex (visible or not) from the camera's side, shaded
+// with the vertex normal (a smooth surface's reflection) on the incident
+// face seen most frontally; 0 for vertices facing away from the camera.
+std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, const Context& ctx,
+                                      const Progress& progress, Tally& tally) {
+  const size_t nv = s.vertexCount();
+  const auto ok = usableFaceMask(s);
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  const std::vector<glm::vec3> vn = s.vertexNormals.size() == nv ? s.vertexNormals : computeVertexNormals(s);
+  std::vector<uint32_t> start(nv + 1, 0), faces;
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) ++start[s.triangles[f][k] + 1];
+  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  faces.resize(start[nv]);
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) faces[fill[s.triangles[f][k]]++] = uint32_t(f);
+  std::vector<glm::vec3> out(nv, glm::vec3(0.f));
+  std::mutex m;
+  const bool qmc = o.mode != RenderMode::PathTraced;
+  parallelBlocks(nv, progress, "radiance towards the camera", [&](size_t b, size_t e) {
+    Tally local;
+    for (size_t v = b; v < e; ++v) {
+      if (start[v] == start[v + 1]) continue;
+      const glm::vec3 toCam = glm::vec3(o.camera.towardsCamera(s.toWorld(s.positions[v])));
+      uint32_t best = faces[start[v]];
+      for (uint32_t j = start[v]; j < start[v + 1]; ++j)
+        if (glm::dot(faceN[faces[j]], toCam) > glm::dot(faceN[best], toCam)) best = faces[j];
+      SurfacePoint sp;
+      sp.x = s.positions[v];
+      sp.face = best;
+      sp.n = glm::dot(vn[v], faceN[best]) > 0.5f ? glm::normalize(vn[v]) : faceN[best];
+      // Facing away: nothing leaves it towards the camera on its outer side
+      // (a glass vertex would start an eye ray inside the glass, beyond the
+      // critical angle where no light can come from).
+      if (!(glm::dot(sp.n, toCam) > 0.f)) continue;
+      const auto& t = s.triangles[best];
+      sp.u = t.y == v ? 1.f : 0.f;
+      sp.v = t.z == v ? 1.f : 0.f;
+      Ray ray;
+      ray.o = sp.x;
+      ray.d = -toCam;
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < o.samplesPerPixel; ++k) {
+        Sampler smp(hash3(uint32_t(v), o.seed, 0x7e47u), uint32_t(k), qmc);
+        sum += glm::dvec3(sampleRadiance(ctx, o.mode, ray, sp, smp, local.counts, local.nonFinite));
+      }
+      out[v] = glm::vec3(sum / double(o.samplesPerPixel));
+    }
+    std::lock_guard<std::mutex> lock(m);
+    tally.counts.add(local.counts);
+    tally.nonFinite += local.nonFinite;
+  });
+  return out;
+}
+
+}  // namespace
+
+RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions& o, const Progress& progress) {
+  validate(o);
+  Timer timer;
+  const auto ok = usableFaceMask(s);
+  if (std::none_of(ok.begin(), ok.end(), [](uint8_t x) { return x != 0; }))
+    throw std::invalid_argument("the mesh has no usable triangles");
+  RenderResult res;
+  RunStats& st = res.stats;
+  const bool twoPass = o.mode == RenderMode::TwoPass;
+  eye::TwoPassData tp;
+  if (twoPass) eye::prepareTwoPass(tp, s, caster, o, progress.sub(0.0, 0.2), st);
+  const Context ctx(s, caster, o, twoPass ? &tp : nullptr);
+  if (!ctx.anyLight() && !(twoPass && o.twoPass == TwoPassDiffuse::Map))
+    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality), "
+                                "no sky, no sun and no point light");
+  Tally tally;
+  const Progress main = progress.sub(twoPass ? 0.2 : 0.0, o.vertexRadiance && o.renderImage ? 0.9 : 1.0);
+  Timer traceTimer;
+  if (o.renderImage) renderImage(s, caster, o, ctx, main, res, tally);
+  if (o.vertexRadiance)
+    res.vertexRadiance = vertexRadiance(s, o, ctx, o.renderImage ? progress.sub(0.9, 1.0) : main, tally);
+  const double traceSeconds = traceTimer.seconds();
+
+  const Counts& c = tally.counts;
+  st.add("samples_per_pixel", o.samplesPerPixel);
+  if (o.renderImage) {
+    st.add("width", o.camera.width());
+    st.add("height", o.camera.height());
+  }
+  st.add("primary_rays", double(c.primary));
+  st.add("shadow_rays", double(c.shadow));
+  st.add("specular_rays", double(c.specular));
+  st.add("glossy_rays", double(c.glossy));
+  st.add("diffuse_rays", double(c.diffuse));
+  if (c.gather) st.add("gather_rays", double(c.gather));
+  st.add("rays", double(c.rays()));
+  st.add("seconds", timer.seconds());
+  st.add("rays_per_second", traceSeconds > 0 ? double(c.rays()) / traceSeconds : 0.0);
+  if (o.renderImage) {
+    double lum = 0, err2 = 0, rel = 0;
+    size_t relN = 0;
+    const size_t n = res.image.px.size();
+    for (size_t p = 0; p < n; ++p) {
+      const double l = luminance(res.image.px[p]);
+      lum += l;
+      err2 += double(res.stdError[p]) * res.stdError[p];
+      if (l > 0) { rel += res.stdError[p] / l; ++relN; }
+    }
+    st.add("mean_radiance", lum / double(n));
+    st.add("rms_std_error", std::sqrt(err2 / double(n)));
+    st.add("mean_relative_std_error", relN ? rel / double(relN) : 0.0);
+  }
+  st.note(std::string("mode ") + renderModeName(o.mode));
+  if (o.mode == RenderMode::PathTraced && o.samplesPerPixel < 2) st.warn("one sample per pixel gives no error estimate");
+  if (o.mode != RenderMode::PathTraced)
+    st.note("error estimate from the spread of QMC pixel samples (an upper bound rather than an error bar)");
+  if (o.mode == RenderMode::Whitted) {
+    st.add("area_lights", double(ctx.areaLightCount()));
+    if (luminance(o.skyRadiance) > 0.f) st.note("Whitted: the sky is seen but lights no diffuse surface");
+    if (o.sunIrradiance != glm::vec3(0.f) && o.sunAngularRadiusDeg > 0.f)
+      st.note("Whitted: the sun lights as a point at infinity (sharp shadows)");
+    if (c.belowWeight) st.note(std::to_string(c.belowWeight) + " branches below whitted_min_weight not traced");
+  }
+  if (o.mode == RenderMode::Distributed || (twoPass && o.twoPass != TwoPassDiffuse::Map))
+    st.note("no diffuse interreflection traced" + std::string(twoPass ? " (the first pass gives it)" : ""));
+  if (c.cutAtMaxDepth)
+    st.note(std::to_string(c.cutAtMaxDepth) + " paths cut at max_depth " + std::to_string(o.maxDepth));
+  if (tally.nonFinite) st.warn(std::to_string(tally.nonFinite) + " samples with a non-finite radiance dropped");
+  return res;
+}
+
+}  // namespace gi

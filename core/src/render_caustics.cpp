@@ -1,0 +1,86 @@
+// The two-pass mode's caustic map: Jensen's density estimate read at eye-
+// ray hit points (Jensen 1996; the cone filter of "Realistic Image Synthesis
+// Using Photon Mapping", 2001, sec. 7.2.2):
+//   H(x) ~ sum_p w_p Phi_p / ((1 - 2 / (3 c)) pi r^2),   w_p = 1 - d_p / (c r),  c = 1.1,
+// over the k nearest caustic photons on the side of n, r the distance to the
+// k-th (or the gather radius if fewer lie within it). The nearest-neighbour
+// search is bounded by the gather radius from the start, so that a hit far
+// from every caustic (most of an image) costs a short descent, not a search
+// of the whole tree; the estimate itself is that of the photon-mapping
+// filter's caustic map.
+#include <algorithm>
+#include <cmath>
+
+#include <nanoflann.hpp>
+
+#include "gi/color.h"
+#include "render_internal.h"
+
+namespace gi::eye {
+
+struct CausticMap::Impl {
+  struct Cloud {
+    std::vector<glm::vec3> pts;
+    size_t kdtree_get_point_count() const { return pts.size(); }
+    float kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
+    template <class B> bool kdtree_get_bbox(B&) const { return false; }
+  };
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
+  std::vector<Photon> photons;
+  Cloud cloud;
+  std::unique_ptr<Tree> tree;
+};
+
+CausticMap::CausticMap(std::vector<Photon> photons) : impl_(std::make_unique<Impl>()) {
+  impl_->photons = std::move(photons);
+  impl_->cloud.pts.reserve(impl_->photons.size());
+  for (const Photon& p : impl_->photons) impl_->cloud.pts.push_back(p.p);
+  impl_->tree = std::make_unique<Impl::Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  impl_->tree->buildIndex();
+}
+
+CausticMap::~CausticMap() = default;
+
+size_t CausticMap::size() const { return impl_->photons.size(); }
+
+glm::vec3 CausticMap::irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max) const {
+  constexpr size_t kMaxQuery = 1024;
+  if (size() == 0 || k < 1) return glm::vec3(0.f);
+  // More than k: photons on the other side of the surface are dropped.
+  const size_t want = std::min<size_t>({size(), size_t(k) * 2, kMaxQuery});
+  uint32_t idx[kMaxQuery];
+  float d2[kMaxQuery];
+  nanoflann::KNNResultSet<float, uint32_t> result(want);
+  result.init(idx, d2);
+  if (r2max < HUGE_VALF) d2[want - 1] = r2max;  // the search's bound until `want` are found
+  const float q[3] = {x.x, x.y, x.z};
+  impl_->tree->findNeighbors(result, q, nanoflann::SearchParams());
+  const size_t found = result.size();
+  if (found == 0) return glm::vec3(0.f);
+  int used = 0;
+  const Photon* ph[kMaxQuery];
+  float dd[kMaxQuery];
+  for (size_t m = 0; m < found && used < k; ++m) {
+    const Photon& p = impl_->photons[idx[m]];
+    if (glm::dot(p.normal(), n) < 0.5f) continue;  // other side or another surface
+    ph[used] = &p;
+    dd[used] = d2[m];
+    ++used;
+  }
+  if (used == 0) return glm::vec3(0.f);
+  float r2 = dd[used - 1];
+  if (used < k) {
+    // Fewer than k on this side: the density of the whole disk examined —
+    // the gather radius if the search ended inside it, else the farthest candidate.
+    r2 = found < want && r2max < HUGE_VALF ? r2max : d2[found - 1];
+  }
+  r2 = std::max(r2, 1e-30f);
+  const float r = std::sqrt(r2);
+  constexpr float c = 1.1f;
+  glm::dvec3 sum(0.0);
+  for (int m = 0; m < used; ++m) sum += double(std::max(0.f, 1.f - std::sqrt(dd[m]) / (c * r))) * glm::dvec3(ph[m]->power);
+  const double area = M_PI * double(r2) * (1.0 - 2.0 / (3.0 * c));
+  return glm::vec3(sum / area);
+}
+
+}  // namespace gi::eye

@@ -1,0 +1,129 @@
+// The first pass's data for the two-pass mode (Chen, Rushmeier, Miller and
+// Turner 1991, "A Progressive Multi-Pass Method for Global Illumination";
+// Jensen 1996, "Global Illumination using Photon Maps", the rendering pass):
+// the per-vertex radiosity B split into what the eye pass recomputes and
+// what it reads from the mesh.
+//   R        = B - E (>= 0)               reflected radiosity (Map, FinalGather)
+//   indirect = B - Bdirect [- rho Hc]     the part due to light that bounced on a
+//                                         diffuse surface first (DirectIndirect,
+//                                         Caustics), where Bdirect = E + rho H_direct
+//                                         and Hc the caustic map's irradiance at
+//                                         the vertex (removed when the first pass
+//                                         has caustics, since the eye pass reads
+//                                         them from the map at the hit point).
+// The indirect part is a difference of noisy estimates and may dip below 0
+// at some vertices: it is kept as it is (clamping zero-mean noise would
+// bias it upwards); the eye pass keeps the diffuse radiance of a hit >= 0,
+// and the log counts such vertices.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "gi/color.h"
+#include "gi/direct.h"
+#include "gi/specular.h"
+#include "render_internal.h"
+
+namespace gi::eye {
+
+TwoPassData::TwoPassData() = default;
+TwoPassData::~TwoPassData() = default;
+
+namespace {
+
+constexpr int kVertexDirectSamples = 256;  // shadow rays per vertex when Bdirect is not given
+
+void checkPerVertex(const std::vector<glm::vec3>& v, size_t nv, const char* what) {
+  if (v.size() != nv)
+    throw std::invalid_argument(std::string(what) + " has " + std::to_string(v.size()) + " values for " +
+                                std::to_string(nv) + " vertices");
+  size_t bad = 0;
+  for (const auto& c : v)
+    for (int k = 0; k < 3; ++k)
+      if (!(c[k] >= 0.f) || !std::isfinite(c[k])) ++bad;
+  if (bad)
+    throw std::invalid_argument(std::string(what) + " has " + std::to_string(bad) +
+                                " negative or non-finite channels (a radiosity is a finite value >= 0)");
+}
+
+bool anySpecularFace(const Scene& s) {
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (isSpecular(s.faceMaterial(f))) return true;
+  return false;
+}
+
+}  // namespace
+
+void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, const RenderOptions& o,
+                    const Progress& progress, RunStats& stats) {
+  const size_t nv = s.vertexCount();
+  if (o.firstPassB.empty())
+    throw std::invalid_argument("the two-pass mode needs a first pass on these layers: run 'GI: Radiosity' or "
+                                "'GI: Photon Mapping' (which store the per-vertex radiosity) first");
+  checkPerVertex(o.firstPassB, nv, "the first pass's radiosity");
+  const VertexMaterial mat = vertexMaterial(s);
+  tp.R.resize(nv);
+  size_t negative = 0;
+  for (size_t i = 0; i < nv; ++i) tp.R[i] = glm::max(o.firstPassB[i] - mat.E[i], glm::vec3(0.f));
+  const bool wantCaustics = o.twoPass == TwoPassDiffuse::Caustics || o.twoPass == TwoPassDiffuse::FinalGather;
+  if (wantCaustics && anySpecularFace(s)) {
+    Timer t;
+    PhotonOptions po;
+    po.photons = o.causticPhotons;
+    po.causticK = o.causticK;
+    po.point = o.point;
+    po.seed = o.seed;
+    PhotonTraceStats ts;
+    std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+    const size_t stored = photons.size();
+    tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
+    if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons));
+    stats.add("caustic_photons_aimed", double(ts.causticEmitted));
+    stats.add("caustic_photons_stored", double(stored));
+    stats.add("caustic_map_seconds", t.seconds());
+    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors or glass");
+  } else if (wantCaustics) {
+    stats.note("no caustic map: the scene has no mirror or glass faces");
+  }
+  if (o.twoPass == TwoPassDiffuse::DirectIndirect || o.twoPass == TwoPassDiffuse::Caustics) {
+    std::vector<glm::vec3> Bd = o.firstPassBdirect;
+    if (!Bd.empty()) {
+      checkPerVertex(Bd, nv, "the first pass's direct radiosity");
+    } else {
+      // Estimated here, from the lights a first pass knows: the emitting faces and the point light.
+      Timer t;
+      std::vector<glm::vec3> Hd =
+          vertexDirectIrradiance(s, caster, kVertexDirectSamples, o.seed ^ 0x2b0du, progress.sub(0.5, 1.0));
+      if (o.point.on()) {
+        const float eps = float(sceneScale(s).rayEpsilon);
+        const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
+        for (size_t i = 0; i < nv; ++i)
+          if (mat.valid[i]) Hd[i] += pointLightIrradiance(o.point, caster, origins[i], mat.n[i]);
+      }
+      Bd.resize(nv);
+      for (size_t i = 0; i < nv; ++i) Bd[i] = mat.E[i] + mat.rho[i] * Hd[i];
+      stats.add("vertex_direct_seconds", t.seconds());
+      stats.note("the first pass's direct part estimated at the vertices (" + std::to_string(kVertexDirectSamples) +
+                 " shadow rays each) and replaced by ray-traced direct light");
+    }
+    tp.indirect.resize(nv);
+    const bool removeCaustics = tp.caustics && o.firstPassHasCaustics;
+    for (size_t i = 0; i < nv; ++i) {
+      glm::vec3 ind = o.firstPassB[i] - Bd[i];
+      if (removeCaustics && mat.valid[i])
+        ind -= mat.rho[i] * tp.caustic(s.positions[i], mat.n[i], o.causticK);
+      tp.indirect[i] = ind;
+      negative += mat.valid[i] && (ind.r < 0.f || ind.g < 0.f || ind.b < 0.f);
+    }
+    if (removeCaustics) stats.note("the first pass's caustics replaced by the caustic map read at the hit points");
+  }
+  if (!tp.indirect.empty()) {
+    stats.add("first_pass_negative_indirect_vertices", double(negative));
+    if (negative > nv / 10)
+      stats.warn(std::to_string(negative) + " of " + std::to_string(nv) +
+                 " vertices have a negative indirect part (B below its direct part: a first pass noisier than "
+                 "the direct estimate, or computed with other lights or materials)");
+  }
+}
+
+}  // namespace gi::eye

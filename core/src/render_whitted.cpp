@@ -1,0 +1,177 @@
+// Whitted ray tracing (Whitted 1980, "An Improved Illumination Model for
+// Shaded Display"): a tree of perfectly specular rays per eye ray, kept on an
+// explicit stack. Glass splits into its reflected (weight F) and refracted
+// (1 - F, times eta^2 for radiance) branches; a branch whose weight (the
+// product of its reflectances and Fresnel factors, without the eta^2 that
+// cancel on leaving the glass) falls below whitted_min_weight is not traced (Hall and Greenberg 1983's adaptive
+// tree depth), nor one deeper than max_depth. At diffuse hits: emission
+// E / pi plus rho / pi times the direct irradiance of
+//   - each area light (a connected set of emitting faces): its exact
+//     unoccluded irradiance, sum over its faces of E_f F(x -> f) with Lambert's
+//     contour integral (gi/form_factor_analytic.h), times the visibility of
+//     ONE shadow ray aimed at the light's centre as seen from x (the
+//     F-weighted mean of its faces' centroids; its area centroid when all of
+//     it is in view, and then the sum is its boundary's contour integral):
+//     hard shadows without noise;
+//   - the point or spot light and the sun's centre: one shadow ray each.
+// The sky lights nothing here (it needs sampled rays: the distributed mode);
+// it is seen only along rays that leave the scene. Glossy faces have no
+// Whitted counterpart: they reflect one ray in the mirror direction weighted
+// by the lobe's Fresnel factor at normal incidence on the microfacets, F(cos theta_o).
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "gi/form_factor_analytic.h"
+#include "gi/specular.h"
+#include "render_internal.h"
+
+namespace gi::eye {
+
+namespace {
+constexpr float kInvPi = 0.318309886f;
+struct Branch {
+  Ray ray;
+  glm::vec3 w;   // product of reflectances and Fresnel factors: what the cut-off compares
+  float scale;   // product of the eta^2 radiance factors (1 again once out of the glass)
+  int depth;
+};
+float maxChannel(const glm::vec3& v) { return std::max({v.r, v.g, v.b}); }
+}  // namespace
+
+glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const {
+  glm::vec3 H(0.f);
+  const glm::dvec3 xd(x), nd(n);
+  for (const AreaLight& light : areaLights_) {
+    glm::dvec3 Hl(0.0), centre(0.0);
+    double wsum = 0.0;
+    bool whole = light.uniform;  // no face clipped: its boundary's contour integral
+    for (size_t k = 0; whole && k < light.corners.size(); ++k) whole = glm::dot(nd, light.corners[k] - xd) > 0.0;
+    for (size_t k = 0; whole && k < light.faces.size(); ++k) {
+      const uint32_t f = light.faces[k];
+      whole = glm::dot(glm::dvec3(faceN_[f]), xd - glm::dvec3(s_.positions[s_.triangles[f].x])) > double(eps_);
+    }
+    if (whole) {
+      double sum = 0.0;
+      for (const auto& [p, q] : light.boundary) {
+        const glm::dvec3 v0 = p - xd, v1 = q - xd, cr = glm::cross(v0, v1);
+        const double lc = glm::length(cr);
+        if (lc > 0.0) sum += std::atan2(lc, glm::dot(v0, v1)) * glm::dot(nd, cr) / lc;
+      }
+      const double F = std::fabs(sum) / (2.0 * M_PI);
+      Hl = F * glm::dvec3(light.E);
+      centre = light.centroid * F;
+      wsum = F;
+    }
+    for (size_t k = 0; !whole && k < light.faces.size(); ++k) {
+      const uint32_t f = light.faces[k];
+      const auto& t = s_.triangles[f];
+      const glm::dvec3 a(s_.positions[t.x]), b(s_.positions[t.y]), cc(s_.positions[t.z]);
+      if (glm::dot(glm::dvec3(faceN_[f]), xd - a) <= double(eps_)) continue;  // behind (or in) the one-sided emitter
+      const double F = pointToTriangleFormFactor(xd, nd, a, b, cc);
+      if (!(F > 0.0)) continue;
+      Hl += F * glm::dvec3(s_.faceEmission(f));
+      centre += F * (a + b + cc) / 3.0;
+      wsum += F;
+    }
+    if (!(wsum > 0.0)) continue;
+    centre /= wsum;
+    glm::vec3 w = glm::vec3(centre) - x;
+    const float r = glm::length(w);
+    if (!(r > 0.f)) continue;
+    w /= r;
+    Ray ray = spawn(x, n, w);
+    ray.tfar = r * (1.f - 1e-4f) - eps_;
+    ++c.shadow;
+    if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
+    H += glm::vec3(Hl);
+  }
+  if (hasSun_) {
+    const float cx = glm::dot(n, o_.sunDirection);
+    if (cx > 0.f) {
+      ++c.shadow;
+      if (!caster_.occluded(spawn(x, n, o_.sunDirection))) H += o_.sunIrradiance * cx;
+    }
+  }
+  if (hasPoint_) {
+    glm::vec3 w = o_.point.position - x;
+    const float r2 = glm::dot(w, w);
+    if (r2 > 0.f) {
+      const float r = std::sqrt(r2);
+      w /= r;
+      const float cx = glm::dot(n, w);
+      if (cx > 0.f && o_.point.shinesTowards(-w)) {
+        Ray ray = spawn(x, n, w);
+        ray.tfar = r * (1.f - 1e-4f);
+        ++c.shadow;
+        if (!caster_.occluded(ray)) H += o_.point.intensity * (cx / r2);
+      }
+    }
+  }
+  return H;
+}
+
+glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, Counts& c) const {
+  thread_local std::vector<Branch> stack;
+  stack.clear();
+  stack.push_back({primary, glm::vec3(1.f), 1.f, 0});
+  glm::vec3 L(0.f);
+  auto push = [&](const Ray& r, const glm::vec3& w, float scale, int depth) {
+    if (maxChannel(w) < o_.whittedMinWeight) { ++c.belowWeight; return; }
+    if (depth > o_.maxDepth) { ++c.cutAtMaxDepth; return; }
+    stack.push_back({r, w, scale, depth});
+    ++c.specular;
+  };
+  while (!stack.empty()) {
+    const Branch br = stack.back();
+    stack.pop_back();
+    SurfacePoint sp;
+    if (first) {
+      sp = *first;
+      first = nullptr;
+    } else {
+      sp = surfaceAt(br.ray, caster_.intersect(br.ray));
+    }
+    const glm::vec3 d = br.ray.d;
+    if (!sp.valid()) {
+      L += br.w * br.scale * escaped(d, true, 0.f, 1.f);
+      continue;
+    }
+    const Material m = s_.faceMaterial(sp.face);
+    const glm::vec3 tint = s_.faceRho(sp.face);
+    if (m == Material::Mirror) {
+      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, sp.n))), br.w * tint, br.scale, br.depth + 1);
+      continue;
+    }
+    if (m == Material::Glass) {
+      const float ior = s_.ior.empty() ? 1.5f : s_.ior[sp.face];
+      const bool entering = glm::dot(d, sp.n) < 0.f;
+      const glm::vec3 nf = entering ? sp.n : -sp.n;  // faces the incoming ray
+      const float eta = entering ? 1.f / ior : ior;
+      const float cosI = std::min(1.f, -glm::dot(d, nf));
+      const float F = fresnelDielectric(cosI, eta);  // 1 beyond the critical angle
+      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, nf))), br.w * tint * F, br.scale, br.depth + 1);
+      if (F < 1.f) {
+        const float sin2T = eta * eta * std::max(0.f, 1.f - cosI * cosI);
+        const float cosT = std::sqrt(std::max(0.f, 1.f - sin2T));
+        const glm::vec3 t = glm::normalize(eta * d + (eta * cosI - cosT) * nf);
+        push(spawn(sp.x, sp.n, t), br.w * tint * (1.f - F), br.scale * eta * eta, br.depth + 1);
+      }
+      continue;
+    }
+    const float cosO = -glm::dot(sp.n, d);
+    if (!(cosO > 0.f)) continue;  // seen from behind: black
+    if (m == Material::Glossy) {
+      const GgxLobe lobe(s_.faceRoughness(sp.face), tint);
+      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, sp.n))), br.w * lobe.fresnel(cosO), br.scale, br.depth + 1);
+      continue;
+    }
+    const glm::vec3 w = br.w * br.scale;
+    L += w * s_.faceEmission(sp.face) * kInvPi;
+    const glm::vec3 rho = s_.faceRho(sp.face);
+    if (rho.r > 0.f || rho.g > 0.f || rho.b > 0.f) L += w * rho * kInvPi * whittedIrradiance(sp.x, sp.n, c);
+  }
+  return L;
+}
+
+}  // namespace gi::eye
