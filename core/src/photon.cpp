@@ -16,6 +16,7 @@
 #include "gi/specular.h"
 #include "photon_map.h"
 #include "photon_internal.h"
+#include "photon_surface.h"
 
 namespace gi {
 
@@ -184,23 +185,28 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (projection) causticPhotons = traceCausticPhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
     const double traceSeconds = traceTimer.seconds();
     Timer buildTimer;
+    const GatherSurface surface(s);
     const unsigned globalPaths = opt.directLight ? (1u << kIndirectPhoton) : 7u;
     // The (single-threaded) kd-tree builds run side by side.
     std::unique_ptr<PhotonMap> globalMap, caustics, all;
+    const bool gather = opt.directLight && opt.finalGather;
     tbb::parallel_invoke(
-        [&] { globalMap = std::make_unique<PhotonMap>(photons, globalPaths); },
         [&] {
-          if (projection && !causticPhotons.empty())
-            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton);
-          else if (opt.directLight && !projection && ts.caustic > 0)
-            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
+          // The final gather reads `all` at the points its rays reach, never the global map at the vertices.
+          if (!gather) globalMap = std::make_unique<PhotonMap>(photons, globalPaths, surface);
         },
         [&] {
-          if (opt.directLight && opt.finalGather) all = std::make_unique<PhotonMap>(photons, 7u);
+          if (projection && !causticPhotons.empty())
+            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton, surface);
+          else if (opt.directLight && !projection && ts.caustic > 0)
+            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
+        },
+        [&] {
+          if (gather) all = std::make_unique<PhotonMap>(photons, 7u, surface);
         });
-    const PhotonMap& global = *globalMap;
     const double buildSeconds = buildTimer.seconds();
-    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon) + global.memoryBytes();
+    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
+    if (globalMap) mapBytes += globalMap->memoryBytes();
     if (caustics) mapBytes += caustics->memoryBytes();
     if (all) mapBytes += all->memoryBytes();
     Timer queryTimer;
@@ -216,7 +222,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
         if (!mat.valid[i]) continue;
         double e1 = 0, e2 = 0;
         glm::vec3 H = all ? gathered[i]
-                          : global.irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, PhotonKernel::Uniform, &e1);
+                          : globalMap->irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, PhotonKernel::Uniform, &e1);
         if (caustics) H += caustics->irradiance(s.positions[i], mat.n[i], opt.causticK, r2max, PhotonKernel::Cone, &e2);
         Hphot[i] = H;
         noise[i] = std::sqrt(e1 * e1 + e2 * e2);
@@ -228,7 +234,9 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.add("kdtree_build_seconds", buildSeconds);
     st.add("query_seconds", queryTimer.seconds());
     st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
-    st.add("photons_global_map", double(global.size()));
+    size_t globalCount = 0;
+    for (const Photon& p : photons) globalCount += (globalPaths >> p.path) & 1u;
+    st.add("photons_global_map", double(globalCount));
     st.add("photons_caustic_map", caustics ? double(caustics->size()) : 0.0);
     st.add("photon_memory_mb", mapBytes / 1048576.0);
     if (!specular) st.note("no caustic map: the scene has no mirror or glass faces");

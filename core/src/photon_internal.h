@@ -1,5 +1,7 @@
 // Internal parts of photon mapping shared by its sources.
 #pragma once
+#include <cmath>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -10,11 +12,22 @@
 
 namespace gi {
 
+// A photon counts in a gather when the normal of the face it landed on is
+// within 60 degrees of the gather point's normal (same side, same surface).
+constexpr float kSameSide = 0.5f;
+
+inline glm::i8vec3 packNormal(const glm::vec3& n) {
+  return glm::i8vec3(int8_t(std::lround(n.x * 127.f)), int8_t(std::lround(n.y * 127.f)), int8_t(std::lround(n.z * 127.f)));
+}
+inline glm::vec3 unpackNormal(const glm::i8vec3& n) { return glm::vec3(n) * (1.f / 127.f); }
+
 // Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
 // vertices as the measurement points: per vertex a radius R, an accumulated
 // photon count N and flux tau. After each pass of M new photons within R,
-//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) R'^2 / R^2,
-// and H = tau / (pi R^2 passes) (each pass's photons carry the full power / count).
+//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) A(R') / A(R),
+// and H = tau / (A(R) passes) (each pass's photons carry the full power / count),
+// with A(R) the area of the counted surface within R (photon_surface.h): pi R^2
+// on a plane, where the flux ratio is Hachisuka's R'^2 / R^2.
 // The first radius is the distance to the k-th nearest photon of the first pass.
 // With `projection`, each pass's caustic photons come from traceCausticPhotons
 // (those of the global pass are dropped).

@@ -89,6 +89,12 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                         size_t count, const Progress& progress, PhotonTraceStats& stats);
 
+// Area of the triangle abc inside the ball of centre x and radius r (exact:
+// the triangle clipped to the disk in which the sphere cuts its plane). The
+// density estimates divide by the sum of these over the faces whose photons
+// they count, instead of pi r^2, which holds only on a plane all around x.
+double triangleBallArea(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& x, double r);
+
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                   const Progress& progress = Progress(nullptr));
 
