@@ -94,8 +94,8 @@ class PhotonMap {
     float farthest2 = 0.f;   // distance^2 of the farthest candidate examined
   };
   // Candidates come from the kd-tree in any orientation: 2k first, then more
-  // (up to kMaxQuery) while fewer than k lie on this side, as at a crease or
-  // corner where most of the nearest photons are on the other faces.
+  // (up to kMaxQuery) while fewer than k (but some) lie on this side, as at a
+  // crease or corner where most of the nearest photons are on the other faces.
   void nearestSameSide(const glm::vec3& x, const glm::vec3& n, int k, float r2max, Query& q) const {
     const float p[3] = {x.x, x.y, x.z};
     uint32_t idx[kMaxQuery];
@@ -115,8 +115,11 @@ class PhotonMap {
       }
       q.farthest2 = found ? d2[found - 1] : 0.f;
       q.exhausted = found < want || pastCap || (found && d2[found - 1] > r2max);
-      if (q.used >= k || q.exhausted || want >= std::min<size_t>(size(), kMaxQuery)) return;
-      want = std::min<size_t>({size(), want * 2, kMaxQuery});
+      // None on this side among 2k: this side holds (next to) none here, as
+      // on a wall beside a caustic; the estimate is 0 without a wider search.
+      if (q.used >= k || q.used == 0 || q.exhausted || want >= std::min<size_t>(size(), kMaxQuery)) return;
+      // Enough candidates for k on this side at the share seen, with a margin.
+      want = std::min<size_t>({size(), std::max(want * 2, want * size_t(k) * 5 / (size_t(q.used) * 4)), kMaxQuery});
     }
   }
   const GatherSurface& surface_;

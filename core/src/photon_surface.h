@@ -22,24 +22,33 @@ class GatherSurface {
  public:
   explicit GatherSurface(const Scene& s);
 
-  // Faces that may meet the ball (x, r) and face n's side, for area() below.
-  void collect(const glm::vec3& x, const glm::vec3& n, float r, std::vector<uint32_t>& faces) const;
-  // A(x, r) over `faces` (from collect with a radius >= r).
-  double area(const std::vector<uint32_t>& faces, const glm::vec3& x, float r) const;
-  double area(const glm::vec3& x, const glm::vec3& n, float r) const;
+  // A(x, r) over the faces facing n's side (m.n >= 0.5). *flat: whether all
+  // of them lie in one plane through x (then A(rho) = A(r) rho^2 / r^2 for
+  // rho < r when A(r) is the whole disk).
+  double area(const glm::vec3& x, const glm::vec3& n, float r, bool* flat = nullptr) const;
   // The cone filter's normalisation (Jensen 1996, w = 1 - d / (k r)):
   //   int_{A} w dA = A(r) (1 - 1/k) + (1 / (k r)) int_0^r A(rho) drho
   // (from int d dA = r A(r) - int_0^r A; pi r^2 (1 - 2 / (3k)) on a plane),
-  // the radial integral by 8-point Gauss-Legendre.
+  // the radial integral by 8-point Gauss-Legendre, or pi r^2 (1 - 2/(3k))
+  // at once where the whole disk lies on one plane through x.
   double coneArea(const glm::vec3& x, const glm::vec3& n, float r, float k) const;
 
  private:
+  // A bounding-volume hierarchy over the faces. A node wholly inside the ball
+  // whose faces share one normal adds its area at once: on the planar walls
+  // of most scenes only the faces the sphere cuts are clipped.
   struct Node {
     glm::vec3 lo, hi;
-    uint32_t first, count;  // leaf: faces order_[first, first + count); inner: count = 0, children (index + 1) and first
+    glm::vec3 m;            // the faces' common quantised normal, or 0 if they differ
+    glm::vec3 plane;        // their common unit normal if they lie in one plane (offset d), else 0
+    float d;
+    double area;            // of the faces below
+    uint32_t first, count;  // leaf: faces order_[first, first + count); inner: count = 0, children index + 1 and first
   };
   uint32_t build(uint32_t begin, uint32_t end, std::vector<glm::vec3>& centroid);
-  std::vector<glm::vec3> a_, b_, c_, m_;  // per counted face: corners and quantised unit normal
+  std::vector<glm::vec3> a_, b_, c_, m_, n_;  // per counted face: corners, quantised and exact unit normals
+  std::vector<double> faceArea_;
+  std::vector<glm::vec4> bound_;  // per face: a bounding sphere (centre, radius)
   std::vector<uint32_t> order_;
   std::vector<Node> nodes_;
 };
