@@ -43,12 +43,14 @@ class PhotonMap {
   // Irradiance at x (unit normal n) from the k nearest photons on the same
   // side within sqrt(r2max), over the area of the counted surface within
   // their radius (photon_surface.h; pi r^2 on a plane all around x). *noise
-  // gets the Poisson standard error.
+  // gets the Poisson standard error, *photons the number of photons used.
   glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max, PhotonKernel kernel,
-                       double* noise = nullptr) const {
+                       double* noise = nullptr, int* photons = nullptr) const {
+    if (photons) *photons = 0;
     if (size() == 0 || k < 1) return glm::vec3(0.f);
     Query q;
     nearestSameSide(x, n, k, r2max, q);
+    if (photons) *photons = q.used;
     if (q.used == 0) return glm::vec3(0.f);
     float r2 = q.d2[q.used - 1];
     if (q.used < k) {

@@ -23,6 +23,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   std::vector<double> N(nv, 0.0);
   std::vector<glm::dvec3> tau(nv, glm::dvec3(0.0));
   std::vector<double> A(nv, 0.0);  // area of the counted surface within each radius
+  std::vector<size_t> seen(nv, 0);  // photons gathered over all passes
   const GatherSurface surface(s);
   const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
   // Vertices where the first pass finds fewer than k photons within the cap
@@ -68,6 +69,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
       cell = std::max(std::sqrt(radii[q]), 1e-6f * diag);
     }
     const PhotonGrid grid(photons, pathMask, cell);
+    r.check.mapPhotons += grid.size();
     r.buildSeconds += bt.seconds();
     r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
                                                (map ? map->memoryBytes() : 0)));
@@ -81,6 +83,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
         size_t M = 0;
         grid.gather(s.positions[i], mat.n[i], R2[i], flux, M);
         if (M == 0) continue;
+        seen[i] += M;
         const double ratio = (N[i] + alpha * double(M)) / (N[i] + double(M));
         N[i] += alpha * double(M);
         R2[i] = float(double(R2[i]) * ratio);
@@ -100,6 +103,10 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   for (size_t i = 0; i < nv; ++i) {
     if (!mat.valid[i]) continue;
     ++valid;
+    if (seen[i] > 0) {
+      ++r.check.estimates;
+      if (seen[i] < size_t(kFewPhotons)) ++r.check.fewEstimates;
+    }
     sumR += std::sqrt(double(R2[i]));
     sumN += N[i];
     if (N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
@@ -109,6 +116,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
     // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
     r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(N[i]);
   }
+  r.check.surfaceArea = surface.totalArea();
   r.meanRadius = valid ? sumR / double(valid) : 0.0;
   r.meanCount = valid ? sumN / double(valid) : 0.0;
   return r;

@@ -21,6 +21,8 @@ namespace gi {
 class GatherSurface {
  public:
   explicit GatherSurface(const Scene& s);
+  // Of all the diffuse faces.
+  double totalArea() const { return nodes_.empty() ? 0.0 : nodes_[0].area; }
 
   // A(x, r) over the faces facing n's side (m.n >= 0.5). *flat: whether all
   // of them lie in one plane through x (then A(rho) = A(r) rho^2 / r^2 for

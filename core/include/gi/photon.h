@@ -11,12 +11,16 @@
 //   - the direct light by explicit light sampling with shadow rays (default),
 //   - the caustic map: density estimate over the k nearest caustic photons on
 //     the same side with Jensen's cone filter (w = 1 - d / (1.1 r)),
-//   - the global map: uniform disk kernel, H ~ sum Phi / (pi r_k^2) over the
-//     k nearest, or a final gather that reads the map where cosine rays from
+//   - the global map: uniform kernel, H ~ sum Phi / A(r_k) over the k
+//     nearest, or a final gather that reads the map where cosine rays from
 //     the vertex land (following mirrors and glass on the way),
 //   - or, with progressive photon mapping (Hachisuka et al. 2008), per-vertex
 //     radius and flux statistics over passes of photons, the radius shrinking
 //     by alpha = 2/3, so that the estimate converges (bias and noise -> 0).
+// A(r) is the area of the surface whose photons count (facing the vertex's
+// side) inside the gather sphere: Jensen's pi r^2 on a plane, a half or a
+// quarter of it at a crease or a corner, less at a mesh border; the cone
+// filter and the progressive flux are normalised the same way.
 #pragma once
 #include <cstdint>
 #include <vector>
