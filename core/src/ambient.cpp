@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <unordered_map>
@@ -160,6 +161,59 @@ void checkOptions(const AmbientOptions& o) {
   if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
 }
 
+// Warnings for settings that make the result meaningless (RunStats::warn).
+void warnMeaningless(const Scene& scene, const AmbientOptions& o, const AmbientResult& res, RunStats& st) {
+  auto num = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::string(buf);
+  };
+  if (o.maxDistance > 0.0) {
+    // Rays start eps off the surface (and eps into the face at lopsided one-rings).
+    const double eps = sceneScale(scene).rayEpsilon;
+    std::vector<float> edges;
+    const auto ok = usableFaceMask(scene);
+    for (size_t f = 0; f < scene.faceCount(); ++f)
+      if (ok[f])
+        for (int k = 0; k < 3; ++k)
+          edges.push_back(glm::length(scene.positions[scene.triangles[f][k]] - scene.positions[scene.triangles[f][(k + 1) % 3]]));
+    float median = 0.f;
+    if (!edges.empty()) {
+      std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+      median = edges[edges.size() / 2];
+    }
+    if (o.maxDistance <= 10.0 * eps)
+      st.warn("max_distance " + num(o.maxDistance) + " is within 10 ray offsets (rays start " + num(eps) +
+              " off the surface): what it sees is where the rays start, not the shape");
+    else if (o.maxDistance < 0.1 * median)
+      st.warn("max_distance " + num(o.maxDistance) + " is below a tenth of the median edge length " + num(median) +
+              ": within it a vertex sees only its own faces, so the result shows the angles between neighbouring faces, "
+              "not the rest of the mesh");
+  }
+  if (o.mode == AmbientMode::Sky) {
+    if (!(o.skyIrradiance > 0.f) && !(o.sunIrradiance > 0.f))
+      st.warn("sky_irradiance and sun_irradiance are both 0: no light, every vertex is black");
+    if (o.sunIrradiance > 0.f && !(o.sunAngularRadiusDeg > 0.f) && o.sunRays > 1)
+      st.warn("sun_angular_radius 0 is a point sun: all " + std::to_string(o.sunRays) +
+              " sun rays per vertex follow one direction (hard shadows; one ray gives the same)");
+  } else if (o.targetError > 0.0) {
+    size_t unmet = 0, traced = 0;
+    float worst = 0.f;
+    for (size_t i = 0; i < res.rays.size(); ++i) {
+      if (res.rays[i] == 0) continue;
+      ++traced;
+      if (res.rays[i] >= o.maxRays && res.stdError[i] > o.targetError) {
+        ++unmet;
+        worst = std::max(worst, res.stdError[i]);
+      }
+    }
+    if (unmet * 10 > traced)
+      st.warn(std::to_string(unmet) + " of " + std::to_string(traced) + " vertices stopped at max_rays " +
+              std::to_string(o.maxRays) + " with their standard error above target_error " + num(o.targetError) +
+              " (up to " + num(worst) + "): the target is not met; raise max_rays or the target");
+  }
+}
+
 }  // namespace
 
 AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& opt, const Progress& progress) {
@@ -269,6 +323,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)
     st.note(std::to_string(rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite) + " degenerate/invalid faces ignored");
+  warnMeaningless(scene, opt, res, st);
   return res;
 }
 

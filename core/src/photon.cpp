@@ -6,6 +6,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <atomic>
+
 #include <tbb/parallel_invoke.h>
 
 #include "gi/color.h"
@@ -16,6 +18,7 @@
 #include "gi/specular.h"
 #include "photon_map.h"
 #include "photon_internal.h"
+#include "photon_surface.h"
 
 namespace gi {
 
@@ -27,7 +30,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        ParamType::Int, 200000, 1, 100000000},
       {"k_nearest", "Photons per estimate",
        "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side of the "
-       "surface, with a uniform disk kernel: more photons mean less noise but more blur.",
+       "surface: their power over the area of that surface within their radius (a disk on a plane, half of it at a "
+       "crease). More photons mean less noise (about 1 / sqrt(k)) but more blur; k = 1 or 2 gives an estimate "
+       "without a finite mean or variance.",
        ParamType::Int, 64, 1, 512},
       {"caustic_k", "Photons per caustic estimate",
        "k for the caustic map (photons that reached a diffuse surface through mirrors or glass only). Its cone "
@@ -41,7 +46,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        ParamType::Bool, 1},
       {"max_radius", "Maximum gather radius",
        "Photons farther than this from a vertex are ignored (0 = no limit); vertices with no photon within it get "
-       "only their direct light. Absolute or % of the bbox diagonal.",
+       "only their direct light. Keep it well above the photon spacing sqrt(diffuse area / stored photons): below "
+       "it an estimate holds 0 or 1 photon and reads 0 or many times too bright (the log warns). Absolute or % of "
+       "the bbox diagonal.",
        ParamType::Distance, 0.05, 0.0, 1.0},
       {"direct_light", "Direct light by light sampling",
        "Compute the direct light at each vertex by explicit light sampling (shadow rays to points on the emitters: "
@@ -153,6 +160,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   std::vector<double> noise(nv, 0.0);
   PhotonTraceStats ts;
   size_t noPhotonVertices = 0;
+  PhotonGatherCheck check;
   // Which photons the vertex estimate reads: all, or all but the direct ones.
   const unsigned vertexPaths = opt.directLight ? (1u << kCausticPhoton) | (1u << kIndirectPhoton) : 7u;
   if (!needPhotons) {
@@ -166,6 +174,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     Hphot = std::move(pr.H);
     noise = std::move(pr.noise);
     noPhotonVertices = pr.verticesWithoutPhotons;
+    check = pr.check;
     st.add("ppm_passes", double(opt.passes));
     st.add("ppm_mean_final_radius", pr.meanRadius);
     st.add("ppm_mean_photons_per_vertex", pr.meanCount);
@@ -184,39 +193,57 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (projection) causticPhotons = traceCausticPhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
     const double traceSeconds = traceTimer.seconds();
     Timer buildTimer;
+    const GatherSurface surface(s);
     const unsigned globalPaths = opt.directLight ? (1u << kIndirectPhoton) : 7u;
     // The (single-threaded) kd-tree builds run side by side.
     std::unique_ptr<PhotonMap> globalMap, caustics, all;
+    const bool gather = opt.directLight && opt.finalGather;
     tbb::parallel_invoke(
-        [&] { globalMap = std::make_unique<PhotonMap>(photons, globalPaths); },
         [&] {
-          if (projection && !causticPhotons.empty())
-            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton);
-          else if (opt.directLight && !projection && ts.caustic > 0)
-            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton);
+          // The final gather reads `all` at the points its rays reach, never the global map at the vertices.
+          if (!gather) globalMap = std::make_unique<PhotonMap>(photons, globalPaths, surface);
         },
         [&] {
-          if (opt.directLight && opt.finalGather) all = std::make_unique<PhotonMap>(photons, 7u);
+          if (projection && !causticPhotons.empty())
+            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton, surface);
+          else if (opt.directLight && !projection && ts.caustic > 0)
+            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
+        },
+        [&] {
+          if (gather) all = std::make_unique<PhotonMap>(photons, 7u, surface);
         });
-    const PhotonMap& global = *globalMap;
     const double buildSeconds = buildTimer.seconds();
-    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon) + global.memoryBytes();
+    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
+    if (globalMap) mapBytes += globalMap->memoryBytes();
     if (caustics) mapBytes += caustics->memoryBytes();
     if (all) mapBytes += all->memoryBytes();
     Timer queryTimer;
     std::vector<glm::vec3> gathered;
+    // Photons per global (or final-gather) estimate: how many held some, how many only a few.
+    std::atomic<size_t> some{0}, few{0};
+    auto count = [&](int used) {
+      if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
+      if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
+    };
     if (all) {
       gathered = specularFinalGather(s, caster, mat, origins, opt.gatherRays, opt.seed ^ 0x6au, eps,
                                      [&](uint32_t f, const glm::vec3& y, const glm::vec3& side) {
-                                       return s.faceRho(f) * all->irradiance(y, side, opt.kNearest, r2max, PhotonKernel::Uniform);
+                                       int used = 0;
+                                       const glm::vec3 H = all->irradiance(y, side, opt.kNearest, r2max,
+                                                                           PhotonKernel::Uniform, nullptr, &used);
+                                       count(used);
+                                       return s.faceRho(f) * H;
                                      });
     }
     parallelBlocks(nv, progress.sub(0.55, 1.0), "density estimation", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         if (!mat.valid[i]) continue;
         double e1 = 0, e2 = 0;
+        int used = 0;
         glm::vec3 H = all ? gathered[i]
-                          : global.irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, PhotonKernel::Uniform, &e1);
+                          : globalMap->irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, PhotonKernel::Uniform, &e1,
+                                                  &used);
+        if (!all) count(used);
         if (caustics) H += caustics->irradiance(s.positions[i], mat.n[i], opt.causticK, r2max, PhotonKernel::Cone, &e2);
         Hphot[i] = H;
         noise[i] = std::sqrt(e1 * e1 + e2 * e2);
@@ -228,7 +255,15 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.add("kdtree_build_seconds", buildSeconds);
     st.add("query_seconds", queryTimer.seconds());
     st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
-    st.add("photons_global_map", double(global.size()));
+    size_t globalCount = 0;
+    for (const Photon& p : photons) globalCount += (globalPaths >> p.path) & 1u;
+    st.add("photons_global_map", double(globalCount));
+    check.surfaceArea = surface.totalArea();
+    check.mapPhotons = all ? all->size() : globalMap->size();
+    check.causticPhotons = caustics ? caustics->size() : 0;
+    check.estimates = some.load();
+    check.fewEstimates = few.load();
+    check.kNearestEstimates = true;
     st.add("photons_caustic_map", caustics ? double(caustics->size()) : 0.0);
     st.add("photon_memory_mb", mapBytes / 1048576.0);
     if (!specular) st.note("no caustic map: the scene has no mirror or glass faces");
@@ -267,6 +302,8 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
       st.note(std::to_string(ts.lostAtMaxDepth) + " paths cut at max_depth, carrying " +
               std::to_string(ts.emittedPower > 0 ? 100.0 * ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0) +
               "% of the emitted power");
+    check.lostPowerFraction = ts.emittedPower > 0 ? ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0;
+    warnMeaninglessPhotonParameters(opt, check, st);
     if (noPhotonVertices)
       st.note(std::to_string(noPhotonVertices) + " vertices reached by no photon within the gather radius: direct light only");
   }

@@ -13,6 +13,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "gi/photon.h"
+#include "photon_internal.h"
 
 namespace gi {
 
@@ -53,7 +54,7 @@ class PhotonGrid {
           for (uint32_t m = starts_[c]; m < starts_[c + 1]; ++m) {
             const Photon& p = photons_[m];
             const glm::vec3 d = p.p - x;
-            if (glm::dot(d, d) > r2 || glm::dot(p.normal(), n) < 0.5f) continue;
+            if (glm::dot(d, d) > r2 || glm::dot(p.normal(), n) < kSameSide) continue;
             flux += glm::dvec3(p.power);
             ++count;
           }

@@ -1,5 +1,7 @@
 // Internal parts of photon mapping shared by its sources.
 #pragma once
+#include <cmath>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -10,11 +12,35 @@
 
 namespace gi {
 
+// A photon counts in a gather when the normal of the face it landed on is
+// within 60 degrees of the gather point's normal (same side, same surface).
+constexpr float kSameSide = 0.5f;
+
+inline glm::i8vec3 packNormal(const glm::vec3& n) {
+  return glm::i8vec3(int8_t(std::lround(n.x * 127.f)), int8_t(std::lround(n.y * 127.f)), int8_t(std::lround(n.z * 127.f)));
+}
+inline glm::vec3 unpackNormal(const glm::i8vec3& n) { return glm::vec3(n) * (1.f / 127.f); }
+
+// What a run's density estimates looked like, for the warnings below.
+struct PhotonGatherCheck {
+  double surfaceArea = 0;        // diffuse area photons land on
+  size_t mapPhotons = 0;         // photons the vertex (or final-gather) estimates read; progressive: all passes
+  size_t causticPhotons = 0;     // in the caustic map read with caustic_k (0: none)
+  size_t estimates = 0;          // estimates that held at least one photon
+  size_t fewEstimates = 0;       // of those, the ones with fewer than kFewPhotons
+  bool kNearestEstimates = false;  // k-nearest estimates (not progressive)
+  double lostPowerFraction = 0;  // of the emitted power, still carried by paths cut at max_depth
+};
+// A handful: below it an estimate's relative noise exceeds 1 / sqrt(4) = 50%.
+constexpr int kFewPhotons = 4;
+
 // Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
 // vertices as the measurement points: per vertex a radius R, an accumulated
 // photon count N and flux tau. After each pass of M new photons within R,
-//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) R'^2 / R^2,
-// and H = tau / (pi R^2 passes) (each pass's photons carry the full power / count).
+//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) A(R') / A(R),
+// and H = tau / (A(R) passes) (each pass's photons carry the full power / count),
+// with A(R) the area of the counted surface within R (photon_surface.h): pi R^2
+// on a plane, where the flux ratio is Hachisuka's R'^2 / R^2.
 // The first radius is the distance to the k-th nearest photon of the first pass.
 // With `projection`, each pass's caustic photons come from traceCausticPhotons
 // (those of the global pass are dropped).
@@ -25,10 +51,17 @@ struct ProgressiveResult {
   double meanRadius = 0, meanCount = 0;
   double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;
   double peakBytes = 0;
+  PhotonGatherCheck check;  // surface, photons over all passes, vertices with few photons
 };
 ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                        const VertexMaterial& mat, unsigned pathMask, bool projection,
                                        const Progress& progress, PhotonTraceStats& stats);
+
+// Warnings (RunStats::warn) for parameters that make the result meaningless:
+// a gather radius cap below the photon spacing, estimates of a handful of
+// photons, k below 3 (no finite mean or variance), k above the map's
+// photons, and paths cut at max_depth carrying much of the power.
+void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st);
 
 // Final gather at every vertex through mirrors and glass: cosine-weighted rays
 // from origins[v] follow specular faces (up to 16 interactions) and, at the

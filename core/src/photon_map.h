@@ -10,18 +10,22 @@
 
 #include "gi/color.h"
 #include "gi/photon.h"
+#include "photon_internal.h"
+#include "photon_surface.h"
 
 namespace gi {
 
 enum class PhotonKernel {
-  Uniform,  // H ~ sum Phi / (pi r^2)
-  Cone,     // Jensen 1996: w = 1 - d / (k r), k = 1.1, normalised by (1 - 2 / (3 k))
+  Uniform,  // H ~ sum Phi / A(r)  (A = pi r^2 on a plane)
+  Cone,     // Jensen 1996: w = 1 - d / (k r), k = 1.1, over int w dA  (pi r^2 (1 - 2 / (3 k)) on a plane)
 };
 
 class PhotonMap {
  public:
   // Photons whose path kind has its bit set in `pathMask` (1 << PhotonPath).
-  PhotonMap(const std::vector<Photon>& all, unsigned pathMask) : cloud_{all, {}} {
+  // `surface` normalises the estimates (it must outlive the map).
+  PhotonMap(const std::vector<Photon>& all, unsigned pathMask, const GatherSurface& surface)
+      : surface_(surface), cloud_{all, {}} {
     for (uint32_t i = 0; i < all.size(); ++i)
       if (pathMask & (1u << all[i].path)) cloud_.idx.push_back(i);
     // Positions copied together: the build reads them many times over.
@@ -37,73 +41,90 @@ class PhotonMap {
   }
 
   // Irradiance at x (unit normal n) from the k nearest photons on the same
-  // side within sqrt(r2max). *noise gets the Poisson standard error.
+  // side within sqrt(r2max), over the area of the counted surface within
+  // their radius (photon_surface.h; pi r^2 on a plane all around x). *noise
+  // gets the Poisson standard error, *photons the number of photons used.
   glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max, PhotonKernel kernel,
-                       double* noise = nullptr) const {
+                       double* noise = nullptr, int* photons = nullptr) const {
+    if (photons) *photons = 0;
     if (size() == 0 || k < 1) return glm::vec3(0.f);
-    // More than k: photons on the other side are dropped.
-    const size_t want = std::min<size_t>({size(), size_t(k) * 2, kMaxQuery});
-    uint32_t idx[kMaxQuery];
-    float d2[kMaxQuery];
-    const float q[3] = {x.x, x.y, x.z};
-    const size_t found = tree_->knnSearch(q, want, idx, d2);
-    float d2raw[kMaxQuery];
-    std::copy(d2, d2 + found, d2raw);
-    int used = 0;
-    float r2 = 0.f;
-    const Photon* ph[kMaxQuery];
-    for (size_t m = 0; m < found && used < k; ++m) {
-      if (d2[m] > r2max) break;
-      const Photon& p = cloud_.all[cloud_.idx[idx[m]]];
-      if (glm::dot(p.normal(), n) < 0.5f) continue;  // other side or another surface
-      ph[used] = &p;
-      d2[used] = d2[m];
-      r2 = d2[m];
-      ++used;
-    }
-    if (used == 0) return glm::vec3(0.f);
-    if (used < k) {
-      // Fewer than k on this side among the candidates: the density is that
-      // of the whole disk examined — up to r2max if the search reached past
-      // it, else up to the farthest candidate (the rest lay on other surfaces).
-      const bool exhausted = found < want || d2raw[found - 1] > r2max;
-      r2 = exhausted && r2max < HUGE_VALF ? r2max : d2raw[found - 1];
+    Query q;
+    nearestSameSide(x, n, k, r2max, q);
+    if (photons) *photons = q.used;
+    if (q.used == 0) return glm::vec3(0.f);
+    float r2 = q.d2[q.used - 1];
+    if (q.used < k) {
+      // Fewer than k on this side: the density is that of the whole ball
+      // examined, up to r2max if the search reached past it, else up to the
+      // farthest candidate (the rest lay on other surfaces).
+      r2 = q.exhausted && r2max < HUGE_VALF ? r2max : q.farthest2;
     }
     r2 = std::max(r2, 1e-30f);
     const float r = std::sqrt(r2);
     glm::dvec3 sum(0.0);
     double sumL2 = 0.0;
-    constexpr float kCone = 1.1f;
-    for (int m = 0; m < used; ++m) {
-      const float w = kernel == PhotonKernel::Cone ? std::max(0.f, 1.f - std::sqrt(d2[m]) / (kCone * r)) : 1.f;
-      sum += double(w) * glm::dvec3(ph[m]->power);
-      const double l = double(w) * luminance(ph[m]->power);
+    for (int m = 0; m < q.used; ++m) {
+      const float w = kernel == PhotonKernel::Cone ? std::max(0.f, 1.f - std::sqrt(q.d2[m]) / (kCone * r)) : 1.f;
+      sum += double(w) * glm::dvec3(q.ph[m]->power);
+      const double l = double(w) * luminance(q.ph[m]->power);
       sumL2 += l * l;
     }
-    double area = M_PI * double(r2);
-    if (kernel == PhotonKernel::Cone) area *= 1.0 - 2.0 / (3.0 * kCone);
+    double area = kernel == PhotonKernel::Cone ? surface_.coneArea(x, n, r, kCone) : surface_.area(x, n, r);
+    // The gather point's own faces hold it; no area only for a point off every counted face.
+    if (!(area > 0.0)) area = M_PI * double(r2) * (kernel == PhotonKernel::Cone ? 1.0 - 2.0 / (3.0 * kCone) : 1.0);
     if (noise) *noise = std::sqrt(sumL2) / area;
     return glm::vec3(sum / area);
   }
 
   // Distance^2 to the k-th nearest photon on the same side (HUGE_VALF if fewer).
   float kthRadius2(const glm::vec3& x, const glm::vec3& n, int k) const {
-    if (size() == 0) return HUGE_VALF;
-    const size_t want = std::min<size_t>({size(), size_t(k) * 2, kMaxQuery});
-    uint32_t idx[kMaxQuery];
-    float d2[kMaxQuery];
-    const float q[3] = {x.x, x.y, x.z};
-    const size_t found = tree_->knnSearch(q, want, idx, d2);
-    int used = 0;
-    for (size_t m = 0; m < found; ++m) {
-      if (glm::dot(cloud_.all[cloud_.idx[idx[m]]].normal(), n) < 0.5f) continue;
-      if (++used == k) return d2[m];
-    }
-    return HUGE_VALF;
+    if (size() == 0 || k < 1) return HUGE_VALF;
+    Query q;
+    nearestSameSide(x, n, k, HUGE_VALF, q);
+    return q.used == k ? q.d2[k - 1] : HUGE_VALF;
   }
 
  private:
   static constexpr size_t kMaxQuery = 1024;
+  static constexpr float kCone = 1.1f;
+  // The nearest photons on n's side (at most k, within r2max), nearest first.
+  struct Query {
+    const Photon* ph[kMaxQuery];
+    float d2[kMaxQuery];
+    int used = 0;
+    bool exhausted = false;  // every photon within sqrt(farthest2) examined, and none beyond r2max left out
+    float farthest2 = 0.f;   // distance^2 of the farthest candidate examined
+  };
+  // Candidates come from the kd-tree in any orientation: 2k first, then more
+  // (up to kMaxQuery) while fewer than k (but some) lie on this side, as at a
+  // crease or corner where most of the nearest photons are on the other faces.
+  void nearestSameSide(const glm::vec3& x, const glm::vec3& n, int k, float r2max, Query& q) const {
+    const float p[3] = {x.x, x.y, x.z};
+    uint32_t idx[kMaxQuery];
+    float d2[kMaxQuery];
+    size_t want = std::min<size_t>({size(), size_t(k) * 2, kMaxQuery});
+    for (;;) {
+      const size_t found = tree_->knnSearch(p, want, idx, d2);
+      q.used = 0;
+      bool pastCap = false;
+      for (size_t m = 0; m < found && q.used < k; ++m) {
+        if (d2[m] > r2max) { pastCap = true; break; }
+        const Photon& ph = cloud_.all[cloud_.idx[idx[m]]];
+        if (glm::dot(ph.normal(), n) < kSameSide) continue;  // other side or another surface
+        q.ph[q.used] = &ph;
+        q.d2[q.used] = d2[m];
+        ++q.used;
+      }
+      q.farthest2 = found ? d2[found - 1] : 0.f;
+      q.exhausted = found < want || pastCap || (found && d2[found - 1] > r2max);
+      // None on this side among 2k: this side holds (next to) none here, as
+      // on a wall beside a caustic; the estimate is 0 without a wider search.
+      if (q.used >= k || q.used == 0 || q.exhausted || want >= std::min<size_t>(size(), kMaxQuery)) return;
+      // Enough candidates for k on this side at the share seen, with a margin.
+      want = std::min<size_t>({size(), std::max(want * 2, want * size_t(k) * 5 / (size_t(q.used) * 4)), kMaxQuery});
+    }
+  }
+  const GatherSurface& surface_;
   struct Cloud {
     const std::vector<Photon>& all;
     std::vector<uint32_t> idx;

@@ -10,6 +10,7 @@
 #include "photon_internal.h"
 #include "photon_grid.h"
 #include "photon_map.h"
+#include "photon_surface.h"
 
 namespace gi {
 
@@ -21,6 +22,9 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   std::vector<float> R2(nv, 0.f);
   std::vector<double> N(nv, 0.0);
   std::vector<glm::dvec3> tau(nv, glm::dvec3(0.0));
+  std::vector<double> A(nv, 0.0);  // area of the counted surface within each radius
+  std::vector<size_t> seen(nv, 0);  // photons gathered over all passes
+  const GatherSurface surface(s);
   const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
   // Vertices where the first pass finds fewer than k photons within the cap
   // start at the cap, or at 1% of the diagonal without one.
@@ -45,12 +49,13 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
     // the 90th percentile of the radii (most gathers visit 27 cells).
     std::unique_ptr<PhotonMap> map;
     if (pass == 0) {
-      map = std::make_unique<PhotonMap>(photons, pathMask);
+      map = std::make_unique<PhotonMap>(photons, pathMask, surface);
       parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) {
           if (!mat.valid[i]) continue;
           const float k2 = map->kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
           R2[i] = k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
+          A[i] = surface.area(s.positions[i], mat.n[i], std::sqrt(R2[i]));
         }
       });
     }
@@ -64,6 +69,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
       cell = std::max(std::sqrt(radii[q]), 1e-6f * diag);
     }
     const PhotonGrid grid(photons, pathMask, cell);
+    r.check.mapPhotons += grid.size();
     r.buildSeconds += bt.seconds();
     r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
                                                (map ? map->memoryBytes() : 0)));
@@ -77,10 +83,15 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
         size_t M = 0;
         grid.gather(s.positions[i], mat.n[i], R2[i], flux, M);
         if (M == 0) continue;
+        seen[i] += M;
         const double ratio = (N[i] + alpha * double(M)) / (N[i] + double(M));
         N[i] += alpha * double(M);
         R2[i] = float(double(R2[i]) * ratio);
-        tau[i] = (tau[i] + flux) * ratio;
+        // The flux scales with the area the radius keeps: ratio on a plane,
+        // not near a crease or border the shrinking disk moves off.
+        const double A1 = surface.area(s.positions[i], mat.n[i], std::sqrt(R2[i]));
+        tau[i] = (tau[i] + flux) * (A[i] > 0.0 && A1 > 0.0 ? A1 / A[i] : ratio);
+        A[i] = A1;
       }
     });
     r.querySeconds += qt.seconds();
@@ -92,14 +103,20 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   for (size_t i = 0; i < nv; ++i) {
     if (!mat.valid[i]) continue;
     ++valid;
+    if (seen[i] > 0) {
+      ++r.check.estimates;
+      if (seen[i] < size_t(kFewPhotons)) ++r.check.fewEstimates;
+    }
     sumR += std::sqrt(double(R2[i]));
     sumN += N[i];
     if (N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
-    const glm::dvec3 H = tau[i] / (M_PI * double(R2[i]) * opt.passes);
+    const double area = A[i] > 0.0 ? A[i] : M_PI * double(R2[i]);
+    const glm::dvec3 H = tau[i] / (area * opt.passes);
     r.H[i] = glm::vec3(H);
     // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
     r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(N[i]);
   }
+  r.check.surfaceArea = surface.totalArea();
   r.meanRadius = valid ? sumR / double(valid) : 0.0;
   r.meanCount = valid ? sumN / double(valid) : 0.0;
   return r;

@@ -9,14 +9,11 @@
 #include "gi/photon.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
+#include "photon_internal.h"
 
 namespace gi {
 
 namespace {
-
-glm::i8vec3 packNormal(const glm::vec3& n) {
-  return glm::i8vec3(int8_t(std::lround(n.x * 127.f)), int8_t(std::lround(n.y * 127.f)), int8_t(std::lround(n.z * 127.f)));
-}
 
 // A photon meets a mirror or glass face (unit normal ng) at x: its new
 // direction and power, with Russian roulette on the tint (a white mirror or

@@ -11,12 +11,16 @@
 //   - the direct light by explicit light sampling with shadow rays (default),
 //   - the caustic map: density estimate over the k nearest caustic photons on
 //     the same side with Jensen's cone filter (w = 1 - d / (1.1 r)),
-//   - the global map: uniform disk kernel, H ~ sum Phi / (pi r_k^2) over the
-//     k nearest, or a final gather that reads the map where cosine rays from
+//   - the global map: uniform kernel, H ~ sum Phi / A(r_k) over the k
+//     nearest, or a final gather that reads the map where cosine rays from
 //     the vertex land (following mirrors and glass on the way),
 //   - or, with progressive photon mapping (Hachisuka et al. 2008), per-vertex
 //     radius and flux statistics over passes of photons, the radius shrinking
 //     by alpha = 2/3, so that the estimate converges (bias and noise -> 0).
+// A(r) is the area of the surface whose photons count (facing the vertex's
+// side) inside the gather sphere: Jensen's pi r^2 on a plane, a half or a
+// quarter of it at a crease or a corner, less at a mesh border; the cone
+// filter and the progressive flux are normalised the same way.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -88,6 +92,12 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 // emitted photon than the global pass gives when the specular objects are small.
 std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                         size_t count, const Progress& progress, PhotonTraceStats& stats);
+
+// Area of the triangle abc inside the ball of centre x and radius r (exact:
+// the triangle clipped to the disk in which the sphere cuts its plane). The
+// density estimates divide by the sum of these over the faces whose photons
+// they count, instead of pi r^2, which holds only on a plane all around x.
+double triangleBallArea(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& x, double r);
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                   const Progress& progress = Progress(nullptr));

@@ -1,0 +1,57 @@
+// Parameters that make a photon-mapping result meaningless, said in the log.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "photon_internal.h"
+
+namespace gi {
+
+namespace {
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+}  // namespace
+
+void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st) {
+  // The mean distance between photons, sqrt(area / photons): a radius below
+  // it holds about pi (r / spacing)^2 < pi photons, mostly 0 or 1.
+  bool capTooSmall = false;
+  if (opt.maxRadius > 0.0 && c.mapPhotons > 0 && c.surfaceArea > 0.0) {
+    const double spacing = std::sqrt(c.surfaceArea / double(c.mapPhotons));
+    if (opt.maxRadius < spacing) {
+      capTooSmall = true;
+      st.warn("max_radius " + num(opt.maxRadius) + " is below the mean photon spacing " + num(spacing) + " (sqrt of " +
+              num(c.surfaceArea) + " diffuse area / " + std::to_string(c.mapPhotons) +
+              " photons): a gather holds 0 or 1 photon, read as the density of its whole disk, so vertex values are 0 or "
+              "many times too bright; use max_radius >= " + num(spacing * std::sqrt(opt.kNearest / M_PI)) + " (room for " +
+              std::to_string(opt.kNearest) + " photons) or more photons");
+    }
+  }
+  if (!capTooSmall && c.estimates > 0 && c.fewEstimates * 10 > c.estimates)
+    st.warn(std::to_string(c.fewEstimates) + " of " + std::to_string(c.estimates) + " density estimates hold fewer than " +
+            std::to_string(kFewPhotons) + " photons (relative noise above 50%): raise max_radius or the photon count");
+  if (c.kNearestEstimates) {
+    // k Phi / A(r_k): A(r_k) / lambda is Gamma(k)-distributed, so the
+    // estimate's mean (k / (k - 1)) is infinite at k = 1, its variance at k = 2.
+    auto kCheck = [&](const char* name, int k, size_t photons, const char* map) {
+      if (k <= 2)
+        st.warn(std::string(name) + " = " + std::to_string(k) + ": the k-nearest estimate k Phi / (pi r_k^2) has " +
+                (k == 1 ? "no finite mean" : "no finite variance") + " (r_k is random); use k >= 16");
+      else if (photons > 0 && photons < size_t(k))
+        st.warn(std::string(name) + " " + std::to_string(k) + " exceeds the " + std::to_string(photons) + " photons of the " +
+                map + ": every estimate spans them all (one blurred average); shoot more photons");
+    };
+    kCheck("k_nearest", opt.kNearest, c.mapPhotons, "global map");
+    if (c.causticPhotons > 0) kCheck("caustic_k", opt.causticK, c.causticPhotons, "caustic map");
+  }
+  if (c.lostPowerFraction > 0.05)
+    st.warn("paths cut at max_depth " + std::to_string(opt.maxDepth) + " still carried " + num(100.0 * c.lostPowerFraction) +
+            "% of the emitted power: the result is too dark by up to that; raise max_depth");
+}
+
+}  // namespace gi

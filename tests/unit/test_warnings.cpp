@@ -1,0 +1,266 @@
+// Parameters that make a result meaningless get a warning (RunStats::warn):
+// each warning appears when its cause is there, and the shipped test meshes
+// run with the default parameters without any.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "gi/ambient.h"
+#include "gi/filters.h"
+#include "gi/photon.h"
+#include "gi/scene_setup.h"
+#include "gi/scenes.h"
+#include "mesh_io.h"
+
+using namespace gi;
+
+namespace {
+
+bool warned(const RunStats& st, const std::string& what) {
+  for (const auto& w : st.warnings)
+    if (w.find(what) != std::string::npos) return true;
+  return false;
+}
+
+std::string all(const RunStats& st) {
+  std::string s;
+  for (const auto& w : st.warnings) s += w + " | ";
+  return s;
+}
+
+// A closed unit box, rho = 0.5, every face emitting E = 1: B = 2 everywhere,
+// 6 of diffuse area.
+Scene litBox(int n = 8, float rho = 0.5f) {
+  auto sf = scenes::closedBox(1.0, n, true);
+  scenes::setUniform(sf, glm::vec3(rho), glm::vec3(1.f));
+  return sf.scene;
+}
+
+}  // namespace
+
+// A gather radius cap below the mean photon spacing sqrt(area / photons):
+// 20k paths in the box (all light from one map of about 40k photons: spacing
+// sqrt(6 / 40k) = 0.012). At a fifth of the spacing a gather holds pi / 25
+// photons on average: most vertices read 0, those that hold one read
+// Phi / (pi r^2), 25 / pi = 8 times the true value, and it is said. At four
+// spacings (room for 50 photons) or without a cap, nothing is said.
+TEST(PhotonWarnings, GatherRadiusBelowThePhotonSpacing) {
+  const Scene s = litBox();
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions o;
+  o.photons = 20000;
+  o.directLight = false;
+  const VertexRadiometry free = computePhotonMap(s, *caster, o);
+  EXPECT_TRUE(free.stats.warnings.empty()) << all(free.stats);
+  const double spacing = std::sqrt(6.0 / free.stats.get("photons_global_map"));
+  o.maxRadius = 0.2 * spacing;
+  const VertexRadiometry tiny = computePhotonMap(s, *caster, o);
+  EXPECT_TRUE(warned(tiny.stats, "below the mean photon spacing")) << all(tiny.stats);
+  float brightest = 0.f;
+  for (const auto& b : tiny.B) brightest = std::max(brightest, b.g);
+  EXPECT_GT(brightest, 5.f * 2.f);  // the symptom the warning names
+  o.maxRadius = 4.0 * spacing;
+  const VertexRadiometry wide = computePhotonMap(s, *caster, o);
+  EXPECT_TRUE(wide.stats.warnings.empty()) << all(wide.stats);
+  o.progressive = true;
+  o.passes = 2;
+  o.maxRadius = 0.1 * spacing;  // the two passes' photons together: spacing / sqrt(2)
+  EXPECT_TRUE(warned(computePhotonMap(s, *caster, o).stats, "below the mean photon spacing"));
+}
+
+// A cap just above the spacing (1.1 x: 3.8 photons per gather on average)
+// leaves most estimates with fewer than 4 photons: said as such (the cap is
+// not below the spacing).
+TEST(PhotonWarnings, EstimatesOfAHandfulOfPhotons) {
+  const Scene s = litBox();
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions o;
+  o.photons = 20000;
+  o.directLight = false;
+  const double spacing = std::sqrt(6.0 / computePhotonMap(s, *caster, o).stats.get("photons_global_map"));
+  o.maxRadius = 1.1 * spacing;
+  const VertexRadiometry r = computePhotonMap(s, *caster, o);
+  EXPECT_TRUE(warned(r.stats, "hold fewer than 4 photons")) << all(r.stats);
+  EXPECT_FALSE(warned(r.stats, "below the mean photon spacing"));
+  o.finalGather = true;  // the final gather's lookups are counted too
+  o.directLight = true;
+  o.gatherRays = 8;
+  const VertexRadiometry g = computePhotonMap(s, *caster, o);
+  EXPECT_TRUE(warned(g.stats, "hold fewer than 4 photons")) << all(g.stats);
+}
+
+// k = 1: k Phi / A(r_k) has no finite mean (A(r_k) lambda is Gamma(1), E[1/X]
+// diverges); k = 2: no finite variance; k = 3 is fine. The same for caustic_k
+// where a caustic map is read; k beyond the photons of the map: every
+// estimate spans the whole map.
+TEST(PhotonWarnings, KNearestBelowThreeOrAboveTheMap) {
+  const Scene s = litBox(4);
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions o;
+  o.photons = 2000;
+  for (int k : {1, 2, 3}) {
+    o.kNearest = k;
+    const RunStats st = computePhotonMap(s, *caster, o).stats;
+    EXPECT_EQ(warned(st, "k_nearest = " + std::to_string(k)), k < 3) << k << ": " << all(st);
+    EXPECT_EQ(warned(st, k == 1 ? "no finite mean" : "no finite variance"), k < 3) << k;
+  }
+  o.kNearest = 64;
+  o.photons = 5;  // about 5 photons in the global map
+  EXPECT_TRUE(warned(computePhotonMap(s, *caster, o).stats, "exceeds the")) << "k_nearest 64 with 5 paths";
+  o.photons = 2000;
+  o.progressive = true;  // k only sets the first radius there (whose few photons are said)
+  o.kNearest = 1;
+  o.passes = 2;
+  EXPECT_FALSE(warned(computePhotonMap(s, *caster, o).stats, "k_nearest"));
+  const Scene caustic = scenes::causticCornell(100.0, 50.0, 2, 1.5f);
+  auto cc = makeEmbreeCaster(caustic);
+  PhotonOptions c;
+  c.photons = 20000;
+  c.lightSamples = 4;
+  c.causticK = 1;
+  EXPECT_TRUE(warned(computePhotonMap(caustic, *cc, c).stats, "caustic_k = 1"));
+}
+
+// Paths cut at max_depth: in the box with rho = 0.9 a path survives two
+// bounces with probability 0.81, so max_depth 2 leaves most of the power
+// unaccounted for: said; the default 32 with rho = 0.5 (0.5^32) says nothing.
+TEST(PhotonWarnings, PathsCutAtMaxDepth) {
+  const Scene bright = litBox(4, 0.9f);
+  auto caster = makeEmbreeCaster(bright);
+  PhotonOptions o;
+  o.photons = 5000;
+  o.maxDepth = 2;
+  EXPECT_TRUE(warned(computePhotonMap(bright, *caster, o).stats, "max_depth 2"));
+  const Scene s = litBox(4);
+  auto c2 = makeEmbreeCaster(s);
+  o.maxDepth = 32;
+  EXPECT_TRUE(computePhotonMap(s, *c2, o).stats.warnings.empty());
+}
+
+// Ambient occlusion's maximum distance within 10 ray offsets (1e-5 of the
+// diagonal each) measures where rays start; below a tenth of the median edge
+// a vertex sees only its own faces; 10% of the diagonal says nothing.
+TEST(AmbientWarnings, MaxDistanceAgainstTheOffsetAndTheMesh) {
+  const auto sf = scenes::floorWithWall(4.0, 1.0, 20);
+  const Scene& s = sf.scene;
+  auto caster = makeEmbreeCaster(s);
+  const SceneScale scale = sceneScale(s);
+  for (AmbientMode mode : {AmbientMode::Occlusion, AmbientMode::Obscurance}) {
+    AmbientOptions o;
+    o.mode = mode;
+    o.raysPerVertex = 16;
+    o.maxDistance = 5.0 * scale.rayEpsilon;
+    EXPECT_TRUE(warned(computeAmbient(s, *caster, o).stats, "within 10 ray offsets"));
+    o.maxDistance = 0.01;  // the patch edge is 0.2: median edge about 0.2
+    EXPECT_TRUE(warned(computeAmbient(s, *caster, o).stats, "median edge length"));
+    o.maxDistance = 0.1 * scale.diagonal;
+    const RunStats st = computeAmbient(s, *caster, o).stats;
+    EXPECT_TRUE(st.warnings.empty()) << all(st);
+  }
+}
+
+// Sky lighting without light; a point sun (angular radius 0) with many sun
+// rays; adaptive sampling whose target the maximum ray count cannot reach
+// (target 1e-3 needs about 250 000 rays at AO 0.5: 64 are allowed).
+TEST(AmbientWarnings, SkyWithoutLightPointSunAndUnmetTarget) {
+  const auto sf = scenes::floorWithWall(4.0, 1.0, 10);
+  auto caster = makeEmbreeCaster(sf.scene);
+  AmbientOptions o;
+  o.mode = AmbientMode::Sky;
+  o.raysPerVertex = 16;
+  o.sunRays = 8;
+  EXPECT_TRUE(computeAmbient(sf.scene, *caster, o).stats.warnings.empty());
+  o.skyIrradiance = 0.f;
+  o.sunIrradiance = 0.f;
+  EXPECT_TRUE(warned(computeAmbient(sf.scene, *caster, o).stats, "no light"));
+  o.sunIrradiance = 3.f;
+  o.sunAngularRadiusDeg = 0.f;
+  EXPECT_TRUE(warned(computeAmbient(sf.scene, *caster, o).stats, "point sun"));
+  o.sunRays = 1;
+  EXPECT_FALSE(warned(computeAmbient(sf.scene, *caster, o).stats, "point sun"));
+  AmbientOptions a;
+  a.targetError = 1e-3;
+  a.minRays = 32;
+  a.maxRays = 64;
+  EXPECT_TRUE(warned(computeAmbient(sf.scene, *caster, a).stats, "the target is not met"));
+  a.targetError = 0.05;
+  a.maxRays = 4096;
+  const RunStats st = computeAmbient(sf.scene, *caster, a).stats;
+  EXPECT_TRUE(st.warnings.empty()) << all(st);
+}
+
+// The shipped meshes with every filter's default parameters, as the CLI
+// runs them (defaults scaled by the diagonal, colours and quality into rho
+// and emitters, layers named mirror/glass): no warning. Photon mapping on
+// the scenes with emitters (the others have no light); its final gather and
+// progressive modes on the Cornell box.
+TEST(Warnings, ShippedMeshesWithDefaultsSayNothing) {
+  namespace fs = std::filesystem;
+  std::vector<std::vector<std::string>> scenesFiles;
+  for (const auto& e : fs::directory_iterator(GI_TEST_MESHES)) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".ply" || name.rfind("caustic_cornell", 0) == 0) continue;
+    scenesFiles.push_back({e.path().string()});
+  }
+  const std::string dir = std::string(GI_TEST_MESHES) + "/";
+  scenesFiles.push_back({dir + "caustic_cornell_box.ply", dir + "caustic_cornell_glass_sphere.ply",
+                         dir + "caustic_cornell_mirror.ply"});
+  std::sort(scenesFiles.begin(), scenesFiles.end());
+  ASSERT_GE(scenesFiles.size(), 12u);
+  for (const auto& files : scenesFiles) {
+    io::LoadedMesh mesh = io::loadMesh(files[0]);
+    std::vector<LayerRange> layers{{fs::path(files[0]).filename().string(), 0, mesh.scene.faceCount()}};
+    for (size_t k = 1; k < files.size(); ++k) {
+      const size_t off = mesh.scene.faceCount();
+      io::appendMesh(mesh, io::loadMesh(files[k]));
+      layers.push_back({fs::path(files[k]).filename().string(), off, mesh.scene.faceCount() - off});
+    }
+    const double diag = analyzeScene(mesh.scene).diagonal;
+    for (FilterKind kind : {FilterKind::AmbientOcclusion, FilterKind::AmbientObscurance, FilterKind::SkyLighting,
+                            FilterKind::PhotonMapping}) {
+      SCOPED_TRACE(files[0] + ", " + filterDesc(kind).cliName);
+      const auto specs = filterSpecs(kind);
+      ParamValues v = defaultValues(specs, diag);
+      Scene s = mesh.scene;
+      const bool lighting = kind == FilterKind::PhotonMapping;
+      if (lighting || findSpec(specs, "reflectance_source")) {
+        ASSERT_FALSE(applySceneConventions(s, mesh.attrs, v, lighting).has_value());
+      }
+      if (findSpec(specs, "mirror_layers")) {
+        ASSERT_FALSE(applyMaterials(s, layers, v).has_value());
+      }
+      if (!lighting) {
+        const AmbientMode mode = kind == FilterKind::AmbientOcclusion   ? AmbientMode::Occlusion
+                                 : kind == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
+                                                                         : AmbientMode::Sky;
+        const AmbientOptions o = AmbientOptions::fromParams(mode, v);
+        auto caster = makeEmbreeCaster(s, o.batch);
+        const RunStats st = computeAmbient(s, *caster, o).stats;
+        EXPECT_TRUE(st.warnings.empty()) << all(st);
+        continue;
+      }
+      if (analyzeScene(s).emitterFaces == 0) continue;
+      auto caster = makeEmbreeCaster(s);
+      PhotonOptions o = PhotonOptions::fromParams(v, s.origin);
+      o.lightSamples = 16;  // the direct light plays no part in the warnings
+      const RunStats st = computePhotonMap(s, *caster, o).stats;
+
+      EXPECT_TRUE(st.warnings.empty()) << all(st);
+      if (files[0].find("cornell_box.ply") == std::string::npos || files.size() > 1) continue;
+      for (int mode : {0, 1}) {
+        // Fewer gather rays and passes than the defaults: the share of thin
+        // estimates is the same per ray, and fewer photons can only add warnings.
+        PhotonOptions m = o;
+        m.finalGather = mode == 0;
+        m.gatherRays = 16;
+        m.progressive = mode == 1;
+        m.passes = 2;
+        const RunStats sm = computePhotonMap(s, *caster, m).stats;
+        EXPECT_TRUE(sm.warnings.empty()) << (mode == 0 ? "final gather: " : "progressive: ") << all(sm);
+      }
+    }
+  }
+}
