@@ -65,55 +65,6 @@ FormFactorRow FormFactors::row(uint32_t i) const {
   }
 }
 
-FormFactorRow FormFactors::analyticRow(uint32_t i) const {
-  FormFactorRow r;
-  const auto& t = s_.triangles[i];
-  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
-  const glm::vec3 n = normal_[i];
-  const int K = std::max(1, set_.analyticPoints);
-  std::vector<glm::vec3> xs(static_cast<size_t>(K));
-  SobolOwenStream pts(hash3(i, set_.seed, 0xf3u));
-  for (auto& x : xs) {
-    const glm::vec2 bc = uniformTriangle(pts.next());
-    const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
-    x = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
-  }
-  Rng rng(hash3(i, set_.seed, 0xf4u));
-  double total = 0;
-  uint64_t rays = 0, far = 0;
-  for (uint32_t j = 0; j < uint32_t(s_.faceCount()); ++j) {
-    if (j == i || !ok_[j]) continue;
-    // Negligible far pairs: F <= A_j / (pi d^2) for any point of i, with d a
-    // lower bound of the distance between the two triangles' bounding spheres.
-    const double d = glm::length(centroid_[i] - centroid_[j]) - radius_[i] - radius_[j];
-    if (d > 0 && area_[j] / (M_PI * d * d) < kNegligibleF) { ++far; continue; }
-    const auto& tj = s_.triangles[j];
-    const glm::dvec3 pa(s_.positions[tj.x]), pb(s_.positions[tj.y]), pc(s_.positions[tj.z]);
-    double F = 0;
-    for (const glm::vec3& x : xs) {
-      if (glm::dot(normal_[j], x - s_.positions[tj.x]) <= 0.f) continue;  // j faces away from x
-      const double f = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), pa, pb, pc);
-      if (f <= 0) continue;
-      if (!unoccluded_) {
-        ++rays;
-        if (!visibleToRandomPoint(caster_, x, s_.positions[tj.x], s_.positions[tj.y], s_.positions[tj.z], rng, eps_))
-          continue;
-      }
-      F += f;
-    }
-    F /= K;
-    if (F > 0) {
-      r.j.push_back(j);
-      r.F.push_back(float(F));
-      total += F;
-    }
-  }
-  rays_[i] += rays;
-  farSkipped_[i] += far;
-  r.escaped = float(std::max(0.0, 1.0 - total));
-  return r;
-}
-
 FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,
                                    uint32_t face, int reciprocityChecks) {
   if (face >= s.faceCount()) throw std::invalid_argument("face " + std::to_string(face) + " does not exist");
@@ -195,18 +146,21 @@ FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
   const glm::vec3 n = normal_[i];
   const Frame frame(n);
-  // Two independently scrambled 2D sequences (points, directions): padding.
-  SobolOwenStream pts(hash3(i, seed, 0xf1u)), dirs(hash3(i, seed, 0xf2u));
+  // Origin (dimension 0) and direction (dimension 1) of ray k from a padded
+  // sampler: independent index shuffles, so a ray's origin on the patch says
+  // nothing about its direction (two streams stepped together did, and the
+  // row did not converge to F on large patches).
+  const PaddedSobol smp(hash3(i, seed, 0xf1u));
   std::vector<uint32_t> hits;
   hits.reserve(size_t(N));
   int lost = 0;
   Ray ray;
   for (int k = 0; k < N; ++k) {
-    const glm::vec2 bc = uniformTriangle(pts.next());
+    const glm::vec2 bc = uniformTriangle(smp(uint32_t(k), 0));
     // Keep the origin strictly inside the triangle, then lift it off the plane.
     const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
     ray.o = w0 * a + w1 * b + (1.f - w0 - w1) * c + n * eps_;
-    ray.d = frame.toWorld(cosineHemisphere(dirs.next()));
+    ray.d = frame.toWorld(cosineHemisphere(smp(uint32_t(k), 1)));
     ray.tnear = 0.f;
     ray.tfar = std::numeric_limits<float>::infinity();
     const Hit h = caster_.intersect(ray);

@@ -40,6 +40,7 @@ class FormFactors {
     int analyticPoints = 4;
     int hemicubeResolution = 128;
     uint32_t seed = 0;
+    int hemicubePoints = 1;  // hemicube views per patch (1: the centre; more: placed adaptively)
   };
   FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings);
   FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
@@ -59,6 +60,7 @@ class FormFactors {
   FormFactorRow monteCarloRow(uint32_t i) const;
   FormFactorRow analyticRow(uint32_t i) const;
   FormFactorRow hemicubeRow(uint32_t i) const;
+  double hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F) const;
   const Scene& s_;
   const RayCaster& caster_;
   Settings set_;

@@ -43,13 +43,36 @@ inline uint32_t sobol1(uint32_t index) { return reverseBits(index); }
 
 // Owen-scrambled 2D Sobol point `i` of the sequence keyed by `key`
 // (e.g. hash of element and seed). Each key gives an independent randomised
-// sequence whose prefixes of 2^k points are stratified.
+// sequence whose prefixes of 2^k points are stratified. The index itself is
+// Owen-scrambled first (its first 2^k values map onto one aligned block of
+// 2^k Sobol indices, which is again a (0,k,2)-net), so two keys give
+// independent sequences even when stepped with the same i.
 glm::vec2 sobolOwen2D(uint32_t i, uint32_t key);
+
+// Independent 2D dimensions of one sample index ("padding", Burley 2020,
+// section 4): dimension pair `dim` of sample i is sobolOwen2D(i, key of dim),
+// so each pair has its own index shuffle and scrambles. Every pair alone is
+// a stratified (0,k,2)-net on power-of-two prefixes, and the pairs are
+// independent of each other. Use it wherever one estimate consumes two or
+// more 2D draws (origin and direction, light point and direction):
+// two Owen-scrambled streams stepped with the same index and no index
+// shuffle share their leading digits, which ties e.g. a ray's origin on a
+// patch to its direction and biases the estimate.
+class PaddedSobol {
+ public:
+  explicit PaddedSobol(uint32_t key) : key_(key) {}
+  glm::vec2 operator()(uint32_t i, uint32_t dim) const { return sobolOwen2D(i, hashCombine(key_, 0x2545f491u * (dim + 1u))); }
+
+ private:
+  uint32_t key_;
+};
 
 // The same kind of sequence, generated in order at O(1) per point: Sobol
 // points in Gray-code order (every power-of-two prefix is the same point set
 // as in natural order), each dimension Owen-scrambled with its own seed.
-// No index shuffle: used where every vertex starts at index 0.
+// No index shuffle: only for an estimate that draws ONE 2D point per sample
+// (AO's directions); two such streams stepped together are correlated (use
+// PaddedSobol).
 struct SobolRevDir1 {
   uint32_t v[32];
   constexpr SobolRevDir1() : v() {
