@@ -203,9 +203,8 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       Rng rng(hash3(uint32_t(i), seed, 0xd5u));
       glm::dvec3 sum(0.0);
       for (int k = 0; k < points; ++k) {
-        const glm::vec2 bc = uniformTriangle(smp(uint32_t(k), 0));
-        const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
-        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] +
+        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
+        const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] +
                             n * direct.eps();
         sum += glm::dvec3(direct.estimate(x, n, smp, uint32_t(k), rng, uint32_t(i)));
       }

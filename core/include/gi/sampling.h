@@ -134,6 +134,13 @@ glm::vec3 uniformCone(glm::vec2 u, float cosMax);
 // Uniform point on a triangle: barycentrics (b1, b2) (Heitz 2019 low-distortion warp).
 glm::vec2 uniformTriangle(glm::vec2 u);
 
+// Barycentrics (b1, b2) pulled towards the centroid by 1e-5 of the
+// triangle: a ray origin strictly inside (one on an edge can slip through the
+// neighbour's edge), in a band too thin to bias an estimate. (A pull of 2e-3
+// cost 1.1% of F from a thin patch to one at its common edge, where the
+// integrand is 20 times its mean.)
+inline glm::vec2 strictlyInside(glm::vec2 b) { return b * (1.f - 3e-5f) + 1e-5f; }
+
 // Orthonormal basis with n as z (Duff et al. 2017).
 struct Frame {
   glm::vec3 t, b, n;
