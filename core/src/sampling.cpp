@@ -5,43 +5,6 @@
 
 namespace gi {
 
-namespace {
-// Direction numbers of Sobol dimension 2 (primitive polynomial x + 1):
-// v_0 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1); the XOR of the v_k selected
-// by each byte of the index, tabulated (the shuffled indices of PaddedSobol
-// use all 32 bits).
-struct Sobol2Table {
-  uint32_t t[4][256];
-  constexpr Sobol2Table() : t() {
-    uint32_t v[32] = {};
-    v[0] = 0x80000000u;
-    for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
-    for (int byte = 0; byte < 4; ++byte)
-      for (int b = 0; b < 256; ++b) {
-        uint32_t x = 0;
-        for (int bit = 0; bit < 8; ++bit)
-          if (b & (1 << bit)) x ^= v[8 * byte + bit];
-        t[byte][b] = x;
-      }
-  }
-};
-constexpr Sobol2Table kSobol2{};
-}  // namespace
-
-uint32_t sobol2(uint32_t index) {
-  return kSobol2.t[0][index & 0xffu] ^ kSobol2.t[1][(index >> 8) & 0xffu] ^ kSobol2.t[2][(index >> 16) & 0xffu] ^
-         kSobol2.t[3][index >> 24];
-}
-
-glm::vec2 sobolOwen2D(uint32_t i, uint32_t key) {
-  // Shuffle the index (Owen scramble of the index), then scramble each
-  // dimension with its own seed: Burley 2020, section 4.
-  uint32_t idx = nestedUniformScramble(i, hash32(key));
-  uint32_t x = nestedUniformScramble(sobol1(idx), hashCombine(key, 0x68bc21ebu));
-  uint32_t y = nestedUniformScramble(sobol2(idx), hashCombine(key, 0x02e5be93u));
-  return {toUnitFloat(x), toUnitFloat(y)};
-}
-
 // sin and cos on [-pi/4, pi/4].
 static inline void fastSinCos(float x, float& s, float& c) {
   const float x2 = x * x;
