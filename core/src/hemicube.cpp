@@ -1,5 +1,6 @@
 // The hemicube (Cohen and Greenberg 1985), on the CPU: at the centre of patch
-// i, every other patch is projected onto the five faces of a unit hemicube
+// i (or at the centroids of parts of it, F_ij then their area-weighted mean),
+// every other patch is projected onto the five faces of a unit hemicube
 // and scan-converted with a depth buffer; each cell's delta form factor goes
 // to the patch it shows,
 //   top face (z = 1):   dF = dA / (pi (x^2 + y^2 + 1)^2)
