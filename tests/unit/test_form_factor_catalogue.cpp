@@ -115,9 +115,10 @@ TEST(FormFactorCatalogue, ClosedForms) {
 // that here, measured over 8 seeds; Convergence.FormFactorsMonteCarlo), so
 // 4 binomial standard errors bound a correct estimator's error with a
 // false-failure probability below 1e-4 per case (normal tail). Tolerance:
-// the larger of that and 0.5%. Relative: 0.5% for the four cases with
-// F > 0.2, 1.1% for F = 0.024 and 3.4% for F = 0.0032 (there 262,144 rays
-// per triangle give about 840 hits: 0.5% would need 40 times more).
+// the larger of that and 0.5%: 0.5% to 1.1% for the four cases with F
+// from 0.2 to 0.64, 3.5% for F = 0.024 and 9.8% for F = 0.0032 (262,144 rays per
+// triangle meet that 0.1 x 0.1 square about 830 times; a standard error of
+// 0.5% would take 24 times more rays).
 TEST(FormFactorCatalogue, MonteCarlo) {
   const int N = 262144;
   for (const Case& c : catalogue()) {
