@@ -106,9 +106,9 @@ std::vector<ParamSpec> formFactorSpecs() {
        "leaves the scene or meets a back face is lost (absorbed).",
        ParamType::Enum, 0, 0, 0, {"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
       {"rays_per_patch", "Rays per patch (Monte Carlo)",
-       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N) or faster (about "
-       "sqrt(F_ij / N) for a small F_ij: 262,144 rays leave 2% on F = 0.003); the radiosity error averages over "
-       "many patches and falls faster.",
+       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N) or faster; for a small "
+       "F_ij it is about 1/sqrt(N F_ij) of it (3.4% for F = 0.003 at 262,144 rays). The radiosity error averages "
+       "over many patches and falls faster.",
        ParamType::Int, 1024, 16, 1 << 22},
       {"analytic_points", "Points per patch (analytic)",
        "Base points per patch: the patch is split into 4^L similar triangles (this number rounded down to a power "

@@ -92,7 +92,8 @@ inline glm::vec2 sobolOwen2D(uint32_t i, uint32_t key) { return sobolOwen2D(i, S
 
 // Independent 2D dimensions of one sample index ("padding", Burley 2020,
 // section 4): dimension pair `dim` of sample i is sobolOwen2D(i, key of dim),
-// so each pair has its own index shuffle and scrambles. Every pair alone is
+// so each pair has its own index shuffle (but the first, which needs none)
+// and its own scrambles. Every pair alone is
 // a stratified (0,k,2)-net on power-of-two prefixes, and the pairs are
 // independent of each other. Use it wherever one estimate consumes two or
 // more 2D draws (origin and direction, light point and direction):
