@@ -91,13 +91,83 @@ class Tracer {
                                   "quality), no sky, no sun and no point light");
   }
 
-  // One-sample estimate of the irradiance at x (unit normal n, the lit side).
-  glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int depth, Rng& rng, uint64_t& rays) const {
-    glm::vec3 H = nextEvent(x, n, rng, rays);
-    const glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
-    const float pdfB = glm::dot(n, w) * 0.318309886f;
-    if (pdfB > 0.f) H += float(M_PI) * radiance(x, w, pdfB, depth, rng, rays);  // cos / pdf = pi
-    return H;
+  // One-sample estimate of the irradiance at x (unit normal n, the lit side):
+  // next-event estimation there, then the path continued by cosine-weighted
+  // sampling, bounce after bounce in a loop (never recursion: a path between
+  // white mirrors can run to max_depth = 100,000 bounces). beta is the path
+  // throughput: what a radiance arriving at the current vertex adds to H.
+  glm::vec3 irradiance(const glm::vec3& x0, const glm::vec3& n0, Rng& rng, uint64_t& rays) const {
+    glm::vec3 H(0.f);
+    glm::vec3 beta(1.f);
+    glm::vec3 x = x0, n = n0;
+    int depth = 0;
+    for (;;) {
+      // A diffuse vertex x (normal n) at `depth` bounces from the start.
+      H += beta * nextEvent(x, n, rng, rays);
+      glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
+      float pdfB = glm::dot(n, w) * 0.318309886f;
+      if (!(pdfB > 0.f)) return H;
+      beta *= float(M_PI);  // cos / pdf = pi
+      // Follow w through mirrors and glass to the next diffuse vertex.
+      // afterSpecular: the direction came from a mirror or glass (a delta
+      // distribution next-event estimation cannot sample, so emitters and
+      // the sun count fully).
+      bool afterSpecular = false;
+      for (;;) {
+        Ray ray;
+        ray.o = x;
+        ray.d = w;
+        ++rays;
+        const Hit h = caster_.intersect(ray);
+        if (!h.valid()) {
+          glm::vec3 L = o_.skyRadiance;
+          if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
+            L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
+          return H + beta * L;
+        }
+        const glm::vec3 ng = faceN_[h.face];
+        const Material m = s_.faceMaterial(h.face);
+        if (!isSpecular(m)) {
+          const float cosY = -glm::dot(ng, w);
+          if (cosY <= 0.f) return H;  // a back face: black, as in the radiosity filter
+          const glm::vec3 E = s_.faceEmission(h.face);
+          if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
+            const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
+            H += beta * (E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL)));
+          }
+          const glm::vec3 rho = s_.faceRho(h.face);
+          const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
+          if (!(q > 0.f) || depth >= o_.maxDepth) return H;
+          float scale = 1.f;
+          if (depth >= 3) {  // Russian roulette
+            if (rng.next() >= q) return H;
+            scale = 1.f / q;
+          }
+          beta *= rho * 0.318309886f * scale;
+          x = x + w * h.t + ng * eps_;
+          n = ng;
+          ++depth;
+          break;
+        }
+        // A mirror or glass hit: continue in the sampled specular direction.
+        if (depth >= o_.maxDepth) return H;
+        const glm::vec3 y = x + w * h.t;
+        const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
+        const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(h.face), ior, rng.next());
+        glm::vec3 weight = ev.weight * ev.radianceScale;
+        if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
+          const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
+          if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return H;
+          weight /= q;
+        }
+        beta *= weight;
+        x = y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
+        w = ev.d;
+        pdfB = 0.f;
+        afterSpecular = true;
+        ++depth;
+      }
+    }
   }
 
  private:
@@ -130,62 +200,6 @@ class Tracer {
       H += pointLightIrradiance(o_.point, caster_, x, n);
     }
     return H;
-  }
-
-  // Radiance arriving at the ray's origin from direction w, sampled with
-  // solid-angle density pdfB (for the MIS weight of emitters it hits);
-  // afterSpecular: the direction came from a mirror or glass (a delta
-  // distribution next-event estimation cannot sample, so emitters count fully).
-  glm::vec3 radiance(const glm::vec3& o, const glm::vec3& w, float pdfB, int depth, Rng& rng, uint64_t& rays,
-                     bool afterSpecular = false) const {
-    Ray ray;
-    ray.o = o;
-    ray.d = w;
-    ++rays;
-    const Hit h = caster_.intersect(ray);
-    if (!h.valid()) {
-      glm::vec3 L = o_.skyRadiance;
-      if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
-        L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
-      return L;
-    }
-    const glm::vec3 ng = faceN_[h.face];
-    const Material m = s_.faceMaterial(h.face);
-    if (isSpecular(m)) return specular(o + w * h.t, w, ng, h.face, m, depth, rng, rays);
-    const float cosY = -glm::dot(ng, w);
-    if (cosY <= 0.f) return glm::vec3(0.f);  // a back face: black, as in the radiosity filter
-    glm::vec3 L(0.f);
-    const glm::vec3 E = s_.faceEmission(h.face);
-    if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
-      const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
-      L += E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL));
-    }
-    const glm::vec3 rho = s_.faceRho(h.face);
-    const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
-    if (!(q > 0.f) || depth >= o_.maxDepth) return L;
-    float scale = 1.f;
-    if (depth >= 3) {  // Russian roulette
-      if (rng.next() >= q) return L;
-      scale = 1.f / q;
-    }
-    const glm::vec3 y = o + w * h.t + ng * eps_;
-    return L + rho * 0.318309886f * scale * irradiance(y, ng, depth + 1, rng, rays);
-  }
-
-  // A mirror or glass hit at x: continue in the sampled specular direction.
-  glm::vec3 specular(const glm::vec3& x, const glm::vec3& w, const glm::vec3& ng, uint32_t face, Material m, int depth,
-                     Rng& rng, uint64_t& rays) const {
-    if (depth >= o_.maxDepth) return glm::vec3(0.f);
-    const float ior = s_.ior.empty() ? 1.5f : s_.ior[face];
-    const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(face), ior, rng.next());
-    glm::vec3 weight = ev.weight * ev.radianceScale;
-    if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
-      const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
-      if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return glm::vec3(0.f);
-      weight /= q;
-    }
-    const glm::vec3 y = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
-    return weight * radiance(y, ev.d, 0.f, depth + 1, rng, rays, true);
   }
 
   const Scene& s_;
@@ -222,7 +236,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     Accum& a = acc[i];
     for (int k = 0; k < count; ++k) {
       Rng rng(hash3(uint32_t(i), uint32_t(a.n), opt.seed ^ 0x9a7eu));
-      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], 0, rng, rays[i]);
+      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], rng, rays[i]);
       const double l = luminance(mat.rho[i] * H);
       a.n += 1;
       a.sumL += l;

@@ -7,7 +7,8 @@
 // (next-event estimation) and combined with the BSDF-sampled hits by multiple
 // importance sampling (power heuristic, Veach 1997). Lights: area emitters,
 // a uniform sky, a sun disk and a point or spot light. Mirror and glass faces
-// (gi/specular.h) are followed in their sampled specular direction; emitters
+// (gi/specular.h) are followed in their sampled specular direction (paths are
+// traced in a loop with a throughput, never by recursion); emitters
 // seen through them count fully (next-event estimation cannot sample them)
 // and shadow rays stop at them. Radiance is scaled by eta^2 across glass
 // (cancelling on paths that enter and leave). Random numbers are
