@@ -59,7 +59,7 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.maxSamples = v.getInt("max_samples");
   o.maxDepth = v.getInt("max_depth");
   o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
-  o.sunDirection = glm::normalize(v.getVec("sun_direction"));
+  o.sunDirection = v.getDirection("sun_direction");
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
   o.point = pointLightFromParams(v, origin);
