@@ -132,6 +132,7 @@ void replaceWithRefined(BridgeScene& b, const RefinedMesh& m, std::vector<glm::v
   const MeshAttributes refinedAttrs = refineAttributes(b.attrs, m);
   Scene s;
   s.origin = m.scene.origin;
+  s.unit = m.scene.unit;
   MeshAttributes a;
   std::vector<glm::vec3> Bv(nv), Bf(nf);
   for (size_t i = 0; i < nv; ++i) {

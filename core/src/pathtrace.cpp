@@ -220,7 +220,10 @@ struct Accum {
 
 }  // namespace
 
-PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& opt, const Progress& progress) {
+PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& optWorld,
+                          const Progress& progress) {
+  PathTraceOptions opt = optWorld;
+  opt.point = pointLightInLocalUnits(optWorld.point, s);
   if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
     throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
   Timer timer;

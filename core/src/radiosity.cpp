@@ -120,12 +120,14 @@ struct Setup {
   size_t n;
   std::vector<double> A;
   std::vector<glm::vec3> E, rho, Hd;  // emission, reflectance, direct irradiance
-  double P = 0;  // emitted power (luminance), W
+  double P = 0;  // emitted power (luminance), local units
+  double unit2 = 1;  // world area of one local unit of area (Scene::unit^2)
 };
 
 Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd) {
   Setup u;
   u.n = s.faceCount();
+  u.unit2 = s.unit * s.unit;
   const auto ok = usableFaceMask(s);
   u.A.resize(u.n);
   u.E.resize(u.n);
@@ -165,9 +167,9 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
     absorbed += u.A[i] * luminance((glm::vec3(1.f) - u.rho[i]) * H);
     escaped += u.A[i] * (luminance(R[i]) * r.escaped - luminance(u.Hd[i]));
   }
-  st.add("emitted_power_W", u.P);
-  st.add("absorbed_power_W", absorbed);
-  st.add("escaped_power_W", escaped);
+  st.add("emitted_power_W", u.P * u.unit2);
+  st.add("absorbed_power_W", absorbed * u.unit2);
+  st.add("escaped_power_W", escaped * u.unit2);
   st.add("energy_balance_error", std::fabs(u.P - absorbed - escaped) / u.P);
 }
 

@@ -188,6 +188,7 @@ struct MeshRefiner::Impl {
   void publish() {
     RefinedMesh& m = mesh;
     m.scene.origin = base.origin;
+    m.scene.unit = base.unit;
     m.scene.positions = positions;
     m.scene.vertexNormals = normals;
     const size_t n = faces.size();

@@ -106,6 +106,13 @@ PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& origin) 
   return p;
 }
 
+PointLight pointLightInLocalUnits(const PointLight& L, const Scene& s) {
+  PointLight p = L;
+  p.position = glm::vec3(glm::dvec3(L.position) / s.unit);
+  p.intensity = glm::vec3(glm::dvec3(L.intensity) / (s.unit * s.unit));
+  return p;
+}
+
 bool matchesLayerPatterns(const std::string& name, const std::string& patterns) {
   std::stringstream ss(patterns);
   std::string item;

@@ -38,7 +38,7 @@ struct PathTraceOptions {
   glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
-  PointLight point;                // optional point or spot light (local coordinates)
+  PointLight point;                // optional point or spot light (relative to the scene origin, world units)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
