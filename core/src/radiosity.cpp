@@ -1,6 +1,7 @@
 #include "gi/radiosity.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <atomic>
 #include <cmath>
@@ -41,8 +42,12 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "relative to the emitted power, is below this.",
        ParamType::Float, 1e-4, 1e-12, 1.0},
       {"max_iterations", "Maximum iterations",
-       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement).",
-       ParamType::Int, 1000, 1, 1000000},
+       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
+       "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
+       "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
+       "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A run stopped by this "
+       "bound before the tolerance is met logs a warning with the possible error.",
+       ParamType::Int, 0, 0, 1000000},
       {"memory_budget_mb", "Memory budget (MB)",
        "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
        "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
@@ -173,6 +178,48 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
   st.add("energy_balance_error", std::fabs(u.P - absorbed - escaped) / u.P);
 }
 
+// The bound r on the spectral radius of rho F: the largest reflectance
+// channel, times the largest row sum of F where one exceeds 1 (analytic
+// quadrature). Rows are read only when they are in memory; computed on the
+// fly they come from Monte Carlo or hemicube rows (sums <= 1) or are too
+// costly to read twice.
+double spectralBound(const Setup& u, const RowFn& row, bool rowsInMemory) {
+  double rhoMax = 0, rowMax = 1;
+  for (size_t i = 0; i < u.n; ++i) {
+    if (u.A[i] == 0) continue;
+    rhoMax = std::max({rhoMax, double(u.rho[i].r), double(u.rho[i].g), double(u.rho[i].b)});
+    if (!rowsInMemory) continue;
+    double sum = 0;
+    for (float F : row(uint32_t(i)).F) sum += F;
+    rowMax = std::max(rowMax, sum);
+  }
+  return rhoMax * rowMax;
+}
+
+// A solve stopped by max_iterations before its tolerance: a warning with the
+// possible error. The remaining reflected power is at most residual x P x
+// r / (1 - r) (each further sweep returns at most r of the last change, or
+// of the unshot power), given as a share of the power found so far.
+void warnIfNotConverged(const Setup& u, const std::vector<glm::vec3>& R, double residual, double tol, double r,
+                        int maxIter, const char* per, RunStats& st) {
+  if (residual < tol) return;
+  double found = u.P;
+  for (size_t i = 0; i < u.n; ++i) found += u.A[i] * luminance(R[i]);
+  char b[400];
+  if (r < 1.0)
+    std::snprintf(b, sizeof b,
+                  "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
+                  "with reflectance up to %.4g the radiosity may be short by up to %.3g%% (raise max_iterations, or "
+                  "0 = automatic)",
+                  maxIter, per, residual, tol, r, 100.0 * residual * u.P * r / (1.0 - r) / found);
+  else
+    std::snprintf(b, sizeof b,
+                  "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
+                  "reflectance x form-factor row sums reach %.4g >= 1, so the iteration need not converge at all",
+                  maxIter, per, residual, tol, r);
+  st.warn(b);
+}
+
 RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
                       int bounces, double tol, int maxIter, const Progress& progress) {
   RadiosityResult res;
@@ -187,6 +234,11 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   const char* names[] = {"auto", "Jacobi", "Gauss-Seidel", "progressive refinement"};
   res.stats.note(std::string("solver ") + names[int(solver)] +
                  (fixedBounces ? " (" + std::to_string(bounces) + " bounces requested)" : ""));
+  const double rBound = fixedBounces ? 0.0 : spectralBound(u, row, transpose);
+  if (!fixedBounces && maxIter <= 0) {
+    maxIter = autoIterations(rBound, tol);
+    res.stats.add("max_iterations_auto", maxIter);
+  }
   if (solver == RadiositySolver::Jacobi || solver == RadiositySolver::GaussSeidel) {
     const int sweeps = fixedBounces ? bounces : maxIter;
     std::vector<glm::vec3> Bn = B;
@@ -216,6 +268,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
                       "solving");
       if (!fixedBounces && res.residual < tol) break;
     }
+    if (!fixedBounces) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "sweeps", res.stats);
   } else {
     // Progressive refinement: shoot the unshot radiosity dB of the patch with
     // the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
@@ -273,6 +326,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
     }
     res.iterations = int(shots);
     res.residual = U / u.P;
+    if (shots >= maxShots) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "shots per patch", res.stats);
     // Ambient term for display (Cohen et al. 1988): the unshot power spread
     // evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
     double Atot = 0, rhoA = 0;
@@ -299,6 +353,13 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
 }
 
 }  // namespace
+
+int autoIterations(double r, double tolerance) {
+  if (!(r > 0.0)) return 10;
+  if (!(r < 1.0)) return 1000000;
+  const double k = 1.5 * std::log(tolerance) / std::log(r);
+  return int(std::clamp(std::ceil(k), 10.0, 1e6));
+}
 
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,

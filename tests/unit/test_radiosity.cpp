@@ -482,3 +482,71 @@ TEST(Radiosity, StressAreasDuplicatesAndRhoNearOne) {
   const auto fr = solveRadiosity(f, *fc, fo);
   for (const auto& b : fr.B) EXPECT_NEAR(b.g / 1000.0, 1.0, 0.01);
 }
+
+namespace {
+// The inward unit box, 3 x 3 patches a side, rho and E uniform: B = E / (1 - rho).
+Scene furnaceBox(float rho) {
+  auto sf = scenes::closedBox(1.0, 3, true);
+  scenes::setUniform(sf, glm::vec3(rho), glm::vec3(1.f));
+  return sf.scene;
+}
+bool warned(const RunStats& st, const std::string& what) {
+  for (const auto& w : st.warnings)
+    if (w.find(what) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+// rho = 0.999 with the default parameters: max_iterations 0 (automatic)
+// gives 1.5 ln(1e-4) / ln(0.999) = 13,809 sweeps of room, and every solver
+// meets the tolerance: B = 1000 on every patch within 0.1% (Monte Carlo rows
+// of a closed box sum to 1 exactly; the direct light, exact factors at 256
+// points, is E to 1e-4; the residual 1e-4 of the emitted power leaves at
+// most 1e-4 x 0.999 / 0.001 = 0.1 of it, 1e-4 of the reflected power).
+// The old fixed bound of 1000 sweeps stopped at 0.999^1000: -37%.
+TEST(Radiosity, FurnaceNearOneConvergesWithTheDefaults) {
+  const Scene s = furnaceBox(0.999f);
+  auto caster = makeEmbreeCaster(s);
+  EXPECT_EQ(autoIterations(0.999, 1e-4), 13809);
+  EXPECT_EQ(autoIterations(0.9, 1e-4), 132);
+  for (auto solver : {RadiositySolver::Jacobi, RadiositySolver::GaussSeidel, RadiositySolver::Progressive}) {
+    RadiosityOptions o;
+    o.solver = solver;
+    o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    EXPECT_TRUE(r.stats.warnings.empty()) << int(solver) << ": " << r.stats.line("radiosity");
+    EXPECT_NEAR(r.stats.get("max_iterations_auto"), 13809.0, 1.0);  // rho is 0.999f
+    EXPECT_LT(r.residual, 1e-4);
+    for (const auto& b : r.B) ASSERT_NEAR(b.g, 1000.0, 1.0) << "solver " << int(solver);
+  }
+}
+
+// A bound that stops the solve early is a warning with an honest bound: 300
+// sweeps (shots per patch) leave B far below 1000, and the warning's
+// "short by up to X%" is at least the true shortfall. A fixed bounce count
+// stops early on purpose: no warning.
+TEST(Radiosity, TooFewIterationsWarn) {
+  const Scene s = furnaceBox(0.999f);
+  auto caster = makeEmbreeCaster(s);
+  for (auto solver : {RadiositySolver::Jacobi, RadiositySolver::GaussSeidel, RadiositySolver::Progressive}) {
+    RadiosityOptions o;
+    o.solver = solver;
+    o.maxIterations = 300;
+    o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    ASSERT_TRUE(warned(r.stats, "not converged")) << int(solver) << ": " << r.stats.line("radiosity");
+    double mean = 0;
+    for (const auto& b : r.B) mean += b.g / double(r.B.size());
+    const double shortBy = 100.0 * (1.0 - mean / 1000.0);
+    EXPECT_GT(shortBy, 10.0) << int(solver);
+    const std::string& w = r.stats.warnings.front();
+    const size_t at = w.find("short by up to ");
+    ASSERT_NE(at, std::string::npos) << w;
+    EXPECT_GE(std::stod(w.substr(at + 15)), shortBy) << w;
+    EXPECT_NE(r.stats.line("radiosity").find("WARNING: not converged"), std::string::npos);
+  }
+  RadiosityOptions fixed;
+  fixed.bounces = 3;
+  fixed.vertexOutput = RadiosityVertexOutput::PatchAverage;
+  EXPECT_TRUE(solveRadiosity(s, *caster, fixed).stats.warnings.empty());
+}

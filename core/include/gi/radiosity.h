@@ -36,7 +36,8 @@ struct RadiosityOptions {
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
   double tolerance = 1e-4;        // on the relative residual / unshot power
-  int maxIterations = 1000;       // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive)
+  int maxIterations = 0;          // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive);
+                                  // 0: automatic, from the largest reflectance (autoIterations)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
   uint32_t seed = 0;
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
@@ -61,7 +62,14 @@ struct RadiosityResult {
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                const Progress& progress = Progress(nullptr));
 
-// Solvers on precomputed rows and direct irradiance (exposed for tests).
+// Sweeps enough for the residual to fall below `tolerance` when each sweep
+// shrinks it at least by the factor r (the spectral radius bound: the
+// largest reflectance, times the largest row sum of F if above 1):
+// 1.5 ln(tolerance) / ln(r), at least 10, at most 1,000,000.
+int autoIterations(double r, double tolerance);
+
+// Solvers on precomputed rows and direct irradiance (exposed for tests;
+// maxIterations 0 = automatic).
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress);
