@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -29,9 +30,13 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
       {"max_samples", "Maximum paths (adaptive)", "Adaptive sampling never traces more than this many paths.",
        ParamType::Int, 65536, 2, 1 << 26},
       {"max_depth", "Maximum bounces",
-       "Paths end after this many bounces (0 = direct light only); Russian roulette (survival = the largest "
-       "reflectance channel) ends them earlier without bias.",
-       ParamType::Int, 1000, 0, 100000},
+       "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the largest "
+       "reflectance channel) ends paths, after about 1 / (1 - rho) bounces; a path still going after 100,000 "
+       "bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths end after k bounces (0 = "
+       "direct light only); the light of more bounces is missing (in a closed room of reflectance rho, a share "
+       "rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: a warning says so when it "
+       "may exceed them.",
+       ParamType::Int, -1, -1, 100000},
       {"sky_color", "Sky colour", "Colour of a uniform sky around the scene (sRGB).", ParamType::Color, 0, 0, 0, {},
        glm::vec3(1.f)},
       {"sky_irradiance", "Sky irradiance (W/m^2)",
@@ -69,10 +74,15 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
 
 namespace {
 
+// max_depth -1: no fixed limit, but a path caught between perfect mirrors
+// (which Russian roulette never ends) stops here.
+constexpr int kDepthCap = 100000;
+
 class Tracer {
  public:
   Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
-      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)) {
+      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)),
+        maxDepth_(o.maxDepth < 0 ? kDepthCap : o.maxDepth) {
     faceN_.resize(s.faceCount());
     for (size_t f = 0; f < s.faceCount(); ++f) {
       const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -96,7 +106,8 @@ class Tracer {
   // sampling, bounce after bounce in a loop (never recursion: a path between
   // white mirrors can run to max_depth = 100,000 bounces). beta is the path
   // throughput: what a radiance arriving at the current vertex adds to H.
-  glm::vec3 irradiance(const glm::vec3& x0, const glm::vec3& n0, Rng& rng, uint64_t& rays) const {
+  // cut: paths ended by the depth limit while they would have gone on.
+  glm::vec3 irradiance(const glm::vec3& x0, const glm::vec3& n0, Rng& rng, uint64_t& rays, uint64_t& cut) const {
     glm::vec3 H(0.f);
     glm::vec3 beta(1.f);
     glm::vec3 x = x0, n = n0;
@@ -137,7 +148,8 @@ class Tracer {
           }
           const glm::vec3 rho = s_.faceRho(h.face);
           const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
-          if (!(q > 0.f) || depth >= o_.maxDepth) return H;
+          if (!(q > 0.f)) return H;
+          if (depth >= maxDepth_) { ++cut; return H; }
           float scale = 1.f;
           if (depth >= 3) {  // Russian roulette
             if (rng.next() >= q) return H;
@@ -150,7 +162,7 @@ class Tracer {
           break;
         }
         // A mirror or glass hit: continue in the sampled specular direction.
-        if (depth >= o_.maxDepth) return H;
+        if (depth >= maxDepth_) { ++cut; return H; }
         const glm::vec3 y = x + w * h.t;
         const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
         const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(h.face), ior, rng.next());
@@ -207,11 +219,43 @@ class Tracer {
   const PathTraceOptions& o_;
   EmitterSampler lights_;
   float eps_;
+  int maxDepth_;
   std::vector<glm::vec3> faceN_;
   float sunCos_ = 1.f, sunPdf_ = 0.f;
   glm::vec3 sunL_{0.f};
   bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
 };
+
+// Paths the depth limit ended while they would have gone on: their further
+// light is missing, a bias outside the error bars. No limit (-1): only paths
+// caught between perfect mirrors reach the cap. A limit k: in a closed room
+// of reflectance rho_max the light of more than k bounces is a share
+// rho_max^(k+1) of B; warn when that may exceed the mean relative error.
+void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, double cut, double relErr,
+                   RunStats& st) {
+  if (!(cut > 0) || !(paths > 0)) return;
+  char b[400];
+  if (opt.maxDepth < 0) {
+    std::snprintf(b, sizeof b,
+                  "%.0f of %.0f paths (%.3g%%) were still going after %d bounces (caught between perfect mirrors?) "
+                  "and were cut: their further light is missing",
+                  cut, paths, 100.0 * cut / paths, kDepthCap);
+    st.warn(b);
+    return;
+  }
+  float rhoMax = 0.f;
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f]) rhoMax = std::max({rhoMax, s.faceRho(f).r, s.faceRho(f).g, s.faceRho(f).b});
+  const double share = std::pow(std::min(1.0, double(rhoMax)), double(opt.maxDepth) + 1.0);
+  if (share <= relErr) return;
+  std::snprintf(b, sizeof b,
+                "max_depth = %d cut %.0f of %.0f paths: the light of more bounces is missing (in a closed room of "
+                "the largest reflectance here, %.4g, a share %.3g%% of B), more than the mean relative error "
+                "%.3g%%, and is not in the error bars (-1 = no limit, unbiased)",
+                opt.maxDepth, cut, paths, rhoMax, 100.0 * share, 100.0 * relErr);
+  st.warn(b);
+}
 
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
@@ -234,12 +278,12 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(rep.rayEpsilon));
   const size_t nv = s.vertexCount();
   std::vector<Accum> acc(nv);
-  std::vector<uint64_t> rays(nv, 0);
+  std::vector<uint64_t> rays(nv, 0), cut(nv, 0);
   auto trace = [&](size_t i, int count) {
     Accum& a = acc[i];
     for (int k = 0; k < count; ++k) {
       Rng rng(hash3(uint32_t(i), uint32_t(a.n), opt.seed ^ 0x9a7eu));
-      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], rng, rays[i]);
+      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], rng, rays[i], cut[i]);
       const double l = luminance(mat.rho[i] * H);
       a.n += 1;
       a.sumL += l;
@@ -292,10 +336,11 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.stdError.assign(nv, 0.f);
   res.stdErrorH.assign(nv, 0.f);
   res.samples.assign(nv, 0);
-  double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0;
+  double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
   size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
     totalRays += double(rays[i]);
+    totalCut += double(cut[i]);
     if (!mat.valid[i] || acc[i].n == 0) continue;
     res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
     res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
@@ -322,6 +367,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_std_error", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
+  st.add("paths_cut_at_max_depth", totalCut);
+  depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
   if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
   return res;
 }

@@ -32,7 +32,8 @@ struct PathTraceOptions {
   int samplesPerVertex = 256;      // fixed count when targetRelativeError == 0
   double targetRelativeError = 0;  // adaptive: stop when stderr(B) / B is below this
   int minSamples = 64, maxSamples = 65536;
-  int maxDepth = 1000;             // bounces (0 = direct light only); Russian roulette ends paths earlier
+  int maxDepth = -1;               // bounces (0 = direct light only); -1: no fixed limit (Russian
+                                   // roulette alone ends paths: unbiased; a safety cap of 100,000)
   uint32_t seed = 0;
   glm::vec3 skyRadiance{0.f};      // uniform sky over the whole sphere, W/(m^2 sr)
   glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
