@@ -8,6 +8,9 @@
 #include <functional>
 #include <stdexcept>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include "gi/color.h"
 #include "gi/direct.h"
 #include "gi/emitters.h"
@@ -49,8 +52,11 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "bound before the tolerance is met logs a warning with the possible error.",
        ParamType::Int, 0, 0, 1000000},
       {"memory_budget_mb", "Memory budget (MB)",
-       "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
-       "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
+       "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
+       "form-factor row per thread (a hemicube's buffers: 151 MB at resolution 4096), about 1 KB per patch of "
+       "the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; beyond "
+       "that, progressive refinement computes each shooter's row on the fly (more rays, memory linear in the "
+       "patch count). A run that cannot fit even so is refused before it starts.",
        ParamType::Float, 1024, 1, 1e7},
       {"vertex_output", "Vertex values",
        "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
@@ -352,7 +358,48 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   return res;
 }
 
+struct MemoryPlan {
+  double rest = 0;    // bytes besides the matrix
+  double matrix = 0;  // the full sparse matrix (and its transpose for progressive refinement)
+  bool fits = false;  // both within the budget: rows kept in memory
+};
+
+MemoryPlan planMemory(size_t n, const FormFactors& ff, const RadiosityOptions& opt) {
+  const double MB = 1048576.0, budget = opt.memoryBudgetMB * MB;
+  const int threads = workerThreads();
+  const double patches = double(n) * kSolverBytesPerPatch, scratch = threads * ff.rowScratchBytes();
+  MemoryPlan m;
+  m.rest = patches + scratch;  // solverBaseBytes, with the method resolved
+  m.matrix = ff.matrixBytesBound() * (opt.solver == RadiositySolver::Progressive && opt.bounces < 0 ? 2.0 : 1.0);
+  m.fits = m.rest + m.matrix <= budget;
+  if (m.rest > budget) {
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "memory_budget_mb = %g is too small: %zu patches need about %.0f MB even with the form factors "
+                  "computed on the fly (%.0f MB for the patches' scene, ray-casting and solver data, %.0f MB for %d "
+                  "threads' form-factor rows%s); raise memory_budget_mb, or use fewer patches%s",
+                  opt.memoryBudgetMB, n, m.rest / MB, patches / MB, scratch / MB, threads,
+                  ff.method() == FormFactorMethod::Hemicube ? ", each with the buffers of a hemicube" : "",
+                  ff.method() == FormFactorMethod::Hemicube ? " or a lower hemicube resolution" : "");
+    throw std::invalid_argument(b);
+  }
+  return m;
+}
+
 }  // namespace
+
+int workerThreads() {
+  return std::max(1, int(std::min<size_t>(size_t(tbb::this_task_arena::max_concurrency()),
+                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+}
+
+double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
+  const double n = double(patches);
+  double row = 8.0 * n;  // a dense row (analytic, hemicube), at least the sparse one of Monte Carlo
+  if (opt.formFactorMethod == FormFactorMethod::Hemicube) row += hemicubeBufferBytes(opt.hemicubeResolution);
+  if (opt.formFactorMethod == FormFactorMethod::MonteCarlo) row = 12.0 * opt.raysPerPatch;
+  return n * kSolverBytesPerPatch + workerThreads() * row;
+}
 
 int autoIterations(double r, double tolerance) {
   if (!(r > 0.0)) return 10;
@@ -373,15 +420,18 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
   if (opt.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   Timer timer;
+  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed});
+  const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
   const double directSeconds = directTimer.seconds();
-  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed});
-  const double bytes = ff.matrixBytesBound();
-  const bool fits = bytes <= opt.memoryBudgetMB * 1048576.0;
+  const double bytes = mem.matrix;
+  const bool fits = mem.fits;
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
   RadiosityResult res;
+  const auto slow = ff.method() == FormFactorMethod::Hemicube ? hemicubeCostWarning(u.n, opt.hemicubeResolution)
+                                                              : std::nullopt;
   if (fits) {
     std::vector<FormFactorRow> rows(u.n);
     Timer ffTimer;
@@ -397,14 +447,15 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     res.stats.add("form_factor_entries", double(entries));
     res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
     res.stats.note("full sparse form-factor matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB <= budget)");
+                   " MB, with the rest " + std::to_string(int((bytes + mem.rest) / 1048576.0 + 0.5)) + " MB <= budget)");
   } else {
     if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
     thread_local FormFactorRow scratch;
     res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; }, false, solver,
                 opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
     res.stats.note("form factors on the fly: the matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB) exceeds the memory budget");
+                   " MB) and the rest (" + std::to_string(int(mem.rest / 1048576.0 + 0.5)) +
+                   " MB) exceed the memory budget");
   }
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) {
     // Per vertex: exact direct light there; the indirect light either
@@ -458,6 +509,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   if (ff.farPairsSkipped())
     res.stats.note(std::to_string(ff.farPairsSkipped()) + " negligible far pairs skipped (F < 1e-7 proved by distance)");
   res.stats.add("patches", double(u.n));
+  if (slow) res.stats.warn(*slow);
+  res.stats.add("memory_estimate_MB", (mem.rest + (fits ? bytes : 0.0)) / 1048576.0);
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());
   return res;

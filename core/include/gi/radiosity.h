@@ -62,6 +62,16 @@ struct RadiosityResult {
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                const Progress& progress = Progress(nullptr));
 
+// The memory memory_budget_mb must cover besides the form-factor matrix, in
+// bytes: per patch, the scene's face arrays, the ray-casting structure and
+// the solver's vectors and vertex output (kSolverBytesPerPatch; measured 330
+// at peak on a box of 1.08 million patches, the matrix apart), and per
+// worker thread the scratch of one form-factor row (a dense row of n values;
+// a hemicube's buffers, 151 MB at resolution 4096).
+inline constexpr double kSolverBytesPerPatch = 400;
+double solverBaseBytes(size_t patches, const RadiosityOptions& opt);
+int workerThreads();  // the threads parallel loops may use now
+
 // Sweeps enough for the residual to fall below `tolerance` when each sweep
 // shrinks it at least by the factor r (the spectral radius bound: the
 // largest reflectance, times the largest row sum of F if above 1):
