@@ -53,7 +53,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        ParamType::Int, 0, 0, 1000000},
       {"memory_budget_mb", "Memory budget (MB)",
        "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
-       "form-factor row per thread (a hemicube's buffers: 151 MB at resolution 4096), about 1 KB per patch of "
+       "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch of "
        "the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; beyond "
        "that, progressive refinement computes each shooter's row on the fly (more rays, memory linear in the "
        "patch count). A run that cannot fit even so is refused before it starts.",
@@ -203,21 +203,24 @@ double spectralBound(const Setup& u, const RowFn& row, bool rowsInMemory) {
 }
 
 // A solve stopped by max_iterations before its tolerance: a warning with the
-// possible error. The remaining reflected power is at most residual x P x
+// possible error. The remaining reflected power M is at most residual x P x
 // r / (1 - r) (each further sweep returns at most r of the last change, or
-// of the unshot power), given as a share of the power found so far.
+// of the unshot power); with F the power found so far, the converged total
+// is F + M, of which M / (F + M) (increasing in M: the bound gives a bound)
+// is missing.
 void warnIfNotConverged(const Setup& u, const std::vector<glm::vec3>& R, double residual, double tol, double r,
                         int maxIter, const char* per, RunStats& st) {
   if (residual < tol) return;
   double found = u.P;
   for (size_t i = 0; i < u.n; ++i) found += u.A[i] * luminance(R[i]);
+  const double missing = residual * u.P * r / (1.0 - r);
   char b[400];
   if (r < 1.0)
     std::snprintf(b, sizeof b,
                   "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
-                  "with reflectance up to %.4g the radiosity may be short by up to %.3g%% (raise max_iterations, or "
-                  "0 = automatic)",
-                  maxIter, per, residual, tol, r, 100.0 * residual * u.P * r / (1.0 - r) / found);
+                  "with reflectance up to %.4g the radiosity may be short by up to %.1f%% of its converged value "
+                  "(raise max_iterations, or 0 = automatic)",
+                  maxIter, per, residual, tol, r, std::ceil(1000.0 * missing / (found + missing)) / 10.0);
   else
     std::snprintf(b, sizeof b,
                   "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "

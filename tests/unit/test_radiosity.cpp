@@ -573,7 +573,7 @@ std::string refusal(const std::function<void(const Progress&)>& f, int* reports)
 // refused with one sentence before any work (no progress reported):
 // refinement that may reach 1e8 patches (48 faces x 4^12 levels capped by
 // the patch budget: about 100 GB), hemicube buffers of resolution 4096
-// (151 MB per thread) under a 100 MB budget, and 10,800 patches (about 4 MB
+// (144 MB per thread) under a 100 MB budget, and 10,800 patches (about 4 MB
 // of solver data) under 1 MB.
 TEST(Radiosity, MemoryBudgetRefusesBeforeTheWork) {
   auto box = scenes::closedBox(1.0, 2, true);  // 48 faces

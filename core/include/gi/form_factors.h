@@ -80,7 +80,7 @@ class FormFactors {
 
 // Bytes of the depth, patch and side buffers a hemicube of this resolution
 // holds at once (its top face, res^2 cells; the sides have half as many),
-// per thread computing rows: 151 MB at resolution 4096.
+// per thread computing rows: 144 MB at resolution 4096.
 double hemicubeBufferBytes(int resolution);
 // The hemicube's work: every patch's row draws and sums its 3 res^2 cells, so
 // the cost grows as patches x res^2 whatever the scene. A sentence to warn

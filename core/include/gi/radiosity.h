@@ -67,7 +67,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
 // the solver's vectors and vertex output (kSolverBytesPerPatch; measured 330
 // at peak on a box of 1.08 million patches, the matrix apart), and per
 // worker thread the scratch of one form-factor row (a dense row of n values;
-// a hemicube's buffers, 151 MB at resolution 4096).
+// a hemicube's buffers, 144 MB at resolution 4096).
 inline constexpr double kSolverBytesPerPatch = 400;
 double solverBaseBytes(size_t patches, const RadiosityOptions& opt);
 int workerThreads();  // the threads parallel loops may use now
