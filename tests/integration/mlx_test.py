@@ -102,7 +102,7 @@ def split_floor_wall(c):
         path = os.path.join(c.tmp, name + ".ply")
         with open(path, "w") as fh:
             fh.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
-                     "element face %d\nproperty list uchar int vertex_indices\nproperty float quality\nend_header\n" % (len(used), len(faces)))
+                     "element face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(used), len(faces)))
             for i in used:
                 fh.write("%r %r %r\n" % (v[i]["x"], v[i]["y"], v[i]["z"]))
             for t in faces:
