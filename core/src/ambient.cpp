@@ -216,8 +216,11 @@ void warnMeaningless(const Scene& scene, const AmbientOptions& o, const AmbientR
 
 }  // namespace
 
-AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& opt, const Progress& progress) {
-  checkOptions(opt);
+AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& optWorld,
+                             const Progress& progress) {
+  checkOptions(optWorld);
+  AmbientOptions opt = optWorld;
+  opt.maxDistance = optWorld.maxDistance / scene.unit;  // local units (Scene::unit)
   Timer timer;
   const SceneReport rep = analyzeScene(scene);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");

@@ -94,14 +94,14 @@ AmbientOptions AmbientOptions::fromParams(AmbientMode mode, const ParamValues& v
   if (mode == AmbientMode::Occlusion) {
     o.bentNormals = v.getBool("bent_normals") || v.getBool("bent_normals_to_vertex_normals");
     o.useCone = v.getBool("use_cone");
-    o.coneDirection = glm::normalize(v.getVec("cone_direction"));
+    o.coneDirection = v.getDirection("cone_direction");
     o.coneAngleDeg = float(v.getFloat("cone_angle"));
   }
   if (mode == AmbientMode::Obscurance) o.falloffExponent = float(v.getFloat("falloff_exponent"));
   if (mode == AmbientMode::Sky) {
     o.skyRadiantColor = lin(v.getVec("sky_color"));
     o.skyIrradiance = float(v.getFloat("sky_irradiance"));
-    o.sunDirection = glm::normalize(v.getVec("sun_direction"));
+    o.sunDirection = v.getDirection("sun_direction");
     o.sunColor = lin(v.getVec("sun_color"));
     o.sunIrradiance = float(v.getFloat("sun_irradiance"));
     o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));

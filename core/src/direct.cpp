@@ -87,7 +87,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   auto& st = out.stats;
   st.add("vertices", double(nv));
   st.add("emitter_faces", double(lights.faceCount()));
-  st.add("emitted_power_W", lights.totalPower());
+  st.add("emitted_power_W", lights.totalPower() * s.unit * s.unit);  // world units (Scene::unit)
   st.add("shadow_rays", double(valid) * N);
   st.add("seconds", timer.seconds());
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);

@@ -53,6 +53,23 @@ class SceneHandle {
   RTCScene s_;
 };
 
+// Embree asserts (aborting the process) on a ray it cannot represent: a NaN
+// or infinite origin or direction, coordinates beyond FLT_LARGE (1.844e18),
+// or a NaN tnear or tfar. No ray of a sound computation is like that (scenes
+// are in local units, Scene::unit), so meeting one is an error to report,
+// never a reason to abort MeshLab.
+constexpr float kFltLarge = 1.844e18f;
+inline bool representable(const glm::vec3& o, const glm::vec3& d) {
+  return std::fabs(o.x) <= kFltLarge && std::fabs(o.y) <= kFltLarge && std::fabs(o.z) <= kFltLarge &&
+         std::fabs(d.x) <= kFltLarge && std::fabs(d.y) <= kFltLarge && std::fabs(d.z) <= kFltLarge;
+}
+inline void checkRay(const glm::vec3& o, const glm::vec3& d, float tnear, float tfar) {
+  if (!representable(o, d) || std::isnan(tnear) || std::isnan(tfar))
+    throw std::runtime_error("a ray with a non-finite or out-of-range origin or direction (a numerical failure, "
+                             "perhaps at this scene's scale): the computation was stopped");
+}
+inline void checkRay(const Ray& r) { checkRay(r.o, r.d, r.tnear, r.tfar); }
+
 inline void toRTC(const Ray& r, RTCRay& e) {
   e.org_x = r.o.x; e.org_y = r.o.y; e.org_z = r.o.z; e.tnear = r.tnear;
   e.dir_x = r.d.x; e.dir_y = r.d.y; e.dir_z = r.d.z; e.time = 0.f;
@@ -95,6 +112,7 @@ class EmbreeCaster final : public RayCaster {
   }
 
   Hit intersect(const Ray& r) const override {
+    checkRay(r);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -111,6 +129,7 @@ class EmbreeCaster final : public RayCaster {
   }
 
   bool occluded(const Ray& r) const override {
+    checkRay(r);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay e;
@@ -126,6 +145,7 @@ class EmbreeCaster final : public RayCaster {
     RTCRay e;
     e.org_x = o.x; e.org_y = o.y; e.org_z = o.z; e.tnear = 0.f; e.time = 0.f; e.mask = 0xffffffffu; e.id = 0; e.flags = 0;
     for (size_t i = 0; i < n; ++i) {
+      checkRay(o, dirs[i], 0.f, tfar);
       e.dir_x = dirs[i].x; e.dir_y = dirs[i].y; e.dir_z = dirs[i].z; e.tfar = tfar;
       rtcOccluded1(scene_.get(), &ctx, &e);
       occ[i] = e.tfar < 0.f ? 1 : 0;
@@ -134,6 +154,7 @@ class EmbreeCaster final : public RayCaster {
 
   void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const override {
     if (mode_ == BatchMode::Single) return RayCaster::occludedBatch(rays, n, occ);
+    for (size_t i = 0; i < n; ++i) checkRay(rays[i]);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;

@@ -56,6 +56,13 @@ double FormFactors::matrixBytesBound() const {
   return n * perRow * 8.0 + n * 64.0;
 }
 
+double FormFactors::rowScratchBytes() const {
+  const double n = double(area_.size());
+  if (set_.method == FormFactorMethod::Hemicube) return 8.0 * n + hemicubeBufferBytes(set_.hemicubeResolution);
+  if (set_.method == FormFactorMethod::MonteCarlo) return 8.0 * std::min<double>(set_.raysPerPatch, n) + 4.0 * set_.raysPerPatch;
+  return 8.0 * n;
+}
+
 FormFactorRow FormFactors::row(uint32_t i) const {
   if (!ok_[i]) return {};
   switch (set_.method) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
 #include <vector>
 
 #include "gi/form_factors.h"
@@ -91,6 +92,23 @@ class HemicubeFace {
 };
 
 }  // namespace
+
+double hemicubeBufferBytes(int resolution) {
+  const double res = std::max(4, resolution & ~1);
+  return res * res * double(sizeof(float) + sizeof(uint32_t) + sizeof(uint8_t));
+}
+
+std::optional<std::string> hemicubeCostWarning(size_t patches, int resolution) {
+  const double res = std::max(4, resolution & ~1), cells = 3.0 * res * res;
+  const double work = double(patches) * 2.0 * cells;  // drawn, then summed
+  if (work < 1e11) return std::nullopt;
+  char b[300];
+  std::snprintf(b, sizeof b,
+                "hemicube resolution %d on %zu patches: about %.2g cell updates (3 x %d^2 cells drawn and summed per "
+                "patch), minutes or more of computing; a lower resolution costs res^2 times less",
+                int(res), patches, work, int(res));
+  return std::string(b);
+}
 
 // One hemicube at point c (lifted off patch i) with its side axes turned by
 // phi about the normal: the delta form factors of the cells, normalised,

@@ -1,5 +1,6 @@
 #include "gi/params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -11,6 +12,21 @@ const ParamValue& ParamValues::at(const std::string& n) const {
   auto it = v_.find(n);
   if (it == v_.end()) throw std::invalid_argument("missing parameter '" + n + "'");
   return it->second;
+}
+
+glm::vec3 ParamValues::getDirection(const std::string& n) const {
+  const auto u = unitDirection(getVec(n));
+  if (!u) throw std::invalid_argument("parameter '" + n + "' must be a non-zero finite direction");
+  return *u;
+}
+
+std::optional<glm::vec3> unitDirection(const glm::vec3& d) {
+  const glm::dvec3 x(d);
+  if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) return std::nullopt;
+  const double m = std::max({std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+  if (!(m > 0.0)) return std::nullopt;
+  const glm::dvec3 y = x / m;  // largest component +-1: its length is in [1, sqrt 3]
+  return glm::vec3(y / glm::length(y));
 }
 
 const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name) {
@@ -88,8 +104,7 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           break;
         }
         case ParamType::Direction: {
-          glm::vec3 d = v.getVec(s.name);
-          if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || glm::length(d) == 0.f)
+          if (!unitDirection(v.getVec(s.name)))
             return "parameter '" + s.name + "' must be a non-zero finite direction";
           break;
         }

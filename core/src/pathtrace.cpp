@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -29,9 +30,13 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
       {"max_samples", "Maximum paths (adaptive)", "Adaptive sampling never traces more than this many paths.",
        ParamType::Int, 65536, 2, 1 << 26},
       {"max_depth", "Maximum bounces",
-       "Paths end after this many bounces (0 = direct light only); Russian roulette (survival = the largest "
-       "reflectance channel) ends them earlier without bias.",
-       ParamType::Int, 1000, 0, 100000},
+       "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the largest "
+       "reflectance channel) ends paths, after about 1 / (1 - rho) bounces; a path still going after 100,000 "
+       "bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths end after k bounces (0 = "
+       "direct light only); the light of more bounces is missing (in a closed room of reflectance rho, a share "
+       "rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: a warning says so when it "
+       "may exceed them.",
+       ParamType::Int, -1, -1, 100000},
       {"sky_color", "Sky colour", "Colour of a uniform sky around the scene (sRGB).", ParamType::Color, 0, 0, 0, {},
        glm::vec3(1.f)},
       {"sky_irradiance", "Sky irradiance (W/m^2)",
@@ -59,7 +64,7 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.maxSamples = v.getInt("max_samples");
   o.maxDepth = v.getInt("max_depth");
   o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
-  o.sunDirection = glm::normalize(v.getVec("sun_direction"));
+  o.sunDirection = v.getDirection("sun_direction");
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
   o.point = pointLightFromParams(v, origin);
@@ -69,10 +74,15 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
 
 namespace {
 
+// max_depth -1: no fixed limit, but a path caught between perfect mirrors
+// (which Russian roulette never ends) stops here.
+constexpr int kDepthCap = 100000;
+
 class Tracer {
  public:
   Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
-      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)) {
+      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)),
+        maxDepth_(o.maxDepth < 0 ? kDepthCap : o.maxDepth) {
     faceN_.resize(s.faceCount());
     for (size_t f = 0; f < s.faceCount(); ++f) {
       const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -91,13 +101,85 @@ class Tracer {
                                   "quality), no sky, no sun and no point light");
   }
 
-  // One-sample estimate of the irradiance at x (unit normal n, the lit side).
-  glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int depth, Rng& rng, uint64_t& rays) const {
-    glm::vec3 H = nextEvent(x, n, rng, rays);
-    const glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
-    const float pdfB = glm::dot(n, w) * 0.318309886f;
-    if (pdfB > 0.f) H += float(M_PI) * radiance(x, w, pdfB, depth, rng, rays);  // cos / pdf = pi
-    return H;
+  // One-sample estimate of the irradiance at x (unit normal n, the lit side):
+  // next-event estimation there, then the path continued by cosine-weighted
+  // sampling, bounce after bounce in a loop (never recursion: a path between
+  // white mirrors can run to max_depth = 100,000 bounces). beta is the path
+  // throughput: what a radiance arriving at the current vertex adds to H.
+  // cut: paths ended by the depth limit while they would have gone on.
+  glm::vec3 irradiance(const glm::vec3& x0, const glm::vec3& n0, Rng& rng, uint64_t& rays, uint64_t& cut) const {
+    glm::vec3 H(0.f);
+    glm::vec3 beta(1.f);
+    glm::vec3 x = x0, n = n0;
+    int depth = 0;
+    for (;;) {
+      // A diffuse vertex x (normal n) at `depth` bounces from the start.
+      H += beta * nextEvent(x, n, rng, rays);
+      glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
+      float pdfB = glm::dot(n, w) * 0.318309886f;
+      if (!(pdfB > 0.f)) return H;
+      beta *= float(M_PI);  // cos / pdf = pi
+      // Follow w through mirrors and glass to the next diffuse vertex.
+      // afterSpecular: the direction came from a mirror or glass (a delta
+      // distribution next-event estimation cannot sample, so emitters and
+      // the sun count fully).
+      bool afterSpecular = false;
+      for (;;) {
+        Ray ray;
+        ray.o = x;
+        ray.d = w;
+        ++rays;
+        const Hit h = caster_.intersect(ray);
+        if (!h.valid()) {
+          glm::vec3 L = o_.skyRadiance;
+          if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
+            L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
+          return H + beta * L;
+        }
+        const glm::vec3 ng = faceN_[h.face];
+        const Material m = s_.faceMaterial(h.face);
+        if (!isSpecular(m)) {
+          const float cosY = -glm::dot(ng, w);
+          if (cosY <= 0.f) return H;  // a back face: black, as in the radiosity filter
+          const glm::vec3 E = s_.faceEmission(h.face);
+          if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
+            const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
+            H += beta * (E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL)));
+          }
+          const glm::vec3 rho = s_.faceRho(h.face);
+          const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
+          if (!(q > 0.f)) return H;
+          if (depth >= maxDepth_) { ++cut; return H; }
+          float scale = 1.f;
+          if (depth >= 3) {  // Russian roulette
+            if (rng.next() >= q) return H;
+            scale = 1.f / q;
+          }
+          beta *= rho * 0.318309886f * scale;
+          x = x + w * h.t + ng * eps_;
+          n = ng;
+          ++depth;
+          break;
+        }
+        // A mirror or glass hit: continue in the sampled specular direction.
+        if (depth >= maxDepth_) { ++cut; return H; }
+        const glm::vec3 y = x + w * h.t;
+        const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
+        const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(h.face), ior, rng.next());
+        glm::vec3 weight = ev.weight * ev.radianceScale;
+        if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
+          const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
+          if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return H;
+          weight /= q;
+        }
+        beta *= weight;
+        x = y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
+        w = ev.d;
+        pdfB = 0.f;
+        afterSpecular = true;
+        ++depth;
+      }
+    }
   }
 
  private:
@@ -132,72 +214,48 @@ class Tracer {
     return H;
   }
 
-  // Radiance arriving at the ray's origin from direction w, sampled with
-  // solid-angle density pdfB (for the MIS weight of emitters it hits);
-  // afterSpecular: the direction came from a mirror or glass (a delta
-  // distribution next-event estimation cannot sample, so emitters count fully).
-  glm::vec3 radiance(const glm::vec3& o, const glm::vec3& w, float pdfB, int depth, Rng& rng, uint64_t& rays,
-                     bool afterSpecular = false) const {
-    Ray ray;
-    ray.o = o;
-    ray.d = w;
-    ++rays;
-    const Hit h = caster_.intersect(ray);
-    if (!h.valid()) {
-      glm::vec3 L = o_.skyRadiance;
-      if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
-        L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
-      return L;
-    }
-    const glm::vec3 ng = faceN_[h.face];
-    const Material m = s_.faceMaterial(h.face);
-    if (isSpecular(m)) return specular(o + w * h.t, w, ng, h.face, m, depth, rng, rays);
-    const float cosY = -glm::dot(ng, w);
-    if (cosY <= 0.f) return glm::vec3(0.f);  // a back face: black, as in the radiosity filter
-    glm::vec3 L(0.f);
-    const glm::vec3 E = s_.faceEmission(h.face);
-    if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
-      const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
-      L += E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL));
-    }
-    const glm::vec3 rho = s_.faceRho(h.face);
-    const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
-    if (!(q > 0.f) || depth >= o_.maxDepth) return L;
-    float scale = 1.f;
-    if (depth >= 3) {  // Russian roulette
-      if (rng.next() >= q) return L;
-      scale = 1.f / q;
-    }
-    const glm::vec3 y = o + w * h.t + ng * eps_;
-    return L + rho * 0.318309886f * scale * irradiance(y, ng, depth + 1, rng, rays);
-  }
-
-  // A mirror or glass hit at x: continue in the sampled specular direction.
-  glm::vec3 specular(const glm::vec3& x, const glm::vec3& w, const glm::vec3& ng, uint32_t face, Material m, int depth,
-                     Rng& rng, uint64_t& rays) const {
-    if (depth >= o_.maxDepth) return glm::vec3(0.f);
-    const float ior = s_.ior.empty() ? 1.5f : s_.ior[face];
-    const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(face), ior, rng.next());
-    glm::vec3 weight = ev.weight * ev.radianceScale;
-    if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
-      const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
-      if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return glm::vec3(0.f);
-      weight /= q;
-    }
-    const glm::vec3 y = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
-    return weight * radiance(y, ev.d, 0.f, depth + 1, rng, rays, true);
-  }
-
   const Scene& s_;
   const RayCaster& caster_;
   const PathTraceOptions& o_;
   EmitterSampler lights_;
   float eps_;
+  int maxDepth_;
   std::vector<glm::vec3> faceN_;
   float sunCos_ = 1.f, sunPdf_ = 0.f;
   glm::vec3 sunL_{0.f};
   bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
 };
+
+// Paths the depth limit ended while they would have gone on: their further
+// light is missing, a bias outside the error bars. No limit (-1): only paths
+// caught between perfect mirrors reach the cap. A limit k: in a closed room
+// of reflectance rho_max the light of more than k bounces is a share
+// rho_max^(k+1) of B; warn when that may exceed the mean relative error.
+void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, double cut, double relErr,
+                   RunStats& st) {
+  if (!(cut > 0) || !(paths > 0)) return;
+  char b[400];
+  if (opt.maxDepth < 0) {
+    std::snprintf(b, sizeof b,
+                  "%.0f of %.0f paths (%.3g%%) were still going after %d bounces (caught between perfect mirrors?) "
+                  "and were cut: their further light is missing",
+                  cut, paths, 100.0 * cut / paths, kDepthCap);
+    st.warn(b);
+    return;
+  }
+  float rhoMax = 0.f;
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f]) rhoMax = std::max({rhoMax, s.faceRho(f).r, s.faceRho(f).g, s.faceRho(f).b});
+  const double share = std::pow(std::min(1.0, double(rhoMax)), double(opt.maxDepth) + 1.0);
+  if (share <= relErr) return;
+  std::snprintf(b, sizeof b,
+                "max_depth = %d cut %.0f of %.0f paths: the light of more bounces is missing (in a closed room of "
+                "the largest reflectance here, %.4g, a share %.3g%% of B), more than the mean relative error "
+                "%.3g%%, and is not in the error bars (-1 = no limit, unbiased)",
+                opt.maxDepth, cut, paths, rhoMax, 100.0 * share, 100.0 * relErr);
+  st.warn(b);
+}
 
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
@@ -206,7 +264,10 @@ struct Accum {
 
 }  // namespace
 
-PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& opt, const Progress& progress) {
+PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& optWorld,
+                          const Progress& progress) {
+  PathTraceOptions opt = optWorld;
+  opt.point = pointLightInLocalUnits(optWorld.point, s);
   if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
     throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
   Timer timer;
@@ -217,12 +278,12 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(rep.rayEpsilon));
   const size_t nv = s.vertexCount();
   std::vector<Accum> acc(nv);
-  std::vector<uint64_t> rays(nv, 0);
+  std::vector<uint64_t> rays(nv, 0), cut(nv, 0);
   auto trace = [&](size_t i, int count) {
     Accum& a = acc[i];
     for (int k = 0; k < count; ++k) {
       Rng rng(hash3(uint32_t(i), uint32_t(a.n), opt.seed ^ 0x9a7eu));
-      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], 0, rng, rays[i]);
+      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], rng, rays[i], cut[i]);
       const double l = luminance(mat.rho[i] * H);
       a.n += 1;
       a.sumL += l;
@@ -275,10 +336,11 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.stdError.assign(nv, 0.f);
   res.stdErrorH.assign(nv, 0.f);
   res.samples.assign(nv, 0);
-  double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0;
+  double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
   size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
     totalRays += double(rays[i]);
+    totalCut += double(cut[i]);
     if (!mat.valid[i] || acc[i].n == 0) continue;
     res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
     res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
@@ -305,6 +367,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_std_error", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
+  st.add("paths_cut_at_max_depth", totalCut);
+  depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
   if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
   return res;
 }

@@ -129,7 +129,11 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
 
 }  // namespace
 
-VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, const Progress& progress) {
+VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
+                                  const Progress& progress) {
+  PhotonOptions opt = optWorld;  // distances and the point light in local units (Scene::unit)
+  opt.maxRadius = optWorld.maxRadius / s.unit;
+  opt.point = pointLightInLocalUnits(optWorld.point, s);
   if (opt.photons < 1 || opt.kNearest < 1 || opt.kNearest > 512 || opt.causticK < 1 || opt.causticK > 512 || opt.passes < 1)
     throw std::invalid_argument("photons and passes must be >= 1, k_nearest and caustic_k in [1, 512]");
   Timer timer;
@@ -176,7 +180,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     noPhotonVertices = pr.verticesWithoutPhotons;
     check = pr.check;
     st.add("ppm_passes", double(opt.passes));
-    st.add("ppm_mean_final_radius", pr.meanRadius);
+    st.add("ppm_mean_final_radius", pr.meanRadius * s.unit);
     st.add("ppm_mean_photons_per_vertex", pr.meanCount);
     st.add("kdtree_build_seconds", pr.buildSeconds);
     st.add("query_seconds", pr.querySeconds);
@@ -297,7 +301,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.add("diffuse_bounces", double(ts.diffuseBounces));
     st.add("specular_bounces", double(ts.specularBounces));
     st.add("total_internal_reflections", double(ts.totalInternal));
-    st.add("emitted_power_W", ts.emittedPower);
+    st.add("emitted_power_W", ts.emittedPower * s.unit * s.unit);
     if (ts.lostAtMaxDepth)
       st.note(std::to_string(ts.lostAtMaxDepth) + " paths cut at max_depth, carrying " +
               std::to_string(ts.emittedPower > 0 ? 100.0 * ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0) +

@@ -1,11 +1,15 @@
 #include "gi/radiosity.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <atomic>
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "gi/color.h"
 #include "gi/direct.h"
@@ -41,11 +45,18 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        "relative to the emitted power, is below this.",
        ParamType::Float, 1e-4, 1e-12, 1.0},
       {"max_iterations", "Maximum iterations",
-       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement).",
-       ParamType::Int, 1000, 1, 1000000},
+       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
+       "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
+       "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
+       "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A run stopped by this "
+       "bound before the tolerance is met logs a warning with the possible error.",
+       ParamType::Int, 0, 0, 1000000},
       {"memory_budget_mb", "Memory budget (MB)",
-       "The sparse form-factor matrix is kept while its estimated size fits this budget; beyond it, progressive "
-       "refinement computes each shooter's row on the fly (more rays, memory linear in the patch count).",
+       "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
+       "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch of "
+       "the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; beyond "
+       "that, progressive refinement computes each shooter's row on the fly (more rays, memory linear in the "
+       "patch count). A run that cannot fit even so is refused before it starts.",
        ParamType::Float, 1024, 1, 1e7},
       {"vertex_output", "Vertex values",
        "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
@@ -121,12 +132,14 @@ struct Setup {
   size_t n;
   std::vector<double> A;
   std::vector<glm::vec3> E, rho, Hd;  // emission, reflectance, direct irradiance
-  double P = 0;  // emitted power (luminance), W
+  double P = 0;  // emitted power (luminance), local units
+  double unit2 = 1;  // world area of one local unit of area (Scene::unit^2)
 };
 
 Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd) {
   Setup u;
   u.n = s.faceCount();
+  u.unit2 = s.unit * s.unit;
   const auto ok = usableFaceMask(s);
   u.A.resize(u.n);
   u.E.resize(u.n);
@@ -166,10 +179,55 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
     absorbed += u.A[i] * luminance((glm::vec3(1.f) - u.rho[i]) * H);
     escaped += u.A[i] * (luminance(R[i]) * r.escaped - luminance(u.Hd[i]));
   }
-  st.add("emitted_power_W", u.P);
-  st.add("absorbed_power_W", absorbed);
-  st.add("escaped_power_W", escaped);
+  st.add("emitted_power_W", u.P * u.unit2);
+  st.add("absorbed_power_W", absorbed * u.unit2);
+  st.add("escaped_power_W", escaped * u.unit2);
   st.add("energy_balance_error", std::fabs(u.P - absorbed - escaped) / u.P);
+}
+
+// The bound r on the spectral radius of rho F: the largest reflectance
+// channel, times the largest row sum of F where one exceeds 1 (analytic
+// quadrature). Rows are read only when they are in memory; computed on the
+// fly they come from Monte Carlo or hemicube rows (sums <= 1) or are too
+// costly to read twice.
+double spectralBound(const Setup& u, const RowFn& row, bool rowsInMemory) {
+  double rhoMax = 0, rowMax = 1;
+  for (size_t i = 0; i < u.n; ++i) {
+    if (u.A[i] == 0) continue;
+    rhoMax = std::max({rhoMax, double(u.rho[i].r), double(u.rho[i].g), double(u.rho[i].b)});
+    if (!rowsInMemory) continue;
+    double sum = 0;
+    for (float F : row(uint32_t(i)).F) sum += F;
+    rowMax = std::max(rowMax, sum);
+  }
+  return rhoMax * rowMax;
+}
+
+// A solve stopped by max_iterations before its tolerance: a warning with the
+// possible error. The remaining reflected power M is at most residual x P x
+// r / (1 - r) (each further sweep returns at most r of the last change, or
+// of the unshot power); with F the power found so far, the converged total
+// is F + M, of which M / (F + M) (increasing in M: the bound gives a bound)
+// is missing.
+void warnIfNotConverged(const Setup& u, const std::vector<glm::vec3>& R, double residual, double tol, double r,
+                        int maxIter, const char* per, RunStats& st) {
+  if (residual < tol) return;
+  double found = u.P;
+  for (size_t i = 0; i < u.n; ++i) found += u.A[i] * luminance(R[i]);
+  const double missing = residual * u.P * r / (1.0 - r);
+  char b[400];
+  if (r < 1.0)
+    std::snprintf(b, sizeof b,
+                  "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
+                  "with reflectance up to %.4g the radiosity may be short by up to %.1f%% of its converged value "
+                  "(raise max_iterations, or 0 = automatic)",
+                  maxIter, per, residual, tol, r, std::ceil(1000.0 * missing / (found + missing)) / 10.0);
+  else
+    std::snprintf(b, sizeof b,
+                  "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
+                  "reflectance x form-factor row sums reach %.4g >= 1, so the iteration need not converge at all",
+                  maxIter, per, residual, tol, r);
+  st.warn(b);
 }
 
 RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
@@ -186,6 +244,11 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   const char* names[] = {"auto", "Jacobi", "Gauss-Seidel", "progressive refinement"};
   res.stats.note(std::string("solver ") + names[int(solver)] +
                  (fixedBounces ? " (" + std::to_string(bounces) + " bounces requested)" : ""));
+  const double rBound = fixedBounces ? 0.0 : spectralBound(u, row, transpose);
+  if (!fixedBounces && maxIter <= 0) {
+    maxIter = autoIterations(rBound, tol);
+    res.stats.add("max_iterations_auto", maxIter);
+  }
   if (solver == RadiositySolver::Jacobi || solver == RadiositySolver::GaussSeidel) {
     const int sweeps = fixedBounces ? bounces : maxIter;
     std::vector<glm::vec3> Bn = B;
@@ -215,6 +278,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
                       "solving");
       if (!fixedBounces && res.residual < tol) break;
     }
+    if (!fixedBounces) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "sweeps", res.stats);
   } else {
     // Progressive refinement: shoot the unshot radiosity dB of the patch with
     // the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
@@ -272,6 +336,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
     }
     res.iterations = int(shots);
     res.residual = U / u.P;
+    if (shots >= maxShots) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "shots per patch", res.stats);
     // Ambient term for display (Cohen et al. 1988): the unshot power spread
     // evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
     double Atot = 0, rhoA = 0;
@@ -297,7 +362,55 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   return res;
 }
 
+struct MemoryPlan {
+  double rest = 0;    // bytes besides the matrix
+  double matrix = 0;  // the full sparse matrix (and its transpose for progressive refinement)
+  bool fits = false;  // both within the budget: rows kept in memory
+};
+
+MemoryPlan planMemory(size_t n, const FormFactors& ff, const RadiosityOptions& opt) {
+  const double MB = 1048576.0, budget = opt.memoryBudgetMB * MB;
+  const int threads = workerThreads();
+  const double patches = double(n) * kSolverBytesPerPatch, scratch = threads * ff.rowScratchBytes();
+  MemoryPlan m;
+  m.rest = patches + scratch;  // solverBaseBytes, with the method resolved
+  m.matrix = ff.matrixBytesBound() * (opt.solver == RadiositySolver::Progressive && opt.bounces < 0 ? 2.0 : 1.0);
+  m.fits = m.rest + m.matrix <= budget;
+  if (m.rest > budget) {
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "memory_budget_mb = %g is too small: %zu patches need about %.0f MB even with the form factors "
+                  "computed on the fly (%.0f MB for the patches' scene, ray-casting and solver data, %.0f MB for %d "
+                  "threads' form-factor rows%s); raise memory_budget_mb, or use fewer patches%s",
+                  opt.memoryBudgetMB, n, m.rest / MB, patches / MB, scratch / MB, threads,
+                  ff.method() == FormFactorMethod::Hemicube ? ", each with the buffers of a hemicube" : "",
+                  ff.method() == FormFactorMethod::Hemicube ? " or a lower hemicube resolution" : "");
+    throw std::invalid_argument(b);
+  }
+  return m;
+}
+
 }  // namespace
+
+int workerThreads() {
+  return std::max(1, int(std::min<size_t>(size_t(tbb::this_task_arena::max_concurrency()),
+                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+}
+
+double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
+  const double n = double(patches);
+  double row = 8.0 * n;  // a dense row (analytic, hemicube), at least the sparse one of Monte Carlo
+  if (opt.formFactorMethod == FormFactorMethod::Hemicube) row += hemicubeBufferBytes(opt.hemicubeResolution);
+  if (opt.formFactorMethod == FormFactorMethod::MonteCarlo) row = 12.0 * opt.raysPerPatch;
+  return n * kSolverBytesPerPatch + workerThreads() * row;
+}
+
+int autoIterations(double r, double tolerance) {
+  if (!(r > 0.0)) return 10;
+  if (!(r < 1.0)) return 1000000;
+  const double k = 1.5 * std::log(tolerance) / std::log(r);
+  return int(std::clamp(std::ceil(k), 10.0, 1e6));
+}
 
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
@@ -311,15 +424,18 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
   if (opt.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   Timer timer;
+  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed, opt.hemicubePoints});
+  const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
   const double directSeconds = directTimer.seconds();
-  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed, opt.hemicubePoints});
-  const double bytes = ff.matrixBytesBound();
-  const bool fits = bytes <= opt.memoryBudgetMB * 1048576.0;
+  const double bytes = mem.matrix;
+  const bool fits = mem.fits;
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
   RadiosityResult res;
+  const auto slow = ff.method() == FormFactorMethod::Hemicube ? hemicubeCostWarning(u.n, opt.hemicubeResolution)
+                                                              : std::nullopt;
   if (fits) {
     std::vector<FormFactorRow> rows(u.n);
     Timer ffTimer;
@@ -335,14 +451,15 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     res.stats.add("form_factor_entries", double(entries));
     res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
     res.stats.note("full sparse form-factor matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB <= budget)");
+                   " MB, with the rest " + std::to_string(int((bytes + mem.rest) / 1048576.0 + 0.5)) + " MB <= budget)");
   } else {
     if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
     thread_local FormFactorRow scratch;
     res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; }, false, solver,
                 opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
     res.stats.note("form factors on the fly: the matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB) exceeds the memory budget");
+                   " MB) and the rest (" + std::to_string(int(mem.rest / 1048576.0 + 0.5)) +
+                   " MB) exceed the memory budget");
   }
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) {
     // Per vertex: exact direct light there; the indirect light either
@@ -396,6 +513,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   if (ff.farPairsSkipped())
     res.stats.note(std::to_string(ff.farPairsSkipped()) + " negligible far pairs skipped (F < 1e-7 proved by distance)");
   res.stats.add("patches", double(u.n));
+  if (slow) res.stats.warn(*slow);
+  res.stats.add("memory_estimate_MB", (mem.rest + (fits ? bytes : 0.0)) / 1048576.0);
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());
   return res;

@@ -3,6 +3,8 @@
 // where B varies; Heckbert 1992 and Lischinski et al. 1992 where shadow
 // boundaries cross patches).
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +14,18 @@ namespace gi {
 
 namespace {
 std::string level(int k) { return "level " + std::to_string(k); }
+
+// Memory per patch of the refined mesh besides the solver's
+// (kSolverBytesPerPatch): the refiner's faces, edge and midpoint maps and the
+// trial copy that checks the patch budget (measured: 790 bytes per patch in
+// all at peak at 587,000 patches, the form factors apart).
+constexpr double kRefinerBytesPerPatch = 624;
+
+// The most patches refinement can reach: the budget, or every input face
+// split at every level (4^depth; green closure never exceeds a full split).
+double reachablePatches(size_t inputFaces, const RefineOptions& ro) {
+  return std::min(double(ro.maxPatches), double(inputFaces) * std::pow(4.0, double(ro.maxDepth)));
+}
 }  // namespace
 
 AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
@@ -20,6 +34,18 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   if (ro.maxDepth < 0) throw std::invalid_argument("refine_max_depth must be >= 0");
   if (ro.maxPatches < 1) throw std::invalid_argument("refine_max_patches must be >= 1");
   if (!(ro.threshold > 0)) throw std::invalid_argument("refine_threshold must be > 0");
+  // Refuse at once, not after hours of refining into a mesh that cannot fit.
+  const double MB = 1048576.0, reach = reachablePatches(s.faceCount(), ro);
+  const double need = reach * kRefinerBytesPerPatch + solverBaseBytes(size_t(reach), opt);
+  if (need > opt.memoryBudgetMB * MB) {
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "adaptive refinement may reach %.0f patches (refine_max_patches %d; %zu faces x 4^%d levels), about "
+                  "%.0f MB for the mesh, the refiner and the solver (the form factors apart): more than "
+                  "memory_budget_mb = %g; lower refine_max_patches or refine_max_depth, or raise memory_budget_mb",
+                  reach, ro.maxPatches, s.faceCount(), ro.maxDepth, need / MB, opt.memoryBudgetMB);
+    throw std::invalid_argument(b);
+  }
   const CasterFactory caster = makeCaster ? makeCaster : [](const Scene& sc) { return makeEmbreeCaster(sc); };
   Timer timer;
   MeshRefiner refiner(s);
@@ -37,6 +63,8 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   for (int k = 0; k < levels; ++k) {
     const Scene& sc = refiner.mesh().scene;
     auto rc = caster(sc);
+    // The refiner's own memory comes out of the solver's budget.
+    levelOpt.memoryBudgetMB = std::max(1.0, opt.memoryBudgetMB - double(sc.faceCount()) * kRefinerBytesPerPatch / MB);
     res = solveRadiosity(sc, *rc, levelOpt, stage(k));
     changed = false;
     const std::vector<float> V =
@@ -78,7 +106,9 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   const Scene& sc = refiner.mesh().scene;
   if (changed || opt.vertexOutput != levelOpt.vertexOutput) {
     auto rc = caster(sc);
-    res = solveRadiosity(sc, *rc, opt, stage(levels));
+    RadiosityOptions lastOpt = opt;
+    lastOpt.memoryBudgetMB = std::max(1.0, opt.memoryBudgetMB - double(sc.faceCount()) * kRefinerBytesPerPatch / MB);
+    res = solveRadiosity(sc, *rc, lastOpt, stage(levels));
   }
   for (const auto& l : log) res.stats.note(l);
   res.stats.note("refinement stopped: " + why);

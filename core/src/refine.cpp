@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -186,6 +188,7 @@ struct MeshRefiner::Impl {
   void publish() {
     RefinedMesh& m = mesh;
     m.scene.origin = base.origin;
+    m.scene.unit = base.unit;
     m.scene.positions = positions;
     m.scene.vertexNormals = normals;
     const size_t n = faces.size();
@@ -200,6 +203,7 @@ struct MeshRefiner::Impl {
     auto inherit = [&](auto& dst, const auto& src) {
       dst.clear();
       if (src.empty()) return;
+      if (src.size() != base.faceCount()) throw std::logic_error("refinement: a per-face array changed size");
       dst.resize(n);
       for (size_t f = 0; f < n; ++f) dst[f] = src[faces[f].src];
     };
@@ -213,6 +217,17 @@ struct MeshRefiner::Impl {
 };
 
 MeshRefiner::MeshRefiner(const Scene& input) : impl_(std::make_unique<Impl>()) {
+  // Per-face attributes are copied from each face's source face: every array
+  // must be empty (the default) or have one entry per face.
+  auto check = [&](size_t n, const char* what) {
+    if (n != 0 && n != input.faceCount())
+      throw std::invalid_argument(std::string("refinement: the scene's ") + what + " has " + std::to_string(n) +
+                                  " entries for " + std::to_string(input.faceCount()) + " faces");
+  };
+  check(input.rho.size(), "reflectance");
+  check(input.emission.size(), "emission");
+  check(input.material.size(), "material");
+  check(input.ior.size(), "index of refraction");
   Impl& d = *impl_;
   d.base = input;
   d.positions = input.positions;

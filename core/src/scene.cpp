@@ -15,19 +15,44 @@ bool Scene::hasEmitters() const {
   return false;
 }
 
-Scene Scene::fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris) {
-  Scene s;
+double Scene::unitFor(double diagonal) {
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return 1.0;
+  if (diagonal >= std::ldexp(1.0, -10) && diagonal <= std::ldexp(1.0, 20)) return 1.0;
+  return std::ldexp(1.0, std::ilogb(diagonal));
+}
+
+namespace {
+// Bounding box of the finite points, in double; {lo > hi} if there are none.
+std::pair<glm::dvec3, glm::dvec3> finiteBox(const std::vector<glm::dvec3>& pts) {
   glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
   for (const auto& p : pts)
     if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  s.origin = lo.x <= hi.x ? (lo + hi) * 0.5 : glm::dvec3(0.0);
+  return {lo, hi};
+}
+// The diagonal hi - lo, without overflow for coordinates near the double range.
+double diagonalOf(const glm::dvec3& lo, const glm::dvec3& hi) {
+  if (!(lo.x <= hi.x)) return 0.0;
+  const glm::dvec3 half = hi * 0.5 - lo * 0.5;
+  return 2.0 * glm::length(half);
+}
+}  // namespace
+
+Scene Scene::fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris) {
+  Scene s;
+  const auto [lo, hi] = finiteBox(pts);
+  s.origin = lo.x <= hi.x ? lo * 0.5 + hi * 0.5 : glm::dvec3(0.0);
+  s.unit = unitFor(diagonalOf(lo, hi));
   s.positions.reserve(pts.size());
-  for (const auto& p : pts) s.positions.push_back(glm::vec3(p - s.origin));
+  for (const auto& p : pts) s.positions.push_back(glm::vec3((p - s.origin) / s.unit));
   s.triangles = std::move(tris);
   return s;
 }
 
 size_t Scene::append(const Scene& o) {
+  if (positions.empty() && triangles.empty()) {  // nothing here yet: take the other's frame as it is
+    origin = o.origin;
+    unit = o.unit;
+  }
   const size_t vOff = positions.size(), fOff = triangles.size();
   auto fillTo = [](auto& v, size_t n, auto value) { if (v.size() < n) v.resize(n, value); };
   // Per-face arrays become explicit as soon as one part has them.
@@ -41,8 +66,21 @@ size_t Scene::append(const Scene& o) {
   if (anyIor) fillTo(ior, fOff, 1.5f);
   if (anyRough) fillTo(roughness, fOff, 0.2f);
   if (anyN) fillTo(vertexNormals, vOff, glm::vec3(0.f));
-  const glm::dvec3 shift = o.origin - origin;
-  for (const auto& p : o.positions) positions.push_back(glm::vec3(glm::dvec3(p) + shift));
+  // The union's unit: rescale what is here (by a power of two: exact) if it changes.
+  std::vector<glm::dvec3> world;
+  world.reserve(positions.size() + o.positions.size());
+  for (const auto& p : positions) world.push_back(toWorld(p));
+  for (const auto& p : o.positions) world.push_back(o.toWorld(p));
+  const auto [lo, hi] = finiteBox(world);
+  const double newUnit = unitFor(diagonalOf(lo, hi));
+  if (newUnit != unit) {
+    const double k = unit / newUnit;
+    for (auto& p : positions) p = glm::vec3(glm::dvec3(p) * k);
+    unit = newUnit;
+  }
+  const glm::dvec3 shift = (o.origin - origin) / unit;
+  const double k = o.unit / unit;
+  for (const auto& p : o.positions) positions.push_back(glm::vec3(glm::dvec3(p) * k + shift));
   for (const auto& t : o.triangles) triangles.push_back(t + glm::uvec3(uint32_t(vOff)));
   for (size_t f = 0; f < o.faceCount(); ++f) {
     if (anyRho) rho.push_back(o.faceRho(f));
@@ -164,7 +202,7 @@ SceneReport analyzeScene(const Scene& s) {
     glm::vec3 E = s.faceEmission(f);
     if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
       ++r.emitterFaces;
-      r.emittedPower += double(luminance(E)) * faceArea(s, f);
+      r.emittedPower += double(luminance(E)) * faceArea(s, f) * s.unit * s.unit;
     }
   }
   for (size_t i = 0; i < nv; ++i) r.isolatedVertices += (finite[i] && !used[i]) ? 1 : 0;
@@ -187,7 +225,7 @@ SceneReport analyzeScene(const Scene& s) {
   }
   if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; }
   const SceneScale sc = sceneScale(s);
-  r.diagonal = sc.diagonal;
+  r.diagonal = sc.diagonal * s.unit;
   r.rayEpsilon = sc.rayEpsilon;
   return r;
 }
@@ -197,8 +235,8 @@ SceneScale sceneScale(const Scene& s) {
   double maxAbs = 0.0;
   for (const glm::vec3& p : s.positions) {
     if (!finite3(p)) continue;
-    lo = glm::min(lo, s.toWorld(p));
-    hi = glm::max(hi, s.toWorld(p));
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
     maxAbs = std::max({maxAbs, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
   }
   SceneScale sc;

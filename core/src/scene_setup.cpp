@@ -118,8 +118,15 @@ PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& origin) 
   p.position = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
   const glm::vec3 c = v.getVec("point_color");
   p.intensity = float(v.getFloat("point_intensity")) * glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
-  p.spotDirection = glm::normalize(v.getVec("spot_direction"));
+  p.spotDirection = v.getDirection("spot_direction");
   p.spotAngleDeg = float(v.getFloat("spot_angle"));
+  return p;
+}
+
+PointLight pointLightInLocalUnits(const PointLight& L, const Scene& s) {
+  PointLight p = L;
+  p.position = glm::vec3(glm::dvec3(L.position) / s.unit);
+  p.intensity = glm::vec3(glm::dvec3(L.intensity) / (s.unit * s.unit));
   return p;
 }
 

@@ -374,6 +374,91 @@ def case_cli(c):
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
 
 
+def scaled_box(path, k, n=3):
+    """The cube [-k/2, k/2]^3 seen from inside, n x n quads a side, as ASCII PLY (face quality 0)."""
+    verts, faces, index = [], [], {}
+
+    def v(p):
+        key = tuple(round(x * 2 * n) for x in p)
+        if key not in index:
+            index[key] = len(verts)
+            verts.append(p)
+        return index[key]
+    for axis in range(3):
+        for sign in (-1, 1):
+            a, b = (axis + 1) % 3, (axis + 2) % 3
+            for i in range(n):
+                for j in range(n):
+                    q = []
+                    for (s, t) in ((i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis], p[a], p[b] = 0.5 * sign, s / n - 0.5, t / n - 0.5
+                        q.append(v(p))
+                    if sign > 0:
+                        q.reverse()
+                    faces += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
+    with open(path, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face %d\nproperty list uchar int vertex_indices\nproperty float quality\nend_header\n" % (len(verts), len(faces)))
+        for p in verts:
+            f.write("%.9g %.9g %.9g\n" % tuple(x * k for x in p))
+        for t in faces:
+            f.write("3 %d %d %d 0\n" % t)
+
+
+def run_gi(c, args):
+    p = subprocess.run([c.gi] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return p
+
+
+def case_robust(c):
+    import json
+    # Scales: closed boxes 1e-20 and 1e38 across compute like the unit box (they aborted in Embree, wrote NaN
+    # or saw an open sky): AO 0 inside, the radiosity furnace B = E / (1 - rho) at every vertex.
+    lit = ["--emitter_source", "1", "--emitter_quality_threshold", "-1", "--emitter_intensity", "1",
+           "--emitter_color", "255,255,255"]
+    rho = ((188 / 255 + 0.055) / 1.055) ** 2.4  # the default constant reflectance, sRGB 188
+    for k in ("1e-20", "1e38"):
+        box = os.path.join(c.tmp, "box_%s.ply" % k)
+        scaled_box(box, float(k))
+        out = os.path.join(c.tmp, "ao_%s.ply" % k)
+        p = run_gi(c, ["ao", box, "-o", out, "-q", "--rays_per_vertex", "64"])
+        check(p.returncode == 0 and all(r["quality"] == 0.0 for r in vertices(out)), "AO 0 inside a box %s across" % k)
+        out = os.path.join(c.tmp, "rad_%s.ply" % k)
+        p = run_gi(c, ["radiosity", box, "-o", out, "-q", "--json"] + lit)
+        exact = 1 / (1 - rho)
+        worst = max(abs(r["quality"] / exact - 1) for r in vertices(out))
+        check(p.returncode == 0 and worst < 0.02, "radiosity furnace in a box %s across: worst %.4f (tol 0.02)" % (k, worst))
+        check(json.loads(p.stdout)["warnings"] == [], "no warning for a converged furnace %s across" % k)
+    # A direction of magnitude 1e20 is the direction, not a zero vector (a sun below every horizon).
+    mesh = os.path.join(c.meshes, "floor_wall.ply")
+    q = []
+    for d in ("1e20,1e20,0", "1,1,0"):
+        out = os.path.join(c.tmp, "sun.ply")
+        p = run_gi(c, ["sky", mesh, "-o", out, "-q", "--sun_direction", d, "--sky_irradiance", "0", "--sun_angular_radius", "0"])
+        q.append([r["quality"] for r in vertices(out)])
+    check(q[0] == q[1] and max(q[0]) > 0, "--sun_direction 1e20,1e20,0 lights like 1,1,0")
+    # Runaway work is refused before it starts: one line, non-zero exit.
+    box = os.path.join(c.tmp, "box48.ply")
+    scaled_box(box, 1.0, 2)
+    for args, words in ((["--refine", "true", "--refine_max_depth", "12", "--refine_max_patches", "100000000"],
+                         "may reach 100000000 patches"),
+                        (["--form_factor_method", "Hemicube", "--hemicube_resolution", "4096", "--memory_budget_mb", "100"],
+                         "memory_budget_mb = 100 is too small")):
+        p = run_gi(c, ["radiosity", box, "-q"] + lit + args)
+        lines = [l for l in p.stderr.splitlines() if l.strip()]
+        check(p.returncode != 0 and len(lines) == 1 and words in lines[0],
+              "refused at once: exit %d, one line: %s" % (p.returncode, lines[-1][:120] if lines else ""))
+    # Non-convergence is a warning in the JSON: rho 0.999 stopped by the bounds set here.
+    white = lit + ["--reflectance", "255,255,255"]
+    p = run_gi(c, ["radiosity", box, "-q", "--json", "--max_iterations", "50"] + white)
+    w = json.loads(p.stdout)["warnings"]
+    check(p.returncode == 0 and len(w) == 1 and "not converged" in w[0], "radiosity stopped early warns: %s" % w[:1])
+    p = run_gi(c, ["reference", box, "-q", "--json", "--max_depth", "20", "--samples_per_vertex", "4"] + white)
+    w = json.loads(p.stdout)["warnings"]
+    check(p.returncode == 0 and len(w) == 1 and "max_depth = 20" in w[0], "reference cut by max_depth warns: %s" % w[:1])
+
+
 def case_refine(c):
     """GI: Radiosity with adaptive mesh refinement: the saved layer is the
     refined mesh; the light, chosen by selection, stays selected, so a second
@@ -474,7 +559,8 @@ def case_refine(c):
 
 
 CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
-         "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump}
+         "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump,
+         "robust": case_robust}
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()

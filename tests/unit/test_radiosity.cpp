@@ -5,6 +5,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
 
 #include "gi/color.h"
 #include "gi/form_factor_analytic.h"
@@ -263,7 +265,8 @@ TEST(Radiosity, DeterministicAcrossThreadCountsAndMemoryPaths) {
   EXPECT_EQ(a.B, b.B);
   // Beyond the memory budget rows are computed on the fly and shot by
   // reciprocity (the classical form): the same answer up to Monte Carlo noise.
-  o.memoryBudgetMB = 0.01;
+  // The budget holds the rest of the solve (solverBaseBytes) but not the matrix.
+  o.memoryBudgetMB = (solverBaseBytes(sf.scene.faceCount(), o) + 4096.0) / 1048576.0;
   const RadiosityResult c = solveRadiosity(sf.scene, *caster, o);
   EXPECT_NE(c.stats.notes[1].find("on the fly"), std::string::npos);
   double num = 0, den = 0;
@@ -481,4 +484,143 @@ TEST(Radiosity, StressAreasDuplicatesAndRhoNearOne) {
   fo.maxIterations = 100000;
   const auto fr = solveRadiosity(f, *fc, fo);
   for (const auto& b : fr.B) EXPECT_NEAR(b.g / 1000.0, 1.0, 0.01);
+}
+
+namespace {
+// The inward unit box, 3 x 3 patches a side, rho and E uniform: B = E / (1 - rho).
+Scene furnaceBox(float rho) {
+  auto sf = scenes::closedBox(1.0, 3, true);
+  scenes::setUniform(sf, glm::vec3(rho), glm::vec3(1.f));
+  return sf.scene;
+}
+bool warned(const RunStats& st, const std::string& what) {
+  for (const auto& w : st.warnings)
+    if (w.find(what) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+// rho = 0.999 with the default parameters: max_iterations 0 (automatic)
+// gives 1.5 ln(1e-4) / ln(0.999) = 13,809 sweeps of room, and every solver
+// meets the tolerance: B = 1000 on every patch within 0.1% (Monte Carlo rows
+// of a closed box sum to 1 exactly; the direct light, exact factors at 256
+// points, is E to 1e-4; the residual 1e-4 of the emitted power leaves at
+// most 1e-4 x 0.999 / 0.001 = 0.1 of it, 1e-4 of the reflected power).
+// The old fixed bound of 1000 sweeps stopped at 0.999^1000: -37%.
+TEST(Radiosity, FurnaceNearOneConvergesWithTheDefaults) {
+  const Scene s = furnaceBox(0.999f);
+  auto caster = makeEmbreeCaster(s);
+  EXPECT_EQ(autoIterations(0.999, 1e-4), 13809);
+  EXPECT_EQ(autoIterations(0.9, 1e-4), 132);
+  for (auto solver : {RadiositySolver::Jacobi, RadiositySolver::GaussSeidel, RadiositySolver::Progressive}) {
+    RadiosityOptions o;
+    o.solver = solver;
+    o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    EXPECT_TRUE(r.stats.warnings.empty()) << int(solver) << ": " << r.stats.line("radiosity");
+    EXPECT_NEAR(r.stats.get("max_iterations_auto"), 13809.0, 1.0);  // rho is 0.999f
+    EXPECT_LT(r.residual, 1e-4);
+    for (const auto& b : r.B) ASSERT_NEAR(b.g, 1000.0, 1.0) << "solver " << int(solver);
+  }
+}
+
+// A bound that stops the solve early is a warning with an honest bound: 300
+// sweeps (shots per patch) leave B far below 1000, and the warning's
+// "short by up to X%" is at least the true shortfall. A fixed bounce count
+// stops early on purpose: no warning.
+TEST(Radiosity, TooFewIterationsWarn) {
+  const Scene s = furnaceBox(0.999f);
+  auto caster = makeEmbreeCaster(s);
+  for (auto solver : {RadiositySolver::Jacobi, RadiositySolver::GaussSeidel, RadiositySolver::Progressive}) {
+    RadiosityOptions o;
+    o.solver = solver;
+    o.maxIterations = 300;
+    o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    ASSERT_TRUE(warned(r.stats, "not converged")) << int(solver) << ": " << r.stats.line("radiosity");
+    double mean = 0;
+    for (const auto& b : r.B) mean += b.g / double(r.B.size());
+    const double shortBy = 100.0 * (1.0 - mean / 1000.0);
+    EXPECT_GT(shortBy, 10.0) << int(solver);
+    const std::string& w = r.stats.warnings.front();
+    const size_t at = w.find("short by up to ");
+    ASSERT_NE(at, std::string::npos) << w;
+    EXPECT_GE(std::stod(w.substr(at + 15)), shortBy) << w;
+    EXPECT_NE(r.stats.line("radiosity").find("WARNING: not converged"), std::string::npos);
+  }
+  RadiosityOptions fixed;
+  fixed.bounces = 3;
+  fixed.vertexOutput = RadiosityVertexOutput::PatchAverage;
+  EXPECT_TRUE(solveRadiosity(s, *caster, fixed).stats.warnings.empty());
+}
+
+namespace {
+// Runs f and returns the message of the std::invalid_argument it throws
+// ("" if none), counting the progress reports made before it.
+std::string refusal(const std::function<void(const Progress&)>& f, int* reports) {
+  *reports = 0;
+  const Progress p([reports](int, const std::string&) { ++*reports; return true; });
+  try {
+    f(p);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+// The memory budget covers all the memory, and a run that cannot fit is
+// refused with one sentence before any work (no progress reported):
+// refinement that may reach 1e8 patches (48 faces x 4^12 levels capped by
+// the patch budget: about 100 GB), hemicube buffers of resolution 4096
+// (144 MB per thread) under a 100 MB budget, and 10,800 patches (about 4 MB
+// of solver data) under 1 MB.
+TEST(Radiosity, MemoryBudgetRefusesBeforeTheWork) {
+  auto box = scenes::closedBox(1.0, 2, true);  // 48 faces
+  scenes::setUniform(box, glm::vec3(0.5f), glm::vec3(1.f));
+  int reports = 0;
+  RadiosityOptions deep;
+  deep.refine = true;
+  deep.refinement.maxDepth = 12;
+  deep.refinement.maxPatches = 100000000;
+  std::string why = refusal([&](const Progress& p) { solveRadiosityAdaptive(box.scene, deep, p); }, &reports);
+  EXPECT_NE(why.find("may reach 100000000 patches"), std::string::npos) << why;
+  EXPECT_NE(why.find("memory_budget_mb = 1024"), std::string::npos) << why;
+  EXPECT_EQ(reports, 0);
+
+  auto caster = makeEmbreeCaster(box.scene);
+  RadiosityOptions hemi;
+  hemi.formFactorMethod = FormFactorMethod::Hemicube;
+  hemi.hemicubeResolution = 4096;
+  hemi.memoryBudgetMB = 100;
+  why = refusal([&](const Progress& p) { solveRadiosity(box.scene, *caster, hemi, p); }, &reports);
+  EXPECT_NE(why.find("hemicube"), std::string::npos) << why;
+  EXPECT_EQ(reports, 0);
+  EXPECT_NEAR(hemicubeBufferBytes(4096) / 1048576.0, 144.0, 1.0);  // 9 bytes x 4096^2
+
+  auto fine = scenes::closedBox(1.0, 30, true);  // 10,800 patches
+  scenes::setUniform(fine, glm::vec3(0.5f), glm::vec3(1.f));
+  auto fineCaster = makeEmbreeCaster(fine.scene);
+  RadiosityOptions tight;
+  tight.memoryBudgetMB = 1;
+  why = refusal([&](const Progress& p) { solveRadiosity(fine.scene, *fineCaster, tight, p); }, &reports);
+  EXPECT_NE(why.find("10800 patches need about"), std::string::npos) << why;
+  EXPECT_EQ(reports, 0);
+
+  // Within the budget: it runs, and the estimate is in the statistics.
+  RadiosityOptions ok;
+  ok.vertexOutput = RadiosityVertexOutput::PatchAverage;
+  const RadiosityResult r = solveRadiosity(box.scene, *caster, ok);
+  EXPECT_GT(r.stats.get("memory_estimate_MB"), 0.0);
+  EXPECT_LT(r.stats.get("memory_estimate_MB"), 1024.0);
+}
+
+// The hemicube's work, patches x 6 res^2 cell updates, warned about from
+// about 1e11 (minutes): resolution 4096 on 2,000 patches is 2e11; the
+// default 128 on 100,000 patches is 1e10.
+TEST(Radiosity, HemicubeCostWarning) {
+  const auto w = hemicubeCostWarning(2000, 4096);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find("resolution 4096 on 2000 patches"), std::string::npos) << *w;
+  EXPECT_FALSE(hemicubeCostWarning(100000, 128).has_value());
 }

@@ -386,6 +386,7 @@ TEST(Refine, BadFacesDoNotBreakIt) {
   s.triangles.push_back({0, 1, nv + 5});
   s.triangles.push_back({0, 1, 1});
   s.rho.resize(s.triangles.size(), glm::vec3(0.5f));
+  s.emission.resize(s.triangles.size(), glm::vec3(0.f));
   MeshRefiner r(s);
   std::vector<uint32_t> all(s.faceCount());
   for (uint32_t f = 0; f < all.size(); ++f) all[f] = f;
@@ -398,4 +399,27 @@ TEST(Refine, BadFacesDoNotBreakIt) {
     for (int k = 0; k < 3; ++k) EXPECT_LT(m.scene.triangles[f][k], m.scene.vertexCount());
   }
   EXPECT_GT(m.scene.faceCount(), 4 * plane.scene.faceCount());
+}
+
+// Per-face arrays shorter (or longer) than the face list: one clear error
+// naming the array, before anything is read past its end.
+TEST(Refine, PerFaceArraysOfTheWrongSizeAreAClearError) {
+  const Scene plane = scenes::openPlane(1.0, 2).scene;
+  for (int which = 0; which < 4; ++which) {
+    Scene s = plane;
+    s.material.assign(s.faceCount(), Material::Diffuse);
+    s.ior.assign(s.faceCount(), 1.5f);
+    s.triangles.push_back(s.triangles.front());  // one face more than the arrays
+    if (which != 0) s.rho.push_back(glm::vec3(0.5f));
+    if (which != 1) s.emission.push_back(glm::vec3(0.f));
+    if (which != 2) s.material.push_back(Material::Diffuse);
+    if (which != 3) s.ior.push_back(1.5f);
+    const char* names[] = {"reflectance", "emission", "material", "index of refraction"};
+    try {
+      MeshRefiner r(s);
+      ADD_FAILURE() << "no error for a short " << names[which] << " array";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(names[which]), std::string::npos) << e.what();
+    }
+  }
 }

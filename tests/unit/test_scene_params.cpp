@@ -13,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "gi/ambient.h"
 #include "gi/color.h"
+#include "gi/pathtrace.h"
 #include "gi/filters.h"
 #include "gi/params.h"
 #include "gi/run.h"
@@ -266,6 +268,66 @@ void expectRejected(const std::string& name, gi::ParamValue x, const char* why) 
   const auto err = validateWith(name, x);
   ASSERT_TRUE(err.has_value()) << name << ": " << why;
   EXPECT_NE(err->find("'" + name + "'"), std::string::npos) << *err;
+}
+
+// Directions of any magnitude keep their direction: 1e20 (whose square
+// overflows a float: glm::normalize gave 0, a sun below every horizon) and
+// 1e-30 (whose square underflows: it was rejected as zero); zero, NaN and
+// infinite ones are rejected with the parameter's name, by validate() and by
+// getDirection().
+TEST(Params, DirectionsOfAnyMagnitude) {
+  const auto specs = testSpecs();
+  for (const float m : {1e20f, 3e38f, 1e-30f, 1e-45f, 1.f}) {
+    for (const glm::vec3 d : {glm::vec3(m, 0.f, 0.f), glm::vec3(-m, m, 0.f), glm::vec3(0.f, 0.f, -m)}) {
+      EXPECT_FALSE(validateWith("dir", d)) << m;
+      gi::ParamValues v = gi::defaultValues(specs, kDiag);
+      v.set("dir", d);
+      const glm::vec3 u = v.getDirection("dir");
+      const glm::vec3 expect = glm::normalize(glm::vec3(d.x != 0.f ? (d.x > 0 ? 1.f : -1.f) : 0.f,
+                                                        d.y != 0.f ? (d.y > 0 ? 1.f : -1.f) : 0.f,
+                                                        d.z != 0.f ? (d.z > 0 ? 1.f : -1.f) : 0.f));
+      EXPECT_NEAR(glm::length(u - expect), 0.f, 1e-6f) << m;
+    }
+  }
+  // The CLI's path: parse "1e20,0,0", validate, read as a unit vector.
+  const gi::ParamValue parsed = gi::parseValue(specs[6], "1e20,0,0", kDiag);
+  gi::ParamValues v = gi::defaultValues(specs, kDiag);
+  v.set("dir", parsed);
+  EXPECT_FALSE(gi::validate(specs, v, kDiag));
+  EXPECT_EQ(v.getDirection("dir"), glm::vec3(1.f, 0.f, 0.f));
+  // "1e39" is infinite as a float: rejected, not normalised to garbage.
+  v.set("dir", gi::parseValue(specs[6], "1e39,0,0", kDiag));
+  ASSERT_TRUE(gi::validate(specs, v, kDiag).has_value());
+  EXPECT_THROW(v.getDirection("dir"), std::invalid_argument);
+  for (const glm::vec3 bad : {glm::vec3(0.f), glm::vec3(-0.f, 0.f, -0.f), glm::vec3(kNaN, 1.f, 0.f),
+                              glm::vec3(kInf, 0.f, 0.f), glm::vec3(1.f, -kInf, 0.f)}) {
+    expectRejected("dir", bad, "zero or non-finite direction");
+    v.set("dir", bad);
+    EXPECT_THROW(v.getDirection("dir"), std::invalid_argument);
+  }
+}
+
+// The filters read their direction parameters through getDirection: a sun
+// given as 1e20,0,0 is the sun along +x, not a zero vector.
+TEST(Params, DirectionParametersReachTheAlgorithmsAsUnitVectors) {
+  const glm::vec3 huge(1e20f, 0.f, 0.f), tiny(0.f, -1e-30f, 0.f);
+  {
+    const auto specs = gi::filterSpecs(gi::FilterKind::SkyLighting);
+    gi::ParamValues v = gi::defaultValues(specs, 1.0);
+    v.set("sun_direction", huge);
+    ASSERT_FALSE(gi::validate(specs, v, 1.0));
+    EXPECT_EQ(gi::AmbientOptions::fromParams(gi::AmbientMode::Sky, v).sunDirection, glm::vec3(1.f, 0.f, 0.f));
+  }
+  {
+    const auto specs = gi::filterSpecs(gi::FilterKind::PathTracedReference);
+    gi::ParamValues v = gi::defaultValues(specs, 1.0);
+    v.set("sun_direction", huge);
+    v.set("spot_direction", tiny);
+    ASSERT_FALSE(gi::validate(specs, v, 1.0));
+    const gi::PathTraceOptions o = gi::PathTraceOptions::fromParams(v, glm::dvec3(0.0));
+    EXPECT_EQ(o.sunDirection, glm::vec3(1.f, 0.f, 0.f));
+    EXPECT_EQ(o.point.spotDirection, glm::vec3(0.f, -1.f, 0.f));
+  }
 }
 
 TEST(Params, ValidateEveryErrorPath) {

@@ -39,7 +39,7 @@ class RayCaster;
 
 // An optional point or spot light (photon mapping and the reference).
 struct PointLight {
-  glm::vec3 position{0.f};          // local scene coordinates
+  glm::vec3 position{0.f};          // relative to the scene origin (see pointLightInLocalUnits)
   glm::vec3 intensity{0.f};         // W/sr, linear RGB; 0 = none
   glm::vec3 spotDirection{0.f, -1.f, 0.f};
   float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light

@@ -15,6 +15,8 @@
 //    exact delta form factor to the patch it shows.
 #pragma once
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,6 +60,9 @@ class FormFactors {
   bool unoccluded() const { return unoccluded_; }            // visibility rays skipped
   // Upper bound of the bytes a full sparse matrix of these rows needs.
   double matrixBytesBound() const;
+  // Bytes one thread holds while computing a row (its dense F and, for the
+  // hemicube, the face buffers: see hemicubeBufferBytes).
+  double rowScratchBytes() const;
 
  private:
   FormFactorRow monteCarloRow(uint32_t i) const;
@@ -77,6 +82,16 @@ class FormFactors {
   std::vector<glm::dvec3> centroid_;
   std::vector<double> radius_;
 };
+
+// Bytes of the depth, patch and side buffers a hemicube of this resolution
+// holds at once (its top face, res^2 cells; the sides have half as many),
+// per thread computing rows: 144 MB at resolution 4096.
+double hemicubeBufferBytes(int resolution);
+// The hemicube's work: every patch's row draws and sums its 3 res^2 cells, so
+// the cost grows as patches x res^2 whatever the scene. A sentence to warn
+// with when that reaches about 1e11 cell updates (minutes of a core), else
+// nothing.
+std::optional<std::string> hemicubeCostWarning(size_t patches, int resolution);
 
 // One row for study (the "GI: Form Factors of Selected Face" filter): F from
 // face i to every other face, its sum, and the reciprocity A_i F_ij = A_j F_ji

@@ -48,6 +48,9 @@ class ParamValues {
   int getInt(const std::string& n) const { return std::get<int>(at(n)); }
   double getFloat(const std::string& n) const { return std::get<double>(at(n)); }
   glm::vec3 getVec(const std::string& n) const { return std::get<glm::vec3>(at(n)); }
+  // A Direction parameter as a unit vector (see unitDirection); throws
+  // std::invalid_argument for a zero or non-finite one.
+  glm::vec3 getDirection(const std::string& n) const;
   const std::string& getString(const std::string& n) const { return std::get<std::string>(at(n)); }
   const std::map<std::string, ParamValue>& all() const { return v_; }
 
@@ -55,6 +58,12 @@ class ParamValues {
   const ParamValue& at(const std::string& n) const;
   std::map<std::string, ParamValue> v_;
 };
+
+// The unit vector along d, normalised in double after dividing by its
+// largest component, so that components of 1e20 (whose squares overflow a
+// float) or 1e-30 (whose squares underflow) keep their direction; nothing for
+// a zero or non-finite d.
+std::optional<glm::vec3> unitDirection(const glm::vec3& d);
 
 // Defaults of a table for a scene of the given bbox diagonal.
 ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal);

@@ -7,7 +7,8 @@
 // (next-event estimation) and combined with the BSDF-sampled hits by multiple
 // importance sampling (power heuristic, Veach 1997). Lights: area emitters,
 // a uniform sky, a sun disk and a point or spot light. Mirror and glass faces
-// (gi/specular.h) are followed in their sampled specular direction; emitters
+// (gi/specular.h) are followed in their sampled specular direction (paths are
+// traced in a loop with a throughput, never by recursion); emitters
 // seen through them count fully (next-event estimation cannot sample them)
 // and shadow rays stop at them. Radiance is scaled by eta^2 across glass
 // (cancelling on paths that enter and leave). Random numbers are
@@ -31,13 +32,14 @@ struct PathTraceOptions {
   int samplesPerVertex = 256;      // fixed count when targetRelativeError == 0
   double targetRelativeError = 0;  // adaptive: stop when stderr(B) / B is below this
   int minSamples = 64, maxSamples = 65536;
-  int maxDepth = 1000;             // bounces (0 = direct light only); Russian roulette ends paths earlier
+  int maxDepth = -1;               // bounces (0 = direct light only); -1: no fixed limit (Russian
+                                   // roulette alone ends paths: unbiased; a safety cap of 100,000)
   uint32_t seed = 0;
   glm::vec3 skyRadiance{0.f};      // uniform sky over the whole sphere, W/(m^2 sr)
   glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
-  PointLight point;                // optional point or spot light (local coordinates)
+  PointLight point;                // optional point or spot light (relative to the scene origin, world units)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

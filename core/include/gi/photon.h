@@ -50,7 +50,7 @@ struct PhotonOptions {
   bool progressive = false;   // progressive photon mapping over `passes` passes
   int passes = 16;
   double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
-  PointLight point;           // optional point or spot light (local coordinates)
+  PointLight point;           // optional point or spot light (relative to the scene origin, world units)
   uint32_t seed = 0;
   static std::vector<ParamSpec> specs();
   static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);

@@ -38,7 +38,8 @@ struct RadiosityOptions {
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
   double tolerance = 1e-4;        // on the relative residual / unshot power
-  int maxIterations = 1000;       // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive)
+  int maxIterations = 0;          // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive);
+                                  // 0: automatic, from the largest reflectance (autoIterations)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
   uint32_t seed = 0;
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
@@ -63,7 +64,24 @@ struct RadiosityResult {
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                const Progress& progress = Progress(nullptr));
 
-// Solvers on precomputed rows and direct irradiance (exposed for tests).
+// The memory memory_budget_mb must cover besides the form-factor matrix, in
+// bytes: per patch, the scene's face arrays, the ray-casting structure and
+// the solver's vectors and vertex output (kSolverBytesPerPatch; measured 330
+// at peak on a box of 1.08 million patches, the matrix apart), and per
+// worker thread the scratch of one form-factor row (a dense row of n values;
+// a hemicube's buffers, 144 MB at resolution 4096).
+inline constexpr double kSolverBytesPerPatch = 400;
+double solverBaseBytes(size_t patches, const RadiosityOptions& opt);
+int workerThreads();  // the threads parallel loops may use now
+
+// Sweeps enough for the residual to fall below `tolerance` when each sweep
+// shrinks it at least by the factor r (the spectral radius bound: the
+// largest reflectance, times the largest row sum of F if above 1):
+// 1.5 ln(tolerance) / ln(r), at least 10, at most 1,000,000.
+int autoIterations(double r, double tolerance);
+
+// Solvers on precomputed rows and direct irradiance (exposed for tests;
+// maxIterations 0 = automatic).
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress);

@@ -14,9 +14,17 @@ enum class Material : uint8_t { Diffuse = 0, Mirror = 1, Glass = 2, Glossy = 3 }
 
 // Positions are stored relative to `origin` (double), so that meshes far from
 // the coordinate origin (offsets of 1e6) keep full float precision in the
-// ray caster. Use Scene::addVertex to fill it from absolute coordinates.
+// ray caster, and in units of `unit` (a world length), so that a scene 1e-20
+// or 1e38 across computes like one of ordinary size: squared distances,
+// areas and ray offsets of such scenes underflow or overflow a float (NaN
+// rays, light escaping closed boxes). Algorithms work in these local units;
+// parameters they take in world units (distances, a point light's position
+// and intensity) are converted on entry (the *InLocalUnits helpers), and
+// results per area (irradiance, radiosity, exitance) need no conversion. Use
+// Scene::fromAbsolute to fill it from absolute coordinates.
 struct Scene {
   glm::dvec3 origin{0.0};
+  double unit = 1.0;                      // world length of one local unit (1 or a power of two)
   std::vector<glm::vec3> positions;       // relative to origin
   std::vector<glm::uvec3> triangles;      // vertex indices, counter-clockwise = front
   std::vector<glm::vec3> vertexNormals;   // optional (empty: computed from faces)
@@ -35,12 +43,19 @@ struct Scene {
   bool hasEmitters() const;
 
   // Absolute <-> local coordinates.
-  glm::dvec3 toWorld(const glm::vec3& p) const { return origin + glm::dvec3(p); }
-  // Re-centres a scene given in absolute double coordinates.
+  glm::dvec3 toWorld(const glm::vec3& p) const { return origin + unit * glm::dvec3(p); }
+  // Re-centres a scene given in absolute double coordinates, in the local
+  // unit unitFor(its bbox diagonal).
   static Scene fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris);
-  // Appends another scene (its vertices re-expressed relative to this origin).
+  // Appends another scene (its vertices re-expressed relative to this origin
+  // and, if the union's size asks for another unit, all of them rescaled).
   // Returns the vertex offset of the appended part.
   size_t append(const Scene& other);
+  // The local unit for a scene of this world diagonal: 1 from 2^-10 to 2^20
+  // (about 1e-3 to 1e6: every scene of ordinary size keeps its numbers bit
+  // for bit), else the power of two at or below it, so that local positions
+  // lie within [-1, 1] and scaling by it is exact.
+  static double unitFor(double diagonal);
 };
 
 // FNV-1a hash of what a lighting result depends on: absolute positions,
@@ -66,7 +81,7 @@ struct SceneReport {
   size_t duplicateFaces = 0;       // usable faces repeating an earlier face's corners
   double emittedPower = 0.0;       // luminance-weighted, W
   glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
-  double diagonal = 0.0;           // bbox diagonal
+  double diagonal = 0.0;           // bbox diagonal (world units)
   double rayEpsilon = 0.0;         // offset for ray origins (local units)
   size_t usableFaces() const { return faces - invalidFaces - degenerateFaces - facesOnNonFinite; }
   std::string summary() const;     // one line for logs
@@ -77,7 +92,7 @@ SceneReport analyzeScene(const Scene& s);
 // Only the scale (one pass over the vertices): what the algorithms need for
 // their ray offsets, without the defect counts of a full report.
 struct SceneScale {
-  double diagonal = 0.0;    // bbox diagonal over finite vertices
+  double diagonal = 0.0;    // bbox diagonal over finite vertices (local units)
   double rayEpsilon = 0.0;  // offset for ray origins (local units)
 };
 SceneScale sceneScale(const Scene& s);

@@ -50,7 +50,12 @@ std::vector<ParamSpec> glossySpecs();
 
 // The optional point or spot light's parameters (photon mapping and the reference).
 std::vector<ParamSpec> pointLightSpecs();
+// Its position relative to sceneOrigin, in world units (as the options hold it).
 PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
+// The light in the scene's local units (Scene::unit): position / unit and,
+// since its irradiance I cos / r^2 must not change when r is measured in
+// local units, intensity / unit^2. The algorithms convert on entry.
+PointLight pointLightInLocalUnits(const PointLight& L, const Scene& s);
 
 // A named range of faces of the scene: a MeshLab layer or an input file.
 struct LayerRange {
