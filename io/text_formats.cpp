@@ -164,7 +164,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       }
       ++c.vertices;
     } else if (key == "vt") {
-      numbers(1, 3, "1 to 3 texture coordinates");
+      numbers(2, 3, "2 or 3 texture coordinates");
       ++nvt;
     } else if (key == "vn") {
       numbers(3, 3, "3 normal components");
