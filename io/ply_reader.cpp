@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_set>
 
 #include "mesh_parts.h"
 
@@ -93,6 +94,8 @@ Header parseHeader(std::string_view b, const std::string& name) {
   Header h;
   size_t pos = b[3] == '\n' ? 4 : 5, lineNo = 1;
   bool formatSeen = false;
+  // Hashed: a 1 MiB header of 50,000 property lines must not cost 10^9 comparisons.
+  std::unordered_set<std::string> elementNames, propertyNames;
   constexpr size_t kMaxHeader = size_t(1) << 20;
   for (;;) {
     const size_t nl = b.find('\n', pos);
@@ -123,9 +126,9 @@ Header parseHeader(std::string_view b, const std::string& name) {
       if (!formatSeen) failRead(name, at + ": an element before the 'format' line");
       if (w.size() != 3 || !parseInt(w[2], count) || count < 0)
         failRead(name, at + ": expected 'element NAME COUNT' with a count >= 0, found " + quoted(line));
-      for (const Element& e : h.elements)
-        if (e.name == w[1]) failRead(name, at + ": a second element " + quoted(w[1]));
+      if (!elementNames.insert(std::string(w[1])).second) failRead(name, at + ": a second element " + quoted(w[1]));
       h.elements.push_back({std::string(w[1]), uint64_t(count), {}});
+      propertyNames.clear();
     } else if (w[0] == "property") {
       if (h.elements.empty()) failRead(name, at + ": a property before any element");
       Property p;
@@ -138,8 +141,8 @@ Header parseHeader(std::string_view b, const std::string& name) {
       if (!typeFromName(w[list ? 3 : 1], p.type)) failRead(name, at + ": unknown type " + quoted(w[list ? 3 : 1]));
       p.name = std::string(w.back());
       Element& e = h.elements.back();
-      for (const Property& q : e.props)
-        if (q.name == p.name) failRead(name, at + ": element '" + e.name + "' has a second property " + quoted(p.name));
+      if (!propertyNames.insert(p.name).second)
+        failRead(name, at + ": element '" + e.name + "' has a second property " + quoted(p.name));
       e.props.push_back(p);
     } else if (w[0] == "end_header") {
       if (w.size() != 1) failRead(name, at + ": text after end_header");

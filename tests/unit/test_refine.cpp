@@ -386,6 +386,7 @@ TEST(Refine, BadFacesDoNotBreakIt) {
   s.triangles.push_back({0, 1, nv + 5});
   s.triangles.push_back({0, 1, 1});
   s.rho.resize(s.triangles.size(), glm::vec3(0.5f));
+  s.emission.resize(s.triangles.size(), glm::vec3(0.f));  // per-face arrays: one entry per face (ASan read past it)
   MeshRefiner r(s);
   std::vector<uint32_t> all(s.faceCount());
   for (uint32_t f = 0; f < all.size(); ++f) all[f] = f;
