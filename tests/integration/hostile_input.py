@@ -18,6 +18,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from plyread import read_ply  # noqa: E402
+
 TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
 # A closed unit cube, outward faces (12 triangles).
 CUBE_V = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
@@ -203,7 +206,7 @@ CASES = [
 ]
 
 # Files that must load (exit 0): the readers' strictness must not reject what MeshLab writes.
-GOOD = [
+GOOD = [  # (id, what, bytes, faces the output must hold: nothing dropped)
     ("meshlab_extras", "binary PLY as MeshLab writes it: vertex quality, flags, float colour with alpha, face texcoord list",
      b"ply\nformat binary_little_endian 1.0\ncomment VCGLIB generated\nelement vertex 3\nproperty float x\n"
      b"property float y\nproperty float z\nproperty float quality\nproperty int flags\nproperty float red\n"
@@ -212,9 +215,9 @@ GOOD = [
      b"property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\nproperty double quality\n"
      b"end_header\n" +
      b"".join(struct.pack("<3ffi4f", *v, float("nan"), 0, 1, 0.5, 0, 1) for v in TRI) +
-     struct.pack("<B3iB6fi4Bd", 3, 0, 1, 2, 6, 0, 0, 1, 0, 0, 1, 0, 10, 20, 30, 255, 1.5)),
-    ("cube_ascii", "the closed box, complete", CUBE_ASCII),
-    ("tri_big_endian", "binary big-endian PLY", binary_ply(TRI, [(0, 1, 2)], endian=">")),
+     struct.pack("<B3iB6fi4Bd", 3, 0, 1, 2, 6, 0, 0, 1, 0, 0, 1, 0, 10, 20, 30, 255, 1.5), 1),
+    ("cube_ascii", "the closed box, complete", CUBE_ASCII, 12),
+    ("tri_big_endian", "binary big-endian PLY", binary_ply(TRI, [(0, 1, 2)], endian=">"), 1),
 ]
 
 
@@ -276,10 +279,10 @@ def main():
                 print("%s: %s -> %s" % ("ok" if ok else "FAIL", cid, describe(rc, err)))
             if not ok:
                 failures.append("%s (%s): expected exit 1 and one line holding %r" % (cid, what, fragment))
-        for cid, what, data in GOOD:
+        for cid, what, data, faces in GOOD:
             d, paths, out, argv = materialize(tmp, cid, {"a.ply": data}, None)
             rc, stdout, err = run([o.gi] + argv + ["--rays_per_vertex", "8", "-q"])
-            ok = rc == 0 and os.path.exists(out)
+            ok = rc == 0 and os.path.exists(out) and len(read_ply(out)["face"]) == faces
             print("%s: %s (must load) -> %s" % ("ok" if ok else "FAIL", cid, describe(rc, err)))
             if not ok:
                 failures.append("%s (%s): should load" % (cid, what))
