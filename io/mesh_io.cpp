@@ -71,13 +71,25 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   } else if (stlBinary) {
     opt += OpenMesh::IO::Options::Binary;
   }
+  std::string text(bytes);
+  if (ext == "obj" && !path.empty()) {
+    // OpenMesh opens each library as the file's folder + its name: check those it will read.
+    const std::string folder = path.substr(0, path.rfind('/') + 1);
+    for (const std::string& lib : declared.materialFiles) {
+      const std::string file = folder + lib;
+      std::ifstream f(file, std::ios::binary);
+      if (f) detail::checkMaterial(std::string{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()}, file);
+    }
+  } else {
+    for (size_t at : declared.materialLines) text[at] = '#';  // from memory: no library is opened
+  }
   bool ok = false;
   try {
     const QuietOpenMesh quiet;
     if (!path.empty() && ext == "obj") {
       ok = OpenMesh::IO::read_mesh(m, path, opt);
     } else {
-      std::istringstream in{std::string(bytes)};
+      std::istringstream in{text};
       ok = OpenMesh::IO::read_mesh(m, in, "." + ext, opt);
     }
   } catch (const std::exception& e) {

@@ -62,8 +62,12 @@ Polygons readOff(std::string_view bytes, const std::string& name);  // text_form
 // vertices and faces the file declares.
 struct Counts {
   size_t vertices = 0, faces = 0;
+  std::vector<std::string> materialFiles;  // OBJ: the mtllib names, as OpenMesh reads them
+  std::vector<size_t> materialLines;       // and the byte offsets of those lines
 };
 Counts checkObj(std::string_view bytes, const std::string& name);  // text_formats.cpp
+// An OBJ material library: every Kd must be three numbers in 0..1.
+void checkMaterial(std::string_view bytes, const std::string& name);
 // Binary (the size is exactly 84 + 50 n bytes, as OpenMesh decides too) or
 // ASCII ("solid ..."); sets `binary`.
 Counts checkStl(std::string_view bytes, const std::string& name, bool& binary);

@@ -13,28 +13,41 @@ namespace gi::io::detail {
 
 namespace {
 
-// Lines with '#' comments removed and the words split; blank lines skipped.
+// Lines split into words at spaces and tabs; blank lines skipped. A control
+// character (other than a tab, or a carriage return ending the line) is an
+// error: OpenMesh's OBJ reader skips a line that starts with one after its
+// trim, so such a line would count as a vertex here and not there, and a
+// face's index would then reach past OpenMesh's vertices (found by fuzzing).
+enum class Comments { Anywhere, WholeLines, None };
 struct Lines {
   std::string_view b;
+  const std::string& name;
+  Comments comments;
   size_t pos = 0, number = 0;
   std::string_view line;
   std::vector<std::string_view> words;
-  bool next(bool stripComments = true) {
+  bool next() {
     while (pos < b.size()) {
       size_t nl = b.find('\n', pos);
       if (nl == std::string_view::npos) nl = b.size();
       line = b.substr(pos, nl - pos);
       pos = nl + 1;
       ++number;
-      if (stripComments)
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      for (const char c : line)
+        if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f)
+          failRead(name, at() + " holds a control character: " + quoted(line));
+      const size_t first = line.find_first_not_of(" \t");
+      if (first == std::string_view::npos) continue;
+      if (comments == Comments::WholeLines && line[first] == '#') continue;
+      if (comments == Comments::Anywhere)
         if (const size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
       words.clear();
       size_t i = 0;
-      auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; };
       while (i < line.size()) {
-        while (i < line.size() && space(line[i])) ++i;
+        while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
         const size_t s = i;
-        while (i < line.size() && !space(line[i])) ++i;
+        while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
         if (i > s) words.push_back(line.substr(s, i - s));
       }
       if (!words.empty()) return true;
@@ -61,7 +74,7 @@ bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3
 }  // namespace
 
 Polygons readOff(std::string_view bytes, const std::string& name) {
-  Lines in{bytes};
+  Lines in{bytes, name, Comments::Anywhere};
   if (!in.next() || in.words[0].size() < 3 || in.words[0].substr(in.words[0].size() - 3) != "OFF")
     failRead(name, "not an OFF file (no OFF header)");
   const std::string_view magic = in.words[0];
@@ -130,8 +143,13 @@ Polygons readOff(std::string_view bytes, const std::string& name) {
   return p;
 }
 
+// OpenMesh reads OBJ in two passes (vertices, then faces), and sets a face
+// corner's normal or colour on its vertex before it checks the index: every
+// reference must be valid here, counted exactly as OpenMesh counts. Comments
+// are whole lines only: OpenMesh does not cut a line at '#', so "f 1 2 3#4 5"
+// is a face of four vertices to it.
 Counts checkObj(std::string_view bytes, const std::string& name) {
-  Lines in{bytes};
+  Lines in{bytes, name, Comments::WholeLines};
   Counts c;
   size_t nvt = 0, nvn = 0;
   std::vector<uint32_t> face;
@@ -192,13 +210,32 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       if (const uint32_t twice = repeatedIndex(face); twice != kNone)
         failRead(name, in.at() + ": the face lists vertex " + std::to_string(twice + 1) + " twice");
       ++c.faces;
-    } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "mtllib" || key == "l" || key == "p") {
+    } else if (key == "mtllib") {
+      // OpenMesh takes the rest of the line, trimmed, as one file name.
+      std::string_view file = in.line.substr(in.line.find("mtllib") + 6);
+      file.remove_prefix(std::min(file.size(), file.find_first_not_of(" \t")));
+      file = file.substr(0, file.find_last_not_of(" \t") + 1);
+      c.materialFiles.emplace_back(file);
+      c.materialLines.push_back(size_t(in.line.data() - bytes.data()));
+    } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "l" || key == "p") {
       // Names, groups and materials (OpenMesh reads the material's Kd as face colour); lines and points are ignored.
     } else {
       failRead(name, in.at() + ": unsupported OBJ statement " + quoted(in.line));
     }
   }
   return c;
+}
+
+void checkMaterial(std::string_view bytes, const std::string& name) {
+  Lines in{bytes, name, Comments::WholeLines};
+  while (in.next()) {
+    if (in.words[0] != "Kd") continue;
+    double v = 0;
+    bool ok = in.words.size() == 4;
+    for (size_t k = 1; ok && k < 4; ++k) ok = parseDouble(in.words[k], v) && v >= 0 && v <= 1;
+    // OpenMesh converts Kd to colour bytes unchecked.
+    if (!ok) failRead(name, in.at() + ": 'Kd' needs 3 numbers in 0..1, found " + quoted(in.line));
+  }
 }
 
 Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
@@ -220,8 +257,8 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
     }
   }
   binary = false;
-  Lines in{bytes};
-  if (!in.next(false) || in.words[0] != "solid") {
+  const size_t start = bytes.find_first_not_of(" \t\r\n");
+  if (start == std::string_view::npos || bytes.substr(start, 5) != "solid") {
     const uint32_t n = [&] {
       uint32_t v = 0;
       if (bytes.size() >= 84) std::memcpy(&v, bytes.data() + 80, 4);
@@ -232,6 +269,8 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
                                            std::to_string(84 + 50 * uint64_t(n)) + " bytes) does not match its " +
                                            std::to_string(bytes.size()) + " bytes, and not an ASCII STL ('solid')");
   }
+  Lines in{bytes, name, Comments::None};
+  in.next();  // solid NAME
   // solid NAME / { facet normal a b c / outer loop / vertex x y z (x3) / endloop / endfacet } / endsolid [NAME]
   auto check = [&](std::initializer_list<const char*> words, size_t numbers) {
     size_t k = 0;
@@ -247,7 +286,7 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
     }
   };
   auto next = [&] {
-    if (!in.next(false)) failRead(name, "the ASCII STL ends without 'endsolid' (truncated?)");
+    if (!in.next()) failRead(name, "the ASCII STL ends without 'endsolid' (truncated?)");
   };
   for (next(); in.words[0] != "endsolid"; next()) {
     check({"facet", "normal"}, 3);
@@ -257,7 +296,7 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
     next(), check({"endfacet"}, 0);
     ++c.faces;
   }
-  if (in.next(false)) failRead(name, in.at() + ": data after 'endsolid'");
+  if (in.next()) failRead(name, in.at() + ": data after 'endsolid'");
   c.vertices = 3 * c.faces;
   return c;
 }

@@ -162,6 +162,9 @@ CASES = [
     ("obj_two_refs", "OBJ face of 2 vertices", {"a.obj": (OBJ_TRI + "f 1 2\n").encode()}, None, "line 4"),
     ("obj_repeated", "OBJ face listing a vertex twice", {"a.obj": (OBJ_TRI + "f 1 2 2\n").encode()}, None,
      "line 4: the face lists vertex 2 twice"),
+    ("obj_formfeed_line", "OBJ vertex line starting with a form feed, faces with normals (OpenMesh skipped the vertex, "
+     "then wrote its normal past the array: found by fuzzing)",
+     {"a.obj": b"v 0 0 0\nv 1 0 0\n\x0cv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n"}, None, "line 3 holds a control character"),
     ("obj_unknown_statement", "OBJ with a statement we do not read", {"a.obj": (OBJ_TRI + "curv 0 1 1 2\nf 1 2 3\n").encode()},
      None, "line 4: unsupported OBJ statement"),
     ("off_counts_high", "OFF whose header claims 5 vertices for 3",

@@ -117,6 +117,11 @@ TEST(MeshReaders, DamagedFilesAreOneSentenceNamingThePlace) {
       {"OBJ mixed reference forms", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2 3\n", "mixes"},
       {"OBJ colour beyond 0..1", "obj", "v 0 0 0 255 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex colour"},
       {"OBJ unknown statement", "obj", "v 0 0 0\nbevel on\n", "line 2: unsupported OBJ statement"},
+      // Found by fuzzing: OpenMesh skips a line starting with a form feed, so its
+      // vertex 3 did not exist there and the face wrote vertex 3's normal past the array.
+      {"OBJ vertex line starting with a form feed", "obj",
+       "v 0 0 0\nv 1 0 0\n\fv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n", "line 3 holds a control character"},
+      {"OBJ comment inside a face", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3#4 5\n", "line 4: vertex index '3#4'"},
       {"OFF counts that lie high", "off", "OFF\n9 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "a count that lies"},
       {"OFF extra faces", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", "line 7: data after the last face"},
       {"OFF index beyond", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "line 6: face 0 uses vertex '3'"},
@@ -218,6 +223,14 @@ TEST(MeshReaders, ObjFormsColoursAndMaterials) {
   std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 1 0 0\nnewmtl grey\nKd 0.5 0.5 0.5\n";
   std::ofstream(dir + "/m.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl grey\nf 1 3 4\n";
   m = gi::io::loadMesh(dir + "/m.obj");
+  // A Kd outside 0..1 would overflow OpenMesh's unchecked conversion to bytes.
+  std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 1 0 0\nnewmtl grey\nKd 0.5 2 0.5\n";
+  try {
+    gi::io::loadMesh(dir + "/m.obj");
+    ADD_FAILURE() << "Kd 2 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("m.mtl: line 4: 'Kd' needs 3 numbers in 0..1"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
   ASSERT_EQ(m.attrs.faceColor.size(), 2u);
   EXPECT_EQ(m.attrs.faceColor[0], glm::u8vec3(255, 0, 0));
