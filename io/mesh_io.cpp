@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstring>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -11,21 +13,23 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include "mesh_parts.h"
+
 namespace gi::io {
+
+using detail::Counts;
+using detail::failRead;
+using detail::Polygons;
 
 namespace {
 
-// Double points: the OBJ/OFF readers keep full precision for far-off meshes
-// (OpenMesh's PLY reader itself reads coordinates as float).
+// Double points: the OBJ reader keeps full precision for far-off meshes.
 struct Traits : OpenMesh::DefaultTraits {
   using Point = OpenMesh::Vec3d;
   using Normal = OpenMesh::Vec3f;
 };
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<Traits>;
 
-[[noreturn]] void failRead(const std::string& path, const std::string& why) {
-  throw std::runtime_error("cannot read " + path + ": " + why + ".");
-}
 [[noreturn]] void failWrite(const std::string& path, const std::string& why) {
   throw std::runtime_error("cannot write " + path + ": " + why + ".");
 }
@@ -37,207 +41,82 @@ std::string lowerExtension(const std::string& path) {
   return e;
 }
 
-int plyTypeSize(const std::string& t) {
-  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
-  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
-  if (t == "double" || t == "float64") return 8;
-  return 0;
-}
-
-// OpenMesh trusts the element counts of a PLY header and allocates for them
-// before reading (a huge count ends in std::bad_alloc, a truncated file reads
-// garbage): check them against the file size first.
-void checkPlyHeader(const std::string& path, uintmax_t fileSize) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line, format;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) failRead(path, "not a PLY file (no 'ply' magic)");
-  uintmax_t minBytes = 0, count = 0, perElement = 0, props = 0;
-  bool ended = false;
-  auto closeElement = [&] {
-    const uintmax_t perEntry = format == "ascii" ? 2 * props : perElement;
-    if (perEntry > 0 && count > (fileSize + perEntry - 1) / perEntry) failRead(path, "the PLY header declares more data than the file holds");
-    minBytes += count * perEntry;
-  };
-  while (std::getline(in, line)) {
-    if (in.tellg() > std::streamoff(1 << 20)) break;
-    std::istringstream ls(line);
-    std::string key;
-    ls >> key;
-    if (key == "format") ls >> format;
-    else if (key == "element") {
-      closeElement();
-      std::string name;
-      long long c = -1;
-      if (!(ls >> name >> c) || c < 0) failRead(path, "malformed PLY element line '" + line + "'");
-      count = uintmax_t(c), perElement = 0, props = 0;
-    } else if (key == "property") {
-      std::string type;
-      ls >> type;
-      if (type == "list") ls >> type;  // the count type is the minimum size of a list
-      const int size = plyTypeSize(type);
-      if (size == 0) failRead(path, "unknown PLY property type in '" + line + "'");
-      perElement += uintmax_t(size), ++props;
-    } else if (key == "end_header") {
-      closeElement();
-      ended = true;
-      break;
-    }
-  }
-  if (!ended) failRead(path, "the PLY header has no end_header");
-  if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
-    failRead(path, "unknown PLY format '" + format + "'");
-  const uintmax_t body = fileSize - std::min<uintmax_t>(fileSize, uintmax_t(std::max<std::streamoff>(0, in.tellg())));
-  const uintmax_t slack = format == "ascii" ? 1 : 0;  // last line without newline
-  if (minBytes > body + slack) failRead(path, "the file is shorter than its PLY header says (truncated?)");
-}
-
-// Face quality arrives as a custom property named after the PLY property, of
-// the type the file declares.
-template <class T>
-bool readFaceQuality(PolyMesh& m, std::vector<float>& q) {
-  OpenMesh::FPropHandleT<T> h;
-  if (!m.get_property_handle(h, "quality")) return false;
-  q.resize(m.n_faces());
-  for (auto f : m.faces()) q[size_t(f.idx())] = float(m.property(h, f));
-  return true;
-}
-
-// A polygon mesh as read, before triangulation (faces as index ranges).
-struct Polygons {
-  std::vector<glm::dvec3> points;
-  std::vector<glm::vec3> normals;          // per vertex, or empty
-  std::vector<glm::u8vec3> vertexColor;    // or empty
-  std::vector<uint32_t> faceStart{0};      // face f: index[faceStart[f] .. faceStart[f+1])
-  std::vector<uint32_t> index;
-  std::vector<glm::u8vec3> faceColor;      // or empty
-  std::vector<float> faceQuality;          // or empty
+// OpenMesh's silence: its readers print warnings (one per skipped face or
+// unknown keyword) on std::cerr, which would break the one-line error of the
+// command-line tool. Our own checks say what is wrong instead.
+struct QuietOpenMesh {
+  QuietOpenMesh() { ::omerr().disable(), ::omlog().disable(), ::omout().disable(); }
+  ~QuietOpenMesh() { ::omerr().enable(), ::omlog().enable(), ::omout().enable(); }
 };
 
-// PLY, OBJ, STL. Vertex indices are OpenMesh's: the file's, plus copies of
-// non-manifold vertices appended; OpenMesh drops faces with repeated indices.
-Polygons readWithOpenMesh(const std::string& path, const std::string& ext) {
+// OBJ and STL through OpenMesh, after checkObj / checkStl. Vertex indices are
+// OpenMesh's: the file's, plus copies of non-manifold vertices appended. An
+// OBJ is read from its path when it has one, so that OpenMesh finds its
+// material library (face colours from Kd).
+Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
+  Counts declared;
+  bool stlBinary = false;
+  if (ext == "obj") declared = detail::checkObj(bytes, name);
+  else declared = detail::checkStl(bytes, name, stlBinary);
   PolyMesh m;
   OpenMesh::IO::Options opt;
   // OpenMesh 9's STL reader reports colours it does not set: ask for none.
-  if (ext != "stl") {
+  if (ext == "obj") {
     m.request_vertex_colors();
     m.request_face_colors();
     m.request_vertex_normals();
     opt += OpenMesh::IO::Options::VertexColor;
-    opt += OpenMesh::IO::Options::FaceColor;  // OBJ: from the material's Kd
+    opt += OpenMesh::IO::Options::FaceColor;  // from the material's Kd
     opt += OpenMesh::IO::Options::VertexNormal;
-    opt += OpenMesh::IO::Options::Custom;  // PLY face "quality" (ASCII and binary)
+  } else if (stlBinary) {
+    opt += OpenMesh::IO::Options::Binary;
+  }
+  std::string text(bytes);
+  if (ext == "obj" && !path.empty()) {
+    // OpenMesh opens each library as the file's folder + its name: check those it will read.
+    const std::string folder = path.substr(0, path.rfind('/') + 1);
+    for (const std::string& lib : declared.materialFiles) {
+      const std::string file = folder + lib;
+      std::ifstream f(file, std::ios::binary);
+      if (f) detail::checkMaterial(std::string{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()}, file);
+    }
+  } else {
+    for (size_t at : declared.materialLines) text[at] = '#';  // from memory: no library is opened
   }
   bool ok = false;
   try {
-    ok = OpenMesh::IO::read_mesh(m, path, opt);
+    const QuietOpenMesh quiet;
+    if (!path.empty() && ext == "obj") {
+      ok = OpenMesh::IO::read_mesh(m, path, opt);
+    } else {
+      std::istringstream in{text};
+      ok = OpenMesh::IO::read_mesh(m, in, "." + ext, opt);
+    }
   } catch (const std::exception& e) {
-    failRead(path, std::string("the reader failed (") + e.what() + ")");
+    failRead(name, std::string("the reader failed (") + e.what() + ")");
   }
-  if (!ok) failRead(path, "OpenMesh could not parse it as a ." + ext + " mesh");
-  const bool hasVC = ext != "stl" && opt.vertex_has_color(), hasVN = ext != "stl" && opt.vertex_has_normal();
-  const bool hasFC = ext != "stl" && opt.face_has_color();
+  if (!ok) failRead(name, "OpenMesh could not parse it as a ." + ext + " mesh");
+  // STL: OpenMesh merges equal corners and drops triangles left with a repeated corner (no area).
+  if (ext == "obj" && (m.n_faces() != declared.faces || m.n_vertices() < declared.vertices))
+    failRead(name, "OpenMesh read " + std::to_string(m.n_faces()) + " faces and " + std::to_string(m.n_vertices()) +
+                       " vertices of the " + std::to_string(declared.faces) + " and " + std::to_string(declared.vertices) +
+                       " in the file");
+  const bool hasVC = ext == "obj" && opt.vertex_has_color(), hasVN = ext == "obj" && opt.vertex_has_normal();
+  const bool hasFC = ext == "obj" && opt.face_has_color();
 
   Polygons p;
   p.points.resize(m.n_vertices());
   for (auto v : m.vertices()) {
     const auto& q = m.point(v);
-    const size_t i = size_t(v.idx());
-    p.points[i] = glm::dvec3(q[0], q[1], q[2]);
+    p.points[size_t(v.idx())] = glm::dvec3(q[0], q[1], q[2]);
     if (hasVC) p.vertexColor.push_back({m.color(v)[0], m.color(v)[1], m.color(v)[2]});
     if (hasVN) p.normals.push_back({m.normal(v)[0], m.normal(v)[1], m.normal(v)[2]});
   }
-  if (ext == "ply")
-    (void)(readFaceQuality<float>(m, p.faceQuality) || readFaceQuality<double>(m, p.faceQuality) ||
-           readFaceQuality<int>(m, p.faceQuality) || readFaceQuality<unsigned char>(m, p.faceQuality));
   p.index.reserve(m.n_faces() * 3);
   for (auto f : m.faces()) {
     for (auto v : m.fv_range(f)) p.index.push_back(uint32_t(v.idx()));
     p.faceStart.push_back(uint32_t(p.index.size()));
     if (hasFC) p.faceColor.push_back({m.color(f)[0], m.color(f)[1], m.color(f)[2]});
-  }
-  return p;
-}
-
-// OFF, read line by line: OpenMesh 9's OFF reader loses the face structure
-// when face lines carry a colour ("3 a b c r g b", as MeshLab writes them).
-// Header [C][N]OFF; colours as 0..255 integers or 0..1 floats.
-Polygons readOff(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  auto next = [&](std::istringstream& ls) {
-    while (std::getline(in, line)) {
-      const size_t hash = line.find('#');
-      if (hash != std::string::npos) line.erase(hash);
-      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      ls.clear();
-      ls.str(line);
-      return true;
-    }
-    return false;
-  };
-  auto colour = [](const std::vector<std::string>& t, size_t first, glm::u8vec3& c) {
-    if (t.size() < first + 3) return false;
-    const bool isFloat = std::any_of(t.begin() + long(first), t.begin() + long(first) + 3,
-                                     [](const std::string& x) { return x.find_first_of(".eE") != std::string::npos; });
-    for (int k = 0; k < 3; ++k) {
-      const double v = std::stod(t[first + size_t(k)]);
-      c[k] = uint8_t(std::clamp(isFloat ? std::lround(v * 255.0) : std::lround(v), 0L, 255L));
-    }
-    return true;
-  };
-  std::istringstream ls;
-  std::string magic;
-  if (!next(ls) || !(ls >> magic) || magic.size() < 3 || magic.compare(magic.size() - 3, 3, "OFF") != 0)
-    failRead(path, "not an OFF file (no OFF header)");
-  const bool hasC = magic.find('C') != std::string::npos, hasN = magic.find('N') != std::string::npos;
-  if (magic.find("ST") != std::string::npos || magic.find('4') != std::string::npos || (ls >> std::ws, ls.peek() == 'B'))
-    failRead(path, "only ASCII [C][N]OFF is supported");
-  long long nv = -1, nf = -1;
-  if (!(ls >> nv) && (!next(ls) || !(ls >> nv))) failRead(path, "the OFF header has no vertex count");
-  if (!(ls >> nf) || nv < 0 || nf < 0) failRead(path, "the OFF header has no valid vertex and face counts");
-  // Each vertex or face line takes at least 6 bytes: counts beyond the file are lies.
-  const auto bytes = std::filesystem::file_size(path);
-  if (uintmax_t(nv) + uintmax_t(nf) > bytes / 6 + 1) failRead(path, "the OFF header declares more data than the file holds");
-  Polygons p;
-  std::vector<std::string> t;
-  auto tokens = [&] {
-    t.clear();
-    for (std::string x; ls >> x;) t.push_back(x);
-  };
-  try {
-    for (long long i = 0; i < nv; ++i) {
-      if (!next(ls)) failRead(path, "the file ends before its " + std::to_string(nv) + " vertices");
-      tokens();
-      if (t.size() < 3) failRead(path, "vertex " + std::to_string(i) + " has fewer than 3 coordinates");
-      p.points.push_back({std::stod(t[0]), std::stod(t[1]), std::stod(t[2])});
-      size_t at = 3;
-      if (hasN && t.size() >= 6) p.normals.push_back({std::stof(t[3]), std::stof(t[4]), std::stof(t[5])}), at = 6;
-      glm::u8vec3 c(255);
-      if (hasC && !colour(t, at, c)) failRead(path, "vertex " + std::to_string(i) + " has no colour");
-      if (hasC) p.vertexColor.push_back(c);
-    }
-    if (p.normals.size() != p.points.size()) p.normals.clear();
-    bool faceColours = true;
-    for (long long f = 0; f < nf; ++f) {
-      if (!next(ls)) failRead(path, "the file ends before its " + std::to_string(nf) + " faces");
-      tokens();
-      const long long n = t.empty() ? -1 : std::stoll(t[0]);
-      if (n < 3 || t.size() < size_t(n) + 1) failRead(path, "face " + std::to_string(f) + " is malformed");
-      for (long long k = 1; k <= n; ++k) {
-        const long long v = std::stoll(t[size_t(k)]);
-        if (v < 0 || v >= nv) failRead(path, "face " + std::to_string(f) + " uses a vertex index out of range");
-        p.index.push_back(uint32_t(v));
-      }
-      p.faceStart.push_back(uint32_t(p.index.size()));
-      glm::u8vec3 c(255);
-      faceColours = colour(t, size_t(n) + 1, c) && faceColours;
-      p.faceColor.push_back(c);
-    }
-    if (!faceColours) p.faceColor.clear();  // only when every face has one
-  } catch (const std::logic_error&) {  // std::stod / std::stoll on a non-number
-    failRead(path, "a number in the OFF data cannot be parsed");
   }
   return p;
 }
@@ -259,19 +138,19 @@ struct ByteWriter {
 
 }  // namespace
 
-LoadedMesh loadMesh(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) failRead(path, "no such file");
-  const uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec || !std::ifstream(path, std::ios::binary)) failRead(path, "the file cannot be opened");
-  const std::string ext = lowerExtension(path);
-  if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
-    failRead(path, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
-  if (ext == "ply") checkPlyHeader(path, size);
-  const Polygons p = ext == "off" ? readOff(path) : readWithOpenMesh(path, ext);
-  if (p.faceStart.size() < 2) failRead(path, "the file has no faces");
+namespace {
 
-  LoadedMesh out;  // triangleToFace: index of the polygon as read (OpenMesh's, for PLY/OBJ/STL)
+LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
+  if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
+    failRead(name, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
+  if (bytes.empty()) failRead(name, "the file is empty (0 bytes)");
+  const Polygons p = ext == "ply"   ? detail::readPly(bytes, name)
+                     : ext == "off" ? detail::readOff(bytes, name)
+                                    : readWithOpenMesh(bytes, ext, name, path);
+  detail::checkPolygons(p, name);  // the readers check as they go; this guards what OpenMesh returns
+  if (p.faceStart.size() < 2) failRead(name, "the file has no faces");
+
+  LoadedMesh out;  // triangleToFace: index of the polygon as read
   const size_t nf = p.faceStart.size() - 1;
   std::vector<glm::uvec3> tris;
   tris.reserve(p.index.size());
@@ -285,11 +164,34 @@ LoadedMesh loadMesh(const std::string& path) {
       if (!p.faceQuality.empty()) out.attrs.faceQuality.push_back(p.faceQuality[f]);
     }
   }
-  if (tris.empty()) failRead(path, "the file has no faces with three or more vertices");
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
   return out;
+}
+
+}  // namespace
+
+LoadedMesh loadMesh(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (path.empty()) failRead("''", "no file name given");
+  if (!fs::exists(st)) failRead(path, "no such file");
+  if (fs::is_directory(st)) failRead(path, "it is a directory, not a mesh file");
+  if (!fs::is_regular_file(st)) failRead(path, "not a regular file");
+  const std::string ext = lowerExtension(path);
+  if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
+    failRead(path, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) failRead(path, "the file cannot be opened (" + std::string(std::strerror(errno)) + ")");
+  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) failRead(path, "the file cannot be read");
+  return parse(bytes, ext, path, path);
+}
+
+LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const std::string& name) {
+  return parse(bytes, format, name, "");
 }
 
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,

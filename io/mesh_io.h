@@ -1,6 +1,9 @@
-// Mesh files for the command-line tool (OpenMesh): PLY/OBJ/OFF/STL in, PLY out.
+// Mesh files for the command-line tool: PLY/OBJ/OFF/STL in, PLY out. PLY and
+// OFF are read by our own strict readers, OBJ and STL by OpenMesh after a
+// strict check; any defect is an error naming the file and the place.
 #pragma once
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gi/filter_run.h"
@@ -15,8 +18,12 @@ struct LoadedMesh {
   std::vector<uint32_t> triangleToFace;  // source polygon of each triangle
 };
 
-// Throws std::runtime_error with one sentence ("cannot read X: ...") on failure.
+// Throws std::runtime_error with one sentence ("cannot read X: ...") on failure:
+// a damaged or hostile file is never partly loaded.
 LoadedMesh loadMesh(const std::string& path);
+// The same from bytes in memory; `format` is ply, obj, off or stl and `name`
+// names it in messages (an OBJ's material library is not followed).
+LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const std::string& name);
 
 // Appends another mesh as a further part of one scene (attributes that only
 // one of them has are filled with defaults: grey 188 colours, quality 0).

@@ -11,6 +11,7 @@ fail() { printf '[setup] FAILED at step "%s": %s\n' "$1" "$2" >&2; exit 1; }
 
 packages=(
   build-essential cmake ninja-build ccache pkg-config dpkg-dev
+  clang libclang-rt-14-dev llvm
   meshlab qtbase5-dev libqt5opengl5-dev libqt5xmlpatterns5-dev libglew-dev libeigen3-dev
   libembree-dev libglm-dev libopenmesh-dev libtbb-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libpng-dev

@@ -4,7 +4,10 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -255,6 +258,36 @@ int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   return 0;
 }
 
+// The error contract: one line on stderr, exit status 1, for every bad input
+// or parameter (CLI11's own parse errors included).
+int failOneLine(std::string what) {
+  for (char& c : what)
+    if (c == '\n' || c == '\r') c = ' ';
+  while (!what.empty() && what.back() == ' ') what.pop_back();
+  std::fprintf(stderr, "gi: error: %s\n", what.c_str());
+  return 1;
+}
+
+// An output that cannot be written is reported before the computation, not after it.
+void checkOutputPath(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw std::invalid_argument(option + " is empty: give a file name");
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  const std::string cannot = "cannot write " + path + ": ";
+  if (fs::is_directory(st)) throw std::invalid_argument(cannot + "it is a directory");
+  if (fs::exists(st)) {
+    if (access(path.c_str(), W_OK) != 0) throw std::invalid_argument(cannot + std::strerror(errno));
+    return;
+  }
+  const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+  const fs::file_status pst = fs::status(parent, ec);
+  if (!fs::exists(pst)) throw std::invalid_argument(cannot + "the folder " + parent.string() + " does not exist");
+  if (!fs::is_directory(pst)) throw std::invalid_argument(cannot + parent.string() + " is not a folder");
+  if (access(parent.c_str(), W_OK | X_OK) != 0)
+    throw std::invalid_argument(cannot + "the folder " + parent.string() + " is not writable (" + std::strerror(errno) + ")");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -263,26 +296,31 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   CommonArgs a;
   std::map<CLI::App*, FilterKind> subs;
+  std::vector<std::pair<CLI::Option*, std::string*>> outputs;  // file options to check before any work
   for (const FilterDesc& d : allFilters()) {
     CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
     sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required();
-    sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file)");
+    outputs.push_back({sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file)"),
+                       &a.output});
     sub->add_option("--layer", a.layers, "another mesh file in the same scene, like a visible layer in MeshLab "
                                          "(repeatable; its file name is its layer name)");
     sub->add_flag("--json", a.json, "print a machine-readable summary on stdout");
     sub->add_flag("-q,--quiet", a.quiet, "no progress bar or log on stderr");
-    sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it");
+    sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it")
+        ->check(CLI::Range(1, 4096));
     addParamOptions(sub, filterSpecs(d.kind), a, false);
     sub->add_option("--cache", a.cacheDir, "folder of cached results: reuse one computed with the same scene and "
                                            "parameters, or store the new one there (e.g. a slow reference)");
-    sub->add_option("--save-result", a.saveResult, "also write the whole result as JSON (quality, colours, attributes "
-                                                   "such as Radiosity, StdError, Paths; statistics)");
+    outputs.push_back({sub->add_option("--save-result", a.saveResult, "also write the whole result as JSON (quality, "
+                                                                      "colours, attributes such as Radiosity, StdError, "
+                                                                      "Paths; statistics)"),
+                       &a.saveResult});
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
   std::string filterName;
   script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)")->required();
-  script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
+  CLI::Option* scriptOutput = script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
   CLI::App* list = app.add_subcommand("filters", "list the filters (the catalogue MeshLab's plugins and this tool share)");
@@ -290,9 +328,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help: the help text, exit 0
+    return failOneLine(e.what());
   }
   try {
+    for (const auto& [opt, path] : outputs)
+      if (opt->count() > 0) checkOutputPath(*path, opt->get_name());
+    if (scriptOutput->count() > 0 && a.output != "-") checkOutputPath(a.output, "--output");
     for (auto& [sub, kind] : subs)
       if (sub->parsed()) return runCommand(kind, a);
     if (list->parsed()) return listFilters(a.json);
@@ -318,9 +360,10 @@ int main(int argc, char** argv) {
       }
       return writeScript({d->kind}, a);
     }
+  } catch (const std::bad_alloc&) {
+    return failOneLine("out of memory");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "gi: error: %s\n", e.what());
-    return 1;
+    return failOneLine(e.what());
   }
   return 0;
 }

@@ -54,7 +54,8 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
         for (size_t i = b; i < e; ++i) {
           if (!mat.valid[i]) continue;
           const float k2 = map->kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
-          R2[i] = k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
+          // Fewer than k photons returns infinity, which would pass an infinite cap.
+          R2[i] = std::isfinite(k2) && k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
           A[i] = surface.area(s.positions[i], mat.n[i], std::sqrt(R2[i]));
         }
       });

@@ -88,6 +88,14 @@ def case_ao(c):
     check(abs(r["quality"] - expect) < 0.03, "floor AO %.4f vs analytic %.4f (2048 rays, tol 0.03)" % (r["quality"], expect))
     far = nearest(v, (4.0, 0.0, 0.0), lambda r: r["z"] == 0.0)
     check(far["quality"] > r["quality"], "AO grows away from the wall")
+    # The file as MeshLab writes it with more attributes (normals, flags, face
+    # colour and quality): the command-line tool's strict reader must load it.
+    full = os.path.join(c.tmp, "ao_full.ply")
+    c.server(os.path.join(c.meshes, "floor_wall.ply"), c.script("ao_few", "ao", "--rays_per_vertex", "16"), full,
+             mask=("vc", "vq", "vn", "vf", "fc", "ff", "fq"))
+    p = subprocess.run([c.gi, "ao", full, "-q", "--rays_per_vertex", "16", "-o", os.path.join(c.tmp, "ao_again.ply")],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "gi reads the PLY meshlabserver wrote with flags and face attributes (%s)" % p.stderr.strip())
 
 
 def split_floor_wall(c):

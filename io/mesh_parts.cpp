@@ -1,0 +1,99 @@
+#include "mesh_parts.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace gi::io::detail {
+
+void failRead(const std::string& name, const std::string& why) {
+  throw std::runtime_error("cannot read " + name + ": " + why + ".");
+}
+
+namespace {
+// from_chars takes '-' but not '+': drop one '+' that a sign could follow.
+bool stripPlus(std::string_view& t) {
+  if (!t.empty() && t[0] == '+') {
+    t.remove_prefix(1);
+    if (!t.empty() && (t[0] == '+' || t[0] == '-')) return false;
+  }
+  return !t.empty();
+}
+}  // namespace
+
+bool parseDouble(std::string_view t, double& v) {
+  if (!stripPlus(t)) return false;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec == std::errc() && end == t.data() + t.size() && std::isfinite(v);
+}
+
+bool parseInt(std::string_view t, long long& v) {
+  if (!stripPlus(t)) return false;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec == std::errc() && end == t.data() + t.size();
+}
+
+bool parseNonFinite(std::string_view t) {
+  if (!t.empty() && (t[0] == '+' || t[0] == '-')) t.remove_prefix(1);
+  std::string s(t);
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s == "nan" || s == "inf" || s == "infinity";
+}
+
+bool fitsFloat(double v) { return std::isfinite(v) && std::fabs(v) <= double(FLT_MAX); }
+
+uint32_t repeatedIndex(const std::vector<uint32_t>& face) {
+  if (face.size() <= 16) {
+    for (size_t a = 0; a < face.size(); ++a)
+      for (size_t b = a + 1; b < face.size(); ++b)
+        if (face[a] == face[b]) return face[a];
+    return kNone;
+  }
+  std::vector<uint32_t> s = face;
+  std::sort(s.begin(), s.end());
+  const auto it = std::adjacent_find(s.begin(), s.end());
+  return it == s.end() ? kNone : *it;
+}
+
+void checkPolygons(const Polygons& p, const std::string& name) {
+  for (size_t v = 0; v < p.points.size(); ++v) {
+    const glm::dvec3& q = p.points[v];
+    if (!fitsFloat(q.x) || !fitsFloat(q.y) || !fitsFloat(q.z))
+      failRead(name, "vertex " + std::to_string(v) + " has a coordinate that is not a finite number within float range");
+  }
+  for (size_t v = 0; v < p.normals.size(); ++v)
+    if (!std::isfinite(p.normals[v].x) || !std::isfinite(p.normals[v].y) || !std::isfinite(p.normals[v].z))
+      failRead(name, "vertex " + std::to_string(v) + " has a normal that is not finite");
+  std::vector<uint32_t> face;
+  for (size_t f = 0; f + 1 < p.faceStart.size(); ++f) {
+    face.assign(p.index.begin() + p.faceStart[f], p.index.begin() + p.faceStart[f + 1]);
+    if (face.size() < 3) failRead(name, "face " + std::to_string(f) + " has fewer than 3 vertices");
+    for (uint32_t v : face)
+      if (v >= p.points.size())
+        failRead(name, "face " + std::to_string(f) + " uses vertex " + std::to_string(v) + ", outside the " +
+                           std::to_string(p.points.size()) + " vertices");
+    if (const uint32_t twice = repeatedIndex(face); twice != kNone)
+      failRead(name, "face " + std::to_string(f) + " lists vertex " + std::to_string(twice) + " twice");
+  }
+}
+
+std::string quoted(std::string_view text) {
+  std::string s = "'";
+  for (size_t i = 0; i < text.size() && i < 60; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 || c == 0x7f) {
+      static const char* kHex = "0123456789abcdef";
+      s += "\\x";
+      s += kHex[c >> 4];
+      s += kHex[c & 15];
+    } else {
+      s += char(c);
+    }
+  }
+  return s + (text.size() > 60 ? "...'" : "'");
+}
+
+}  // namespace gi::io::detail

@@ -1,0 +1,75 @@
+// Internal to io/: a polygon mesh as a reader returns it (before triangulation)
+// and the strict number parsing every reader shares. A file is hostile until
+// proven otherwise: every count is bounded by the bytes left, every number is
+// a whole token and finite, every index is in range.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace gi::io::detail {
+
+struct Polygons {
+  std::vector<glm::dvec3> points;
+  std::vector<glm::vec3> normals;          // per vertex, or empty
+  std::vector<glm::u8vec3> vertexColor;    // or empty
+  std::vector<uint32_t> faceStart{0};      // face f: index[faceStart[f] .. faceStart[f+1])
+  std::vector<uint32_t> index;
+  std::vector<glm::u8vec3> faceColor;      // or empty
+  std::vector<float> faceQuality;          // or empty
+};
+
+// Throws std::runtime_error "cannot read NAME: WHY." (one line).
+[[noreturn]] void failRead(const std::string& name, const std::string& why);
+
+// The whole token as a number, or false: no trailing characters, no NaN or
+// infinity, no overflow. A leading '+' is accepted (printf writes none, but
+// some writers do).
+bool parseDouble(std::string_view token, double& v);
+bool parseInt(std::string_view token, long long& v);
+
+// Accepts "nan", "inf", "-inf", "infinity" (any case): for values we skip.
+bool parseNonFinite(std::string_view token);
+
+// The first vertex a face lists twice, or kNone (sorting for long faces, so
+// that a face of 10^6 indices is not 10^12 comparisons).
+constexpr uint32_t kNone = 0xffffffffu;
+uint32_t repeatedIndex(const std::vector<uint32_t>& face);
+
+// The engine keeps positions as float relative to the bounding-box centre:
+// a coordinate beyond float's range would become infinite there.
+bool fitsFloat(double v);
+
+// Throws unless every face has >= 3 distinct indices below the vertex count
+// and every point and normal is finite and within float range. Messages say
+// "FACE_WORD f" / "vertex v" (face numbers as the reader counts them).
+void checkPolygons(const Polygons& p, const std::string& name);
+
+// One "a b c" text in quotes for a message: control bytes shown as \xNN,
+// at most 60 characters.
+std::string quoted(std::string_view text);
+
+// The readers (each in its own file). Every one throws std::runtime_error
+// with one sentence naming `name` on any defect.
+Polygons readPly(std::string_view bytes, const std::string& name);  // ply_reader.cpp
+Polygons readOff(std::string_view bytes, const std::string& name);  // text_formats.cpp
+
+// OBJ and STL are parsed by OpenMesh after these strict passes, which reject
+// what OpenMesh would skip, misread or crash on. They return the number of
+// vertices and faces the file declares.
+struct Counts {
+  size_t vertices = 0, faces = 0;
+  std::vector<std::string> materialFiles;  // OBJ: the mtllib names, as OpenMesh reads them
+  std::vector<size_t> materialLines;       // and the byte offsets of those lines
+};
+Counts checkObj(std::string_view bytes, const std::string& name);  // text_formats.cpp
+// An OBJ material library: every Kd must be three numbers in 0..1.
+void checkMaterial(std::string_view bytes, const std::string& name);
+// Binary (the size is exactly 84 + 50 n bytes, as OpenMesh decides too) or
+// ASCII ("solid ..."); sets `binary`.
+Counts checkStl(std::string_view bytes, const std::string& name, bool& binary);
+
+}  // namespace gi::io::detail

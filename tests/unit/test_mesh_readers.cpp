@@ -1,0 +1,267 @@
+// The mesh readers on damaged and hostile bytes (one sentence naming the
+// place, never a partial mesh) and on the valid variants they must accept:
+// both binary PLY byte orders and every numeric type, float colours, the
+// extra properties MeshLab writes, OBJ reference forms, materials and vertex
+// colours, ASCII STL. The command-line contract on the same kinds of files is
+// tests/integration/hostile_input.py.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "mesh_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Little- or big-endian binary data.
+struct Bytes {
+  bool big = false;
+  std::string s;
+  template <class T>
+  Bytes& put(T v) {
+    char raw[sizeof(T)];
+    std::memcpy(raw, &v, sizeof(T));
+    if (big) std::reverse(raw, raw + sizeof(T));
+    s.append(raw, sizeof(T));
+    return *this;
+  }
+};
+
+const std::string kTriHeader =
+    "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nproperty uchar red\nproperty uchar green\n"
+    "property uchar blue\nend_header\n";
+
+std::string asciiTri(const std::string& v0, const std::string& face) {
+  return "ply\nformat ascii 1.0\n" + kTriHeader + v0 + "\n1 0 0\n0 1 0\n" + face + "\n";
+}
+
+std::string binaryTri(float x0, const std::vector<int32_t>& face, uint8_t count) {
+  Bytes b;
+  b.s = "ply\nformat binary_little_endian 1.0\n" + kTriHeader;
+  for (float c : {x0, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) b.put(c);
+  b.put(count);
+  for (int32_t i : face) b.put(i);
+  b.put(uint8_t(200)).put(uint8_t(100)).put(uint8_t(50));
+  return b.s;
+}
+
+std::string tempPath(const std::string& name) {
+  return (fs::temp_directory_path() / ("gi_readers_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+
+}  // namespace
+
+TEST(MeshReaders, DamagedFilesAreOneSentenceNamingThePlace) {
+  const std::string bomb = [] {  // 2^30 list items claimed in under 1 KB
+    Bytes b;
+    b.s = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+          "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n";
+    for (int k = 0; k < 9; ++k) b.put(0.f);
+    b.put(int32_t(1) << 30).put(int32_t(0)).put(int32_t(1)).put(int32_t(2));
+    return b.s;
+  }();
+  struct Case {
+    const char* what;
+    const char* format;
+    std::string bytes;
+    const char* fragment;
+  };
+  const Case cases[] = {
+      {"face index beyond the vertices", "ply", asciiTri("0 0 0", "3 0 1 7 1 2 3"), "face 0 uses vertex index 7"},
+      {"negative face index", "ply", asciiTri("0 0 0", "3 0 -1 2 1 2 3"), "face 0 uses vertex index -1"},
+      {"repeated face index", "ply", asciiTri("0 0 0", "3 0 2 2 1 2 3"), "face 0 lists vertex 2 twice"},
+      {"face of two indices", "ply", asciiTri("0 0 0", "2 0 1 1 2 3"), "face 0 has 2 vertex indices"},
+      {"ASCII nan", "ply", asciiTri("nan 0 0", "3 0 1 2 1 2 3"), "vertex 0: property 'x'"},
+      {"ASCII 1e39 in a float", "ply", asciiTri("1e39 0 0", "3 0 1 2 1 2 3"), "vertex 0: property 'x'"},
+      {"ASCII half a token", "ply", asciiTri("0.5x 0 0", "3 0 1 2 1 2 3"), "vertex 0: property 'x'"},
+      {"ASCII colour beyond uchar", "ply", asciiTri("0 0 0", "3 0 1 2 1 2 300"), "face 0: property 'blue'"},
+      {"ASCII list count as a float", "ply", asciiTri("0 0 0", "3.0 0 1 2 1 2 3"), "face 0: property 'vertex_indices'"},
+      {"ASCII truncated in the header's bound", "ply", asciiTri("0 0 0", "3"), "more data than the file holds"},
+      {"ASCII truncated inside a face", "ply", asciiTri("0 0 0", "3 0 1 2 1 2"), "the file ends inside face 0"},
+      {"ASCII extra data", "ply", asciiTri("0 0 0", "3 0 1 2 1 2 3 4"), "data follows the last element"},
+      {"binary NaN", "ply", binaryTri(std::numeric_limits<float>::quiet_NaN(), {0, 1, 2}, 3), "vertex 0: property 'x'"},
+      {"binary infinity", "ply", binaryTri(std::numeric_limits<float>::infinity(), {0, 1, 2}, 3), "vertex 0: property 'x'"},
+      {"binary index beyond", "ply", binaryTri(0.f, {0, 1, 3}, 3), "face 0 uses vertex index 3"},
+      {"binary missing its last byte", "ply", [] { std::string b = binaryTri(0.f, {0, 1, 2}, 3); b.pop_back(); return b; }(),
+       "the file ends inside face 0"},
+      {"binary list count 2^30", "ply", bomb, "claims 1073741824 items"},
+      {"property before element", "ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n", "a property before any element"},
+      {"control character in format", "ply", "ply\nformat\x02 ascii 1.0\nend_header\n", "control character"},
+      {"unknown format", "ply", "ply\nformat utf8 1.0\nend_header\n", "unknown format 'utf8'"},
+      {"no format", "ply", "ply\nelement vertex 0\nend_header\n", "an element before the 'format' line"},
+      {"negative element count", "ply", "ply\nformat ascii 1.0\nelement vertex -3\nend_header\n", "count >= 0"},
+      {"element count beyond the file", "ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n",
+       "more data than the file holds"},
+      {"two vertex elements", "ply", "ply\nformat ascii 1.0\nelement vertex 0\nelement vertex 0\nend_header\n", "a second element"},
+      {"no vertex coordinates", "ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nend_header\n1\n", "x, y and z"},
+      {"no faces", "ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                          "end_header\n0 0 0\n", "the file has no faces"},
+      {"OBJ word as coordinate", "obj", "v 0 0 0\nv 1 one 0\nv 0 1 0\nf 1 2 3\n", "line 2"},
+      {"OBJ index 0", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "line 4: vertex index '0'"},
+      {"OBJ index beyond", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "line 4: vertex index '4'"},
+      {"OBJ forward reference", "obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n", "line 3: vertex index '3'"},
+      {"OBJ relative index beyond", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "line 4: vertex index '-4'"},
+      {"OBJ normal index beyond", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n", "normal index '2'"},
+      {"OBJ mixed reference forms", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2 3\n", "mixes"},
+      {"OBJ colour beyond 0..1", "obj", "v 0 0 0 255 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1: a vertex colour"},
+      {"OBJ unknown statement", "obj", "v 0 0 0\nbevel on\n", "line 2: unsupported OBJ statement"},
+      // Found by fuzzing: OpenMesh skips a line starting with a form feed, so its
+      // vertex 3 did not exist there and the face wrote vertex 3's normal past the array.
+      {"OBJ vertex line starting with a form feed", "obj",
+       "v 0 0 0\nv 1 0 0\n\fv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n", "line 3 holds a control character"},
+      {"OBJ comment inside a face", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3#4 5\n", "line 4: vertex index '3#4'"},
+      {"OFF counts that lie high", "off", "OFF\n9 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "a count that lies"},
+      {"OFF extra faces", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", "line 7: data after the last face"},
+      {"OFF index beyond", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "line 6: face 0 uses vertex '3'"},
+      {"OFF inf", "off", "OFF\n3 1 0\ninf 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "line 3: 'inf'"},
+      {"STL count that lies", "stl", std::string(80, 'x') + std::string("\x05\0\0\0", 4) + std::string(50, '\0'),
+       "triangle count (5"},
+      {"STL too short", "stl", "abc", "not an STL file"},
+      {"STL ASCII bad number", "stl",
+       "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 x\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n",
+       "line 5: 'x'"},
+      {"empty", "ply", "", "empty"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    try {
+      gi::io::parseMesh(c.bytes, c.format, "bad." + std::string(c.format));
+      ADD_FAILURE() << "accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind("cannot read bad." + std::string(c.format) + ": ", 0), 0u) << m;
+      EXPECT_NE(m.find(c.fragment), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+  }
+}
+
+// The same quad in ASCII, little- and big-endian binary, with coordinates as
+// double, indices as uint and list counts as ushort: identical meshes.
+TEST(MeshReaders, PlyByteOrdersAndTypesAgree) {
+  const std::string header =
+      "element vertex 4\nproperty double x\nproperty double y\nproperty double z\nproperty uchar red\n"
+      "property uchar green\nproperty uchar blue\nelement face 1\nproperty list ushort uint vertex_indices\n"
+      "property float red\nproperty float green\nproperty float blue\nproperty short quality\nend_header\n";
+  const double xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0.25, 1, 0.5}};
+  std::string ascii = "ply\nformat ascii 1.0\n" + header;
+  for (const auto& p : xyz) ascii += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + " 1 2 3\n";
+  ascii += "4 0 1 2 3 1.0 0.5 0 -7\n";
+  std::vector<gi::io::LoadedMesh> meshes{gi::io::parseMesh(ascii, "ply", "a.ply")};
+  for (bool big : {false, true}) {
+    Bytes b{big, "ply\nformat " + std::string(big ? "binary_big_endian" : "binary_little_endian") + " 1.0\n" + header};
+    for (const auto& p : xyz) b.put(p[0]).put(p[1]).put(p[2]).put(uint8_t(1)).put(uint8_t(2)).put(uint8_t(3));
+    b.put(uint16_t(4)).put(uint32_t(0)).put(uint32_t(1)).put(uint32_t(2)).put(uint32_t(3));
+    b.put(1.f).put(0.5f).put(0.f).put(int16_t(-7));
+    meshes.push_back(gi::io::parseMesh(b.s, "ply", "b.ply"));
+  }
+  for (const auto& m : meshes) {
+    ASSERT_EQ(m.scene.vertexCount(), 4u);
+    ASSERT_EQ(m.scene.faceCount(), 2u);
+    for (size_t v = 0; v < 4; ++v)
+      EXPECT_EQ(m.scene.toWorld(m.scene.positions[v]), meshes[0].scene.toWorld(meshes[0].scene.positions[v]));
+    EXPECT_EQ(m.scene.toWorld(m.scene.positions[3]), glm::dvec3(0.25, 1, 0.5));
+    EXPECT_EQ(m.scene.triangles, meshes[0].scene.triangles);
+    EXPECT_EQ(m.attrs.faceColor, (std::vector<glm::u8vec3>(2, {255, 128, 0})));  // float colour x 255, rounded
+    EXPECT_EQ(m.attrs.faceQuality, (std::vector<float>{-7.f, -7.f}));
+    EXPECT_EQ(m.attrs.vertexColor, (std::vector<glm::u8vec3>(4, {1, 2, 3})));
+  }
+}
+
+// As MeshLab saves with every attribute ticked: vertex quality (here NaN, which
+// we do not read), flags, float colours with alpha, a face texture-coordinate
+// list, an empty edge element; CRLF line ends and comments in the header.
+TEST(MeshReaders, MeshLabExtrasAreSkipped) {
+  Bytes b;
+  b.s = "ply\r\nformat binary_little_endian 1.0\r\ncomment VCGLIB generated\r\nobj_info x\r\nelement vertex 3\r\n"
+        "property float x\r\nproperty float y\r\nproperty float z\r\nproperty float nx\r\nproperty float ny\r\n"
+        "property float nz\r\nproperty int flags\r\nproperty float quality\r\nproperty float texture_u\r\n"
+        "property float texture_v\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\n"
+        "property list uchar float texcoord\r\nproperty int flags\r\nproperty uchar red\r\nproperty uchar green\r\n"
+        "property uchar blue\r\nproperty uchar alpha\r\nproperty float quality\r\nelement edge 0\r\n"
+        "property int vertex1\r\nproperty int vertex2\r\nend_header\r\n";
+  const float p[3][3] = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+  for (const auto& q : p)
+    b.put(q[0]).put(q[1]).put(q[2]).put(0.f).put(0.f).put(1.f).put(int32_t(0)).put(std::numeric_limits<float>::quiet_NaN())
+        .put(0.f).put(0.f);
+  b.put(uint8_t(3)).put(int32_t(0)).put(int32_t(1)).put(int32_t(2)).put(uint8_t(6));
+  for (int k = 0; k < 6; ++k) b.put(0.5f);
+  b.put(int32_t(0)).put(uint8_t(9)).put(uint8_t(8)).put(uint8_t(7)).put(uint8_t(255)).put(1.5f);
+  const auto m = gi::io::parseMesh(b.s, "ply", "meshlab.ply");
+  ASSERT_EQ(m.scene.faceCount(), 1u);
+  EXPECT_EQ(m.attrs.faceColor, (std::vector<glm::u8vec3>{{9, 8, 7}}));
+  EXPECT_EQ(m.attrs.faceQuality, (std::vector<float>{1.5f}));
+  ASSERT_EQ(m.scene.vertexNormals.size(), 3u);
+  EXPECT_EQ(m.scene.vertexNormals[2], glm::vec3(0, 0, 1));
+  EXPECT_TRUE(m.attrs.vertexColor.empty());
+}
+
+// OBJ through OpenMesh after the strict check: v/t/n forms, negative
+// references, vertex colours, w, and face colours from a material library.
+TEST(MeshReaders, ObjFormsColoursAndMaterials) {
+  auto m = gi::io::parseMesh("v 0 0 0 1\nv 1 0 0 1\nv 1 1 0 1\nv 0 1 0 1\nvt 0 0\nvn 0 0 1\n"
+                             "f 1/1/1 2/1/1 3/1/1\nf -4//1 -2//1 -1//1\n", "obj", "a.obj");
+  EXPECT_EQ(m.scene.faceCount(), 2u);
+  EXPECT_EQ(m.scene.triangles[1], glm::uvec3(0, 2, 3));
+  m = gi::io::parseMesh("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n", "obj", "c.obj");
+  EXPECT_EQ(m.attrs.vertexColor, (std::vector<glm::u8vec3>{{255, 0, 0}, {0, 255, 0}, {0, 0, 255}}));
+
+  const std::string dir = tempPath("obj");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 1 0 0\nnewmtl grey\nKd 0.5 0.5 0.5\n";
+  std::ofstream(dir + "/m.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl grey\nf 1 3 4\n";
+  m = gi::io::loadMesh(dir + "/m.obj");
+  // A Kd outside 0..1 would overflow OpenMesh's unchecked conversion to bytes.
+  std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 1 0 0\nnewmtl grey\nKd 0.5 2 0.5\n";
+  try {
+    gi::io::loadMesh(dir + "/m.obj");
+    ADD_FAILURE() << "Kd 2 accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("m.mtl: line 4: 'Kd' needs 3 numbers in 0..1"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+  ASSERT_EQ(m.attrs.faceColor.size(), 2u);
+  EXPECT_EQ(m.attrs.faceColor[0], glm::u8vec3(255, 0, 0));
+  EXPECT_NEAR(m.attrs.faceColor[1].r, 128, 1);
+}
+
+TEST(MeshReaders, AsciiStlCornersAreMerged) {
+  const auto m = gi::io::parseMesh(
+      "solid q\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 1 1 0\n  endloop\n"
+      " endfacet\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 1 0\n   vertex 0 1 0\n  endloop\n"
+      " endfacet\nendsolid q\n", "stl", "q.stl");
+  EXPECT_EQ(m.scene.vertexCount(), 4u);
+  EXPECT_EQ(m.scene.faceCount(), 2u);
+}
+
+// Paths that are not mesh files: one sentence each.
+TEST(MeshReaders, PathsThatAreNoMeshFile) {
+  const std::string dir = tempPath("dir.ply"), empty = tempPath("empty.ply");
+  fs::create_directories(dir);
+  std::ofstream(empty).close();
+  for (const auto& [path, fragment] : {std::pair<std::string, std::string>{dir, "is a directory"},
+                                       {empty, "empty (0 bytes)"},
+                                       {tempPath("none.ply"), "no such file"},
+                                       {"/dev/null", "not a regular file"}}) {
+    try {
+      gi::io::loadMesh(path);
+      ADD_FAILURE() << path;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  }
+  fs::remove_all(dir);
+  fs::remove(empty);
+}
