@@ -120,11 +120,11 @@ class DirectLight {
   // Shadow rays per estimate() call.
   int raysPerPoint() const { return analytic_ ? int(emitters_.size()) : 1; }
 
-  glm::vec3 estimate(const glm::vec3& x, const glm::vec3& n, SobolOwenStream& lsmp, Rng& rng, uint32_t skip) const {
-    if (!analytic_) {
-      const glm::vec2 uDir = lsmp.next();  // a second point of the same stream: decorrelated enough here
-      return sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, {rng.next(), rng.next()}, uDir, eps_);
-    }
+  // Sample k of the point's padded sequence: dimensions 1 (light point) and 2
+  // (direction) here; dimension 0 is left to the caller (the point on a patch).
+  glm::vec3 estimate(const glm::vec3& x, const glm::vec3& n, const PaddedSobol& smp, uint32_t k, Rng& rng,
+                     uint32_t skip) const {
+    if (!analytic_) return sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, smp(k, 1), smp(k, 2), eps_);
     glm::dvec3 sum(0.0);
     for (uint32_t L : emitters_) {
       if (L == skip) continue;
@@ -160,10 +160,10 @@ DirectLightAt::DirectLightAt(const Scene& s, const RayCaster& caster, int sample
 DirectLightAt::~DirectLightAt() = default;
 glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const {
   if (impl_->empty()) return glm::vec3(0.f);
-  SobolOwenStream lsmp(hash3(key, 0xd8u, 0x5au));
+  const PaddedSobol smp(hash3(key, 0xd8u, 0x5au));
   Rng rng(hash3(key, 0xd9u, 0x5bu));
   glm::vec3 sum(0.f);
-  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, lsmp, rng, kNoHit);
+  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, smp, uint32_t(k), rng, kNoHit);
   return sum / float(samples_);
 }
 
@@ -180,15 +180,16 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       if (!ok[i]) continue;
       const auto& t = s.triangles[i];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
-      SobolOwenStream pts(hash3(uint32_t(i), seed, 0xd3u)), lsmp(hash3(uint32_t(i), seed, 0xd4u));
+      // Point k on the patch (dimension 0) and its light sample (dimensions 1
+      // and 2) from one padded sequence: independent of each other.
+      const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd3u));
       Rng rng(hash3(uint32_t(i), seed, 0xd5u));
       glm::dvec3 sum(0.0);
       for (int k = 0; k < points; ++k) {
-        const glm::vec2 bc = uniformTriangle(pts.next());
-        const float w0 = 0.998f * bc.x + 0.000667f, w1 = 0.998f * bc.y + 0.000667f;
-        const glm::vec3 x = w0 * s.positions[t.x] + w1 * s.positions[t.y] + (1.f - w0 - w1) * s.positions[t.z] +
+        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
+        const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] +
                             n * direct.eps();
-        sum += glm::dvec3(direct.estimate(x, n, lsmp, rng, uint32_t(i)));
+        sum += glm::dvec3(direct.estimate(x, n, smp, uint32_t(k), rng, uint32_t(i)));
       }
       H[i] = glm::vec3(sum / double(points));
     }
@@ -207,10 +208,11 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
   parallelBlocks(s.vertexCount(), progress, "direct light at vertices", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
-      SobolOwenStream lsmp(hash3(uint32_t(i), seed, 0xd6u));
+      const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd6u));
       Rng rng(hash3(uint32_t(i), seed, 0xd7u));
       glm::dvec3 sum(0.0);
-      for (int k = 0; k < points; ++k) sum += glm::dvec3(direct.estimate(origins[i], mat.n[i], lsmp, rng, kNoHit));
+      for (int k = 0; k < points; ++k)
+        sum += glm::dvec3(direct.estimate(origins[i], mat.n[i], smp, uint32_t(k), rng, kNoHit));
       H[i] = glm::vec3(sum / double(points));
     }
   });

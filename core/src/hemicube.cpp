@@ -1,5 +1,6 @@
 // The hemicube (Cohen and Greenberg 1985), on the CPU: at the centre of patch
-// i, every other patch is projected onto the five faces of a unit hemicube
+// i (or at the centroids of parts of it, F_ij then their area-weighted mean),
+// every other patch is projected onto the five faces of a unit hemicube
 // and scan-converted with a depth buffer; each cell's delta form factor goes
 // to the patch it shows,
 //   top face (z = 1):   dF = dA / (pi (x^2 + y^2 + 1)^2)
@@ -8,6 +9,7 @@
 // away). A cell that shows a patch's back, or nothing, is light lost.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "gi/form_factors.h"
@@ -90,17 +92,19 @@ class HemicubeFace {
 
 }  // namespace
 
-FormFactorRow FormFactors::hemicubeRow(uint32_t i) const {
+// One hemicube at point c (lifted off patch i) with its side axes turned by
+// phi about the normal: the delta form factors of the cells, normalised,
+// per patch shown (dense, indexed by face) and the fraction lost.
+double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F) const {
   const int res = std::max(4, set_.hemicubeResolution & ~1);
-  const auto& ti = s_.triangles[i];
-  const glm::vec3 c = (s_.positions[ti.x] + s_.positions[ti.y] + s_.positions[ti.z]) / 3.f + normal_[i] * eps_;
-  const Frame fr(normal_[i]);
+  const Frame f0(normal_[i]);
+  const float cp = std::cos(phi), sp = std::sin(phi);
+  const glm::vec3 tt = f0.t * cp + f0.b * sp, bb = f0.b * cp - f0.t * sp, nn = f0.n;
   // Five views: forward axis, right axis, up axis (local frame of patch i).
-  const glm::vec3 views[5][3] = {{fr.n, fr.t, fr.b},  {fr.t, fr.b, fr.n},  {-fr.t, -fr.b, fr.n},
-                                 {fr.b, -fr.t, fr.n}, {-fr.b, fr.t, fr.n}};
+  const glm::vec3 views[5][3] = {{nn, tt, bb}, {tt, bb, nn}, {-tt, -bb, nn}, {bb, -tt, nn}, {-bb, tt, nn}};
   const float nearD = eps_;
   double lost = 0, total = 0;
-  std::vector<double> F(s_.faceCount(), 0.0);
+  F.assign(s_.faceCount(), 0.0);
   for (int v = 0; v < 5; ++v) {
     HemicubeFace face(res, v == 0);
     const glm::vec3 fwd = views[v][0], right = views[v][1], up = views[v][2];
@@ -129,10 +133,95 @@ FormFactorRow FormFactors::hemicubeRow(uint32_t i) const {
     }
     total += face.accumulate(F, lost);
   }
+  for (double& x : F) x /= total;
+  return lost / total;
+}
+
+FormFactorRow FormFactors::hemicubeRow(uint32_t i) const {
+  const auto& ti = s_.triangles[i];
+  const glm::vec3 lift = normal_[i] * eps_;
+  const int budget = std::max(1, set_.hemicubePoints);
+  // A part of patch i with the hemicube seen from its centroid (sparse row,
+  // the lost fraction as the last entry, j = kNoHit).
+  struct Part {
+    glm::vec3 a, b, c;
+    double w;  // share of patch i's area
+    std::vector<uint32_t> j;
+    std::vector<double> F;
+    double need;  // expected error of its one-view estimate, area-weighted (L1 over the row)
+  };
+  std::vector<double> F;
+  uint32_t views = 0;
+  auto render = [&](const glm::vec3& pa, const glm::vec3& pb, const glm::vec3& pc, double w) {
+    Part p{pa, pb, pc, w, {}, {}, 0.0};
+    // With several views each one's side axes are turned by a hashed angle,
+    // so that the cells' aliasing of a small or distant patch differs from
+    // view to view and averages out; a single view is the classic one.
+    const float phi = budget > 1 ? 6.2831853f * toUnitFloat(hash3(i, views, set_.seed ^ 0x4c1bu)) : 0.f;
+    ++views;
+    const double lost = hemicubeAt(i, (pa + pb + pc) / 3.f + lift, phi, F);
+    for (uint32_t j = 0; j < uint32_t(F.size()); ++j)
+      if (F[j] > 0) { p.j.push_back(j); p.F.push_back(F[j]); }
+    p.j.push_back(kNoHit);
+    p.F.push_back(lost);
+    return p;
+  };
+  std::vector<Part> parts{render(s_.positions[ti.x], s_.positions[ti.y], s_.positions[ti.z], 1.0)};
+  parts[0].need = std::numeric_limits<double>::infinity();
+  // More views: bisect the part with the largest expected error across its
+  // longest edge (the halves stay well shaped, even for a sliver) and view
+  // from both halves' centroids, while the budget allows (2 views a split).
+  // The halves' centroids average to the parent's, so the linear part of
+  // the row's variation cancels in e = w |F_parent - (F_1 + F_2) / 2|: e is
+  // the one-view (midpoint) rule's error there, and each half is expected
+  // to carry a quarter of it (half the area, half the squared size). Parts
+  // next to a common edge or close to another patch, where the view
+  // changes fastest, are split most.
+  auto dist = [](const Part& x, const Part& y) {
+    double d = 0;
+    size_t p = 0, q = 0;
+    while (p < x.j.size() || q < y.j.size()) {
+      if (q == y.j.size() || (p < x.j.size() && x.j[p] < y.j[q])) d += x.F[p++];
+      else if (p == x.j.size() || y.j[q] < x.j[p]) d += y.F[q++];
+      else { d += std::fabs(x.F[p] - y.F[q]); ++p; ++q; }
+    }
+    return d;
+  };
+  while (int(views) + 2 <= budget) {
+    size_t worst = 0;
+    for (size_t k = 1; k < parts.size(); ++k)
+      if (parts[k].need > parts[worst].need) worst = k;
+    Part parent = std::move(parts[worst]);
+    parts.erase(parts.begin() + std::ptrdiff_t(worst));
+    // Rotate the corners so that (a, b) is the longest edge, then split it at its midpoint.
+    const float lab = glm::length(parent.b - parent.a), lbc = glm::length(parent.c - parent.b),
+                lca = glm::length(parent.a - parent.c);
+    if (lbc >= lab && lbc >= lca) parent = Part{parent.b, parent.c, parent.a, parent.w, std::move(parent.j), std::move(parent.F), 0};
+    else if (lca >= lab && lca >= lbc) parent = Part{parent.c, parent.a, parent.b, parent.w, std::move(parent.j), std::move(parent.F), 0};
+    const glm::vec3 m = 0.5f * (parent.a + parent.b);
+    Part h1 = render(parent.c, parent.a, m, 0.5 * parent.w), h2 = render(parent.c, m, parent.b, 0.5 * parent.w);
+    // Mean of the halves' rows against the parent's: 0.5 (F1 + F2) - F_parent.
+    Part mean{{}, {}, {}, 0, {}, {}, 0};
+    {
+      size_t p = 0, q = 0;
+      while (p < h1.j.size() || q < h2.j.size()) {
+        if (q == h2.j.size() || (p < h1.j.size() && h1.j[p] < h2.j[q])) { mean.j.push_back(h1.j[p]); mean.F.push_back(0.5 * h1.F[p++]); }
+        else if (p == h1.j.size() || h2.j[q] < h1.j[p]) { mean.j.push_back(h2.j[q]); mean.F.push_back(0.5 * h2.F[q++]); }
+        else { mean.j.push_back(h1.j[p]); mean.F.push_back(0.5 * (h1.F[p] + h2.F[q])); ++p; ++q; }
+      }
+    }
+    const double e = parent.w * dist(mean, parent);
+    h1.need = h2.need = 0.25 * e;
+    parts.push_back(std::move(h1));
+    parts.push_back(std::move(h2));
+  }
+  std::vector<double> sum(s_.faceCount() + 1, 0.0);
+  for (const Part& p : parts)
+    for (size_t k = 0; k < p.j.size(); ++k) sum[p.j[k] == kNoHit ? s_.faceCount() : p.j[k]] += p.w * p.F[k];
   FormFactorRow r;
-  for (uint32_t j = 0; j < uint32_t(F.size()); ++j)
-    if (F[j] > 0) { r.j.push_back(j); r.F.push_back(float(F[j] / total)); }
-  r.escaped = float(lost / total);
+  for (uint32_t j = 0; j < uint32_t(s_.faceCount()); ++j)
+    if (sum[j] > 0) { r.j.push_back(j); r.F.push_back(float(sum[j])); }
+  r.escaped = float(sum[s_.faceCount()]);
   return r;
 }
 

@@ -94,6 +94,7 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.raysPerPatch = v.getInt("rays_per_patch");
   o.analyticPoints = v.getInt("analytic_points");
   o.hemicubeResolution = v.getInt("hemicube_resolution");
+  o.hemicubePoints = v.getInt("hemicube_points");
   o.lightSamples = v.getInt("light_samples");
   o.solver = RadiositySolver(v.getInt("solver"));
   o.bounces = v.getInt("bounces");
@@ -313,7 +314,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   Timer directTimer;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
   const double directSeconds = directTimer.seconds();
-  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed});
+  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed, opt.hemicubePoints});
   const double bytes = ff.matrixBytesBound();
   const bool fits = bytes <= opt.memoryBudgetMB * 1048576.0;
   RadiositySolver solver = opt.solver;

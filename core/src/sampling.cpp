@@ -5,24 +5,6 @@
 
 namespace gi {
 
-uint32_t sobol2(uint32_t index) {
-  // Direction numbers of Sobol dimension 2 (primitive polynomial x + 1):
-  // v_0 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1).
-  uint32_t x = 0, v = 0x80000000u;
-  for (; index; index >>= 1, v ^= v >> 1)
-    if (index & 1u) x ^= v;
-  return x;
-}
-
-glm::vec2 sobolOwen2D(uint32_t i, uint32_t key) {
-  // Shuffle the index (Owen scramble of the index), then scramble each
-  // dimension with its own seed: Burley 2020, section 4.
-  uint32_t idx = nestedUniformScramble(i, hash32(key));
-  uint32_t x = nestedUniformScramble(sobol1(idx), hashCombine(key, 0x68bc21ebu));
-  uint32_t y = nestedUniformScramble(sobol2(idx), hashCombine(key, 0x02e5be93u));
-  return {toUnitFloat(x), toUnitFloat(y)};
-}
-
 // sin and cos on [-pi/4, pi/4].
 static inline void fastSinCos(float x, float& s, float& c) {
   const float x2 = x * x;

@@ -2,7 +2,12 @@
 // normal n) to a polygon: Lambert's contour integral,
 //   F = 1/(2 pi) sum_k Theta_k n . (v_k x v_k+1) / |v_k x v_k+1|,  v_k = p_k - x,
 // with the polygon first clipped to the half-space in front of x (Baum et al.
-// 1989 and Wallace et al. 1989 use it per vertex with ray-cast visibility).
+// 1989 and Wallace et al. 1989 use it per vertex with ray-cast visibility),
+// and its mean over a source triangle i,
+//   F_ij = 1/A_i int_{A_i} F(x -> j) dA_x,
+// by an adaptive midpoint rule: the centroids of 4^L congruent sub-triangles
+// (midpoint subdivision), and where a sub-triangle's one-point value and its
+// four quarters' differ by more than a tolerance, the quarters are split again.
 #pragma once
 #include <glm/glm.hpp>
 
@@ -11,5 +16,18 @@ namespace gi {
 // Triangle (a, b, c), seen from either side; 0 if it lies behind x's tangent plane.
 double pointToTriangleFormFactor(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
                                  const glm::dvec3& c);
+
+// The source triangle split into 4^level congruent sub-triangles (level =
+// floor(log4(points)), at most 6): the analytic method's base points are
+// their centroids.
+int analyticBaseLevel(int points);
+
+// Unoccluded F from source triangle s (front: counter-clockwise) to the front
+// of target triangle t, by the adaptive midpoint rule: base level L, then each
+// sub-triangle whose quarters change the estimate by more than
+// relTol x (the base estimate) x (its share of the area) is split, at most
+// maxRefine levels further. Exact as relTol -> 0 and maxRefine grows.
+double triangleToTriangleFormFactor(const glm::dvec3 s[3], const glm::dvec3 t[3], int baseLevel, double relTol,
+                                    int maxRefine);
 
 }  // namespace gi

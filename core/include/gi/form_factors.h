@@ -2,14 +2,17 @@
 // at patch j) by three methods of the course, row by row:
 //  - Monte Carlo: from stratified points on patch i, cosine-weighted rays;
 //    F_ij ~ (rays landing on the front of j) / N. Visibility comes free.
-//  - Analytic point-to-polygon (Wallace et al. 1989): at a few points on i,
-//    the exact unoccluded differential-area-to-triangle factor to every patch
-//    j in front (Lambert's contour integral), times the visibility of one
-//    ray to a random point of j; no rays at all in a scene where nothing can
-//    block anything (an empty convex room).
-//  - Hemicube (Cohen and Greenberg 1985): at the patch centre, every patch
-//    rasterised onto the five faces of a hemicube with a depth buffer; each
-//    cell adds its exact delta form factor to the patch it shows.
+//    Origin and direction are independent dimensions of a padded sampler.
+//  - Analytic point-to-polygon (Wallace et al. 1989): the exact unoccluded
+//    differential-area-to-triangle factor to every patch j in front
+//    (Lambert's contour integral), averaged over i by an adaptive midpoint
+//    rule (gi/form_factor_analytic.h), times the visibility of one ray per
+//    base point to a random point of j; no rays at all in a scene where
+//    nothing can block anything (an empty convex room).
+//  - Hemicube (Cohen and Greenberg 1985): at the patch centre (or at several
+//    points placed where the views differ most), every patch rasterised onto
+//    the five faces of a hemicube with a depth buffer; each cell adds its
+//    exact delta form factor to the patch it shows.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -40,6 +43,7 @@ class FormFactors {
     int analyticPoints = 4;
     int hemicubeResolution = 128;
     uint32_t seed = 0;
+    int hemicubePoints = 1;  // hemicube views per patch (1: the centre; more: placed adaptively)
   };
   FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings);
   FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
@@ -59,6 +63,7 @@ class FormFactors {
   FormFactorRow monteCarloRow(uint32_t i) const;
   FormFactorRow analyticRow(uint32_t i) const;
   FormFactorRow hemicubeRow(uint32_t i) const;
+  double hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F) const;
   const Scene& s_;
   const RayCaster& caster_;
   Settings set_;

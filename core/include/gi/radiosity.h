@@ -33,6 +33,7 @@ struct RadiosityOptions {
   int raysPerPatch = 1024;        // form-factor rays per patch (Monte Carlo)
   int analyticPoints = 4;         // points per patch (analytic point-to-polygon)
   int hemicubeResolution = 128;   // cells across the top face (hemicube)
+  int hemicubePoints = 1;         // hemicube views per patch (1: the centre)
   int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
