@@ -35,7 +35,8 @@ QString GiFilterPlugin::filterName(FilterIDType f) const { return QString::fromS
 
 QString GiFilterPlugin::filterInfo(FilterIDType f) const { return QString::fromStdString(filterDesc(kindOf(f)).info); }
 
-MeshFilterInterface::FilterClass GiFilterPlugin::getClass(QAction*) {
+MeshFilterInterface::FilterClass GiFilterPlugin::getClass(QAction* a) {
+  if (filterDesc(kindOf(ID(a))).writes & WritesImage) return FilterClass(MeshFilterInterface::RasterLayer);
   return FilterClass(MeshFilterInterface::VertexColoring | MeshFilterInterface::Quality);
 }
 
@@ -69,8 +70,10 @@ bool GiFilterPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParamet
     BridgeScene b;
     FilterInput in = gatherInput(md, par, kind, b);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
-    // Everything is computed: only now does the mesh change.
+    // Everything is computed: only now does the document change.
+    writeImages(r);
     writeResult(b, r);
+    addRasters(md, r);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);
   });
 }

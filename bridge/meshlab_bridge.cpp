@@ -6,6 +6,10 @@
 #include <stdexcept>
 
 #include <QCoreApplication>
+#include <QImage>
+
+#include <cstring>
+#include <type_traits>
 
 #include <vcg/complex/algorithms/update/color.h>
 
@@ -235,6 +239,94 @@ bool guarded(QString& errorMessage, const std::function<void(const std::string&)
 
 namespace gi::ml {
 
+namespace {
+
+// The per-vertex attributes every participating layer has (Scalarm or
+// Point3m), in scene vertex order: what earlier filters left on the mesh.
+std::vector<VertexAttribute> readAttributes(const BridgeScene& b) {
+  std::vector<VertexAttribute> out;
+  if (b.parts.empty()) return out;
+  size_t nv = 0;
+  for (const LayerPart& p : b.parts) nv += p.vertexCount;
+  auto collect = [&](auto tag, int components) {
+    using T = decltype(tag);
+    std::vector<std::string> names;
+    vcg::tri::Allocator<CMeshO>::GetAllPerVertexAttribute<T>(b.parts[0].mm->cm, names);
+    for (const std::string& name : names) {
+      VertexAttribute a{name, components, std::vector<float>(nv * size_t(components), 0.f)};
+      bool everywhere = true;
+      for (const LayerPart& p : b.parts) {
+        CMeshO& m = p.mm->cm;
+        auto h = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<T>(m, name);
+        if (!vcg::tri::Allocator<CMeshO>::IsValidHandle<T>(m, h)) { everywhere = false; break; }
+        for (size_t i = 0; i < m.vert.size(); ++i) {
+          if (p.sceneVertex[i] < 0) continue;
+          float* x = &a.values[size_t(p.sceneVertex[i]) * size_t(components)];
+          if constexpr (std::is_same_v<T, Point3m>) x[0] = h[i][0], x[1] = h[i][1], x[2] = h[i][2];
+          else x[0] = float(h[i]);
+        }
+      }
+      if (everywhere) out.push_back(std::move(a));
+    }
+  };
+  collect(Scalarm(), 1);
+  collect(Point3m(), 3);
+  return out;
+}
+
+ShotData toShotData(const Shotm& shot) {
+  ShotData s;
+  const Point3m vp = shot.GetViewPoint();
+  const auto R = shot.Extrinsics.Rot();
+  for (int i = 0; i < 3; ++i) {
+    s.viewpoint[i] = vp[i];
+    for (int j = 0; j < 3; ++j) s.rotation[i][j] = R[i][j];
+  }
+  s.focalMm = shot.Intrinsics.FocalMm;
+  for (int k = 0; k < 2; ++k) {
+    s.pixelSizeMm[k] = shot.Intrinsics.PixelSizeMm[k];
+    s.centerPx[k] = shot.Intrinsics.CenterPx[k];
+    s.viewportPx[k] = shot.Intrinsics.ViewportPx[k];
+  }
+  s.orthographic = shot.Intrinsics.cameraType == vcg::Camera<Scalarm>::ORTHO;
+  return s;
+}
+
+Shotm toShotm(const ShotData& s) {
+  Shotm shot;
+  vcg::Matrix44<Scalarm> R;
+  R.SetIdentity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R[i][j] = Scalarm(s.rotation[i][j]);
+  shot.Extrinsics.SetRot(R);
+  shot.Extrinsics.SetTra(Point3m(Scalarm(s.viewpoint[0]), Scalarm(s.viewpoint[1]), Scalarm(s.viewpoint[2])));
+  shot.Intrinsics.FocalMm = Scalarm(s.focalMm);
+  for (int k = 0; k < 2; ++k) {
+    shot.Intrinsics.PixelSizeMm[k] = Scalarm(s.pixelSizeMm[k]);
+    shot.Intrinsics.CenterPx[k] = Scalarm(s.centerPx[k]);
+    shot.Intrinsics.ViewportPx[k] = s.viewportPx[k];
+  }
+  shot.Intrinsics.cameraType = s.orthographic ? vcg::Camera<Scalarm>::ORTHO : vcg::Camera<Scalarm>::PERSPECTIVE;
+  return shot;
+}
+
+}  // namespace
+
+void addRasters(MeshDocument& md, const FilterResult& r) {
+  for (const FilterImage& img : r.images) {
+    const std::vector<uint8_t> rgb = toSrgb8(img.image, img.exposure);
+    QImage q(img.image.width, img.image.height, QImage::Format_RGB888);
+    for (int y = 0; y < img.image.height; ++y)
+      std::memcpy(q.scanLine(y), &rgb[size_t(y) * size_t(img.image.width) * 3], size_t(img.image.width) * 3);
+    RasterModel* rm = md.addNewRaster();
+    rm->setLabel(QString::fromStdString(img.name));
+    auto* plane = new Plane(QString::fromStdString(img.path.empty() ? img.name + ".png" : img.path), Plane::RGBA);
+    plane->image = q.convertToFormat(QImage::Format_ARGB32);
+    rm->addPlane(plane);
+    rm->shot = toShotm(img.camera.toShot());
+  }
+}
+
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b) {
   FilterInput in;
   in.values = readParams(par, filterSpecs(kind));
@@ -243,6 +335,8 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
   in.scene = std::move(b.scene);  // the bridge keeps the layers' indexing, the engine the geometry
   in.attrs = b.attrs;
   for (const LayerPart& p : b.parts) in.layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
+  in.attributes = readAttributes(b);
+  if (md.mm() && md.mm()->cm.shot.IsValid()) in.layerCamera = toShotData(md.mm()->cm.shot);
   return in;
 }
 

@@ -79,5 +79,7 @@ namespace gi::ml {
 // The filter's input from the document: its parameters, the participating
 // layers (scene extent) as one scene with their names.
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b);
+// Each image of the result as a new raster layer with the camera it was seen from.
+void addRasters(MeshDocument& md, const FilterResult& r);
 
 }  // namespace gi::ml

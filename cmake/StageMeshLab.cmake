@@ -3,7 +3,7 @@
 # a plugin folder linking the system plugins plus ours. Nothing goes into /usr.
 set(GI_STAGE_DIR "${PROJECT_BINARY_DIR}/stage")
 set(_stage_lib "${GI_STAGE_DIR}/lib/${CMAKE_LIBRARY_ARCHITECTURE}/meshlab")
-set(_our_plugins filter_ambient filter_radiosity filter_photonmap filter_reference)
+set(_our_plugins filter_ambient filter_radiosity filter_photonmap filter_reference filter_raytrace)
 set(_cmds
   COMMAND ${CMAKE_COMMAND} -E make_directory "${GI_STAGE_DIR}/bin" "${_stage_lib}/plugins"
   COMMAND ${CMAKE_COMMAND} -E copy_if_different /usr/bin/meshlabserver /usr/bin/meshlab "${GI_STAGE_DIR}/bin/"

@@ -186,6 +186,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
   extras.attributes = r.attributes;
   if (!a.output.empty()) io::writePly(a.output, out, attrs, r.vertexQuality, r.vertexColor, extras);
+  writeImages(r);
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {
@@ -208,6 +209,8 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   } else if (!a.quiet) {
     for (const std::string& l : lines) std::cerr << l << "\n";
     if (!a.output.empty()) std::cerr << "wrote " << a.output << "\n";
+    for (const FilterImage& img : r.images)
+      if (!img.path.empty()) std::cerr << "wrote " << img.path << " (and .pfm)\n";
   }
   return 0;
 }
@@ -225,7 +228,8 @@ int listFilters(bool asJson) {
     json writes = json::array();
     const std::pair<unsigned, const char*> bits[] = {
         {WritesVertexQuality, "vertex_quality"}, {WritesVertexColor, "vertex_color"}, {WritesVertexNormal, "vertex_normal"},
-        {WritesFaceQuality, "face_quality"},     {WritesFaceColor, "face_color"},     {WritesGeometry, "geometry"}};
+        {WritesFaceQuality, "face_quality"},     {WritesFaceColor, "face_color"},     {WritesGeometry, "geometry"},
+        {WritesImage, "image"}};
     for (const auto& [bit, name] : bits)
       if (d.writes & bit) writes.push_back(name);
     all.push_back({{"cli", d.cliName}, {"meshlab", d.meshlabName}, {"plugin", d.plugin}, {"summary", d.summary},

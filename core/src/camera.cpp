@@ -110,6 +110,26 @@ Camera Camera::fromShot(const ShotData& s, int width, int height) {
   return c;
 }
 
+ShotData Camera::toShot() const {
+  ShotData s;
+  for (int k = 0; k < 3; ++k) {
+    s.viewpoint[k] = eye_[k];
+    s.rotation[0][k] = right_[k];
+    s.rotation[1][k] = up_[k];
+    s.rotation[2][k] = -fwd_[k];
+  }
+  s.orthographic = ortho_;
+  s.pixelSizeMm[0] = s.pixelSizeMm[1] = 0.0369;
+  // A tangent-space unit spans pixelsPerTan_ pixels: f = pixelsPerTan_ x pixel size.
+  s.focalMm = ortho_ ? 0.0 : pixelsPerTan_ * 0.0369;
+  if (ortho_) s.pixelSizeMm[0] = s.pixelSizeMm[1] = 1.0 / pixelsPerTan_;
+  s.viewportPx[0] = width_;
+  s.viewportPx[1] = height_;
+  s.centerPx[0] = cx_;
+  s.centerPx[1] = height_ - cy_;  // viewport y points up
+  return s;
+}
+
 void Camera::setLens(double apertureRadius, double focusDistance) {
   if (!(apertureRadius >= 0.0) || !std::isfinite(apertureRadius))
     throw std::invalid_argument("the aperture radius must be a finite distance >= 0");

@@ -113,6 +113,26 @@ const std::vector<FilterDesc>& allFilters() {
        "F<sub>ij</sub> over the strongest receivers. Compare the three methods (Monte Carlo rays, analytic "
        "point-to-polygon, hemicube) on the same face to see their errors and artefacts.",
        WritesVertexQuality | WritesFaceQuality | WritesFaceColor},
+      {FilterKind::RayTracedView, "GI: Ray Traced View", "render", "filter_raytrace",
+       "an image ray traced from a camera: Whitted, distributed, two-pass or path traced",
+       "The <b>eye pass</b>: an image of the scene seen from a camera, each pixel the radiance "
+       "<i>L(x, &omega;)</i> arriving along eye rays (the rendering equation, Kajiya 1986). Four methods, as in "
+       "the course: <b>Whitted</b> ray tracing (1980: perfect mirror and glass rays, Fresnel and Snell, sharp "
+       "shadows, no noise); <b>distributed</b> ray tracing (Cook, Porter and Carpenter 1984: soft shadows, "
+       "<b>glossy</b> reflection, antialiasing, depth of field through a thin lens, all sampled); "
+       "<b>two-pass</b> (Chen et al. 1991; Jensen 1996): eye rays through mirrors and glass, the diffuse light "
+       "from a first pass already on the mesh (run 'GI: Radiosity' or 'GI: Photon Mapping' first: they leave the "
+       "per-vertex attribute <i>Radiosity</i>), with ray-traced direct light, a caustic photon map or a final "
+       "gather; and unbiased <b>path tracing</b> with a standard error per pixel, the yardstick for the "
+       "others.<br>"
+       "<b>Camera</b>: framing the scene, 'Look at' (eye, target, up, field of view: for scripts), or the "
+       "layer's camera: set it from the current view with <i>Filters &gt; Camera &gt; Set Mesh Camera</i> "
+       "(MeshLab 2020.09 cannot store a camera in a script parameter). <b>Materials</b>: layers named like "
+       "the mirror, glass and glossy patterns (GGX microfacet lobe, Walter et al. 2007).<br>"
+       "Output: the image as a new <b>raster layer</b> with its camera, and, at the image path, a PNG "
+       "(sRGB at the exposure) and the linear radiance as PFM. Optionally each vertex's radiance towards the "
+       "camera as vertex colour (what a mirror vertex shows from this viewpoint).",
+       WritesVertexQuality | WritesVertexColor | WritesImage},
   };
   return f;
 }

@@ -13,14 +13,11 @@
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/radiosity.h"
+#include "gi/render.h"
 
 namespace gi {
 
 namespace {
-
-bool needsEmitters(FilterKind k) {
-  return k == FilterKind::Radiosity || k == FilterKind::PhotonMapping || k == FilterKind::PathTracedReference;
-}
 
 VertexAttribute scalarAttribute(const std::string& name, const std::vector<float>& v) { return {name, 1, v}; }
 
@@ -50,7 +47,7 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   if (auto err = validate(specs, in.values, diagonal)) throw std::invalid_argument(*err);
   const ParamValues& v = in.values;
   if (v.has("reflectance_source"))
-    if (auto err = applySceneConventions(in.scene, in.attrs, v, needsEmitters(kind), &res.setupLog))
+    if (auto err = applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog))
       throw std::invalid_argument(*err);
   if (v.has("mirror_layers")) {
     std::string log;
@@ -172,6 +169,35 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   if (r.stdError.size() == r.B.size()) res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
+void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const ParamValues& v = in.values;
+  RenderOptions opt = RenderOptions::fromParams(v, in.scene, in.layerCamera ? &*in.layerCamera : nullptr);
+  if (const VertexAttribute* B = in.attribute("Radiosity"); B && B->components == 3 && opt.mode == RenderMode::TwoPass) {
+    opt.firstPassB.resize(in.scene.vertexCount());
+    for (size_t i = 0; i < opt.firstPassB.size() && 3 * i + 2 < B->values.size(); ++i)
+      opt.firstPassB[i] = {B->values[3 * i], B->values[3 * i + 1], B->values[3 * i + 2]};
+  }
+  const auto caster = makeEmbreeCaster(in.scene);
+  RenderResult r = render(in.scene, *caster, opt, progress);
+  res.stats = std::move(r.stats);
+  FilterImage img;
+  img.name = std::string(renderModeName(opt.mode)) + " view";
+  img.exposure = imageExposure(r.image, v.getFloat("exposure"), r.seesEmitter);
+  img.image = std::move(r.image);
+  img.camera = opt.camera;
+  img.path = v.getString("image_path");
+  res.stats.add("exposure", img.exposure);
+  if (opt.vertexRadiance) {
+    // What each vertex shows the camera, at the image's exposure.
+    for (const glm::vec3& L : r.vertexRadiance) {
+      res.vertexQuality.push_back(luminance(L));
+      res.vertexColor.push_back(displayMap(L, img.exposure));
+    }
+    res.attributes.push_back(vectorAttribute("Radiance", r.vertexRadiance));
+  }
+  res.images.push_back(std::move(img));
+}
+
 // Step 4: every array has the output scene's size and nothing non-finite
 // leaves the engine (a NaN in MeshLab's quality breaks its colour ramps).
 void finish(FilterResult& res, const Scene& out) {
@@ -202,6 +228,22 @@ void finish(FilterResult& res, const Scene& out) {
 }
 
 }  // namespace
+
+const VertexAttribute* FilterInput::attribute(const std::string& name) const {
+  for (const auto& a : attributes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+void writeImages(const FilterResult& r) {
+  for (const FilterImage& img : r.images) {
+    if (img.path.empty()) continue;
+    writePng(img.path, img.image, img.exposure);
+    const size_t dot = img.path.find_last_of('.'), slash = img.path.find_last_of('/');
+    const std::string stem = dot != std::string::npos && (slash == std::string::npos || dot > slash) ? img.path.substr(0, dot) : img.path;
+    writePfm(stem + ".pfm", img.image);
+  }
+}
 
 const VertexAttribute* FilterResult::attribute(const std::string& name) const {
   for (const auto& a : attributes)
@@ -250,6 +292,7 @@ void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Pr
     case FilterKind::PathTracedReference: runReference(in, res, progress); break;
     case FilterKind::Radiosity: runRadiosity(in, res, progress); break;
     case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
+    case FilterKind::RayTracedView: runRender(in, res, progress); break;
   }
   finish(res, res.refined ? res.refined->scene : in.scene);
 }

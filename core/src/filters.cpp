@@ -11,6 +11,7 @@
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/radiosity.h"
+#include "gi/render.h"
 #include "gi/scene_setup.h"
 
 namespace gi {
@@ -53,6 +54,13 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
                    ParamType::Int, -1, -1, 2147483647});
       add(formFactorSpecs());
       s.push_back(seedSpec("form-factor rays"));
+      break;
+    case FilterKind::RayTracedView:
+      add(lightingSceneSpecs());
+      add(materialSpecs());
+      add(glossySpecs());
+      add(RenderOptions::specs());
+      add(displaySpecs());
       break;
     case FilterKind::PathTracedReference:
       add(lightingSceneSpecs());

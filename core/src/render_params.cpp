@@ -3,6 +3,7 @@
 // after it (lightingSceneSpecs, materialSpecs, glossySpecs, displaySpecs).
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "gi/color.h"
 #include "gi/pathtrace.h"
@@ -30,8 +31,11 @@ std::vector<ParamSpec> RenderOptions::specs() {
                ParamType::Int, 16, 1, 1 << 20});
   s.push_back({"camera", "Camera",
                "'Frame the scene': look along the view direction at the centre of the bounding box, from just far "
-               "enough to see all of it. 'Look at': from the eye position towards the target.",
-               ParamType::Enum, 0, 0, 0, {"Frame the scene", "Look at"}});
+               "enough to see all of it. 'Look at': from the eye position towards the target. 'The layer's camera': "
+               "the camera stored with the current layer; in MeshLab set it from the current view with Filters > "
+               "Camera > Set Mesh Camera (its shot widget takes the trackball's view). MeshLab 2020.09 cannot keep "
+               "a camera in a script parameter, so scripts use 'Look at'.",
+               ParamType::Enum, 0, 0, 0, {"Frame the scene", "Look at", "The layer's camera"}});
   s.push_back({"view_direction", "View direction (framing)",
                "Direction the camera looks in when framing the scene (the Cornell box is seen along +z).",
                ParamType::Direction, 0, 0, 0, {}, glm::vec3(0.f, 0.f, 1.f)});
@@ -113,10 +117,15 @@ std::vector<ParamSpec> RenderOptions::specs() {
     if (p.name.rfind("sky_", 0) == 0 || p.name.rfind("sun_", 0) == 0) s.push_back(p);
   for (const ParamSpec& p : pointLightSpecs()) s.push_back(p);
   s.push_back(seedSpec("pixel samples, lights and photons"));
+  s.push_back({"image_path", "Image file",
+               "Where to write the image: a PNG (sRGB at the exposure below) and, beside it, the linear radiance as "
+               "a PFM (same name, .pfm) for numerical comparison. Empty: MeshLab shows the image as a raster layer "
+               "only, and the command-line tool writes no image.",
+               ParamType::String, 0, 0, 0, {}, glm::vec3(0.f), false, ""});
   return s;
 }
 
-RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene) {
+RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene, const ShotData* layerCamera) {
   RenderOptions o;
   auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
   o.mode = RenderMode(v.getInt("mode"));
@@ -143,6 +152,11 @@ RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene
   const double fov = v.getFloat("fov");
   if (v.getInt("camera") == 1) {
     o.camera = Camera::lookAt(glm::dvec3(v.getVec("eye")), glm::dvec3(v.getVec("target")), up, fov, w, h);
+  } else if (v.getInt("camera") == 2) {
+    if (!layerCamera)
+      throw std::invalid_argument("the current layer has no camera: set one from the view with Filters > Camera > "
+                                  "Set Mesh Camera, or choose 'Frame the scene' or 'Look at'");
+    o.camera = Camera::fromShot(*layerCamera, w, h);
   } else {
     glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
     for (const auto& p : scene.positions)

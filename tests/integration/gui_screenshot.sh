@@ -35,8 +35,10 @@
 #
 # Environment knobs: GUI_NO_CHECK=1 (just take the screenshot), GUI_TIMEOUT, GUI_MIN_FRACTION, GUI_RENDER_WAIT (seconds to keep
 # re-taking screenshots until the check passes, default 30), PYTHON, GUI_SCREEN_HEIGHT (default 1024);
-# GUI_APPLY_AO=1 or GUI_APPLY_FILTER=name with GUI_APPLY_DOWNS=its place in Color Creation and Processing
-# (GUI_MENU_PEEK=1: screenshot that submenu and stop) and GUI_APPLY_LOG=text its log line must hold.
+# GUI_APPLY_AO=1 or GUI_APPLY_FILTER=name with GUI_APPLY_DOWNS=its place in its submenu of Filters
+# (GUI_APPLY_MENU_DOWNS=the submenu's place, default 7: Color Creation and Processing; GUI_MENU_PEEK=1:
+# screenshot that submenu and stop) and GUI_APPLY_LOG=text its log line must hold; GUI_SHOW_RASTER=1: then
+# show the raster layer the filter made and run the colour check on it.
 #
 # MeshLab 2020.09 quirks handled here:
 #  * it keeps state in ~/.config/VCG/MeshLab_64bit_fp.conf (a loaded-mesh counter,
@@ -237,7 +239,7 @@ if [[ -n "$apply_name" ]]; then
   # walk relies on Debian's MeshLab 2020.09 menus (fixed order).
   sleep 2
   xdo mousemove 120 11 click 1; sleep 1
-  for _ in 1 2 3 4 5 6 7; do xdo key Down; done; sleep 0.3
+  for _ in $(seq 1 "${GUI_APPLY_MENU_DOWNS:-7}"); do xdo key Down; done; sleep 0.3
   xdo key Right; sleep 1
   if [[ "${GUI_MENU_PEEK:-0}" == 1 ]]; then timeout 30 import -window root "$out_png"; note "menu screenshot $out_png"; exit 0; fi
   for _ in $(seq 1 "$apply_downs"); do xdo key Down; done; sleep 0.3
@@ -256,8 +258,21 @@ if [[ -n "$apply_name" ]]; then
   timeout 30 import -window root "$out_png" || fail "import -window root failed"
   grep -q "Applied filter $apply_name" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report $apply_name applied (screenshot: $out_png)"; }
   grep -q "${GUI_APPLY_LOG:-$apply_name: vertices=}" "$tmp/meshlab.log" || { ml_log; fail "no log line of $apply_name (screenshot: $out_png)"; }
-  note "PASS: $apply_name applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
-  exit 0
+  if [[ "${GUI_SHOW_RASTER:-0}" != 1 ]]; then
+    note "PASS: $apply_name applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
+    exit 0
+  fi
+  # The filter made a raster layer: close the dialog and show it (View ->
+  # Show Current Raster Mode, Shift+R); the colour check below must then
+  # find the rendered Cornell box's red wall left of its green one.
+  xdo mousemove $((X + WIDTH / 4)) $((Y + HEIGHT - 15)) click 1; sleep 1  # Close
+  # A main window of the usual shape (the tall screen was for the dialog) shows the whole picture.
+  height=1024
+  fill_screen
+  # GUI_RASTER_CONTROL=1: the negative control, the same without showing the raster.
+  [[ "${GUI_RASTER_CONTROL:-0}" == 1 ]] || { xdo windowfocus "$main_win"; xdo mousemove 600 400; xdo key --clearmodifiers shift+r; }
+  sleep 2
+  note "$apply_name applied from the GUI menus; showing its raster layer"
 fi
 if [[ "${GUI_NO_CHECK:-0}" == 1 ]]; then
   # Documentation screenshots (scripts/readme_images.sh): no colour check.

@@ -566,7 +566,48 @@ def case_refine(c):
           "the refined file lights again: its light faces kept their quality")
 
 
-CASES = {"cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
+def read_pfm(path):
+    """A colour PFM (as gi writes it: "PF", width height, -1 = little endian, rows bottom to top)."""
+    import struct
+    with open(path, "rb") as f:
+        data = f.read()
+    parts = data.split(b"\n", 3)
+    check(parts[0] == b"PF", "%s is a colour PFM" % os.path.basename(path))
+    w, h = (int(x) for x in parts[1].split())
+    px = struct.unpack("<%df" % (w * h * 3), parts[3][:w * h * 12])
+    return w, h, px
+
+
+def case_raytrace(c):
+    box = os.path.join(c.meshes, "cornell_box.ply")
+    size = ["--width", "64", "--height", "48"]
+    # Without a first pass, two-pass rendering says which filter to run first and changes nothing.
+    log = c.server(box, c.script("tp0", "render", "--mesh", box, "--mode", "Two-pass", *size), expect_ok=False)
+    check("GI: Radiosity" in log and "first pass" in log, "two-pass without a first pass: a clear reason")
+    # Radiosity, then the two-pass view in the same script: the Radiosity attribute carries the first pass.
+    first = c.script("rad", "radiosity", "--mesh", box, "--rays_per_patch", "256")
+    png = os.path.join(c.tmp, "two_pass.png")
+    view = c.script("tp", "render", "--mesh", box, "--mode", "Two-pass", "--samples_per_pixel", "16",
+                    "--image_path", png, *size)
+    both = os.path.join(c.tmp, "rad_tp.mlx")
+    with open(first) as f1, open(view) as f2, open(both, "w") as out:
+        out.write(f1.read().replace("</FilterScript>\n", "") + "".join(f2.read().splitlines(True)[2:]))
+    log = c.server(box, both, os.path.join(c.tmp, "tp.ply"))
+    check("GI: Ray Traced View: " in log and "mode Two-pass" in log, "two-pass view logged after the radiosity pass")
+    w, h, tp = read_pfm(png[:-4] + ".pfm")
+    check((w, h) == (64, 48) and os.path.getsize(png) > 0, "meshlabserver wrote the PNG and the 64 x 48 PFM")
+    check(all(math.isfinite(x) and x >= 0 for x in tp), "radiance finite and non-negative")
+    # The path-traced view of the same camera: the yardstick. Whole-image means agree within 5%
+    # (the two-pass image carries the radiosity solution's own error, about 1-2% on this box).
+    ref = os.path.join(c.tmp, "path.png")
+    c.server(box, c.script("pt", "render", "--mesh", box, "--mode", "Path traced", "--samples_per_pixel", "256",
+                           "--image_path", ref, *size), os.path.join(c.tmp, "pt.ply"))
+    _, _, pt = read_pfm(ref[:-4] + ".pfm")
+    m_tp, m_pt = sum(tp) / len(tp), sum(pt) / len(pt)
+    check(abs(m_tp / m_pt - 1) < 0.05, "two-pass and path-traced images agree: mean %.4f vs %.4f" % (m_tp, m_pt))
+
+
+CASES = {"raytrace": case_raytrace, "cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
          "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump,
          "robust": case_robust}
 

@@ -52,6 +52,9 @@ VARIANTS = {
     "photonmap": [["--photons", "20000", "--light_samples", "16"]],
     "reference": [["--samples_per_vertex", "8", "--max_depth", "8"]],
     "formfactors": [["--face_index", "5", "--rays_per_patch", "4096"]],
+    "render": [["--width", "48", "--height", "32", "--samples_per_pixel", "2", "--vertex_radiance", "true"],
+               ["--width", "40", "--height", "40", "--samples_per_pixel", "4", "--mode", "Path traced",
+                "--max_depth", "4", "--vertex_radiance", "true"]],
 }
 STANDARD = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "quality", "radius", "flags"}
 
@@ -113,11 +116,20 @@ def main():
         for k, params in enumerate(VARIANTS.get(name, [[]])):
             label = "%s #%d" % (name, k + 1)
             script = os.path.join(tmp, "%s%d.mlx" % (name, k))
-            run([gi, "script", name, "--mesh", mesh, "-o", script] + params)
+            images = "image" in filt["writes"]
+            ml_img, cli_img = os.path.join(tmp, "ml.png"), os.path.join(tmp, "cli.png")
+            run([gi, "script", name, "--mesh", mesh, "-o", script] + params + (["--image_path", ml_img] if images else []))
             ml_out, cli_out = os.path.join(tmp, "ml.ply"), os.path.join(tmp, "cli.ply")
             mask = ["vc", "vq", "vn", "fc", "fq"]
             run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + ["-s", script])
-            run([gi, name, mesh, "-o", cli_out, "-q"] + params)
+            run([gi, name, mesh, "-o", cli_out, "-q"] + params + (["--image_path", cli_img] if images else []))
+            if images:
+                for ext in (".png", ".pfm"):
+                    with open(ml_img[:-4] + ext, "rb") as f1, open(cli_img[:-4] + ext, "rb") as f2:
+                        a1, a2 = f1.read(), f2.read()
+                    if a1 != a2:
+                        fail("%s: the %s images differ (%d and %d bytes)" % (label, ext, len(a1), len(a2)))
+                    print("ok: %s: %s image identical (%d bytes)" % (label, ext, len(a1)))
             ml, cli = read_ply(ml_out), read_ply(cli_out)
             writes = set(filt["writes"])
             mv, cv = ml["vertex"], cli["vertex"]
@@ -137,7 +149,7 @@ def main():
                 same(label, [(r["red"], r["green"], r["blue"]) for r in mf],
                      [(r["red"], r["green"], r["blue"]) for r in cf], "face colour")
             extra = [p for p in cv[0] if p not in STANDARD]
-            if not extra and name in ("ao", "reference", "radiosity", "photonmap", "sky"):
+            if not extra and name in ("ao", "reference", "radiosity", "photonmap", "sky", "render"):
                 fail("%s: the CLI wrote no per-vertex attribute" % label)
             readable = []
             for group in (sorted(p for p in extra if not p.endswith(("_x", "_y", "_z"))),

@@ -47,6 +47,24 @@ TEST(Camera, RayAndProjectRoundTrip) {
   EXPECT_GT(glm::dot(glm::dvec3(top.d), c.up()), 0.0);
 }
 
+// The shot stored with a rendered raster layer gives the same camera back:
+// every film point projects identically.
+TEST(Camera, ShotRoundTrip) {
+  const Camera c = Camera::lookAt({1, 2, 3}, {4, -1, 10}, {0, 1, 0}, 50.0, 320, 200);
+  const Camera d = Camera::fromShot(c.toShot(), 320, 200);
+  EXPECT_NEAR(glm::length(d.eye() - c.eye()), 0.0, 1e-12);
+  EXPECT_NEAR(glm::dot(d.forward(), c.forward()), 1.0, 1e-12);
+  EXPECT_NEAR(d.pixelsPerTangent(), c.pixelsPerTangent(), 1e-9);
+  Rng rng(5);
+  for (int i = 0; i < 50; ++i) {
+    const glm::dvec3 p(rng.next() * 10.0, rng.next() * 10.0 - 5.0, 10.0 + rng.next() * 10.0);
+    const auto a = c.project(p), b = d.project(p);
+    ASSERT_TRUE(a && b);
+    EXPECT_NEAR(a->x, b->x, 1e-7);
+    EXPECT_NEAR(a->y, b->y, 1e-7);
+  }
+}
+
 // Framing: every corner of the box is inside the image, and the box touches
 // the border (within the 2% margin): no wasted pixels.
 TEST(Camera, FrameFitsTheBox) {

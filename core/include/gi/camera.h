@@ -49,6 +49,10 @@ class Camera {
   // vertical extent is kept and pixels are square, so an image of another
   // aspect ratio than the viewport shows more or less to the sides.
   static Camera fromShot(const ShotData& shot, int width, int height);
+  // The shot MeshLab stores with a raster layer rendered by this camera
+  // (pixel size 0.0369 mm, MeshLab's default): fromShot(toShot(), width(),
+  // height()) gives this camera back, lens aside.
+  ShotData toShot() const;
 
   // Thin lens: aperture radius A and focus distance F (scene units, F > 0).
   // A = 0 is a pinhole (every depth sharp).

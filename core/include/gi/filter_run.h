@@ -18,8 +18,10 @@
 #include <string>
 #include <vector>
 
+#include "gi/camera.h"
 #include "gi/color.h"
 #include "gi/filters.h"
+#include "gi/image.h"
 #include "gi/params.h"
 #include "gi/refine.h"
 #include "gi/run.h"
@@ -28,19 +30,37 @@
 
 namespace gi {
 
-struct FilterInput {
-  Scene scene;                     // all layers as one scene (vertex normals are not used: see docs/design.md)
-  MeshAttributes attrs;            // colours, face quality and selection, as the meshes carry them
-  std::vector<LayerRange> layers;  // layer names and face ranges, in scene order
-  ParamValues values;              // every parameter of the filter's table (distances absolute)
-};
-
 // A per-vertex attribute: MeshLab stores it as a named per-vertex attribute
 // (Scalarm or Point3m), the command-line tool as PLY vertex properties.
 struct VertexAttribute {
   std::string name;           // e.g. "BentNormal", "StdError", "Radiosity"
   int components = 1;         // 1 (scalar) or 3 (vector)
   std::vector<float> values;  // vertexCount x components
+};
+
+struct FilterInput {
+  Scene scene;                     // all layers as one scene (vertex normals are not used: see docs/design.md)
+  MeshAttributes attrs;            // colours, face quality and selection, as the meshes carry them
+  std::vector<LayerRange> layers;  // layer names and face ranges, in scene order
+  ParamValues values;              // every parameter of the filter's table (distances absolute)
+  // What an earlier filter left on the mesh, per vertex of the scene (e.g.
+  // "Radiosity", the first pass of a two-pass rendering).
+  std::vector<VertexAttribute> attributes;
+  // The camera stored with the current layer (MeshLab: Filters > Camera >
+  // Set Mesh Camera takes the current view), if it has one.
+  std::optional<ShotData> layerCamera;
+  const VertexAttribute* attribute(const std::string& name) const;
+};
+
+// An image a filter made (the ray-traced view): linear radiance, the
+// exposure of its display, the camera it was seen from, and where to write
+// it (PNG for viewing, PFM with the linear values; empty: not written).
+struct FilterImage {
+  std::string name;
+  Image image;
+  float exposure = 1.f;
+  Camera camera;
+  std::string path;
 };
 
 struct FilterResult {
@@ -53,6 +73,7 @@ struct FilterResult {
   std::vector<Rgb8> faceColor;
   std::vector<VertexAttribute> attributes;
   std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
+  std::vector<FilterImage> images;
 
   SceneReport report;    // the scene the algorithm saw (after the conventions)
   std::string setupLog;  // reflectance, emitters, materials: what the conventions chose
@@ -75,5 +96,10 @@ FilterResult runFilter(FilterKind kind, FilterInput& in, const Progress& progres
 // the set-up log), then steps 3-4.
 FilterResult prepareFilter(FilterKind kind, FilterInput& in);
 void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress = Progress(nullptr));
+
+// Writes each image that has a path: the PNG there (sRGB at its exposure)
+// and the linear values beside it as PFM (same name, .pfm). Throws
+// std::runtime_error naming the file on failure.
+void writeImages(const FilterResult& r);
 
 }  // namespace gi

@@ -12,7 +12,16 @@
 
 namespace gi {
 
-enum class FilterKind { AmbientOcclusion, AmbientObscurance, SkyLighting, Radiosity, PhotonMapping, PathTracedReference, FormFactorsOfFace };
+enum class FilterKind {
+  AmbientOcclusion,
+  AmbientObscurance,
+  SkyLighting,
+  Radiosity,
+  PhotonMapping,
+  PathTracedReference,
+  FormFactorsOfFace,
+  RayTracedView,
+};
 
 // What a filter may change in the mesh (MeshLab's postCondition, the PLY the CLI writes).
 enum FilterWrites : unsigned {
@@ -22,6 +31,7 @@ enum FilterWrites : unsigned {
   WritesFaceQuality = 1u << 3,
   WritesFaceColor = 1u << 4,
   WritesGeometry = 1u << 5,  // the mesh may be refined (new vertices and faces)
+  WritesImage = 1u << 6,     // an image (MeshLab: a raster layer with its camera)
 };
 
 struct FilterDesc {

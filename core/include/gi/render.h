@@ -93,8 +93,9 @@ struct RenderOptions {
   std::vector<glm::vec3> firstPassB, firstPassBdirect;
 
   static std::vector<ParamSpec> specs();
-  // Camera from the table: framing the scene's bounding box, or look-at.
-  static RenderOptions fromParams(const ParamValues& v, const Scene& s);
+  // Camera from the table: framing the scene's bounding box, look-at, or
+  // the layer's camera (layerCamera; a clear error if there is none).
+  static RenderOptions fromParams(const ParamValues& v, const Scene& s, const ShotData* layerCamera = nullptr);
 };
 
 struct RenderResult {

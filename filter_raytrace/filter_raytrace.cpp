@@ -1,0 +1,3 @@
+#include "filter_raytrace.h"
+
+MESHLAB_PLUGIN_NAME_EXPORTER(FilterRayTracePlugin)
