@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Radiosity and photon mapping: error versus time against the cached
-path-traced reference (`gi reference`, DESIGN.md: the yardstick), and time /
+path-traced reference (`gi reference`, docs/design.md: the yardstick), and time /
 memory of radiosity against the patch count.
 
 Error: RMS over the non-emitting vertices of (B - B_ref), weighted by vertex

@@ -1,5 +1,5 @@
 // Ambient occlusion, obscurance and sky lighting against the analytic values
-// of DESIGN.md §5, plus convergence, determinism, skipping and stress cases.
+// of docs/design.md, "Analytic references", plus convergence, determinism, skipping and stress cases.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 

@@ -318,7 +318,7 @@ TEST(PathTracer, NoLightIsAClearError) {
 }
 
 // A disk emitter (a 256-gon fan, E = 1, facing down) at height h above the
-// centre vertex of a black floor: H = E R^2 / (R^2 + h^2) (DESIGN.md §5, the
+// centre vertex of a black floor: H = E R^2 / (R^2 + h^2) (docs/design.md, "Analytic references", the
 // polygon's deficit is below 1e-4). 4096 paths: within 4 standard errors.
 TEST(PathTracer, PointToDiskIrradiance) {
   const double R = 0.5, h = 0.8;

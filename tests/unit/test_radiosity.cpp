@@ -1,5 +1,5 @@
-// Radiosity: Monte Carlo form factors against the closed forms of DESIGN.md
-// §5, reciprocity and closure, the furnace, the solvers against each other,
+// Radiosity: Monte Carlo form factors against the closed forms of docs/design.md
+// ("Analytic references"), reciprocity and closure, the furnace, the solvers against each other,
 // progressive refinement, energy balance and bad input.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -41,7 +41,7 @@ double plateToPlate(const Scene& s, const std::vector<FormFactorRow>& rows, size
   return num / den;
 }
 
-// Closed form for coaxial parallel rectangles X x Y at distance L (DESIGN.md §5).
+// Closed form for coaxial parallel rectangles X x Y at distance L (docs/design.md, "Analytic references").
 double parallelPlates(double X, double Y, double L) {
   const double x = X / L, y = Y / L;
   return 2.0 / (M_PI * x * y) *
@@ -309,7 +309,7 @@ TEST(Radiosity, SingleTriangle) {
 }
 
 // Lambert's contour integral against closed forms: the unit square's centre
-// at distance L (DESIGN.md §5 family: 0.23945 at L = 1), a coaxial disk as a
+// at distance L (docs/design.md, "Analytic references" family: 0.23945 at L = 1), a coaxial disk as a
 // 512-gon R^2/(R^2+h^2) (polygon error < 1e-4), and a triangle cut by the
 // tangent plane (half of a square straddling it).
 TEST(FormFactors, PointToPolygonClosedForms) {
@@ -396,7 +396,7 @@ Scene coaxialDisks(double r, double L, int rings, int segments) {
 }
 }  // namespace
 
-// Coaxial disks (DESIGN.md §5): r_i = r_j = L gives F = (S - sqrt(S^2 - 4)) / 2
+// Coaxial disks (docs/design.md, "Analytic references"): r_i = r_j = L gives F = (S - sqrt(S^2 - 4)) / 2
 // with S = 1 + (1 + R^2) / R^2 = 3, F = 0.381966; for the 64-gon disks used
 // here the polygon's area is 0.9984 of the circle's (below 1e-3 in F). Each
 // method, both directions (reciprocity: equal areas, equal F): Monte Carlo
@@ -427,7 +427,7 @@ TEST(FormFactors, CoaxialDisksMatchClosedForm) {
   EXPECT_NEAR(plateToPlate(u, rows, split, true), closed(1, 0.5, 1), 0.003);
 }
 
-// Stress (DESIGN.md §7 and the issue): patch areas differing by 1e8 in one
+// Stress (docs/design.md, "Robustness" and the issue): patch areas differing by 1e8 in one
 // scene (triangles of 0.125 mm^2 floating in a room of 12.5 m^2 wall
 // triangles: finite, lit), coplanar duplicated faces (the duplicate of an
 // emitter and of a wall patch: finite results, the duplicates counted and

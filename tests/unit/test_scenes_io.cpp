@@ -1,5 +1,5 @@
 // Canonical scenes (gi::scenes) and mesh files (gi::io): geometry against the
-// analytic sizes of DESIGN.md §5, orientation, and PLY round trips.
+// analytic sizes of docs/design.md, "Analytic references", orientation, and PLY round trips.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -184,7 +184,7 @@ TEST(Scenes, OpenGeometriesForAmbientOcclusion) {
   EXPECT_NEAR(areaWhere(fw.scene, [](const glm::dvec3& c) { return c.x == 0.0; }), 1.0 * W, 1e-6);
   expectFacing(fw.scene, [](const glm::dvec3& c) { return c.z == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(0, 0, 1); }, "floor");
   expectFacing(fw.scene, [](const glm::dvec3& c) { return c.x == 0.0; }, [](const glm::dvec3&) { return glm::dvec3(1, 0, 0); }, "wall");
-  // Reference points of DESIGN.md §5 (d = 0, H, 2H) are vertices.
+  // Reference points of docs/design.md, "Analytic references" (d = 0, H, 2H) are vertices.
   for (double d : {0.0, 1.0, 2.0}) EXPECT_TRUE(hasVertexAt(fw.scene, {d, 0.0, 0.0})) << d;
 
   const SceneFile bowl = gi::scenes::hemisphericalBowl(2.0, 12);

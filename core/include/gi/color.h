@@ -1,4 +1,4 @@
-// Colour conventions shared by all filters (DESIGN.md §4).
+// Colour conventions shared by all filters (docs/design.md, "Conventions").
 #pragma once
 #include <cstdint>
 #include <glm/glm.hpp>

@@ -1,4 +1,4 @@
-// Per-vertex results into the common output convention (DESIGN.md §4):
+// Per-vertex results into the common output convention (docs/design.md, "Conventions"):
 // quality = the physical scalar, colour = its display mapping.
 #pragma once
 #include <string>

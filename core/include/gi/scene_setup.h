@@ -1,4 +1,4 @@
-// DESIGN.md §4 conventions in one place: how a mesh's colours, quality and
+// The conventions (docs/design.md, "Conventions") in one place: how a mesh's colours, quality and
 // selection become reflectance and emission, for the MeshLab bridge and the
 // CLI alike; and how per-vertex results become quality and display colour.
 #pragma once

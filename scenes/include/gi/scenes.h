@@ -1,4 +1,4 @@
-// Canonical test scenes with analytic references (DESIGN.md §5), built in
+// Canonical test scenes with analytic references (docs/design.md, "Analytic references"), built in
 // double precision. Every triangle is counter-clockwise seen from its front
 // (the side light reflects from); walls are split into roughly square patches
 // of two triangles each.
