@@ -28,6 +28,39 @@ double reachablePatches(size_t inputFaces, const RefineOptions& ro) {
 }
 }  // namespace
 
+std::vector<ParamSpec> RefineOptions::specs() {
+  return {
+      {.name = "refine_max_depth", .label = "Refinement: maximum depth",
+       .help = "Levels of refinement: each level splits the marked patches once (a patch of depth d is 4^d times "
+               "smaller than its original triangle) and solves again, so the cost grows with the levels.",
+       .type = ParamType::Int, .def = 3, .min = 1, .max = 12},
+      {.name = "refine_max_patches", .label = "Refinement: patch budget",
+       .help = "Never more patches than this; when a level would exceed it, the patches that need refinement most "
+               "(largest jump or visibility difference times area) are split first.",
+       .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000},
+      {.name = "refine_threshold", .label = "Refinement: radiosity jump",
+       .help = "Split the two patches on either side of an edge when their reflected radiosity differs by more than "
+               "this fraction of the larger one (ignoring differences below 1% of the scene's mean). Smaller: more "
+               "patches. Edges sharper than 30 degrees are not tested: B jumps there for real.",
+       .type = ParamType::Float, .def = 0.1, .min = 1e-4, .max = 100.0},
+      {.name = "refine_shadow_threshold", .label = "Refinement: shadow boundary",
+       .help = "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) "
+               "differs by more than this between two of its vertices: a shadow boundary crosses it. 1 turns this "
+               "test off.",
+       .type = ParamType::Float, .def = 0.3, .min = 0.0, .max = 1.0},
+  };
+}
+
+RefineOptions RefineOptions::fromParams(const ParamValues& v) {
+  RefineOptions o;
+  o.maxDepth = v.getInt("refine_max_depth");
+  o.maxPatches = v.getInt("refine_max_patches");
+  o.threshold = v.getFloat("refine_threshold");
+  o.shadowThreshold = v.getFloat("refine_shadow_threshold");
+  o.seed = uint32_t(v.getInt("seed"));
+  return o;
+}
+
 AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
                                          const CasterFactory& makeCaster) {
   const RefineOptions& ro = opt.refinement;
