@@ -71,7 +71,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
        .help = "Rays per vertex for the final gather of the indirect light (cosine-weighted).",
        .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
-      seedSpec("form-factor rays"),
+      seedSpec("form-factor, shadow and final-gather rays"),
       {.name = "refine", .label = "Adaptive mesh refinement",
        .help = "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
                "midpoints where its reflected radiosity jumps across an edge (staircase artefacts) or where a shadow "

@@ -26,6 +26,42 @@ constexpr double kRefinerBytesPerPatch = 624;
 double reachablePatches(size_t inputFaces, const RefineOptions& ro) {
   return std::min(double(ro.maxPatches), double(inputFaces) * std::pow(4.0, double(ro.maxDepth)));
 }
+
+// Refuses unusable limits, and at once a refinement whose mesh cannot fit
+// the memory budget, not after hours of refining.
+void checkRefinement(const Scene& s, const RadiosityOptions& opt) {
+  const RefineOptions& ro = opt.refinement;
+  if (ro.maxDepth < 0) throw std::invalid_argument("refine_max_depth must be >= 0");
+  if (ro.maxPatches < 1) throw std::invalid_argument("refine_max_patches must be >= 1");
+  if (!(ro.threshold > 0)) throw std::invalid_argument("refine_threshold must be > 0");
+  const double MB = 1048576.0, reach = reachablePatches(s.faceCount(), ro);
+  const double need = reach * kRefinerBytesPerPatch + solverBaseBytes(size_t(reach), opt);
+  if (need > opt.memoryBudgetMB * MB) {
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "adaptive refinement may reach %.0f patches (refine_max_patches %d; %zu faces x 4^%d levels), about "
+                  "%.0f MB for the mesh, the refiner and the solver (the form factors apart): more than "
+                  "memory_budget_mb = %g; lower refine_max_patches or refine_max_depth, or raise memory_budget_mb",
+                  reach, ro.maxPatches, s.faceCount(), ro.maxDepth, need / MB, opt.memoryBudgetMB);
+    throw std::invalid_argument(b);
+  }
+}
+
+// How many of the marked faces (most needing first) can be refined within
+// the patch budget: the prefix is shrunk until its conforming closure fits;
+// 0 when not even a small one does.
+size_t facesWithinBudget(const MeshRefiner& refiner, const std::vector<uint32_t>& marked, size_t budget) {
+  const size_t n = refiner.mesh().scene.faceCount();
+  size_t take = marked.size(), after = refiner.faceCountAfter(marked);
+  for (int tries = 0; after > budget && take > 0 && tries < 40; ++tries) {
+    const double room = n < budget ? double(budget - n) : 0.0;
+    const size_t shrunk = size_t(double(take) * room / double(after - n) * 0.9);
+    take = std::min(take - 1, shrunk);
+    after = refiner.faceCountAfter({marked.begin(), marked.begin() + long(take)});
+  }
+  return after > budget ? 0 : take;
+}
+
 }  // namespace
 
 std::vector<ParamSpec> RefineOptions::specs() {
@@ -64,21 +100,8 @@ RefineOptions RefineOptions::fromParams(const ParamValues& v) {
 AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
                                          const CasterFactory& makeCaster) {
   const RefineOptions& ro = opt.refinement;
-  if (ro.maxDepth < 0) throw std::invalid_argument("refine_max_depth must be >= 0");
-  if (ro.maxPatches < 1) throw std::invalid_argument("refine_max_patches must be >= 1");
-  if (!(ro.threshold > 0)) throw std::invalid_argument("refine_threshold must be > 0");
-  // Refuse at once, not after hours of refining into a mesh that cannot fit.
-  const double MB = 1048576.0, reach = reachablePatches(s.faceCount(), ro);
-  const double need = reach * kRefinerBytesPerPatch + solverBaseBytes(size_t(reach), opt);
-  if (need > opt.memoryBudgetMB * MB) {
-    char b[600];
-    std::snprintf(b, sizeof b,
-                  "adaptive refinement may reach %.0f patches (refine_max_patches %d; %zu faces x 4^%d levels), about "
-                  "%.0f MB for the mesh, the refiner and the solver (the form factors apart): more than "
-                  "memory_budget_mb = %g; lower refine_max_patches or refine_max_depth, or raise memory_budget_mb",
-                  reach, ro.maxPatches, s.faceCount(), ro.maxDepth, need / MB, opt.memoryBudgetMB);
-    throw std::invalid_argument(b);
-  }
+  checkRefinement(s, opt);
+  const double MB = 1048576.0;
   const CasterFactory caster = makeCaster ? makeCaster : [](const Scene& sc) { return makeEmbreeCaster(sc); };
   Timer timer;
   MeshRefiner refiner(s);
@@ -108,16 +131,8 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
       why = "nothing left above the thresholds";
       break;
     }
-    // Within the budget: the most needing faces first; shrink the marked
-    // prefix until the conforming closure fits.
-    size_t take = marks.faces.size(), after = refiner.faceCountAfter(marks.faces);
-    for (int tries = 0; after > budget && take > 0 && tries < 40; ++tries) {
-      const double room = n < budget ? double(budget - n) : 0.0;
-      const size_t shrunk = size_t(double(take) * room / double(after - n) * 0.9);
-      take = std::min(take - 1, shrunk);
-      after = refiner.faceCountAfter({marks.faces.begin(), marks.faces.begin() + long(take)});
-    }
-    if (after > budget || take == 0) {
+    const size_t take = facesWithinBudget(refiner, marks.faces, budget);
+    if (take == 0) {
       why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(marks.faces.size()) +
             " faces still above the thresholds)";
       break;
