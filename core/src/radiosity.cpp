@@ -468,7 +468,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     // cut through patches) or interpolated from the incident patches.
     Timer vt;
     const VertexMaterial mat = vertexMaterial(s);
-    const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed);
+    const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed, Progress(nullptr), opt.vertices);
     std::vector<glm::vec3> Hi;
     if (opt.vertexOutput == RadiosityVertexOutput::FinalGather) {
       // Cosine-weighted: the irradiance estimate is the mean of the reflected radiosity seen.
@@ -491,8 +491,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
         std::memcpy(bits, &y, sizeof bits);
         const uint32_t key = hash3(bits[0] ^ opt.seed, bits[1], bits[2] ^ f);
         return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
-      });
-      res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
+      }, opt.vertices);
+      res.stats.add("gather_rays", double(opt.vertices.count(s.vertexCount())) * opt.gatherRays);
       if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
     } else {
       Hi = faceToVertex(s, res.Hindirect);
