@@ -61,7 +61,8 @@ void sumOverRanks(std::vector<double>& v) {
 // Strings of every rank on rank 0 (empty elsewhere).
 std::vector<std::string> gatherText(const std::string& mine) {
   int n = int(mine.size());
-  std::vector<int> counts(size_t(g_size)), displs(size_t(g_size));
+  const size_t ranks = static_cast<size_t>(g_size);
+  std::vector<int> counts(ranks), displs(ranks);
   MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
   std::vector<char> all;
   if (g_rank == 0) {
@@ -91,7 +92,8 @@ RunStats statsFrom(const nlohmann::json& j) {
 // vertex, the rank's vertices in order) and puts them in place. Returns the
 // bytes received.
 double gatherArray(float* a, size_t n, int components, const VertexPart& part) {
-  std::vector<int> counts(size_t(g_size)), displs(size_t(g_size));
+  const size_t ranks = static_cast<size_t>(g_size);
+  std::vector<int> counts(ranks), displs(ranks);
   for (int r = 0; r < g_size; ++r) {
     const size_t c = part.other(uint32_t(r)).count(n) * size_t(components);
     if (c > size_t(INT_MAX)) throw std::length_error("a rank's part exceeds 2^31 values: use more ranks");
@@ -143,7 +145,8 @@ bool abandon() {
 }
 
 void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress, const SplitOptions& split) {
-  if (g_size == 1) return computeFilter(kind, in, res, progress);
+  // One rank runs the split path too (its gather and report), except for a filter that cannot be split.
+  if (!g_started || (g_size == 1 && !splitsVertices(kind))) return computeFilter(kind, in, res, progress);
   if (!splitsVertices(kind))
     throw std::invalid_argument("'" + filterDesc(kind).cliName + "' computes all vertices together and cannot be "
                                 "split over MPI ranks: run it without mpirun (ao, obscurance, sky, reference and "

@@ -159,6 +159,7 @@ def main():
     ap.add_argument("--meshes", required=True)
     ap.add_argument("--examples", required=True)
     a = ap.parse_args()
+    a.examples, a.meshes = os.path.abspath(a.examples), os.path.abspath(a.meshes)
     tmp = tempfile.mkdtemp(prefix="gi_slurm_")
     os.chmod(tmp, 0o755)
     slurm = Slurm(os.path.join(tmp, "slurm"))
@@ -203,6 +204,8 @@ def main():
             baked += rep["baked"]
         check(baked == len(MESHES), "the tasks baked %d meshes in all, each once (%d)" % (len(MESHES), baked))
         rays = 0
+        if baked != len(MESHES):
+            raise RuntimeError("the array did not bake the collection; logs:\n" + logs[-3000:])
         for k, m in enumerate(MESHES):
             s = json.load(open(os.path.join(out, m + ".json")))
             rays += s["rays"]
@@ -217,7 +220,7 @@ def main():
         again = sum(json.load(open(os.path.join(out, "report-%d-of-%d.json" % (i, TASKS))))["done_before"]
                     for i in range(TASKS))
         check(again == len(MESHES), "the array submitted again skips all %d meshes (%d)" % (len(MESHES), again))
-    except RuntimeError as e:
+    except (RuntimeError, OSError, ValueError, KeyError) as e:
         check(False, str(e))
     finally:
         slurm.stop()

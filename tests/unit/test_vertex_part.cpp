@@ -168,6 +168,12 @@ void expectSplitEqualsWhole(const io::LoadedMesh& mesh, FilterKind kind, const s
 
   FilterResult merged = rs[0];
   const size_t n = merged.refined ? merged.refined->scene.vertexCount() : ins[0].scene.vertexCount();
+  for (const FilterResult& r : rs) {  // every part on the same (refined) mesh
+    ASSERT_EQ(r.refined.has_value(), merged.refined.has_value());
+    if (r.refined) {
+      ASSERT_TRUE(sameBits(r.refined->scene.positions, merged.refined->scene.positions));
+    }
+  }
   for (uint32_t p = 1; p < parts; ++p)
     for (uint32_t v : ins[p].vertices.vertices(n)) {
       if (!merged.vertexQuality.empty()) merged.vertexQuality[v] = rs[p].vertexQuality[v];
@@ -233,6 +239,12 @@ TEST(SplitRun, RadiosityFinalGatherAndFaces) {
                                                 {"gather_rays", "16"}, {"face_output", "true"}};
   expectSplitEqualsWhole(m, FilterKind::Radiosity, p, 3, 17, true);
   expectSplitEqualsWhole(m, FilterKind::Radiosity, p, 2, 64, false);
+  // Refinement decides from every vertex's value at the coarser levels: each part refines alike.
+  std::map<std::string, std::string> refine = p;
+  refine["refine"] = "true", refine["refine_max_depth"] = "1";
+  expectSplitEqualsWhole(m, FilterKind::Radiosity, refine, 3, 29, true);
+  refine["vertex_output"] = "Interpolated indirect";
+  expectSplitEqualsWhole(m, FilterKind::Radiosity, refine, 2, 31, false);
 }
 
 TEST(SplitRun, AFilterOfAllVerticesTogetherIsNotSplit) {
