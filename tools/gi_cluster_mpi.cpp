@@ -51,6 +51,13 @@ double peakMB() {
   return double(u.ru_maxrss) / 1024.0;  // kilobytes on Linux
 }
 
+// CPU seconds of this process, all threads: a rank's work even where ranks share cores.
+double cpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 // Element-wise sum over the ranks, in blocks that fit MPI's int counts.
 void sumOverRanks(std::vector<double>& v) {
   const size_t block = size_t(1) << 28;
@@ -166,6 +173,7 @@ void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress
   // is this rank's own (memory, say) and may leave the others inside a
   // collective: it ends the whole run.
   Timer timer;
+  const double cpu0 = cpuSeconds();
   std::string paramError;
   try {
     estimateFilter(kind, in, res, g_rank == 0 ? progress : Progress(nullptr));
@@ -176,7 +184,7 @@ void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress
   } catch (const std::exception& e) {
     abortRun(e.what());
   }
-  const double seconds = timer.seconds();
+  const double seconds = timer.seconds(), cpu = cpuSeconds() - cpu0;
   int mine = paramError.empty() ? INT_MAX : g_rank, lowest = INT_MAX;
   MPI_Allreduce(&mine, &lowest, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (lowest != INT_MAX) {
@@ -207,6 +215,7 @@ void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress
   nlohmann::json me = {{"rank", g_rank},
                        {"vertices", part.count(n)},
                        {"seconds", seconds},
+                       {"cpu_seconds", cpu},
                        {"rays", res.stats.get("rays")},
                        {"peak_memory_MB", peakMB()},
                        {"stats", statsJson(res.stats)}};
