@@ -331,7 +331,9 @@ int runCli(int argc, char** argv) {
   CLI::App* list = app.add_subcommand("filters", "list the filters (the catalogue MeshLab's plugins and this tool share)");
   list->add_flag("--json", a.json, "as JSON: names, plugin, description, what each writes, parameters");
   CLI::App* batch = app.add_subcommand("batch", "one filter over many meshes (a manifest, or a folder and a pattern): "
-                                                "resumable, one result and summary per mesh, --shard I/N for cluster jobs");
+                                                "resumable, one result and summary per mesh, --shard I/N for cluster "
+                                                "jobs; the filter's parameters follow as --name value (gi FILTER "
+                                                "--help lists them)");
   batch::Args batchArgs;
   batch::addOptions(batch, batchArgs);
   try {
