@@ -326,6 +326,11 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   std::error_code ec;
   fs::create_directories(a.outDir, ec);
   if (!fs::is_directory(a.outDir)) throw std::invalid_argument("cannot create the output folder " + a.outDir);
+  for (const Job& j : jobs) {
+    const fs::path ply = fs::path(a.outDir) / (j.stem + ".ply");
+    if (fs::exists(ply, ec) && fs::exists(j.input, ec) && fs::equivalent(ply, j.input, ec))
+      throw std::invalid_argument("the result " + ply.string() + " would overwrite its input: choose another output folder");
+  }
   int threads = a.threads;
   if (threads == 0 && std::getenv("SLURM_CPUS_PER_TASK")) threads = std::max(1, std::atoi(std::getenv("SLURM_CPUS_PER_TASK")));
   std::unique_ptr<tbb::global_control> cap;
@@ -405,8 +410,8 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   rep["failures"] = failures;
   rep["rays_all"] = raysAll;
   rep["compute_seconds_all"] = computeAll;
-  const std::string name = a.reportOnly && !explicitShard ? "report.json"
-                                                          : "report-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".json";
+  const std::string part = std::to_string(shard) + "-of-" + std::to_string(shards) + ".json";
+  const std::string name = !a.reportOnly ? "report-" + part : explicitShard ? "report-only-" + part : "report.json";
   writeJson(fs::path(a.outDir) / name, rep);
   if (a.json) std::cout << rep.dump(2) << std::endl;
   if (!a.quiet) {

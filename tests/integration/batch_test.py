@@ -221,6 +221,7 @@ def case_inputs(a, tmp):
     one_line(["ao", "--dir", meshes, "-o", out, "--shard", "3/3"], "--shard", "a shard outside 0..N-1")
     one_line(["render", "--dir", meshes, "-o", out], "image", "a filter that writes an image")
     one_line(["ao", "--dir", meshes, "-o", out, "--rays_per_vertex"], "needs a value", "a parameter without value")
+    one_line(["ao", "--dir", meshes, "-o", meshes], "overwrite", "results that would overwrite their inputs")
 
 
 CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs}
