@@ -148,6 +148,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   in.values = resolve(specs, a, analyzeScene(mesh.scene).diagonal);
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
+  in.attributes = std::move(mesh.attributes);  // what an earlier run left (PLY properties), e.g. a first pass
 
   const Progress progress(stderrProgress(a.quiet));
   FilterResult r = prepareFilter(kind, in);

@@ -43,6 +43,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::PhotonMapping:
       add(lightingSceneSpecs());
       add(materialSpecs());
+      add(glossySpecs());
       add(PhotonOptions::specs());
       add(displaySpecs());
       break;
@@ -65,6 +66,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::PathTracedReference:
       add(lightingSceneSpecs());
       add(materialSpecs());
+      add(glossySpecs());
       add(PathTraceOptions::specs());
       add(displaySpecs());
       break;

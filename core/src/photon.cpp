@@ -105,13 +105,13 @@ namespace {
 
 bool anySpecular(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isSpecular(s.faceMaterial(f))) return true;
+    if (isCausticSurface(s.faceMaterial(f))) return true;
   return false;
 }
 
 bool anyDiffuseReflection(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (!isSpecular(s.faceMaterial(f)) && luminance(s.faceRho(f)) > 0.f) return true;
+    if (s.faceMaterial(f) == Material::Diffuse && luminance(s.faceRho(f)) > 0.f) return true;
   return false;
 }
 
@@ -270,7 +270,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     check.kNearestEstimates = true;
     st.add("photons_caustic_map", caustics ? double(caustics->size()) : 0.0);
     st.add("photon_memory_mb", mapBytes / 1048576.0);
-    if (!specular) st.note("no caustic map: the scene has no mirror or glass faces");
+    if (!specular) st.note("no caustic map: the scene has no mirror, glass or glossy faces");
     else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
     if (all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
   }
@@ -293,13 +293,14 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (projection) {
       st.add("caustic_photons_aimed", double(ts.causticEmitted));
       st.add("caustic_photons_stored", double(ts.causticStored));
-      st.note("caustic photons aimed at the mirrors and glass (projection): " +
+      st.note("caustic photons aimed at the mirrors, glass and glossy objects (projection): " +
               std::to_string(ts.causticEmitted - ts.causticMissed) + " of " + std::to_string(ts.causticEmitted) +
               " hit them first");
     }
     st.add("photons_stored", double(ts.stored));
     st.add("diffuse_bounces", double(ts.diffuseBounces));
     st.add("specular_bounces", double(ts.specularBounces));
+    if (ts.glossyBounces) st.add("glossy_bounces", double(ts.glossyBounces));
     st.add("total_internal_reflections", double(ts.totalInternal));
     st.add("emitted_power_W", ts.emittedPower * s.unit * s.unit);
     if (ts.lostAtMaxDepth)
@@ -319,7 +320,8 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
                           : "all light from the photon map");
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
   if (specular && specOnly)
-    st.note(std::to_string(specOnly) + " vertices on mirror or glass faces only (or unusable) have no diffuse radiosity: 0");
+    st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only (or unusable) have no diffuse "
+            "radiosity: 0");
   return out;
 }
 

@@ -48,7 +48,7 @@ void checkPerVertex(const std::vector<glm::vec3>& v, size_t nv, const char* what
 
 bool anySpecularFace(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isSpecular(s.faceMaterial(f))) return true;
+    if (isCausticSurface(s.faceMaterial(f))) return true;
   return false;
 }
 
@@ -81,9 +81,9 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     stats.add("caustic_photons_aimed", double(ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
-    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors or glass");
+    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors, glass or glossy faces");
   } else if (wantCaustics) {
-    stats.note("no caustic map: the scene has no mirror or glass faces");
+    stats.note("no caustic map: the scene has no mirror, glass or glossy faces");
   }
   if (o.twoPass == TwoPassDiffuse::DirectIndirect || o.twoPass == TwoPassDiffuse::Caustics) {
     std::vector<glm::vec3> Bd = o.firstPassBdirect;
