@@ -118,8 +118,9 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
         if (positive(f)) {
           Ray ray = spawn(x, n, w, lift);
           ray.tfar = r * (1.f - 1e-4f) - eps_;
-          ++c.shadow;
-          if (!(ray.tfar > 0.f) || !caster_.occluded(ray)) {
+          const bool cast = ray.tfar > 0.f;  // else the emitter point is closer than the offset: visible
+          c.shadow += cast;
+          if (!cast || !caster_.occluded(ray)) {
             const float pdfL = e.pdfArea * r2 / ce;  // solid angle
             L += f * e.E * kInvPi * (cx / pdfL) * (powerHeuristic(fn * pdfL, b.pdf(w)) / fn);
           }
@@ -171,6 +172,7 @@ void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& sm
   const SpecularEvent ev = scatterSpecular(m, st.ray.d, sp.n, s_.faceRho(sp.face), ior, smp.next1D());
   st.beta *= ev.weight * ev.radianceScale;
   st.delta = true;
+  st.kind = PathState::Kind::Specular;
   st.ray = spawn(sp.x, sp.n, ev.d);
 }
 
@@ -184,6 +186,12 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       sp = *first;
       first = nullptr;
     } else {
+      switch (st.kind) {
+        case PathState::Kind::Primary: ++c.primary; break;
+        case PathState::Kind::Specular: ++c.specular; break;
+        case PathState::Kind::Glossy: ++c.glossy; break;
+        case PathState::Kind::Diffuse: ++c.diffuse; break;
+      }
       sp = surfaceAt(st.ray, caster_.intersect(st.ray));
     }
     if (!sp.valid()) {
@@ -196,7 +204,6 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       if (st.depth >= rules_.maxDepth) { ++c.cutAtMaxDepth; break; }
       ++st.depth;
       specularStep(sp, st, smp);
-      ++c.specular;
     } else {
       const float cosO = -glm::dot(sp.n, st.ray.d);
       if (!(cosO > 0.f)) break;  // seen from behind: black
@@ -236,7 +243,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       st.pdfPrev = pdf;
       st.nLPrev = float(nL);
       st.ray = spawn(sp.x, sp.n, wi);
-      ++(m == Material::Glossy ? c.glossy : c.diffuse);
+      st.kind = m == Material::Glossy ? PathState::Kind::Glossy : PathState::Kind::Diffuse;
       if (goOn) ++st.depth;
       st.lightOnly = !goOn;
     }
@@ -271,7 +278,7 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
   st.diffuseVertices = 1;
   st.depth = goOn ? 1 : 0;
   st.lightOnly = !goOn;
-  ++c.diffuse;
+  st.kind = PathState::Kind::Diffuse;
   return L + trace(st, nullptr, smp, c);
 }
 

@@ -129,7 +129,9 @@ class StoredLight {
 // its vertex, for the MIS weights of what the ray finds; lightOnly: the ray
 // may only find a light directly (its vertex was the last).
 struct PathState {
+  enum class Kind : uint8_t { Primary, Specular, Glossy, Diffuse };
   Ray ray;
+  Kind kind = Kind::Primary;  // what spawned the ray (counted when cast; primary rays by the caller)
   glm::vec3 beta{1.f};
   bool delta = true, lightOnly = false;
   float pdfPrev = 0.f, nLPrev = 1.f;
