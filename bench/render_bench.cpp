@@ -194,6 +194,7 @@ int run(int w, int h, const std::string& stem, const std::string& mode, int a, i
     o.causticK = po.causticK;
     o.causticMaxRadius = radius;
     o.firstPassB = first.B;
+    o.firstPassBdirect = first.Bdirect;  // as the filter passes it on (RadiosityDirect)
   }
   const RenderResult r = render(s, *caster, o);
   const double seconds = t.seconds();

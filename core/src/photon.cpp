@@ -275,6 +275,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
   }
   out.B.assign(nv, glm::vec3(0.f));
+  if (opt.directLight) out.Bdirect.assign(nv, glm::vec3(0.f));
   out.H.assign(nv, glm::vec3(0.f));
   out.stdError.assign(nv, 0.f);
   double lum = 0, err2 = 0;
@@ -283,6 +284,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     if (!mat.valid[i]) continue;
     out.H[i] = Hd[i] + Hphot[i];
     out.B[i] = mat.E[i] + mat.rho[i] * out.H[i];
+    if (opt.directLight) out.Bdirect[i] = mat.E[i] + mat.rho[i] * Hd[i];
     out.stdError[i] = float(luminance(mat.rho[i]) * noise[i]);
     lum += luminance(out.B[i]);
     err2 += double(out.stdError[i]) * out.stdError[i];
