@@ -200,6 +200,11 @@ int run(int w, int h, const std::string& stem, const std::string& mode, int a, i
   const double seconds = t.seconds();
   if (const char* keepImage = std::getenv("RENDER_BENCH_IMAGE")) writePfm(keepImage, r.image);
   const std::vector<uint8_t> keep = lightFreeMask(s, *caster, o.camera);
+  if (const char* maskPath = std::getenv("RENDER_BENCH_MASK")) {
+    Image m(w, h);
+    for (size_t p = 0; p < m.px.size(); ++p) m.px[p] = glm::vec3(float(keep[p]));
+    writePfm(maskPath, m);
+  }
   const ImageError e = imageError(r.image, ref, refSe, keep);
   std::printf("{\"mode\": \"%s\", \"a\": %d, \"b\": %d, \"seed\": %u, \"seconds\": %.4f, \"first_pass_seconds\": %.4f, "
               "\"rays\": %.0f, \"relative_rms_error\": %.6g, \"relative_rms_error_corrected\": %.6g, "

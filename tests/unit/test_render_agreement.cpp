@@ -12,7 +12,7 @@
 // plus a stated share of the path-traced tile for the first pass's own bias
 // (what the first pass computes at the vertices and the eye pass
 // interpolates: radiosity's discretisation and photon mapping's density
-// estimates), and the whole image within 4 errors plus half that share.
+// estimates), and the whole image within 4 errors plus a smaller share.
 #include <gtest/gtest.h>
 
 #include <cmath>
