@@ -323,8 +323,9 @@ int main(int argc, char** argv) {
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
-  std::string filterName;
-  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)")->required();
+  std::string filterName, filterNames;  // the catalogue's subcommands, for the help and the error
+  for (const FilterDesc& d : allFilters()) filterNames += (filterNames.empty() ? "" : ", ") + d.cliName;
+  script->add_option("filter", filterName, "filter subcommand name (" + filterNames + ")")->required();
   CLI::Option* scriptOutput = script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
@@ -347,7 +348,7 @@ int main(int argc, char** argv) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())
         if (f.cliName == filterName) d = &f;
-      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)");
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (" + filterNames + ")");
       // Parameters after the filter name: --name value pairs, checked against the filter's table.
       const auto specs = filterSpecs(d->kind);
       const auto extras = script->remaining();

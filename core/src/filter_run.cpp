@@ -104,7 +104,8 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
     radiometric(res, in.scene, r.rgb, v.getFloat("exposure"), "Irradiance");
   } else {
     res.vertexQuality = r.value;
-    const auto mapping = AOColorMapping(mode == AmbientMode::Occlusion ? v.getInt("color_mapping") : 0);
+    const AOColorMapping mapping =
+        mode == AmbientMode::Occlusion ? kAOColorMappings.get(v, "color_mapping") : AOColorMapping::Grey;
     if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(r.value);
     else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, r.value);
     if (opt.bentNormals) {

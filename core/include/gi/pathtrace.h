@@ -42,7 +42,7 @@ struct PathTraceOptions {
                                    // alone ends paths: unbiased; a safety cap of 100,000)
   uint32_t seed = 0;
   glm::vec3 skyRadiance{0.f};      // uniform sky over the whole sphere, W/(m^2 sr)
-  glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
+  glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
