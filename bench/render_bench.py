@@ -25,7 +25,7 @@ packets, a stream) and the path tracer's secondary rays (recorded, then
 replayed) against a bare Embree loop over the very same rays.
 
 Writes results/render_bench.{json,csv,md,png}.
-usage: /usr/bin/python3 bench/render_bench.py [--build build] [--quick] [--report]
+usage: /usr/bin/python3 bench/render_bench.py [--build build] [--quick] [--repeats N] [--report]
 """
 import argparse
 import csv
@@ -87,6 +87,7 @@ def main():
     ap.add_argument("--build", default=os.path.join(os.path.dirname(HERE), "build"))
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--repeats", type=int, default=0, help="seeds per setting (default 3; --quick 1)")
     ap.add_argument("--report", action="store_true", help="only rewrite the tables and plot from results/render_bench.json")
     a = ap.parse_args()
     if a.report:
@@ -95,6 +96,7 @@ def main():
     exe = os.path.join(a.build, "bench", "render_bench")
     # The reference's own relative RMS error: about 2.2% at 64 x 64 x 32768 (13 minutes on 2 cores).
     w, h, ref_spp, repeats = (32, 32, 4096, 1) if a.quick else (64, 64, 32768, 3)
+    repeats = a.repeats or repeats
     refs = os.path.join(a.out, "refs")
     os.makedirs(refs, exist_ok=True)
     stem = os.path.join(refs, "render_ref_%dx%d_%d" % (w, h, ref_spp))

@@ -175,27 +175,36 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     return std::sqrt(std::max(0.0, (a.sumL2 - a.n * m * m) / (a.n - 1)) / a.n);
   };
   const bool adaptive = opt.targetRelativeError > 0;
+  const VertexPart& part = opt.vertices;  // a split run traces its part of the vertices
+  if (adaptive && !part.all() && !part.sumOverParts)
+    throw std::logic_error("an adaptive reference split over parts needs their sum (VertexPart::sumOverParts)");
   Timer traceTimer;
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i]) trace(i, opt.samplesPerVertex);
+        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.samplesPerVertex);
     });
   } else {
     // Pilot pass, then rounds of 32 paths for the vertices still above target.
     parallelBlocks(nv, progress.sub(0.0, 0.2), "tracing paths (pilot)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i]) trace(i, opt.minSamples);
+        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.minSamples);
     });
+    // The pilot's mean B over all vertices, summed in vertex order: the same
+    // bits in one process and in a split run (each part fills its vertices).
+    std::vector<double> pilot(nv, 0.0);
+    for (size_t i = 0; i < nv; ++i)
+      if (mat.valid[i] && part.contains(i, nv)) pilot[i] = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
+    if (!part.all()) part.sumOverParts(pilot);
     double meanB = 0;
     size_t valid = 0;
     for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i]) { meanB += luminance(mat.E[i]) + acc[i].sumL / acc[i].n; ++valid; }
+      if (mat.valid[i]) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
     const double floorB = 0.1 * meanB;
     parallelBlocks(nv, progress.sub(0.2, 1.0), "tracing paths (adaptive)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        if (!mat.valid[i]) continue;
+        if (!mat.valid[i] || !part.contains(i, nv)) continue;
         while (acc[i].n < opt.maxSamples) {
           const double B = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
           if (stdErr(acc[i]) <= opt.targetRelativeError * std::max(B, floorB)) break;
@@ -244,9 +253,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
-  if (valid < nv)
-    st.note(std::to_string(nv - valid) + " vertices without a usable diffuse face (isolated, or on mirror, glass or "
-            "glossy faces only: no diffuse radiosity) got 0");
+  if (valid < part.count(nv))
+    st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
+            "glass or glossy faces only: no diffuse radiosity) got 0");
   return res;
 }
 

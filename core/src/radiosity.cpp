@@ -494,8 +494,8 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     const uint32_t key = hash3(bits[0] ^ seed, bits[1], bits[2] ^ f);
     return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
   };
-  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen);
-  res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
+  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices);
+  res.stats.add("gather_rays", double(opt.vertices.count(s.vertexCount())) * opt.gatherRays);
   if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
   return Hi;
 }
@@ -507,7 +507,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
 void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res) {
   Timer vt;
   const VertexMaterial mat = vertexMaterial(s);
-  const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed);
+  const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, Progress(nullptr), opt.vertices);
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
   const std::vector<glm::vec3> Hi = gather ? gatherIndirect(s, caster, mat, opt, res) : faceToVertex(s, res.Hindirect);
   for (size_t v = 0; v < s.vertexCount(); ++v)

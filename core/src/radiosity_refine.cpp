@@ -106,6 +106,7 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   Timer timer;
   MeshRefiner refiner(s);
   RadiosityOptions levelOpt = opt;
+  levelOpt.vertices = VertexPart();  // where to refine depends on every vertex's value
   // Intermediate levels: direct light at the vertices, indirect interpolated (no gather rays).
   if (levelOpt.vertexOutput == RadiosityVertexOutput::FinalGather)
     levelOpt.vertexOutput = RadiosityVertexOutput::InterpolatedIndirect;

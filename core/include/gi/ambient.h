@@ -16,6 +16,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -56,6 +57,7 @@ struct AmbientOptions {
   BatchMode batch = BatchMode::Single;
   bool skipOpenVertices = true;  // prove-and-skip vertices with nothing within maxDistance
   bool mergeDuplicates = true;   // same position and normal computed once
+  VertexPart vertices;           // which vertices to compute (a split run); the others are left 0
 
   static std::vector<ParamSpec> specs(AmbientMode mode);
   static AmbientOptions fromParams(AmbientMode mode, const ParamValues& v);

@@ -30,6 +30,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -46,6 +47,7 @@ struct PathTraceOptions {
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
+  VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

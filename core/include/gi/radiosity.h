@@ -22,6 +22,7 @@
 #include "gi/refine.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -55,6 +56,8 @@ struct RadiosityOptions {
   int gatherRays = 256;           // final-gather rays per vertex
   bool refine = false;            // adaptive mesh refinement (solveRadiosityAdaptive)
   RefineOptions refinement;       // its limits, thresholds and seed (RefineOptions::fromParams)
+  VertexPart vertices;            // which vertices' final gather to compute (a split run; the patch
+                                  // solution is computed whole); the others are left 0
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
