@@ -140,6 +140,41 @@ struct ByteWriter {
 
 namespace {
 
+// The kept vertex properties as named attributes, as writePly writes them:
+// NAME_x, NAME_y, NAME_z (all three present, no scalar NAME) make the vector
+// NAME; every other one is the scalar of its name.
+std::vector<VertexAttribute> vertexAttributes(const Polygons& p) {
+  const std::vector<std::string>& names = p.vertexFloatNames;
+  auto find = [&](const std::string& n) {
+    return size_t(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  std::vector<VertexAttribute> out;
+  std::vector<uint8_t> used(names.size(), 0);
+  const size_t nv = p.points.size();
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (used[k]) continue;
+    const std::string& n = names[k];
+    if (n.size() > 2 && n.compare(n.size() - 2, 2, "_x") == 0) {
+      const std::string base = n.substr(0, n.size() - 2);
+      const size_t y = find(base + "_y"), z = find(base + "_z");
+      if (y < names.size() && z < names.size() && find(base) == names.size()) {
+        VertexAttribute a{base, 3, std::vector<float>(3 * nv)};
+        for (size_t i = 0; i < nv; ++i) {
+          a.values[3 * i] = p.vertexFloats[k][i];
+          a.values[3 * i + 1] = p.vertexFloats[y][i];
+          a.values[3 * i + 2] = p.vertexFloats[z][i];
+        }
+        used[k] = used[y] = used[z] = 1;
+        out.push_back(std::move(a));
+        continue;
+      }
+    }
+  }
+  for (size_t k = 0; k < names.size(); ++k)
+    if (!used[k]) out.push_back({names[k], 1, p.vertexFloats[k]});
+  return out;
+}
+
 LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
   if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
     failRead(name, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
@@ -167,6 +202,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
+  out.attributes = vertexAttributes(p);
   return out;
 }
 
@@ -288,6 +324,17 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
     into.scene.vertexNormals.insert(into.scene.vertexNormals.end(), otherNormals.begin(), otherNormals.end());
   }
   for (uint32_t t : other.triangleToFace) into.triangleToFace.push_back(uint32_t(tri0 + t));
+  // Attributes every part has (as MeshLab's layers give a filter those all
+  // of them carry); the others are dropped.
+  std::vector<VertexAttribute> kept;
+  for (VertexAttribute& a : into.attributes)
+    for (const VertexAttribute& b : other.attributes)
+      if (a.name == b.name && a.components == b.components) {
+        a.values.insert(a.values.end(), b.values.begin(), b.values.end());
+        kept.push_back(std::move(a));
+        break;
+      }
+  into.attributes = std::move(kept);
 }
 
 }  // namespace gi::io

@@ -16,6 +16,9 @@ struct LoadedMesh {
   Scene scene;            // positions (re-centred), triangles (polygons fan-triangulated), normals if the file has them
   MeshAttributes attrs;   // face/vertex colours (sRGB bytes), face quality, if present in the file
   std::vector<uint32_t> triangleToFace;  // source polygon of each triangle
+  // Per-vertex values an earlier filter left (PLY only: the vertex element's
+  // other float properties; NAME_x, NAME_y, NAME_z as the vector NAME).
+  std::vector<VertexAttribute> attributes;
 };
 
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure:
@@ -25,8 +28,9 @@ LoadedMesh loadMesh(const std::string& path);
 // names it in messages (an OBJ's material library is not followed).
 LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const std::string& name);
 
-// Appends another mesh as a further part of one scene (attributes that only
-// one of them has are filled with defaults: grey 188 colours, quality 0).
+// Appends another mesh as a further part of one scene (colours and face
+// quality that only one of them has are filled with defaults: grey 188
+// colours, quality 0; per-vertex attributes that not both have are dropped).
 void appendMesh(LoadedMesh& into, const LoadedMesh& other);
 
 // Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and

@@ -20,6 +20,11 @@ struct Polygons {
   std::vector<uint32_t> index;
   std::vector<glm::u8vec3> faceColor;      // or empty
   std::vector<float> faceQuality;          // or empty
+  // The vertex element's other float and double properties, by name, in
+  // file order (what an earlier filter left: "Radiosity_x", "StdError"); a
+  // value that is not finite in float is kept as NaN for its reader to judge.
+  std::vector<std::string> vertexFloatNames;
+  std::vector<std::vector<float>> vertexFloats;
 };
 
 // Throws std::runtime_error "cannot read NAME: WHY." (one line).

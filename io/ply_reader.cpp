@@ -4,9 +4,10 @@
 // numbers are whole tokens, in range for their declared type; binary data is
 // little or big endian. Read: vertex x y z, nx ny nz, red green blue (integer
 // 0..255 or float 0..1); face vertex_indices (or vertex_index), red green
-// blue, quality (any numeric type). Every other element and property is
-// skipped by its size, so MeshLab's extras (quality, flags, texture
-// coordinates) load.
+// blue, quality (any numeric type); the vertex element's other float and
+// double properties are kept by name (an earlier filter's per-vertex
+// results). Every other element and property is skipped by its size, so
+// MeshLab's extras (flags, texture coordinates) load.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -53,7 +54,7 @@ std::pair<double, double> integerRange(Type t) {
   }
 }
 
-enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices };
+enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices, Keep };
 
 struct Property {
   std::string name;
@@ -179,6 +180,7 @@ void assignRoles(Header& h, const std::string& name) {
         if (n == "quality") p.role = Role::Quality;
         else if (n == "vertex_indices" || n == "vertex_index") p.role = Role::Indices;
       }
+      if (vertex && p.role == Role::Skip && !p.list && !isInteger(p.type)) p.role = Role::Keep;
       if (p.role == Role::Indices && (!p.list || !isInteger(p.type)))
         failRead(name, "the face property '" + n + "' must be a list of integers");
       if (p.role != Role::Skip && p.role != Role::Indices && p.list)
@@ -224,7 +226,9 @@ struct AsciiSource {
       return Status::Ok;
     }
     if (parseDouble(t, v)) return type == Type::F32 && !fitsFloat(v) ? Status::Bad : Status::Ok;
-    return !used && parseNonFinite(t) ? Status::Ok : Status::Bad;
+    if (used || !parseNonFinite(t)) return Status::Bad;
+    v = std::numeric_limits<double>::quiet_NaN();  // a kept value says it is not a number
+    return Status::Ok;
   }
   Status skip(Type type, uint64_t n) {
     double v;
@@ -303,6 +307,15 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
     const bool colours = (isVertex || isFace) && has(e, Role::R) && has(e, Role::G) && has(e, Role::B);
     const bool quality = isFace && has(e, Role::Quality);
     if (e.props.empty()) continue;  // takes no bytes, whatever its count
+    // Slot of each kept vertex property in out.vertexFloats.
+    std::vector<size_t> slot(e.props.size(), 0);
+    if (isVertex)
+      for (size_t k = 0; k < e.props.size(); ++k)
+        if (e.props[k].role == Role::Keep) {
+          slot[k] = out.vertexFloats.size();
+          out.vertexFloatNames.push_back(e.props[k].name);
+          out.vertexFloats.emplace_back(size_t(e.count), 0.f);
+        }
     if (isVertex) {
       out.points.resize(size_t(e.count));
       if (normals) out.normals.resize(size_t(e.count));
@@ -323,7 +336,8 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
         failRead(name, what() + ": property '" + p.name + "' is not " +
                            (isInteger(t) ? "an integer within the range of its type" : "a finite number within the range of its type"));
       };
-      for (const Property& p : e.props) {
+      for (size_t pi = 0; pi < e.props.size(); ++pi) {
+        const Property& p = e.props[pi];
         double v = 0;
         if (p.list) {
           if (const Status s = src.value(p.countType, v, true); s != Status::Ok) fail(s, p);
@@ -350,8 +364,14 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
           out.faceStart.push_back(uint32_t(out.index.size()));
           continue;
         }
-        if (const Status s = src.value(p.type, v, p.role != Role::Skip); s != Status::Ok) fail(s, p);
+        const bool used = p.role != Role::Skip && p.role != Role::Keep;
+        if (const Status s = src.value(p.type, v, used); s != Status::Ok) fail(s, p);
         if (p.role == Role::Skip) continue;
+        if (p.role == Role::Keep) {
+          out.vertexFloats[slot[pi]][size_t(i)] =
+              std::isfinite(v) && fitsFloat(v) ? float(v) : std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
         if (!std::isfinite(v) || !fitsFloat(v))
           failRead(name, what() + ": property '" + p.name + "' is not a finite number within float range");
         const size_t k = size_t(i);

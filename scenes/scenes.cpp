@@ -232,6 +232,44 @@ Scene causticCornell(double h, double hf, int sphereSubdiv, float ior) {
   return s;
 }
 
+SceneFile glossyBlock(double patch) {
+  Builder b;
+  const glm::vec3 colour(0.9f, 0.72f, 0.42f);  // brass-like; a glossy layer takes the glossy colour parameter
+  const double a = glm::radians(kGlossyTurnDeg), c = std::cos(a), sn = std::sin(a);
+  const dvec3 centre(kGlossyCentre.x, 0.0, kGlossyCentre.z);
+  dvec3 top[4];
+  const double hx[4] = {-1, 1, 1, -1}, hz[4] = {-1, -1, 1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const double x = kGlossyHalfWidth * hx[k], z = kGlossyHalfWidth * hz[k];
+    top[k] = centre + dvec3(c * x + sn * z, kGlossyHeight, -sn * x + c * z);
+  }
+  b.quadH(top[0], top[1], top[2], top[3], patch, {0, 1, 0}, colour);
+  for (int k = 0; k < 4; ++k) {
+    const dvec3 p = top[k], q = top[(k + 1) % 4], p0(p.x, 0, p.z), q0(q.x, 0, q.z);
+    b.quadH(p0, q0, q, p, patch, (p + q0) * 0.5 - (centre + dvec3(0, kGlossyHeight / 2, 0)), colour);
+  }
+  return b.finish();
+}
+
+std::vector<NamedLayer> causticCornellGlossyLayers(double patchSize, double floorPatch, int sphereSubdiv) {
+  std::vector<NamedLayer> out = causticCornellLayers(patchSize, floorPatch, sphereSubdiv);
+  out.push_back({"caustic_cornell_glossy_block.ply", glossyBlock(20.0)});
+  return out;
+}
+
+Scene causticCornellGlossy(double patchSize, double floorPatch, int sphereSubdiv, float ior, float roughness,
+                           const glm::vec3& F0) {
+  Scene s = causticCornell(patchSize, floorPatch, sphereSubdiv, ior);
+  Scene block = glossyBlock(20.0).scene;
+  block.material.assign(block.faceCount(), Material::Glossy);
+  block.ior.assign(block.faceCount(), ior);
+  block.rho.assign(block.faceCount(), F0);
+  block.roughness.assign(block.faceCount(), roughness);
+  if (s.roughness.empty()) s.roughness.assign(s.faceCount(), roughness);
+  s.append(block);
+  return s;
+}
+
 SceneFile parallelPlates(double L, int n) {
   Builder b;
   const glm::vec3 black(0.f), E(1.f);
@@ -374,11 +412,12 @@ SceneFile cylindricalHole(double a, double h, int n) {
 std::vector<std::string> names() {
   return {"cornell_box", "cornell_box_fine", "parallel_plates", "perpendicular_plates", "furnace_sphere",
           "closed_box",  "open_plane",       "floor_wall",      "bowl",                 "cylinder_hole",
-          "caustic_cornell"};
+          "caustic_cornell", "caustic_cornell_glossy"};
 }
 
 std::vector<NamedLayer> layersByName(const std::string& name) {
   if (name == "caustic_cornell") return causticCornellLayers(50.0, 10.0, 5);
+  if (name == "caustic_cornell_glossy") return causticCornellGlossyLayers(50.0, 10.0, 5);
   if (name == "caustic_cornell_coarse") return causticCornellLayers(50.0, 20.0, 5);  // benchmarks
   return {{name + ".ply", byName(name)}};
 }

@@ -152,6 +152,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   in.values = resolve(specs, a, analyzeScene(mesh.scene).diagonal);
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
+  in.attributes = std::move(mesh.attributes);  // what an earlier run left (PLY properties), e.g. a first pass
 
   const bool writer = cluster::rank() == 0;  // under mpirun only rank 0 writes and prints
   const Progress progress(stderrProgress(a.quiet || !writer));

@@ -152,6 +152,61 @@ class EmbreeCaster final : public RayCaster {
     }
   }
 
+  // Coherent rays (a tile of primary rays): Embree's 8-wide packets or its
+  // stream interface (rtcIntersect1M), both told the rays are coherent.
+  // bench/render_bench.py measures the three modes.
+  void intersectBatch(const Ray* rays, size_t n, Hit* hits) const override {
+    if (mode_ == BatchMode::Single) return RayCaster::intersectBatch(rays, n, hits);
+    for (size_t i = 0; i < n; ++i) checkRay(rays[i]);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    auto hitOf = [&](unsigned geomID, unsigned primID, float t, float u, float v, float nx, float ny, float nz) {
+      Hit h;
+      if (geomID != RTC_INVALID_GEOMETRY_ID) {
+        h.t = t; h.face = primToFace_[primID]; h.u = u; h.v = v;
+        h.ng = {nx, ny, nz};
+      }
+      return h;
+    };
+    if (mode_ == BatchMode::Stream) {
+      constexpr size_t kChunk = 64;
+      RTCRayHit buf[kChunk];
+      for (size_t b = 0; b < n; b += kChunk) {
+        const size_t m = std::min(kChunk, n - b);
+        for (size_t i = 0; i < m; ++i) {
+          toRTC(rays[b + i], buf[i].ray);
+          buf[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          buf[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect1M(scene_.get(), &ctx, buf, unsigned(m), sizeof(RTCRayHit));
+        for (size_t i = 0; i < m; ++i) {
+          const RTCRayHit& r = buf[i];
+          hits[b + i] = hitOf(r.hit.geomID, r.hit.primID, r.ray.tfar, r.hit.u, r.hit.v, r.hit.Ng_x, r.hit.Ng_y, r.hit.Ng_z);
+        }
+      }
+      return;
+    }
+    alignas(32) RTCRayHit8 p;
+    alignas(32) int valid[8];
+    for (size_t b = 0; b < n; b += 8) {
+      const size_t m = std::min<size_t>(8, n - b);
+      for (size_t i = 0; i < 8; ++i) {
+        const Ray& r = rays[b + (i < m ? i : 0)];
+        valid[i] = i < m ? -1 : 0;
+        p.ray.org_x[i] = r.o.x; p.ray.org_y[i] = r.o.y; p.ray.org_z[i] = r.o.z; p.ray.tnear[i] = r.tnear;
+        p.ray.dir_x[i] = r.d.x; p.ray.dir_y[i] = r.d.y; p.ray.dir_z[i] = r.d.z; p.ray.time[i] = 0.f;
+        p.ray.tfar[i] = r.tfar; p.ray.mask[i] = 0xffffffffu; p.ray.id[i] = 0; p.ray.flags[i] = 0;
+        p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        p.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect8(valid, scene_.get(), &ctx, &p);
+      for (size_t i = 0; i < m; ++i)
+        hits[b + i] = hitOf(p.hit.geomID[i], p.hit.primID[i], p.ray.tfar[i], p.hit.u[i], p.hit.v[i], p.hit.Ng_x[i],
+                            p.hit.Ng_y[i], p.hit.Ng_z[i]);
+    }
+  }
+
   void occludedBatch(const Ray* rays, size_t n, uint8_t* occ) const override {
     if (mode_ == BatchMode::Single) return RayCaster::occludedBatch(rays, n, occ);
     for (size_t i = 0; i < n; ++i) checkRay(rays[i]);

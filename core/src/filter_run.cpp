@@ -178,17 +178,23 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.stats = std::move(r.stats);
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
   radiometric(res, in.scene, in.values.getFloat("exposure"), "Radiosity");
+  // Its direct part, for a two-pass view (which then need not estimate it again).
+  if (r.Bdirect.size() == r.B.size()) res.attributes.push_back(vectorAttribute("RadiosityDirect", r.Bdirect));
   if (r.stdError.size() == r.B.size()) res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
 void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
   const ParamValues& v = in.values;
   RenderOptions opt = RenderOptions::fromParams(v, in.scene, in.layerCamera ? &*in.layerCamera : nullptr);
-  if (const VertexAttribute* B = in.attribute("Radiosity"); B && B->components == 3 && opt.mode == RenderMode::TwoPass) {
-    opt.firstPassB.resize(in.scene.vertexCount());
-    for (size_t i = 0; i < opt.firstPassB.size() && 3 * i + 2 < B->values.size(); ++i)
-      opt.firstPassB[i] = {B->values[3 * i], B->values[3 * i + 1], B->values[3 * i + 2]};
-  }
+  auto perVertex = [&](const char* name, std::vector<glm::vec3>& out) {
+    const VertexAttribute* a = in.attribute(name);
+    if (!a || a->components != 3 || opt.mode != RenderMode::TwoPass) return;
+    out.resize(in.scene.vertexCount());
+    for (size_t i = 0; i < out.size() && 3 * i + 2 < a->values.size(); ++i)
+      out[i] = {a->values[3 * i], a->values[3 * i + 1], a->values[3 * i + 2]};
+  };
+  perVertex("Radiosity", opt.firstPassB);
+  perVertex("RadiosityDirect", opt.firstPassBdirect);  // photon mapping's direct part, if it left one
   const auto caster = makeEmbreeCaster(in.scene);
   RenderResult r = render(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);

@@ -44,6 +44,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::PhotonMapping:
       add(lightingSceneSpecs());
       add(materialSpecs());
+      add(glossySpecs());
       add(PhotonOptions::specs());
       add(displaySpecs());
       break;
@@ -66,6 +67,7 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::PathTracedReference:
       add(lightingSceneSpecs());
       add(materialSpecs());
+      add(glossySpecs());
       add(PathTraceOptions::specs());
       add(displaySpecs());
       break;

@@ -12,6 +12,7 @@
 #include "gi/sampling.h"
 #include "gi/scene_setup.h"
 #include "gi/specular.h"
+#include "path_integrator.h"
 
 namespace gi {
 
@@ -33,9 +34,9 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
        .type = ParamType::Int, .def = 65536, .min = 2, .max = 1 << 26},
       {.name = "max_depth", .label = "Maximum bounces",
        .help = "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the "
-               "largest reflectance channel) ends paths, after about 1 / (1 - rho) bounces; a path still going after "
-               "100,000 bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths end after k "
-               "bounces (0 = direct light only); the light of more bounces is missing (in a closed room of "
+               "largest channel of the path's throughput) ends paths, after about 1 / (1 - rho) bounces; a path still "
+               "going after 100,000 bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths "
+               "end after k bounces (diffuse, glossy, mirror or glass; 0 = direct light only); the light of more bounces is missing (in a closed room of "
                "reflectance rho, a share rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: "
                "a warning says so when it may exceed them.",
        .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
@@ -86,154 +87,6 @@ namespace {
 // (which Russian roulette never ends) stops here.
 constexpr int kDepthCap = 100000;
 
-class Tracer {
- public:
-  Tracer(const Scene& s, const RayCaster& c, const PathTraceOptions& o)
-      : s_(s), caster_(c), o_(o), lights_(s), eps_(float(sceneScale(s).rayEpsilon)),
-        maxDepth_(o.maxDepth < 0 ? kDepthCap : o.maxDepth) {
-    faceN_.resize(s.faceCount());
-    for (size_t f = 0; f < s.faceCount(); ++f) {
-      const glm::vec3 n = faceNormalUnnormalized(s, f);
-      const float l = glm::length(n);
-      faceN_[f] = l > 0 ? n / l : glm::vec3(0.f, 0.f, 1.f);
-    }
-    sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
-    const float omega = 2.f * float(M_PI) * (1.f - sunCos_);
-    hasSun_ = luminance(o.sunIrradiance) > 0.f;
-    sunDisk_ = hasSun_ && o.sunAngularRadiusDeg > 0.f;
-    sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
-    sunL_ = sunDisk_ ? o.sunIrradiance / omega : glm::vec3(0.f);
-    hasPoint_ = o.point.on();
-    if (lights_.empty() && luminance(o.skyRadiance) <= 0.f && !hasSun_ && !hasPoint_)
-      throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
-                                  "quality), no sky, no sun and no point light");
-  }
-
-  // One-sample estimate of the irradiance at x (unit normal n, the lit side):
-  // next-event estimation there, then the path continued by cosine-weighted
-  // sampling, bounce after bounce in a loop (never recursion: a path between
-  // white mirrors can run to max_depth = 100,000 bounces). beta is the path
-  // throughput: what a radiance arriving at the current vertex adds to H.
-  // cut: paths ended by the depth limit while they would have gone on.
-  glm::vec3 irradiance(const glm::vec3& x0, const glm::vec3& n0, Rng& rng, uint64_t& rays, uint64_t& cut) const {
-    glm::vec3 H(0.f);
-    glm::vec3 beta(1.f);
-    glm::vec3 x = x0, n = n0;
-    int depth = 0;
-    for (;;) {
-      // A diffuse vertex x (normal n) at `depth` bounces from the start.
-      H += beta * nextEvent(x, n, rng, rays);
-      glm::vec3 w = Frame(n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
-      float pdfB = glm::dot(n, w) * 0.318309886f;
-      if (!(pdfB > 0.f)) return H;
-      beta *= float(M_PI);  // cos / pdf = pi
-      // Follow w through mirrors and glass to the next diffuse vertex.
-      // afterSpecular: the direction came from a mirror or glass (a delta
-      // distribution next-event estimation cannot sample, so emitters and
-      // the sun count fully).
-      bool afterSpecular = false;
-      for (;;) {
-        Ray ray;
-        ray.o = x;
-        ray.d = w;
-        ++rays;
-        const Hit h = caster_.intersect(ray);
-        if (!h.valid()) {
-          glm::vec3 L = o_.skyRadiance;
-          if (sunDisk_ && glm::dot(w, o_.sunDirection) >= sunCos_)
-            L += sunL_ * (afterSpecular ? 1.f : powerHeuristic(pdfB, sunPdf_));
-          return H + beta * L;
-        }
-        const glm::vec3 ng = faceN_[h.face];
-        const Material m = s_.faceMaterial(h.face);
-        if (!isSpecular(m)) {
-          const float cosY = -glm::dot(ng, w);
-          if (cosY <= 0.f) return H;  // a back face: black, as in the radiosity filter
-          const glm::vec3 E = s_.faceEmission(h.face);
-          if (E.r > 0.f || E.g > 0.f || E.b > 0.f) {
-            const float pdfL = lights_.pdfArea(h.face) * h.t * h.t / cosY;
-            H += beta * (E * 0.318309886f * (afterSpecular ? 1.f : powerHeuristic(pdfB, pdfL)));
-          }
-          const glm::vec3 rho = s_.faceRho(h.face);
-          const float q = std::min(1.f, std::max({rho.r, rho.g, rho.b}));
-          if (!(q > 0.f)) return H;
-          if (depth >= maxDepth_) { ++cut; return H; }
-          float scale = 1.f;
-          if (depth >= 3) {  // Russian roulette
-            if (rng.next() >= q) return H;
-            scale = 1.f / q;
-          }
-          beta *= rho * 0.318309886f * scale;
-          x = x + w * h.t + ng * eps_;
-          n = ng;
-          ++depth;
-          break;
-        }
-        // A mirror or glass hit: continue in the sampled specular direction.
-        if (depth >= maxDepth_) { ++cut; return H; }
-        const glm::vec3 y = x + w * h.t;
-        const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
-        const SpecularEvent ev = scatterSpecular(m, w, ng, s_.faceRho(h.face), ior, rng.next());
-        glm::vec3 weight = ev.weight * ev.radianceScale;
-        if (depth >= 3) {  // Russian roulette on the tint (clear glass and white mirrors always continue)
-          const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
-          if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return H;
-          weight /= q;
-        }
-        beta *= weight;
-        x = y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps_;
-        w = ev.d;
-        pdfB = 0.f;
-        afterSpecular = true;
-        ++depth;
-      }
-    }
-  }
-
- private:
-  // Direct irradiance from every light, each sampled once (MIS with the
-  // cosine-weighted direction for the lights a BSDF ray can also hit).
-  glm::vec3 nextEvent(const glm::vec3& x, const glm::vec3& n, Rng& rng, uint64_t& rays) const {
-    glm::vec3 H(0.f);
-    Ray ray;
-    ray.o = x;
-    if (!lights_.empty()) {
-      const glm::vec2 u{rng.next(), rng.next()};
-      H += sampleLightMIS(lights_, caster_, x, n, u, eps_, &rays);
-    }
-    if (hasSun_) {
-      const glm::vec3 w = sunDisk_ ? Frame(o_.sunDirection).toWorld(uniformCone({rng.next(), rng.next()}, sunCos_))
-                                   : o_.sunDirection;
-      const float cx = glm::dot(n, w);
-      if (cx > 0.f) {
-        ray.d = w;
-        ray.tfar = std::numeric_limits<float>::infinity();
-        ++rays;
-        if (!caster_.occluded(ray)) {
-          const float mis = sunDisk_ ? powerHeuristic(sunPdf_, cx * 0.318309886f) : 1.f;
-          H += (sunDisk_ ? sunL_ * cx / sunPdf_ : o_.sunIrradiance * cx) * mis;
-        }
-      }
-    }
-    if (hasPoint_) {
-      ++rays;
-      H += pointLightIrradiance(o_.point, caster_, x, n);
-    }
-    return H;
-  }
-
-  const Scene& s_;
-  const RayCaster& caster_;
-  const PathTraceOptions& o_;
-  EmitterSampler lights_;
-  float eps_;
-  int maxDepth_;
-  std::vector<glm::vec3> faceN_;
-  float sunCos_ = 1.f, sunPdf_ = 0.f;
-  glm::vec3 sunL_{0.f};
-  bool hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
-};
-
 // Paths the depth limit ended while they would have gone on: their further
 // light is missing, a bias outside the error bars. No limit (-1): only paths
 // caught between perfect mirrors reach the cap. A limit k: in a closed room
@@ -279,19 +132,33 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
     throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
   Timer timer;
-  const Tracer tracer(s, caster, opt);
+  // The shared integrator (path_integrator.h): every vertex continues,
+  // Russian roulette, one light sample per light at every vertex.
+  paths::LightSettings lights;
+  lights.skyRadiance = opt.skyRadiance;
+  lights.sunDirection = opt.sunDirection;
+  lights.sunIrradiance = opt.sunIrradiance;
+  lights.sunAngularRadiusDeg = opt.sunAngularRadiusDeg;
+  lights.point = opt.point;
+  paths::PathRules rules;
+  rules.maxDepth = opt.maxDepth < 0 ? kDepthCap : opt.maxDepth;
+  const paths::Integrator tracer(s, caster, lights, rules);
+  if (!tracer.anyLight())
+    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
+                                "quality), no sky, no sun and no point light");
   const SceneReport rep = analyzeScene(s);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const VertexMaterial mat = vertexMaterial(s);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(rep.rayEpsilon));
   const size_t nv = s.vertexCount();
   std::vector<Accum> acc(nv);
-  std::vector<uint64_t> rays(nv, 0), cut(nv, 0);
+  std::vector<paths::Counts> counts(nv);
   auto trace = [&](size_t i, int count) {
     Accum& a = acc[i];
     for (int k = 0; k < count; ++k) {
-      Rng rng(hash3(uint32_t(i), uint32_t(a.n), opt.seed ^ 0x9a7eu));
-      const glm::vec3 H = tracer.irradiance(origins[i], mat.n[i], rng, rays[i], cut[i]);
+      // Independent numbers keyed by (vertex, path, seed): honest error bars, any thread count.
+      paths::Sampler smp(hash3(uint32_t(i), opt.seed, 0x9a7eu), uint32_t(a.n), false);
+      const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(origins[i], mat.n[i], smp, counts[i]);
       const double l = luminance(mat.rho[i] * H);
       a.n += 1;
       a.sumL += l;
@@ -356,8 +223,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
   size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
-    totalRays += double(rays[i]);
-    totalCut += double(cut[i]);
+    totalRays += double(counts[i].rays());
+    totalCut += double(counts[i].cutAtMaxDepth);
     if (!mat.valid[i] || acc[i].n == 0) continue;
     res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
     res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
@@ -386,7 +253,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
-  if (valid < part.count(nv)) st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
+  if (valid < part.count(nv))
+    st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
+            "glass or glossy faces only: no diffuse radiosity) got 0");
   return res;
 }
 

@@ -110,13 +110,13 @@ namespace {
 
 bool anySpecular(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isSpecular(s.faceMaterial(f))) return true;
+    if (isCausticSurface(s.faceMaterial(f))) return true;
   return false;
 }
 
 bool anyDiffuseReflection(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (!isSpecular(s.faceMaterial(f)) && luminance(s.faceRho(f)) > 0.f) return true;
+    if (s.faceMaterial(f) == Material::Diffuse && luminance(s.faceRho(f)) > 0.f) return true;
   return false;
 }
 
@@ -294,7 +294,7 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   e.check.kNearestEstimates = true;
   st.add("photons_caustic_map", maps.caustics ? double(maps.caustics->size()) : 0.0);
   st.add("photon_memory_mb", maps.bytes / 1048576.0);
-  if (!r.specular) st.note("no caustic map: the scene has no mirror or glass faces");
+  if (!r.specular) st.note("no caustic map: the scene has no mirror, glass or glossy faces");
   else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
   if (maps.all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
   return e;
@@ -306,13 +306,14 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
   if (r.projection) {
     st.add("caustic_photons_aimed", double(ts.causticEmitted));
     st.add("caustic_photons_stored", double(ts.causticStored));
-    st.note("caustic photons aimed at the mirrors and glass (projection): " +
+    st.note("caustic photons aimed at the mirrors, glass and glossy objects (projection): " +
             std::to_string(ts.causticEmitted - ts.causticMissed) + " of " + std::to_string(ts.causticEmitted) +
             " hit them first");
   }
   st.add("photons_stored", double(ts.stored));
   st.add("diffuse_bounces", double(ts.diffuseBounces));
   st.add("specular_bounces", double(ts.specularBounces));
+  if (ts.glossyBounces) st.add("glossy_bounces", double(ts.glossyBounces));
   st.add("total_internal_reflections", double(ts.totalInternal));
   st.add("emitted_power_W", ts.emittedPower * r.s.unit * r.s.unit);
   if (ts.lostAtMaxDepth)
@@ -327,14 +328,16 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
 }
 
 // B = E + rho (H_direct + H_photons) at the vertices, with the photons'
-// noise carried to B; the mean luminance and the rms noise for the log.
+// noise carried to B, and (direct light apart) Bdirect = E + rho H_direct,
+// which the two-pass view reads; the mean luminance and the rms noise for the log.
 struct Totals {
   double meanLuminance = 0, rmsNoise = 0;
 };
-Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const PhotonEstimate& e,
+Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const PhotonEstimate& e, bool directApart,
                VertexRadiometry& out) {
   const size_t nv = Hd.size();
   out.B.assign(nv, glm::vec3(0.f));
+  if (directApart) out.Bdirect.assign(nv, glm::vec3(0.f));
   out.H.assign(nv, glm::vec3(0.f));
   out.stdError.assign(nv, 0.f);
   double lum = 0, err2 = 0;
@@ -343,6 +346,7 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
     if (!mat.valid[i]) continue;
     out.H[i] = Hd[i] + e.H[i];
     out.B[i] = mat.E[i] + mat.rho[i] * out.H[i];
+    if (directApart) out.Bdirect[i] = mat.E[i] + mat.rho[i] * Hd[i];
     out.stdError[i] = float(luminance(mat.rho[i]) * e.noise[i]);
     lum += luminance(out.B[i]);
     err2 += double(out.stdError[i]) * out.stdError[i];
@@ -396,7 +400,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   } else {
     photons = kNearestEstimate(run, progress, ts, st);
   }
-  const Totals totals = combine(mat, Hd, photons, out);
+  const Totals totals = combine(mat, Hd, photons, opt.directLight, out);
   if (needPhotons) photonStats(run, ts, photons, st);
   st.add("direct_light_seconds", directSeconds);
   st.add("seconds", timer.seconds());
@@ -406,7 +410,8 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
                           : "all light from the photon map");
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
   if (specular && specOnly)
-    st.note(std::to_string(specOnly) + " vertices on mirror or glass faces only (or unusable) have no diffuse radiosity: 0");
+    st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only (or unusable) have no diffuse "
+            "radiosity: 0");
   return out;
 }
 

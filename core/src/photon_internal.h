@@ -63,8 +63,9 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 // photons, and paths cut at max_depth carrying much of the power.
 void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st);
 
-// Final gather at every vertex through mirrors and glass: cosine-weighted rays
-// from origins[v] follow specular faces (up to 16 interactions) and, at the
+// Final gather at every vertex through mirrors, glass and glossy faces:
+// cosine-weighted rays from origins[v] follow them (up to 16 interactions;
+// a glossy lobe by one sample of it) and, at the
 // first diffuse face, add value(face, point, its unit normal) if the ray hit its front (0 otherwise).
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,

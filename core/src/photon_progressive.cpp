@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "gi/color.h"
+#include "gi/glossy.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
 #include "photon_internal.h"
@@ -189,9 +190,23 @@ std::vector<glm::vec3> specularFinalGather(
           const glm::vec3 ng = faceN[h.face];
           const glm::vec3 y = ray.o + ray.d * h.t;
           const Material m = s.faceMaterial(h.face);
-          if (!isSpecular(m)) {
+          if (m == Material::Diffuse) {
             if (glm::dot(ray.d, ng) < 0.f) sum += glm::dvec3(weight * value(h.face, y, ng));
             break;
+          }
+          if (m == Material::Glossy) {
+            // The lobe sampled towards where the light comes from (weight f cos / pdf); the back is black.
+            if (!(glm::dot(ray.d, ng) < 0.f)) break;
+            const Frame fr(ng);
+            const glm::vec2 u{rng.next(), rng.next()};
+            const GgxLobe::Sample g = GgxLobe(s.faceRoughness(h.face), s.faceRho(h.face)).sample(fr.toLocal(-ray.d), u);
+            if (!g.valid) break;
+            weight *= g.weight;
+            ray.o = y + ng * eps;
+            ray.d = fr.toWorld(g.wi);
+            ray.tnear = 0.f;
+            ray.tfar = std::numeric_limits<float>::infinity();
+            continue;
           }
           const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
           const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());

@@ -72,7 +72,7 @@ GatherSurface::GatherSurface(const Scene& s) {
   std::vector<glm::vec3> centroid;
   for (size_t f = 0; f < s.faceCount(); ++f) {
     // Photons are stored on diffuse faces only.
-    if (!ok[f] || isSpecular(s.faceMaterial(f))) continue;
+    if (!ok[f] || isCausticSurface(s.faceMaterial(f))) continue;
     const auto& t = s.triangles[f];
     a_.push_back(s.positions[t.x]);
     b_.push_back(s.positions[t.y]);

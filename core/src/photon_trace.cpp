@@ -6,6 +6,7 @@
 
 #include "gi/color.h"
 #include "gi/emitters.h"
+#include "gi/glossy.h"
 #include "gi/photon.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
@@ -29,6 +30,31 @@ bool specularStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm:
   power *= ev.weight / q;
   ray.o = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
   ray.d = ev.d;
+  ray.tnear = 0.f;
+  ray.tfar = std::numeric_limits<float>::infinity();
+  return true;
+}
+
+// A photon meets the front of a glossy face (the GGX lobe of gi/glossy.h)
+// at x, arriving along ray.d. The BRDF is reciprocal, so the lobe's
+// visible-normal sample conditioned on the direction the photon came from
+// (-ray.d) draws the outgoing direction with weight f cos(theta_out) / pdf =
+// F G2 / G1 <= 1, the factor of the flux. Russian roulette on that weight
+// (a one-sample estimate of the lobe's albedo): survival q = its largest
+// channel, the power divided by q. A direction drawn below the surface is
+// lost (the lobe's G2 < G1 energy loss). False if the photon is absorbed.
+bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::vec3& x, float eps, Rng& rng, Ray& ray,
+                glm::vec3& power) {
+  const GgxLobe lobe(s.faceRoughness(face), s.faceRho(face));
+  const Frame frame(ng);
+  const glm::vec2 u{rng.next(), rng.next()};
+  const GgxLobe::Sample smp = lobe.sample(frame.toLocal(-ray.d), u);
+  if (!smp.valid) return false;
+  const float q = std::min(1.f, std::max({smp.weight.r, smp.weight.g, smp.weight.b}));
+  if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return false;
+  power *= smp.weight / q;
+  ray.o = x + ng * eps;
+  ray.d = frame.toWorld(smp.wi);
   ray.tnear = 0.f;
   ray.tfar = std::numeric_limits<float>::infinity();
   return true;
@@ -135,9 +161,16 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
             viaSpecular = true;
             continue;
           }
-          // Diffuse faces are one-sided, as in the radiosity filter and the
-          // reference: the back of a face is black.
+          // Diffuse and glossy faces are one-sided, as in the radiosity
+          // filter and the reference: the back of a face is black.
           if (glm::dot(ng, ray.d) > 0.f) break;
+          if (m == Material::Glossy) {
+            // Not stored (no diffuse light to estimate there); a caustic path's S (gi/specular.h).
+            if (!glossyStep(s, h.face, ng, x, eps, rng, ray, power)) break;
+            ++st.glossyBounces;
+            viaSpecular = true;
+            continue;
+          }
           const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
           out.push_back({x, power, packNormal(ng), path});
           st.storedPower += luminance(power);
@@ -171,6 +204,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
     stats.indirect += t.indirect;
     stats.diffuseBounces += t.diffuseBounces;
     stats.specularBounces += t.specularBounces;
+    stats.glossyBounces += t.glossyBounces;
     stats.totalInternal += t.totalInternal;
     stats.lostAtMaxDepth += t.lostAtMaxDepth;
     stats.escaped += t.escaped;
@@ -186,7 +220,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 
 namespace {
 
-// Bounding spheres of the connected groups of mirror and glass faces.
+// Bounding spheres of the connected groups of mirror, glass and glossy faces.
 struct SpecularTarget {
   glm::vec3 c;
   float r;
@@ -200,12 +234,12 @@ std::vector<SpecularTarget> specularTargets(const Scene& s) {
   };
   const auto ok = usableFaceMask(s);
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f] && isSpecular(s.faceMaterial(f)))
+    if (ok[f] && isCausticSurface(s.faceMaterial(f)))
       for (int k = 1; k < 3; ++k) parent[find(s.triangles[f][k])] = find(s.triangles[f][0]);
   std::vector<int> group(s.vertexCount(), -1);
   std::vector<glm::vec3> lo, hi;
   for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f] || !isSpecular(s.faceMaterial(f))) continue;
+    if (!ok[f] || !isCausticSurface(s.faceMaterial(f))) continue;
     const uint32_t root = find(s.triangles[f][0]);
     if (group[root] < 0) {
       group[root] = int(lo.size());
@@ -266,7 +300,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
   std::vector<std::vector<Photon>> blocks(nBlocks);
-  std::vector<size_t> specular(nBlocks, 0), missed(nBlocks, 0);
+  std::vector<size_t> specular(nBlocks, 0), glossy(nBlocks, 0), missed(nBlocks, 0);
   const uint32_t kPos = hash32(opt.seed ^ 0xca57u), kDir = hash32(opt.seed ^ 0xca58u);
   parallelBlocks(nBlocks, progress, "tracing caustic photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
@@ -301,17 +335,22 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
           if (!h.valid()) break;
           const Material m = s.faceMaterial(h.face);
           const glm::vec3 x = ray.o + ray.d * h.t, ng = faceN[h.face];
-          if (!isSpecular(m)) {
+          if (m == Material::Diffuse) {
             // L S+ D: stored at the first diffuse front face. A first hit on a
             // diffuse face is not a caustic path: the global photons carry it.
             if (viaSpecular && glm::dot(ng, ray.d) < 0.f) blocks[b].push_back({x, power, packNormal(ng), kCausticPhoton});
             if (!viaSpecular) ++missed[b];
             break;
           }
-          size_t tir = 0;
-          if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, tir)) break;
+          if (m == Material::Glossy) {
+            if (glm::dot(ng, ray.d) > 0.f || !glossyStep(s, h.face, ng, x, eps, rng, ray, power)) break;
+            ++glossy[b];
+          } else {
+            size_t tir = 0;
+            if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, tir)) break;
+            ++specular[b];
+          }
           viaSpecular = true;
-          ++specular[b];
         }
       }
     }
@@ -324,6 +363,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
     all.insert(all.end(), blocks[b].begin(), blocks[b].end());
     std::vector<Photon>().swap(blocks[b]);
     stats.specularBounces += specular[b];
+    stats.glossyBounces += glossy[b];
     stats.causticMissed += missed[b];
   }
   stats.causticEmitted += count;

@@ -1,21 +1,14 @@
-// The sampled eye-path integrator shared by the distributed, two-pass and
-// path-traced modes: one loop (no recursion: a path in a box of mirrors may
-// bounce hundreds of times). Per vertex:
-//   mirror, glass   the Fresnel-weighted choice is sampled (gi/specular.h); emitters
-//                   and the sun seen after it count fully (delta event);
-//   glossy          next-event estimation + one lobe sample, MIS (power heuristic);
-//   diffuse         emission (MIS-weighted after a non-delta event), then by mode:
-//     path traced   next-event estimation + a cosine-weighted continuation;
-//     distributed   next-event estimation + one cosine ray that may only reach
-//                   a light directly (sky, sun, emitter: MIS): no interreflection;
-//     two-pass      the same direct light plus the first pass's indirect light
-//                   (or the first pass alone: Map).
-// The path-traced mode's diffuse vertices beyond max_diffuse_bounces behave
-// as the distributed mode's, so that 0 gives exactly the distributed image's
-// expectation. max_depth bounds the events that continue a path (0: the
-// direct light at the first hit only); a cosine or lobe ray that may only
-// find a light directly does not count. Russian roulette (path traced only) after 3 events, with
-// survival probability min(1, max channel of the throughput).
+// The eye pass's sampled modes on the shared integrator (path_integrator.h):
+//   distributed   every diffuse vertex ends the path with its direct light
+//                 (next-event estimation + one cosine ray that may only reach a
+//                 light directly: sky, sun, emitter, MIS); no interreflection;
+//   two-pass      the same direct light plus the first pass's indirect light
+//                 (or the first pass alone: Map), read here;
+//   path traced   every vertex continues (Russian roulette after 3 events);
+//                 diffuse vertices beyond max_diffuse_bounces behave as the
+//                 distributed mode's, so that 0 gives exactly the distributed
+//                 image's expectation.
+// Mirrors, glass and glossy surfaces are followed in every mode.
 #include <algorithm>
 #include <cmath>
 
@@ -28,115 +21,28 @@ namespace gi::eye {
 namespace {
 constexpr float kInvPi = 0.318309886f;
 constexpr int kGatherMaxEvents = 16;  // specular and glossy events a gather ray may follow
-bool positive(const glm::vec3& v) { return v.r > 0.f || v.g > 0.f || v.b > 0.f; }
 }  // namespace
 
-glm::vec3 Context::traceSampled(Ray ray, const SurfacePoint* first, Sampler& smp, Counts& c) const {
-  const bool path = o_.mode == RenderMode::PathTraced, twoPass = o_.mode == RenderMode::TwoPass;
-  // A continuation ray that can only find lights is worth casting only if it can find one.
-  const bool lightRays = !lights_.empty() || hasSky_ || sunDisk_;
-  glm::vec3 L(0.f), beta(1.f);
-  bool delta = true, lightOnly = false;
-  float pdfPrev = 0.f, nLPrev = 1.f;
-  int depth = 0, diffuseVertices = 0;
-  for (;;) {
-    SurfacePoint sp;
-    if (first) {
-      sp = *first;
-      first = nullptr;
-    } else {
-      sp = surfaceAt(ray, caster_.intersect(ray));
-    }
-    if (!sp.valid()) {
-      L += beta * escaped(ray.d, delta, pdfPrev, nLPrev);
-      break;
-    }
-    const Material m = s_.faceMaterial(sp.face);
-    if (isSpecular(m)) {
-      if (lightOnly) break;
-      if (depth >= o_.maxDepth) { ++c.cutAtMaxDepth; break; }
-      ++depth;
-      const float ior = s_.ior.empty() ? 1.5f : s_.ior[sp.face];
-      const SpecularEvent ev = scatterSpecular(m, ray.d, sp.n, s_.faceRho(sp.face), ior, smp.next1D());
-      beta *= ev.weight * ev.radianceScale;
-      delta = true;
-      ray = spawn(sp.x, sp.n, ev.d);
-      ++c.specular;
-    } else {
-      const float cosO = -glm::dot(sp.n, ray.d);
-      if (!(cosO > 0.f)) break;  // seen from behind: black
-      if (m == Material::Glossy) {
-        if (lightOnly) break;
-        const Bsdf b = bsdfAt(sp, -ray.d);
-        L += beta * nextEvent(sp.x, sp.n, b, smp, c, 1);
-        // At max_depth the lobe sample may still find a light directly (its
-        // MIS share of the direct light), but goes no further.
-        const bool goOn = depth < o_.maxDepth;
-        if (!goOn) ++c.cutAtMaxDepth;
-        glm::vec3 wi, w;
-        float pdf;
-        if (!b.sample(smp.next2D(), wi, w, pdf)) break;
-        beta *= w;
-        delta = false;
-        pdfPrev = pdf;
-        nLPrev = 1.f;
-        ray = spawn(sp.x, sp.n, wi);
-        ++c.glossy;
-        if (goOn) ++depth;
-        lightOnly = !goOn;
-      } else {
-        // Diffuse.
-        const glm::vec3 rho = s_.faceRho(sp.face);
-        if (emits(sp.face)) {
-          const float pdfL = lights_.pdfArea(sp.face) * sp.t * sp.t / cosO;
-          L += beta * s_.faceEmission(sp.face) * kInvPi * (delta ? 1.f : powerHeuristic(pdfPrev, nLPrev * pdfL));
-        }
-        if (lightOnly) break;
-        if (twoPass && o_.twoPass == TwoPassDiffuse::Map) {
-          L += beta * interpolate(tp_->R, sp) * kInvPi;
-          break;
-        }
-        ++diffuseVertices;
-        const int nL = diffuseVertices == 1 ? o_.lightSamples : 1;
-        const Bsdf b = bsdfAt(sp, -ray.d);
-        glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL);
-        if (twoPass) Ld = glm::max(Ld + twoPassIndirect(sp, rho, smp, c), glm::vec3(0.f));  // see render_twopass.cpp
-        L += beta * Ld;
-        const bool wanted = path && (o_.maxDiffuseBounces < 0 || diffuseVertices <= o_.maxDiffuseBounces);
-        const bool goOn = wanted && depth < o_.maxDepth;
-        if (wanted && !goOn) ++c.cutAtMaxDepth;
-        if (!goOn && !lightRays) break;
-        glm::vec3 wi, w;
-        float pdf;
-        if (!b.sample(smp.next2D(), wi, w, pdf)) break;
-        beta *= w;
-        delta = false;
-        pdfPrev = pdf;
-        nLPrev = float(nL);
-        ray = spawn(sp.x, sp.n, wi);
-        ++c.diffuse;
-        if (goOn) ++depth;
-        lightOnly = !goOn;
-      }
-    }
-    if (!positive(beta)) break;
-    if (path && depth >= 3 && !lightOnly) {  // Russian roulette
-      const float q = std::min(1.f, std::max({beta.r, beta.g, beta.b}));
-      if (q < 1.f) {
-        if (smp.next1D() >= q) { ++c.roulette; break; }
-        beta /= q;
-      }
-    }
-  }
-  return L;
+glm::vec3 Context::traceSampled(const Ray& ray, const SurfacePoint* first, Sampler& smp, Counts& c) const {
+  PathState st;
+  st.ray = ray;
+  return trace(st, first, smp, c);
 }
 
-glm::vec3 Context::twoPassIndirect(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const {
+bool Context::alone() const { return o_.twoPass == TwoPassDiffuse::Map; }
+
+glm::vec3 Context::reflected(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const {
+  if (o_.twoPass == TwoPassDiffuse::Map) return interpolate(tp_->R, sp) * kInvPi;
   glm::vec3 L(0.f);
   if (o_.twoPass != TwoPassDiffuse::DirectIndirect) L += rho * kInvPi * tp_->caustic(sp.x, sp.n, o_.causticK);
   if (o_.twoPass == TwoPassDiffuse::FinalGather) L += rho * kInvPi * finalGather(sp, smp, c);
   else L += interpolate(tp_->indirect, sp) * kInvPi;
   return L;
+}
+
+glm::vec3 Context::interpolate(const std::vector<glm::vec3>& perVertex, const SurfacePoint& sp) const {
+  const auto& t = s_.triangles[sp.face];
+  return (1.f - sp.u - sp.v) * perVertex[t.x] + sp.u * perVertex[t.y] + sp.v * perVertex[t.z];
 }
 
 // Irradiance at sp from the first pass's reflected radiosity R (emission

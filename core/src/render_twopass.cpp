@@ -7,10 +7,13 @@
 //   indirect = B - Bdirect [- rho Hc]     the part due to light that bounced on a
 //                                         diffuse surface first (DirectIndirect,
 //                                         Caustics), where Bdirect = E + rho H_direct
-//                                         and Hc the caustic map's irradiance at
-//                                         the vertex (removed when the first pass
-//                                         has caustics, since the eye pass reads
-//                                         them from the map at the hit point).
+//                                         (photon mapping's own, the attribute
+//                                         RadiosityDirect, else estimated here at
+//                                         the vertices) and Hc the caustic map's
+//                                         irradiance at the vertex (removed when
+//                                         the first pass has caustics, since the
+//                                         eye pass reads them from the map at the
+//                                         hit point).
 // The indirect part is a difference of noisy estimates and may dip below 0
 // at some vertices: it is kept as it is (clamping zero-mean noise would
 // bias it upwards); the eye pass keeps the diffuse radiance of a hit >= 0,
@@ -48,7 +51,7 @@ void checkPerVertex(const std::vector<glm::vec3>& v, size_t nv, const char* what
 
 bool anySpecularFace(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isSpecular(s.faceMaterial(f))) return true;
+    if (isCausticSurface(s.faceMaterial(f))) return true;
   return false;
 }
 
@@ -81,15 +84,30 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     stats.add("caustic_photons_aimed", double(ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
-    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors or glass");
+    if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors, glass or glossy faces");
   } else if (wantCaustics) {
-    stats.note("no caustic map: the scene has no mirror or glass faces");
+    stats.note("no caustic map: the scene has no mirror, glass or glossy faces");
   }
   if (o.twoPass == TwoPassDiffuse::DirectIndirect || o.twoPass == TwoPassDiffuse::Caustics) {
     std::vector<glm::vec3> Bd = o.firstPassBdirect;
     if (!Bd.empty()) {
       checkPerVertex(Bd, nv, "the first pass's direct radiosity");
-    } else {
+      // Its direct part is part of it: B >= Bdirect (up to rounding) wherever
+      // the two come from one run; one left by an earlier run (a later
+      // radiosity pass replaced B) is not used.
+      size_t above = 0;
+      for (size_t i = 0; i < nv; ++i)
+        for (int k = 0; k < 3; ++k)
+          if (Bd[i][k] - o.firstPassB[i][k] > 1e-5f * std::max(Bd[i][k], 1e-30f)) { ++above; break; }
+      if (above) {
+        stats.note("the stored direct part exceeds the first pass's radiosity at " + std::to_string(above) +
+                   " vertices (left by another run): not used");
+        Bd.clear();
+      } else {
+        stats.note("the first pass's own direct part replaced by ray-traced direct light");
+      }
+    }
+    if (Bd.empty()) {
       // Estimated here, from the lights a first pass knows: the emitting faces and the point light.
       Timer t;
       std::vector<glm::vec3> Hd =

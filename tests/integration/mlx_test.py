@@ -605,6 +605,30 @@ def case_raytrace(c):
     _, _, pt = read_pfm(ref[:-4] + ".pfm")
     m_tp, m_pt = sum(tp) / len(tp), sum(pt) / len(pt)
     check(abs(m_tp / m_pt - 1) < 0.05, "two-pass and path-traced images agree: mean %.4f vs %.4f" % (m_tp, m_pt))
+    # The same two passes through the command-line tool: the first pass read back from its PLY
+    # (the attribute Radiosity as the properties Radiosity_x, _y, _z).
+    pass1 = os.path.join(c.tmp, "pass1.ply")
+    p = run_gi(c, ["radiosity", box, "-o", pass1, "--rays_per_patch", "256", "-q"])
+    check(p.returncode == 0, "gi radiosity writes pass1.ply " + p.stderr)
+    check(any(k.startswith("Radiosity_") for k in vertices(pass1)[0]), "gi radiosity wrote the Radiosity properties")
+    cli_png = os.path.join(c.tmp, "cli_two_pass.png")
+    p = run_gi(c, ["render", pass1, "--mode", "Two-pass", "--samples_per_pixel", "16", "--image_path", cli_png, "-q"]
+               + size)
+    check(p.returncode == 0, "gi render --mode Two-pass reads the first pass from pass1.ply " + p.stderr)
+    _, _, cli = read_pfm(cli_png[:-4] + ".pfm")
+    m_cli = sum(cli) / len(cli)
+    check(abs(m_cli / m_pt - 1) < 0.05, "CLI two-pass (first pass from pass1.ply) and path-traced images agree: "
+          "mean %.4f vs %.4f" % (m_cli, m_pt))
+    # Same first pass, same camera, same samples: the meshlabserver image, up to the rounding of the
+    # positions pass1.ply stores (absolute coordinates in float, re-centred on reading).
+    dmax = max(abs(a - b) for a, b in zip(cli, tp))
+    check(dmax < 1e-3 * max(tp), "CLI two-pass image matches meshlabserver's (max difference %.3g of %.3g)"
+          % (dmax, max(tp)))
+    # Without the first pass's properties the CLI says what to run first.
+    p = subprocess.run([c.gi, "render", box, "--mode", "Two-pass", "-q"] + size, stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 1 and "first pass" in p.stderr and len(p.stderr.strip().splitlines()) == 1,
+          "CLI two-pass on a mesh without a first pass: one line saying what to run first")
 
 
 CASES = {"raytrace": case_raytrace, "cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,

@@ -16,7 +16,9 @@ what each writes must be bit-identical:
   one vector for scalars and one for vector components, each in name order,
   so a variable pushed before the vector's last reallocation reads freed
   memory (0 here): with n variables only those from index 2^floor(log2(n-1))
-  on are readable (n = 3: the last; n = 6: the last two). Seen: BentNormal_x
+  on are readable (n = 3: the last; n = 6: the last two; vector components
+  ordered by attribute name, then component: Radiosity_z before
+  RadiosityDirect_x, though "D" sorts before "_"). Seen: BentNormal_x
   and _y read 0 and _z the true value; with Irradiance and Radiosity only
   Radiosity_y and _z are right. The test reads exactly the readable ones and
   requires at least one per filter that writes attributes; the others are
@@ -153,7 +155,7 @@ def main():
                 fail("%s: the CLI wrote no per-vertex attribute" % label)
             readable = []
             for group in (sorted(p for p in extra if not p.endswith(("_x", "_y", "_z"))),
-                          sorted(p for p in extra if p.endswith(("_x", "_y", "_z")))):
+                          sorted((p for p in extra if p.endswith(("_x", "_y", "_z"))), key=lambda p: (p[:-2], p[-2:]))):
                 first = 1 << ((len(group) - 1).bit_length() - 1) if len(group) > 1 else 0
                 readable += group[first:]
             for attr in readable:

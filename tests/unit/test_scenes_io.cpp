@@ -374,6 +374,58 @@ TEST(ScenesIo, BadFilesThrowOneSentenceNamingTheFile) {
   EXPECT_THROW(gi::io::writePly(tempPath("bad.ply"), sf.scene, sf.attrs, {1.f}, {}), std::runtime_error);
 }
 
+// What an earlier run left per vertex comes back: a vector attribute is
+// written as NAME_x, NAME_y, NAME_z and read as the vector NAME, a scalar
+// as itself, value for value (both are floats); other float and double
+// vertex properties are kept by name (an ASCII "nan" as NaN, for the filter
+// that reads it to judge), integer ones are not; appending keeps only what
+// both parts have.
+TEST(ScenesIo, PlyVertexAttributesRoundTrip) {
+  const SceneFile sf = gi::scenes::byName("cornell_box");
+  const auto& s = sf.scene;
+  gi::io::PlyExtras extras;
+  gi::VertexAttribute B{"Radiosity", 3, {}}, n{"Paths", 1, {}};
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    B.values.insert(B.values.end(), {0.1f * float(v), 1.f / float(v + 3), 7e-20f});
+    n.values.push_back(float(64 * v));
+  }
+  extras.attributes = {B, n};
+  const std::string path = tempPath("attributes.ply");
+  gi::io::writePly(path, s, sf.attrs, {}, {}, extras);
+  gi::io::LoadedMesh m = gi::io::loadMesh(path);
+  fs::remove(path);
+  ASSERT_EQ(m.attributes.size(), 2u);
+  EXPECT_EQ(m.attributes[0].name, "Radiosity");
+  EXPECT_EQ(m.attributes[0].components, 3);
+  EXPECT_EQ(m.attributes[0].values, B.values);
+  EXPECT_EQ(m.attributes[1].name, "Paths");
+  EXPECT_EQ(m.attributes[1].components, 1);
+  EXPECT_EQ(m.attributes[1].values, n.values);
+
+  const auto a = gi::io::parseMesh(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property double E_x\nproperty float E_y\nproperty float quality\nproperty int flags\nproperty float E_z\n"
+      "property double big\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 1 2 nan 5 3 1\n1 0 0 4 5 0.5 5 6 2\n0 1 0 7 8 2 5 9 1e300\n3 0 1 2\n",
+      "ply", "a.ply");
+  ASSERT_EQ(a.attributes.size(), 3u);
+  EXPECT_EQ(a.attributes[0].name, "E");
+  EXPECT_EQ(a.attributes[0].values, (std::vector<float>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  EXPECT_EQ(a.attributes[1].name, "quality");
+  EXPECT_TRUE(std::isnan(a.attributes[1].values[0]));
+  EXPECT_EQ(a.attributes[1].values[1], 0.5f);
+  EXPECT_EQ(a.attributes[2].name, "big");
+  EXPECT_TRUE(std::isnan(a.attributes[2].values[2]));  // a double beyond float's range
+
+  gi::io::LoadedMesh both = a, other = a;
+  other.attributes.resize(1);  // only E
+  gi::io::appendMesh(both, other);
+  ASSERT_EQ(both.attributes.size(), 1u);
+  EXPECT_EQ(both.attributes[0].name, "E");
+  EXPECT_EQ(both.attributes[0].values.size(), 18u);
+  EXPECT_EQ(both.attributes[0].values[9], 1.f);
+}
+
 TEST(ScenesIo, CommittedTestMeshesMatchTheGenerators) {
   for (const auto& name : gi::scenes::names())
   for (const auto& layer : gi::scenes::layersByName(name)) {

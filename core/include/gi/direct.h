@@ -25,6 +25,7 @@ struct DirectOptions {
 
 struct VertexRadiometry {
   std::vector<glm::vec3> B;        // radiosity per vertex (W/m^2, RGB)
+  std::vector<glm::vec3> Bdirect;  // its direct part E + rho H_direct, where computed apart (else empty)
   std::vector<glm::vec3> H;        // incident irradiance per vertex
   std::vector<float> stdError;     // standard error of luminance(B)
   RunStats stats;

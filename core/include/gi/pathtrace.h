@@ -1,19 +1,24 @@
 // A per-vertex path tracer: the reference solution of the rendering equation
-// (Kajiya 1986) for diffuse surfaces, against which the other filters are
-// measured. At each vertex it estimates the incident irradiance
+// (Kajiya 1986), against which the other filters are measured. At each
+// vertex (on diffuse faces) it estimates the incident irradiance
 //   H(x) = ∫ L_i(x, w) cos(theta) dw,   and   B(x) = E(x) + rho(x) H(x)
-// (outgoing radiance B / pi). Paths continue by cosine-weighted sampling with
-// Russian roulette; at every diffuse vertex the lights are sampled too
-// (next-event estimation) and combined with the BSDF-sampled hits by multiple
-// importance sampling (power heuristic, Veach 1997). Lights: area emitters,
-// a uniform sky, a sun disk and a point or spot light. Mirror and glass faces
-// (gi/specular.h) are followed in their sampled specular direction (paths are
-// traced in a loop with a throughput, never by recursion); emitters
-// seen through them count fully (next-event estimation cannot sample them)
-// and shadow rays stop at them. Radiance is scaled by eta^2 across glass
-// (cancelling on paths that enter and leave). Random numbers are
-// independent per (vertex, sample, seed), so the reported standard error is
-// an honest Monte Carlo error bar and the result does not depend on threads.
+// (outgoing radiance B / pi). The estimator is the eye pass's path
+// integrator (core/src/path_integrator.h), started at the vertex as on a
+// white Lambertian surface (H = pi x the radiance it reflects): next-event
+// estimation at every diffuse and glossy vertex combined with the BSDF-
+// sampled hits by multiple importance sampling (power heuristic, Veach
+// 1997), cosine-weighted continuation at diffuse faces, the GGX lobe
+// (gi/glossy.h) importance-sampled at glossy ones, mirror and glass faces
+// (gi/specular.h) followed in their sampled specular direction (emitters seen
+// through them count fully: light sampling cannot reach them, and shadow
+// rays stop at them), Russian roulette on the path throughput, paths traced
+// in a loop (never recursion). Lights: area emitters, a uniform sky, a sun
+// disk and a point or spot light. Radiance is scaled by eta^2 across glass
+// (cancelling on paths that enter and leave). Random numbers are independent
+// per (vertex, sample, seed), so the reported standard error is an honest
+// Monte Carlo error bar and the result does not depend on threads. Vertices
+// with no diffuse face (only on mirror, glass or glossy faces) have no
+// diffuse radiosity: they get 0, and the log says how many.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -33,8 +38,9 @@ struct PathTraceOptions {
   int samplesPerVertex = 256;      // fixed count when targetRelativeError == 0
   double targetRelativeError = 0;  // adaptive: stop when stderr(B) / B is below this
   int minSamples = 64, maxSamples = 65536;
-  int maxDepth = -1;               // bounces (0 = direct light only); -1: no fixed limit (Russian
-                                   // roulette alone ends paths: unbiased; a safety cap of 100,000)
+  int maxDepth = -1;               // scattering events (diffuse, glossy, mirror, glass) that continue a
+                                   // path (0 = direct light only); -1: no fixed limit (Russian roulette
+                                   // alone ends paths: unbiased; a safety cap of 100,000)
   uint32_t seed = 0;
   glm::vec3 skyRadiance{0.f};      // uniform sky over the whole sphere, W/(m^2 sr)
   glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length

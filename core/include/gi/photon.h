@@ -2,10 +2,13 @@
 // Photons leave the lights in proportion to power (area emitters; an optional
 // point or spot light), low-discrepancy in position and direction, and are
 // traced with Russian roulette through diffuse (Lambertian), mirror and glass
-// faces (gi/specular.h). Every diffuse hit is stored; by the path so far a
-// photon is
+// faces (gi/specular.h) and glossy ones (the GGX lobe, gi/glossy.h,
+// importance-sampled). Every diffuse hit is stored (glossy hits are not);
+// by the path so far a photon is
 //   direct   L D      (read only when the direct light is not computed apart),
-//   caustic  L S+ D   (the caustic map),
+//   caustic  L S+ D   (the caustic map; S: mirror, glass or glossy, so that
+//                      light a glossy surface focuses, a blurred caustic, is
+//                      read with the caustic map's sharper filter),
 //   indirect L ... D D (at least one diffuse bounce before: the global map).
 // Per-vertex radiosity B = E + rho H, with the irradiance H from
 //   - the direct light by explicit light sampling with shadow rays (default),
@@ -68,7 +71,7 @@ struct Photon {
 
 struct PhotonTraceStats {
   size_t emitted = 0, stored = 0, caustic = 0, direct = 0, indirect = 0;
-  size_t diffuseBounces = 0, specularBounces = 0, totalInternal = 0;
+  size_t diffuseBounces = 0, specularBounces = 0, glossyBounces = 0, totalInternal = 0;
   size_t lostAtMaxDepth = 0, escaped = 0;
   size_t causticEmitted = 0, causticStored = 0, causticMissed = 0;  // the projection pass
   size_t passes = 0;                             // calls of tracePhotons summed here
@@ -84,10 +87,11 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 
 // Caustic photons by projection (Jensen 1996's projection maps): from points
 // on the lights, directions only towards the bounding spheres of the groups of
-// mirror and glass faces (uniform in the cones they subtend, chosen by solid
-// angle; the density sums the cones containing a direction); photons whose
-// first hit is diffuse are dropped (the global photons carry those paths), the
-// others follow mirrors and glass and are stored at their first diffuse hit
+// mirror, glass and glossy faces (uniform in the cones they subtend, chosen by
+// solid angle; the density sums the cones containing a direction); photons
+// whose first hit is diffuse are dropped (the global photons carry those
+// paths), the others follow mirrors, glass and glossy lobes and are stored at
+// their first diffuse hit
 // (L S+ D) with flux L cos / (pdf_A pdf_w count). Far more caustic photons per
 // emitted photon than the global pass gives when the specular objects are small.
 std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,

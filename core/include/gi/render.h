@@ -100,8 +100,9 @@ struct RenderOptions {
   uint32_t seed = 0;
   // The first pass (two-pass mode): per-vertex radiosity B (linear RGB,
   // W/m^2, emission included) and optionally its direct part Bdirect = E +
-  // rho H_direct (empty: estimated here at the vertices from the area
-  // emitters and the point light with 256 shadow rays each).
+  // rho H_direct (photon mapping leaves it as the attribute RadiosityDirect;
+  // empty, or not below B everywhere: estimated here at the vertices from
+  // the area emitters and the point light with 256 shadow rays each).
   std::vector<glm::vec3> firstPassB, firstPassBdirect;
 
   static std::vector<ParamSpec> specs();

@@ -9,7 +9,8 @@
 namespace gi {
 
 // Glossy: the GGX microfacet reflector of gi/glossy.h (roughness per face,
-// specular colour in rho); only the ray tracer (gi/render.h) shades it so far.
+// specular colour in rho), shaded by the ray tracer, photon mapping and the
+// reference; like mirrors and glass it carries no diffuse radiosity.
 enum class Material : uint8_t { Diffuse = 0, Mirror = 1, Glass = 2, Glossy = 3 };
 
 // Positions are stored relative to `origin` (double), so that meshes far from

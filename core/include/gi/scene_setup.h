@@ -61,9 +61,10 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
 // specular, by name patterns, and their colour and index of refraction.
 std::vector<ParamSpec> materialSpecs();
 
-// Glossy layers (the ray tracer): name patterns, GGX roughness and specular
-// colour. Apart from materialSpecs so that filters without glossy shading do
-// not offer it; applyMaterials reads them when present.
+// Glossy layers (the ray tracer, photon mapping, the reference): name
+// patterns, GGX roughness and specular colour. Apart from materialSpecs so
+// that filters without glossy shading do not offer it; applyMaterials reads
+// them when present.
 std::vector<ParamSpec> glossySpecs();
 
 // The optional point or spot light's parameters (photon mapping and the reference).

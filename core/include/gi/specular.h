@@ -32,5 +32,9 @@ struct SpecularEvent {
 SpecularEvent scatterSpecular(Material m, const glm::vec3& d, const glm::vec3& n, const glm::vec3& tint, float ior, float u);
 
 inline bool isSpecular(Material m) { return m == Material::Mirror || m == Material::Glass; }
+// The surfaces a caustic path L S+ D passes through: mirror and glass, and
+// glossy faces (gi/glossy.h), counted as S; photons are stored, and radiosity
+// lives, on the other (diffuse) faces only.
+inline bool isCausticSurface(Material m) { return m != Material::Diffuse; }
 
 }  // namespace gi

@@ -61,6 +61,22 @@ inline constexpr double kGlassRadius = 80.0;
 // '*mirror*', glass_layers '*glass*', the given index of refraction).
 Scene causticCornell(double patchSize, double floorPatch, int sphereSubdiv, float ior);
 
+// A glossy block standing on the caustic Cornell box's floor, right of
+// centre in front of the mirror (its reflection and the mirror stay in the
+// framing camera's view): a square of side 2 kGlossyHalfWidth turned by
+// kGlossyTurnDeg about the vertical (its faces reflect the coloured walls),
+// kGlossyHeight high, no bottom face; patches of about `patch`.
+inline const glm::dvec3 kGlossyCentre{415.0, 0.0, 175.0};
+inline constexpr double kGlossyHalfWidth = 50.0, kGlossyHeight = 85.0, kGlossyTurnDeg = 35.0;
+SceneFile glossyBlock(double patch);
+// The caustic Cornell box's layers and the glossy block's,
+// caustic_cornell_glossy_block.ply (a glossy layer by its name: *glossy*).
+std::vector<NamedLayer> causticCornellGlossyLayers(double patchSize, double floorPatch, int sphereSubdiv);
+// Those layers in one scene, the block Glossy with GGX roughness alpha and
+// specular colour F0 (linear).
+Scene causticCornellGlossy(double patchSize, double floorPatch, int sphereSubdiv, float ior, float roughness,
+                           const glm::vec3& F0);
+
 // Sets uniform reflectance and emission on every face (and the attributes).
 void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E);
 

@@ -1,0 +1,285 @@
+// The shared path integrator (path_integrator.h): BSDFs, lights, next-event
+// estimation and the path loop.
+#include "path_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gi/color.h"
+#include "gi/specular.h"
+
+namespace gi::paths {
+
+namespace {
+constexpr float kInvPi = 0.318309886f;
+bool positive(const glm::vec3& v) { return v.r > 0.f || v.g > 0.f || v.b > 0.f; }
+}  // namespace
+
+glm::vec3 Bsdf::f(const glm::vec3& wi) const {
+  if (glossy) return lobe.eval(woLocal, frame.toLocal(wi));
+  return glm::dot(frame.n, wi) > 0.f ? rho * kInvPi : glm::vec3(0.f);
+}
+
+float Bsdf::pdf(const glm::vec3& wi) const {
+  if (glossy) return lobe.pdf(woLocal, frame.toLocal(wi));
+  return std::max(0.f, glm::dot(frame.n, wi)) * kInvPi;
+}
+
+bool Bsdf::sample(glm::vec2 u, glm::vec3& wi, glm::vec3& weight, float& pdfOut) const {
+  if (glossy) {
+    const GgxLobe::Sample smp = lobe.sample(woLocal, u);
+    if (!smp.valid) return false;
+    wi = frame.toWorld(smp.wi);
+    weight = smp.weight;
+    pdfOut = smp.pdf;
+    return true;
+  }
+  const glm::vec3 l = cosineHemisphere(u);
+  if (!(l.z > 0.f)) return false;
+  wi = frame.toWorld(l);
+  weight = rho;  // (rho / pi) cos / (cos / pi)
+  pdfOut = l.z * kInvPi;
+  return true;
+}
+
+Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& lights, const PathRules& rules,
+                       const StoredLight* stored)
+    : s_(s), caster_(c), L_(lights), rules_(rules), stored_(stored), emitters_(s), faceN_(unitFaceNormals(s)),
+      eps_(float(sceneScale(s).rayEpsilon)) {
+  hasSky_ = luminance(L_.skyRadiance) > 0.f;
+  hasSun_ = luminance(L_.sunIrradiance) > 0.f;
+  sunDisk_ = hasSun_ && L_.sunAngularRadiusDeg > 0.f;
+  sunCos_ = std::cos(glm::radians(L_.sunAngularRadiusDeg));
+  const float omega = 2.f * float(M_PI) * (1.f - sunCos_);
+  sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
+  sunL_ = sunDisk_ ? L_.sunIrradiance / omega : glm::vec3(0.f);
+  hasPoint_ = L_.point.on();
+}
+
+bool Integrator::emits(uint32_t face) const { return positive(s_.faceEmission(face)); }
+
+SurfacePoint Integrator::surfaceAt(const Ray& r, const Hit& h) const {
+  SurfacePoint sp;
+  if (!h.valid()) return sp;
+  sp.x = r.o + r.d * h.t;
+  sp.n = faceN_[h.face];
+  sp.face = h.face;
+  sp.u = h.u;
+  sp.v = h.v;
+  sp.t = h.t;
+  return sp;
+}
+
+Ray Integrator::spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, float lift) const {
+  Ray r;
+  r.o = x + (glm::dot(d, n) > 0.f ? n : -n) * lift;
+  r.d = d;
+  return r;
+}
+
+glm::vec3 Integrator::escaped(const glm::vec3& d, bool delta, float pdfPrev, float nLPrev) const {
+  glm::vec3 L = L_.skyRadiance;
+  if (sunDisk_ && glm::dot(d, L_.sunDirection) >= sunCos_)
+    L += sunL_ * (delta ? 1.f : powerHeuristic(pdfPrev, nLPrev * sunPdf_));
+  return L;
+}
+
+glm::vec3 Integrator::emitted(uint32_t face, float t, float cosO, bool delta, float pdfPrev, float nLPrev) const {
+  const float pdfL = emitters_.pdfArea(face) * t * t / cosO;  // the light sample's density in solid angle
+  return s_.faceEmission(face) * kInvPi * (delta ? 1.f : powerHeuristic(pdfPrev, nLPrev * pdfL));
+}
+
+Bsdf Integrator::bsdfAt(const SurfacePoint& sp, const glm::vec3& wo) const {
+  Bsdf b(sp.n);
+  if (s_.faceMaterial(sp.face) == Material::Glossy) {
+    b.glossy = true;
+    b.lobe = GgxLobe(s_.faceRoughness(sp.face), s_.faceRho(sp.face));
+    b.woLocal = b.frame.toLocal(wo);
+  } else {
+    b.rho = s_.faceRho(sp.face);
+  }
+  return b;
+}
+
+glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bsdf& b, Sampler& smp, Counts& c, int nL,
+                                float lift) const {
+  glm::vec3 L(0.f);
+  const float fn = float(nL);
+  for (int k = 0; k < nL; ++k) {
+    if (!emitters_.empty()) {
+      const auto e = emitters_.sample(smp.next2D());
+      glm::vec3 w = e.p - x;
+      const float r2 = glm::dot(w, w);
+      if (r2 > 0.f) {
+        const float r = std::sqrt(r2);
+        w /= r;
+        const float cx = glm::dot(n, w), ce = -glm::dot(e.n, w);
+        const glm::vec3 f = cx > 0.f && ce > 0.f ? b.f(w) : glm::vec3(0.f);
+        if (positive(f)) {
+          Ray ray = spawn(x, n, w, lift);
+          ray.tfar = r * (1.f - 1e-4f) - eps_;
+          const bool cast = ray.tfar > 0.f;  // else the emitter point is closer than the offset: visible
+          c.shadow += cast;
+          if (!cast || !caster_.occluded(ray)) {
+            const float pdfL = e.pdfArea * r2 / ce;  // solid angle
+            L += f * e.E * kInvPi * (cx / pdfL) * (powerHeuristic(fn * pdfL, b.pdf(w)) / fn);
+          }
+        }
+      }
+    }
+    if (sunDisk_) {
+      const glm::vec3 w = Frame(L_.sunDirection).toWorld(uniformCone(smp.next2D(), sunCos_));
+      const float cx = glm::dot(n, w);
+      const glm::vec3 f = cx > 0.f ? b.f(w) : glm::vec3(0.f);
+      if (positive(f)) {
+        ++c.shadow;
+        if (!caster_.occluded(spawn(x, n, w, lift)))
+          L += f * sunL_ * (cx / sunPdf_) * (powerHeuristic(fn * sunPdf_, b.pdf(w)) / fn);
+      }
+    }
+  }
+  if (hasSun_ && !sunDisk_) {  // a sharp directional sun: one shadow ray
+    const glm::vec3 w = L_.sunDirection;
+    const float cx = glm::dot(n, w);
+    const glm::vec3 f = cx > 0.f ? b.f(w) : glm::vec3(0.f);
+    if (positive(f)) {
+      ++c.shadow;
+      if (!caster_.occluded(spawn(x, n, w, lift))) L += f * L_.sunIrradiance * cx;
+    }
+  }
+  if (hasPoint_) {
+    glm::vec3 w = L_.point.position - x;
+    const float r2 = glm::dot(w, w);
+    if (r2 > 0.f) {
+      const float r = std::sqrt(r2);
+      w /= r;
+      const float cx = glm::dot(n, w);
+      const glm::vec3 f = cx > 0.f && L_.point.shinesTowards(-w) ? b.f(w) : glm::vec3(0.f);
+      if (positive(f)) {
+        Ray ray = spawn(x, n, w, lift);
+        ray.tfar = r * (1.f - 1e-4f);
+        ++c.shadow;
+        if (!caster_.occluded(ray)) L += f * L_.point.intensity * (cx / r2);
+      }
+    }
+  }
+  return L;
+}
+
+void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& smp) const {
+  const Material m = s_.faceMaterial(sp.face);
+  const float ior = s_.ior.empty() ? 1.5f : s_.ior[sp.face];
+  const SpecularEvent ev = scatterSpecular(m, st.ray.d, sp.n, s_.faceRho(sp.face), ior, smp.next1D());
+  st.beta *= ev.weight * ev.radianceScale;
+  st.delta = true;
+  st.kind = PathState::Kind::Specular;
+  st.ray = spawn(sp.x, sp.n, ev.d);
+}
+
+glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c) const {
+  // A continuation ray that can only find lights is worth casting only if it can find one.
+  const bool lightRays = !emitters_.empty() || hasSky_ || sunDisk_;
+  glm::vec3 L(0.f);
+  for (;;) {
+    SurfacePoint sp;
+    if (first) {
+      sp = *first;
+      first = nullptr;
+    } else {
+      switch (st.kind) {
+        case PathState::Kind::Primary: ++c.primary; break;
+        case PathState::Kind::Specular: ++c.specular; break;
+        case PathState::Kind::Glossy: ++c.glossy; break;
+        case PathState::Kind::Diffuse: ++c.diffuse; break;
+      }
+      sp = surfaceAt(st.ray, caster_.intersect(st.ray));
+    }
+    if (!sp.valid()) {
+      L += st.beta * escaped(st.ray.d, st.delta, st.pdfPrev, st.nLPrev);
+      break;
+    }
+    const Material m = s_.faceMaterial(sp.face);
+    if (isSpecular(m)) {
+      if (st.lightOnly) break;
+      if (st.depth >= rules_.maxDepth) { ++c.cutAtMaxDepth; break; }
+      ++st.depth;
+      specularStep(sp, st, smp);
+    } else {
+      const float cosO = -glm::dot(sp.n, st.ray.d);
+      if (!(cosO > 0.f)) break;  // seen from behind: black
+      int nL = 1;
+      bool wanted = true;
+      const Bsdf b = bsdfAt(sp, -st.ray.d);
+      if (m == Material::Glossy) {
+        if (st.lightOnly) break;
+        L += st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1);
+      } else {
+        if (emits(sp.face)) L += st.beta * emitted(sp.face, sp.t, cosO, st.delta, st.pdfPrev, st.nLPrev);
+        if (st.lightOnly) break;
+        if (stored_ && stored_->alone()) {
+          L += st.beta * stored_->reflected(sp, b.rho, smp, c);
+          break;
+        }
+        ++st.diffuseVertices;
+        nL = st.diffuseVertices == 1 ? rules_.firstLightSamples : 1;
+        glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL);
+        // A first pass's indirect part is a difference of noisy estimates: keep the sum >= 0.
+        if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, b.rho, smp, c), glm::vec3(0.f));
+        L += st.beta * Ld;
+        wanted = rules_.interreflection &&
+                 (rules_.maxDiffuseBounces < 0 || st.diffuseVertices <= rules_.maxDiffuseBounces);
+        if (!b.reflects()) break;
+      }
+      // The BSDF sample: it continues the path, or (at the limit, or beyond
+      // the diffuse bounces wanted) may only find a light directly.
+      const bool goOn = wanted && st.depth < rules_.maxDepth;
+      if (wanted && !goOn) ++c.cutAtMaxDepth;
+      if (!goOn && !lightRays && m != Material::Glossy) break;
+      glm::vec3 wi, w;
+      float pdf;
+      if (!b.sample(smp.next2D(), wi, w, pdf)) break;
+      st.beta *= w;
+      st.delta = false;
+      st.pdfPrev = pdf;
+      st.nLPrev = float(nL);
+      st.ray = spawn(sp.x, sp.n, wi);
+      st.kind = m == Material::Glossy ? PathState::Kind::Glossy : PathState::Kind::Diffuse;
+      if (goOn) ++st.depth;
+      st.lightOnly = !goOn;
+    }
+    if (!positive(st.beta)) break;
+    if (rules_.roulette && st.depth >= 3 && !st.lightOnly) {
+      const float q = std::min(1.f, std::max({st.beta.r, st.beta.g, st.beta.b}));
+      if (q < 1.f) {
+        if (smp.next1D() >= q) { ++c.roulette; break; }
+        st.beta /= q;
+      }
+    }
+  }
+  return L;
+}
+
+glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c) const {
+  Bsdf b(n);
+  b.rho = glm::vec3(1.f);
+  const int nL = rules_.firstLightSamples;
+  glm::vec3 L = nextEvent(x, n, b, smp, c, nL, 0.f);
+  const bool lightRays = !emitters_.empty() || hasSky_ || sunDisk_;
+  const bool wanted = rules_.interreflection && rules_.maxDiffuseBounces != 0;
+  const bool goOn = wanted && rules_.maxDepth > 0;
+  if (wanted && !goOn) ++c.cutAtMaxDepth;
+  if (!goOn && !lightRays) return L;
+  PathState st;
+  glm::vec3 wi;
+  if (!b.sample(smp.next2D(), wi, st.beta, st.pdfPrev)) return L;
+  st.delta = false;
+  st.nLPrev = float(nL);
+  st.ray = spawn(x, n, wi, 0.f);
+  st.diffuseVertices = 1;
+  st.depth = goOn ? 1 : 0;
+  st.lightOnly = !goOn;
+  st.kind = PathState::Kind::Diffuse;
+  return L + trace(st, nullptr, smp, c);
+}
+
+}  // namespace gi::paths
