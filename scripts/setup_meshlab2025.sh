@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Fetches MeshLab 2025.07's sources (Debian's source package meshlab
-# 2025.07~dfsg-4 from unstable, which holds MeshLab's and vcglib's sources) and
+# 2025.07~dfsg-N from unstable, which holds MeshLab's and vcglib's sources) and
 # builds what our plugins need to load and be tested: libmeshlab-common, the
 # GUI (meshlab) and the PLY reader (io_base), not MeshLab's other plugins.
 #
-#   bash scripts/setup_meshlab2025.sh        (GI_JOBS=N: parallel jobs, default nproc)
+#   bash scripts/setup_meshlab2025.sh            (GI_JOBS=N: parallel jobs, default nproc)
+#   bash scripts/setup_meshlab2025.sh --sources  only fetch and unpack the sources (seconds): what
+#                                                the default build's compile check of the 2025.07
+#                                                adapter needs (scripts/setup.sh runs this)
 #
 # Everything goes to GI_MESHLAB2025_HOME (default .deps/meshlab-2025.07, git-ignored):
 #   meshlab/            the sources (meshlab/src holds common/ and vcglib/: the SDK)
@@ -21,7 +24,12 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 home="${GI_MESHLAB2025_HOME:-$root/.deps/meshlab-2025.07}"
 jobs="${GI_JOBS:-$(nproc)}"
-version="2025.07~dfsg-4"   # Debian's source package
+sources_only=0
+if [[ "${1:-}" == "--sources" ]]; then sources_only=1; fi
+# Debian's source packages 2025.07~dfsg-N (N = 4 when this was written) share one
+# upstream tarball; sid keeps only its newest revision, so any N is taken and the
+# cache is keyed by the tarball's version, not by N.
+orig="2025.07~dfsg"        # Debian's upstream version: the tarball meshlab_2025.07~dfsg.orig.tar.xz
 upstream="2025.07"         # MeshLab's version (ML_VERSION), what plugins are checked against
 step() { printf '[setup-2025] %s\n' "$*" >&2; }
 fail() { printf '[setup-2025] FAILED at step "%s": %s\n' "$1" "$2" >&2; exit 1; }
@@ -34,30 +42,16 @@ cmake_args=(
   -DMESHLAB_ALLOW_BUNDLED_SOURCE_GLEW=OFF       # Debian's GLEW
 )
 targets=(meshlab io_base copy-distrib-files)
-settings="$version ${cmake_args[*]} ${targets[*]}"
+settings="$orig ${cmake_args[*]} ${targets[*]}"
 distrib="$home/build/src/distrib"
-if [[ -f "$home/.stamp" && "$(cat "$home/.stamp")" == "$settings" && -x "$distrib/meshlab" ]]; then
+if ((!sources_only)) && [[ -f "$home/.stamp" && "$(cat "$home/.stamp")" == "$settings" && -x "$distrib/meshlab" ]]; then
   step "MeshLab $upstream present in $home (built; remove $home/.stamp to rebuild)"
   exit 0
 fi
 
-# 1. Packages MeshLab 2025.07 needs beyond scripts/setup.sh's (its GUI uses GLU).
-extra=(libglu1-mesa-dev xz-utils)
-missing=()
-for p in "${extra[@]}"; do
-  s=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
-  [[ "$s" == "install ok installed" ]] || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  step "installing ${missing[*]}"
-  if [[ $(id -u) -ne 0 ]]; then sudo=sudo; else sudo=; fi
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null \
-    || fail "apt-get install" "could not install: ${missing[*]}"
-fi
-
-# 2. The sources, unless an earlier run unpacked them.
+# 1. The sources, unless an earlier run unpacked them.
 src="$home/meshlab"
-if [[ ! -f "$src/.source-version" || "$(cat "$src/.source-version")" != "$version" ]]; then
+if [[ ! -f "$src/.source-version" || "$(cut -d' ' -f1 "$src/.source-version")" != "$orig"-* ]]; then
   work="$home/apt-src"
   rm -rf "$work" "$src"
   mkdir -p "$work/parts" "$work/lists/partial" "$work/download"
@@ -78,6 +72,10 @@ if [[ ! -f "$src/.source-version" || "$(cat "$src/.source-version")" != "$versio
   step "reading Debian unstable's source index ($uri, private apt state)"
   apt-get "${aptopts[@]}" update -qq >/dev/null 2>"$work/update.log" \
     || fail "apt-get update (sid sources)" "$(tail -1 "$work/update.log")"
+  version=$(apt-cache "${aptopts[@]}" showsrc meshlab 2>/dev/null | sed -n 's/^Version: //p' \
+            | grep -E "^${orig//./\\.}-[0-9]+\$" | sort -V | tail -1 || true)
+  [[ -n "$version" ]] || fail "source index" "Debian unstable no longer has meshlab $orig-N; it has: $(
+    apt-cache "${aptopts[@]}" showsrc meshlab 2>/dev/null | sed -n 's/^Version: //p' | tr '\n' ' ')"
   # The files of the source package and their SHA256, from the signed index.
   (cd "$work/download" && apt-get "${aptopts[@]}" source --print-uris -qq "meshlab=$version") > "$work/uris" 2>"$work/uris.log" \
     || fail "apt-get source --print-uris meshlab=$version" "$(tail -1 "$work/uris.log")"
@@ -93,13 +91,14 @@ if [[ ! -f "$src/.source-version" || "$(cat "$src/.source-version")" != "$versio
       || fail "checksum" "$name does not match the signed index"
   done < <(tr -d "'" < "$work/uris")
   dsc="$work/download/meshlab_$version.dsc"
-  orig="$work/download/meshlab_${version%-*}.orig.tar.xz"
+  tarball="$work/download/meshlab_$orig.orig.tar.xz"
   mkdir -p "$home"
   if ((fetched)) && [[ -f "$dsc" ]]; then
     step "unpacking with Debian's patches (dpkg-source)"
     dpkg-source --no-check -x "$dsc" "$src" >/dev/null 2>"$work/unpack.log" \
       || fail "dpkg-source -x" "$(tail -1 "$work/unpack.log")"
-  elif [[ -f "$orig" ]]; then
+    how="$version"
+  elif [[ -f "$tarball" ]]; then
     # The archive (or its mirror) may serve the upstream tarball but not this
     # revision's .dsc and Debian patches (seen: 404 for -4's). The tarball is the
     # upstream source whatever the revision; Debian's patches only change
@@ -108,15 +107,35 @@ if [[ ! -f "$src/.source-version" || "$(cat "$src/.source-version")" != "$versio
     step "$(grep -m1 -o "Failed to fetch [^ ]*" "$work/source.log" || echo "the .dsc was not fetched"):" \
          "building the upstream tarball (SHA256 checked against the signed index) without Debian's patches"
     mkdir -p "$src"
-    tar -xJf "$orig" -C "$src" --strip-components=1 || fail "tar -x" "could not unpack $(basename "$orig")"
+    tar -xJf "$tarball" -C "$src" --strip-components=1 || fail "tar -x" "could not unpack $(basename "$tarball")"
+    how="$version upstream-tarball"
   else
     fail "apt-get source meshlab=$version" "$(tail -1 "$work/source.log")"
   fi
   got=$(cat "$src/ML_VERSION" 2>/dev/null || true)
   [[ "$got" == "$upstream" ]] || fail "version check" "the sources are MeshLab '$got', not $upstream"
   [[ -f "$src/src/vcglib/vcg/complex/complex.h" ]] || fail "sources" "vcglib is missing from the source package"
-  echo "$version" > "$src/.source-version"
+  echo "$how" > "$src/.source-version"
   rm -rf "$work"
+fi
+
+if ((sources_only)); then
+  step "MeshLab $upstream sources in $src"
+  exit 0
+fi
+
+# 2. Packages MeshLab 2025.07 needs beyond scripts/setup.sh's (its GUI uses GLU).
+extra=(libglu1-mesa-dev xz-utils)
+missing=()
+for p in "${extra[@]}"; do
+  s=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$s" == "install ok installed" ]] || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  step "installing ${missing[*]}"
+  if [[ $(id -u) -ne 0 ]]; then sudo=sudo; else sudo=; fi
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null \
+    || fail "apt-get install" "could not install: ${missing[*]}"
 fi
 
 # 3. Build (ccache when installed: a rebuild after a wiped build folder is quick).
