@@ -144,7 +144,7 @@ if command -v ccache >/dev/null; then launcher=(-DCMAKE_C_COMPILER_LAUNCHER=ccac
 step "configuring MeshLab $upstream (GUI + io_base) in $home/build"
 cmake -S "$src" -B "$home/build" "${cmake_args[@]}" "${launcher[@]}" >"$home/configure.log" 2>&1 \
   || fail "cmake configure" "see $home/configure.log: $(grep -m1 -A2 'CMake Error' "$home/configure.log" | tr '\n' ' ')"
-step "building ${targets[*]} with $jobs jobs (cold: about 25 min of CPU time; log: $home/build.log)"
+step "building ${targets[*]} with $jobs jobs (cold: about 40 min at 2 jobs; log: $home/build.log)"
 t0=$SECONDS
 nice cmake --build "$home/build" -j "$jobs" --target "${targets[@]}" >"$home/build.log" 2>&1 \
   || fail "build" "see $home/build.log: $(grep -m1 -B1 -A3 'error' "$home/build.log" | tr '\n' ' ')"
