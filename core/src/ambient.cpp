@@ -229,7 +229,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
 
   // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
-  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen };
+  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart };
   std::vector<uint8_t> status(nv, kTrace);
   std::vector<uint32_t> rep_of(nv);
   for (size_t i = 0; i < nv; ++i) {
@@ -254,6 +254,15 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       auto [it, inserted] = first.emplace(k, uint32_t(i));
       if (!inserted) { status[i] = kDuplicate; rep_of[i] = it->second; ++duplicates; }
     }
+  }
+  const VertexPart& part = opt.vertices;
+  if (!part.all()) {
+    // A split run computes its part and the representatives its duplicates copy.
+    std::vector<uint8_t> need(nv, 0);
+    for (size_t i = 0; i < nv; ++i)
+      if (part.contains(i, nv)) need[rep_of[i]] = 1;
+    for (size_t i = 0; i < nv; ++i)
+      if (status[i] == kTrace && !need[i]) status[i] = kOtherPart;
   }
   if (opt.skipOpenVertices && opt.maxDistance > 0.0 && opt.mode != AmbientMode::Sky && !opt.useCone) {
     OpenSpaceTest test(scene, float(rep.rayEpsilon));
@@ -303,12 +312,17 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       res.value[i] = 0.f;  // no hemisphere (isolated, NaN, or degenerate-only vertex)
     }
   }
+  if (!part.all()) {  // counts over this part's vertices: the parts' counts add up to the whole's
+    duplicates = open = invalid = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (part.contains(i, nv)) duplicates += status[i] == kDuplicate, open += status[i] == kOpen, invalid += status[i] == kInvalid;
+  }
   // Summary (sequential: deterministic).
   double rays = 0, sum = 0, var = 0;
   size_t counted = 0;
   for (size_t i = 0; i < nv; ++i) {
     rays += res.rays[i];
-    if (status[i] == kInvalid) continue;
+    if (status[i] == kInvalid || !part.contains(i, nv)) continue;
     sum += res.value[i]; var += double(res.stdError[i]) * res.stdError[i]; ++counted;
   }
   auto& st = res.stats;
