@@ -9,14 +9,13 @@
 namespace gi::ml {
 
 namespace {
-FilterKind kindOf(MeshFilterInterface::FilterIDType f) { return FilterKind(f); }
+FilterKind kindOf(compat::FilterId f) { return FilterKind(f); }
 }  // namespace
 
 GiFilterPlugin::GiFilterPlugin(std::string plugin) : plugin_(std::move(plugin)) {}
 
 void GiFilterPlugin::createActions(QObject* owner) {
-  for (FilterKind k : pluginFilters(plugin_)) typeList << FilterIDType(k);
-  for (FilterIDType t : types()) actionList << new QAction(filterName(t), owner);
+  for (FilterKind k : pluginFilters(plugin_)) giAddAction(compat::FilterId(k), filterName(compat::FilterId(k)), owner);
 }
 
 QString GiFilterPlugin::pluginName() const {
@@ -31,21 +30,17 @@ QString GiFilterPlugin::pluginName() const {
   return QString::fromStdString(n + "GI");
 }
 
-QString GiFilterPlugin::filterName(FilterIDType f) const { return QString::fromStdString(filterDesc(kindOf(f)).meshlabName); }
+QString GiFilterPlugin::filterName(compat::FilterId f) const { return QString::fromStdString(filterDesc(kindOf(f)).meshlabName); }
 
-QString GiFilterPlugin::filterInfo(FilterIDType f) const { return QString::fromStdString(filterDesc(kindOf(f)).info); }
+QString GiFilterPlugin::filterInfo(compat::FilterId f) const { return QString::fromStdString(filterDesc(kindOf(f)).info); }
 
-MeshFilterInterface::FilterClass GiFilterPlugin::getClass(QAction* a) {
-  if (filterDesc(kindOf(ID(a))).writes & WritesImage) return FilterClass(MeshFilterInterface::RasterLayer);
-  return FilterClass(MeshFilterInterface::VertexColoring | MeshFilterInterface::Quality);
+int GiFilterPlugin::giClass(compat::FilterId f) const {
+  if (filterDesc(kindOf(f)).writes & WritesImage) return compat::FilterBase::RasterLayer;
+  return compat::FilterBase::VertexColoring | compat::FilterBase::Quality;
 }
 
-MeshFilterInterface::FILTER_ARITY GiFilterPlugin::filterArity(QAction*) const { return VARIABLE; }
-
-int GiFilterPlugin::getPreConditions(QAction*) const { return MeshModel::MM_NONE; }
-
-int GiFilterPlugin::postCondition(QAction* a) const {
-  const unsigned w = filterDesc(kindOf(ID(a))).writes;
+int GiFilterPlugin::giPostCondition(compat::FilterId f) const {
+  const unsigned w = filterDesc(kindOf(f)).writes;
   int mask = 0;
   if (w & WritesVertexQuality) mask |= MeshModel::MM_VERTQUALITY;
   if (w & WritesVertexColor) mask |= MeshModel::MM_VERTCOLOR;
@@ -58,15 +53,16 @@ int GiFilterPlugin::postCondition(QAction* a) const {
   return mask;
 }
 
-void GiFilterPlugin::initParameterSet(QAction* a, MeshDocument& md, RichParameterList& par) {
-  addParams(par, filterSpecs(kindOf(ID(a))), documentDiagonal(md));
+void GiFilterPlugin::giParams(compat::FilterId f, MeshDocument& md, RichParameterList& par) {
+  addParams(par, filterSpecs(kindOf(f)), documentDiagonal(md));
 }
 
-bool GiFilterPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb) {
-  const FilterKind kind = kindOf(ID(a));
-  const QString name = filterName(ID(a));
-  auto logLine = [this](const std::string& s) { Log("%s", s.c_str()); };
-  return guarded(errorMessage, logLine, name, [&] {
+QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb) {
+  const FilterKind kind = kindOf(f);
+  const QString name = filterName(f);
+  auto logLine = [this](const std::string& s) { giLog(s); };
+  QString why;
+  guarded(why, logLine, name, [&] {
     BridgeScene b;
     FilterInput in = gatherInput(md, par, kind, b);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
@@ -76,6 +72,7 @@ bool GiFilterPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParamet
     addRasters(md, r);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);
   });
+  return why;
 }
 
 }  // namespace gi::ml

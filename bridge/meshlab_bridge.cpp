@@ -19,7 +19,7 @@ std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent
   std::vector<MeshModel*> out;
   const bool all = extent == SceneExtent::AllVisibleLayers;
   if (all) {
-    for (MeshModel* m : md.meshList)
+    for (MeshModel* m : compat::meshes(md))
       if (m && m->isVisible()) out.push_back(m);
   } else if (md.mm()) {
     out.push_back(md.mm());
@@ -93,7 +93,7 @@ void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, doub
       case ParamType::Int: out.addParam(RichInt(name, int(s.def), label, help)); break;
       case ParamType::Float: out.addParam(RichFloat(name, float(s.def), label, help)); break;
       case ParamType::Distance:
-        out.addParam(RichAbsPerc(name, float(s.def * d), 0.f, float((s.max > 0 ? s.max : 1.0) * d), label, help));
+        compat::addDistance(out, name, float(s.def * d), float((s.max > 0 ? s.max : 1.0) * d), label, help);
         break;
       case ParamType::Enum: {
         QStringList l;
@@ -104,7 +104,7 @@ void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, doub
       case ParamType::Color: out.addParam(RichColor(name, toColor(s.defVec), label, help)); break;
       case ParamType::Direction:
       case ParamType::Point:
-        out.addParam(RichPoint3f(name, vcg::Point3f(s.defVec.x, s.defVec.y, s.defVec.z), label, help));
+        compat::addPoint(out, name, Point3m(s.defVec.x, s.defVec.y, s.defVec.z), s.type == ParamType::Direction, label, help);
         break;
       case ParamType::String: out.addParam(RichString(name, QString::fromStdString(s.defText), label, help)); break;
     }
@@ -129,8 +129,8 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
       }
       case ParamType::Direction:
       case ParamType::Point: {
-        vcg::Point3f p = in.getPoint3f(n);
-        v.set(s.name, glm::vec3(p[0], p[1], p[2]));
+        const Point3m p = in.getPoint3m(n);
+        v.set(s.name, glm::vec3(float(p[0]), float(p[1]), float(p[2])));
         break;
       }
       case ParamType::String: v.set(s.name, in.getString(n).toStdString()); break;
@@ -141,8 +141,8 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
 
 double documentDiagonal(MeshDocument& md) {
   vcg::Box3<MESHLAB_SCALAR> box;
-  for (MeshModel* m : md.meshList)
-    if (m && (m == md.mm() || m->isVisible())) box.Add(m->cm.bbox);
+  for (MeshModel* m : compat::meshes(md))
+    if (m == md.mm() || m->isVisible()) box.Add(m->cm.bbox);
   const double d = box.IsNull() ? 1.0 : double(box.Diag());
   return d > 0 && std::isfinite(d) ? d : 1.0;
 }
@@ -321,7 +321,8 @@ void addRasters(MeshDocument& md, const FilterResult& r) {
       std::memcpy(q.scanLine(y), &rgb[size_t(y) * size_t(img.image.width) * 3], size_t(img.image.width) * 3);
     RasterModel* rm = md.addNewRaster();
     rm->setLabel(QString::fromStdString(img.name));
-    auto* plane = new Plane(QString::fromStdString(img.path.empty() ? img.name + ".png" : img.path), Plane::RGBA);
+    auto* plane = new compat::ImagePlane(QString::fromStdString(img.path.empty() ? img.name + ".png" : img.path),
+                                         compat::ImagePlane::RGBA);
     plane->image = q.convertToFormat(QImage::Format_ARGB32);
     rm->addPlane(plane);
     rm->shot = toShotm(img.camera.toShot());

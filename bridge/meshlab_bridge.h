@@ -1,4 +1,5 @@
-// The one bridge between MeshLab (MeshDocument / CMeshO, 2020.09 API) and the
+// The one bridge between MeshLab (MeshDocument / CMeshO; 2020.09 or 2025.07,
+// the differences in ml_compat.h) and the
 // engine's Scene: layers in, per-vertex results out, parameter tables to
 // RichParameterList and back. Plugins call this and contain no algorithm code.
 #pragma once
@@ -7,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include <common/interfaces.h>
+#include "ml_compat.h"
 
 #include "gi/filter_run.h"
 #include "gi/filters.h"
@@ -63,7 +64,7 @@ struct RefinedOrder {
 RefinedOrder replaceWithRefined(BridgeScene& b, const RefinedMesh& m);
 
 // MeshLab progress callback -> engine progress (cancellation not supported by
-// 2020.09's cb). meshlabserver prints the labels back to back, so there each
+// MeshLab's cb). meshlabserver prints the labels back to back, so there each
 // ends with a newline.
 ProgressFn progressFrom(vcg::CallBackPos* cb);
 

@@ -6,8 +6,7 @@
 
 class FilterPhotonMapPlugin : public QObject, public gi::ml::GiFilterPlugin {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  GI_MESHLAB_FILTER_PLUGIN
 
  public:
   FilterPhotonMapPlugin() : GiFilterPlugin("filter_photonmap") { createActions(this); }

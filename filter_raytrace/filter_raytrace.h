@@ -7,8 +7,7 @@
 
 class FilterRayTracePlugin : public QObject, public gi::ml::GiFilterPlugin {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  GI_MESHLAB_FILTER_PLUGIN
 
  public:
   FilterRayTracePlugin() : GiFilterPlugin("filter_raytrace") { createActions(this); }

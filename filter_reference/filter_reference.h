@@ -6,8 +6,7 @@
 
 class FilterReferencePlugin : public QObject, public gi::ml::GiFilterPlugin {
   Q_OBJECT
-  MESHLAB_PLUGIN_IID_EXPORTER(MESH_FILTER_INTERFACE_IID)
-  Q_INTERFACES(MeshFilterInterface)
+  GI_MESHLAB_FILTER_PLUGIN
 
  public:
   FilterReferencePlugin() : GiFilterPlugin("filter_reference") { createActions(this); }

@@ -38,7 +38,11 @@
 # GUI_APPLY_AO=1 or GUI_APPLY_FILTER=name with GUI_APPLY_DOWNS=its place in its submenu of Filters
 # (GUI_APPLY_MENU_DOWNS=the submenu's place, default 7: Color Creation and Processing; GUI_MENU_PEEK=1:
 # screenshot that submenu and stop) and GUI_APPLY_LOG=text its log line must hold; GUI_SHOW_RASTER=1: then
-# show the raster layer the filter made and run the colour check on it.
+# show the raster layer the filter made and run the colour check on it. GUI_EXPORT_PLY=path: after the filter,
+# File -> Export Mesh As (Ctrl+Shift+E) to that path with MeshLab's default attributes, then compare it with
+# GUI_EXPECT_PLY (what the command-line tool wrote for the same filter, mesh and parameters: vertex and face
+# quality and colour must agree to GUI_EXPECT_TOL, default 0 = bit-identical). GUI_MESHLAB=2025.07 for a
+# self-built MeshLab 2025.07 (see below).
 #
 # MeshLab 2020.09 quirks handled here:
 #  * it keeps state in ~/.config/VCG/MeshLab_64bit_fp.conf (a loaded-mesh counter,
@@ -53,6 +57,12 @@
 #    (about 853x724); we resize it to fill the screen so the mesh is large.
 #  * Qt warns when XDG_RUNTIME_DIR is unset; we give it a private one.  Xvfb has no
 #    DRI, so Mesa renders with llvmpipe (LIBGL_ALWAYS_SOFTWARE=1 makes that explicit).
+# MeshLab 2025.07 (upstream sources, without Debian's patch that turns these off)
+# asks on its first start whether to send usage statistics (a modal question) and
+# checks meshlab.net for a newer version: its throwaway configuration says the
+# question was answered and not to remind about upgrades. It logs "Applied filter:
+# NAME in N msec" where 2020.09 logs "Applied filter NAME". Its menus, dialogs and
+# buttons are laid out as 2020.09's, so the same keyboard walk and clicks apply.
 set -uo pipefail
 
 me=gui_screenshot
@@ -143,6 +153,13 @@ note "Xvfb on $disp"
 
 # ---- MeshLab ---------------------------------------------------------------------
 mkdir -p "$tmp/home/.config" "$tmp/home/.cache" "$tmp/runtime" && chmod 700 "$tmp/runtime"
+applied="Applied filter"
+if [[ "${GUI_MESHLAB:-2020.09}" == 2025.07 ]]; then
+  mkdir -p "$tmp/home/.config/VCG"
+  printf '[General]\ninformativeShown=true\ndontRemindMeAboutUpgrade=true\ndontRemindMeToSendEmail=true\n' \
+    >"$tmp/home/.config/VCG/MeshLab_64bit_fp.conf"
+  applied="Applied filter:"
+fi
 (
   unset WAYLAND_DISPLAY QT_QPA_PLATFORM
   export DISPLAY=$disp HOME=$tmp/home XDG_CONFIG_HOME=$tmp/home/.config \
@@ -203,6 +220,42 @@ fill_screen() {
   xdo windowsize "$main_win" "$width" "$height"
   sleep 2
 }
+# A new visible top-level window whose name matches $1, within $2 seconds.
+wait_window() {
+  local w deadline=$((SECONDS + $2))
+  while ((SECONDS < deadline)); do
+    w=$(xdo search --onlyvisible --maxdepth 1 --name "$1" | head -n 1)
+    [[ -n "$w" ]] && { echo "$w"; return 0; }
+    sleep 0.5
+  done
+  return 1
+}
+# GUI_EXPORT_PLY: close the filter's dialog, File -> Export Mesh As (Ctrl+Shift+E),
+# type the path into the file dialog, accept MeshLab's default attributes (vertex
+# and face colour and quality are ticked when the mesh has them), then compare
+# what MeshLab wrote with GUI_EXPECT_PLY.
+export_and_compare() {
+  local dlg
+  xdo mousemove $((X + WIDTH / 4)) $((Y + HEIGHT - 15)) click 1; sleep 1  # Close
+  rm -f "$GUI_EXPORT_PLY"
+  xdo windowfocus "$main_win"; sleep 0.5
+  xdo key --clearmodifiers ctrl+shift+e
+  dlg=$(wait_window '^Save .*Layer' 15) || { timeout 30 import -window root "$out_png"; fail "no file dialog after Ctrl+Shift+E (screenshot: $out_png)"; }
+  xdo windowfocus "$dlg"; sleep 0.5
+  xdo key --clearmodifiers ctrl+a; xdo type --delay 5 "$GUI_EXPORT_PLY"; xdo key Return
+  dlg=$(wait_window '^Choose Saving Options' 15) || { timeout 30 import -window root "$out_png"; fail "no saving options after the file dialog (screenshot: $out_png)"; }
+  xdo windowfocus "$dlg"; sleep 0.5
+  xdo key Return  # OK
+  for _ in $(seq 1 60); do
+    grep -qF "Saved Mesh $GUI_EXPORT_PLY" "$tmp/meshlab.log" 2>/dev/null && break
+    sleep 0.5
+  done
+  [[ -s "$GUI_EXPORT_PLY" ]] || { ml_log; fail "MeshLab did not write $GUI_EXPORT_PLY"; }
+  [[ -n "${GUI_EXPECT_PLY:-}" ]] || return 0
+  verdict=$(timeout 60 "$py" "$here/gui_compare_ply.py" "$GUI_EXPORT_PLY" "$GUI_EXPECT_PLY" "${GUI_EXPECT_TOL:-0}" 2>&1) \
+    || fail "the mesh MeshLab wrote differs from the command-line tool's: ${verdict##*$'\n'}"
+  note "written mesh: ${verdict##*$'\n'}"
+}
 fill_screen
 sleep 2  # llvmpipe is slow to draw the first frames
 
@@ -251,13 +304,14 @@ if [[ -n "$apply_name" ]]; then
   eval "$(xdo getwindowgeometry --shell "$dlg")"
   xdo mousemove $((X + WIDTH * 3 / 4)) $((Y + HEIGHT - 15)) click 1  # the Apply button
   for _ in $(seq 1 120); do
-    grep -q "Applied filter $apply_name" "$tmp/meshlab.log" 2>/dev/null && break
+    grep -qF "$applied $apply_name" "$tmp/meshlab.log" 2>/dev/null && break
     sleep 0.5
   done
   sleep 2
   timeout 30 import -window root "$out_png" || fail "import -window root failed"
-  grep -q "Applied filter $apply_name" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report $apply_name applied (screenshot: $out_png)"; }
+  grep -qF "$applied $apply_name" "$tmp/meshlab.log" || { ml_log; fail "MeshLab did not report $apply_name applied (screenshot: $out_png)"; }
   grep -q "${GUI_APPLY_LOG:-$apply_name: vertices=}" "$tmp/meshlab.log" || { ml_log; fail "no log line of $apply_name (screenshot: $out_png)"; }
+  if [[ -n "${GUI_EXPORT_PLY:-}" ]]; then export_and_compare; fi
   if [[ "${GUI_SHOW_RASTER:-0}" != 1 ]]; then
     note "PASS: $apply_name applied from the GUI menus; screenshot $out_png; $((SECONDS - t0)) s"
     exit 0
