@@ -14,6 +14,7 @@
 #include "gi/photon.h"
 #include "gi/radiosity.h"
 #include "gi/render.h"
+#include "gi/thickness.h"
 
 namespace gi {
 
@@ -112,6 +113,29 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
       if (v.getBool("bent_normals_to_vertex_normals")) res.vertexNormal = r.bentNormal;
     }
   }
+  res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+}
+
+// Values divided by the q-quantile of the positive ones (a display scale
+// that one outlier cannot wash out); unchanged if none is positive.
+std::vector<float> relativeToPercentile(const std::vector<float>& v, double q) {
+  std::vector<float> pos;
+  for (float x : v)
+    if (std::isfinite(x) && x > 0.f) pos.push_back(x);
+  if (pos.empty()) return v;
+  const size_t k = std::min(pos.size() - 1, size_t(q * double(pos.size())));
+  std::nth_element(pos.begin(), pos.begin() + long(k), pos.end());
+  std::vector<float> out(v.size());
+  for (size_t i = 0; i < v.size(); ++i) out[i] = v[i] / pos[k];
+  return out;
+}
+
+void runThickness(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const auto caster = makeEmbreeCaster(in.scene);
+  ThicknessResult r = computeThickness(in.scene, *caster, ThicknessOptions::fromParams(in.values), progress);
+  res.stats = std::move(r.stats);
+  res.vertexQuality = r.value;
+  res.vertexColor = greyColors(relativeToPercentile(r.value, 0.99));
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
@@ -288,6 +312,7 @@ void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Pr
     case FilterKind::AmbientOcclusion:
     case FilterKind::AmbientObscurance:
     case FilterKind::SkyLighting: runAmbient(kind, in, res, progress); break;
+    case FilterKind::Thickness: runThickness(in, res, progress); break;
     case FilterKind::FormFactorsOfFace: runFormFactors(in, res); break;
     case FilterKind::PathTracedReference: runReference(in, res, progress); break;
     case FilterKind::Radiosity: runRadiosity(in, res, progress); break;

@@ -20,9 +20,12 @@ namespace gi {
 
 enum class AmbientMode { Occlusion = 0, Obscurance = 1, Sky = 2 };
 enum class AOColorMapping { Grey = 0, MultiplyColor = 1, KeepColor = 2 };
+// PerVertex: each vertex's own rays only (independent estimates). Shared: see ao_shared.h.
+enum class AOEstimator { PerVertex = 0, Shared = 1 };
 
 struct AmbientOptions {
   AmbientMode mode = AmbientMode::Occlusion;
+  AOEstimator estimator = AOEstimator::PerVertex;
   int raysPerVertex = 256;       // fixed count when targetError == 0
   double targetError = 0.0;      // adaptive: stop at this standard error per vertex
   int minRays = 32, maxRays = 4096;
