@@ -71,6 +71,27 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
     s.push_back({"sun_rays", "Sun rays per vertex", "Shadow rays towards the sun's disk per vertex.",
                  ParamType::Int, 64, 1, 1 << 20});
   }
+  if (mode != AmbientMode::Sky) {
+    s.push_back({"estimator", "Estimator",
+                 "'Per vertex': each vertex averages its own rays only (independent, unbiased estimates). 'Shared "
+                 "with neighbours': each vertex also counts the rays of the vertices around it whose normals are "
+                 "within the tolerance below, as far as (Lepski's rule) their pooled value agrees with its own "
+                 "within two standard errors: on dense meshes neighbours see almost the same hemisphere, so the same "
+                 "error needs several times fewer rays; at creases, contact shadows and thin features the "
+                 "neighbourhood stays small. The standard error counts every ray pooled. The cone option is always "
+                 "per vertex.",
+                 ParamType::Enum, 0, 0, 0, {"Per vertex", "Shared with neighbours"}});
+    s.push_back({"share_rings", "Sharing: largest neighbourhood (rings)",
+                 "Shared estimator: how far a vertex may pool, in mesh rings (1 = its direct neighbours, about 7 "
+                 "vertices; 3 = about 37; 5 = about 91). Larger pools more rays where the occlusion varies slowly; "
+                 "the cost of pooling grows with the square of it.",
+                 ParamType::Int, 3, 1, 16});
+    s.push_back({"share_normal_angle", "Sharing: normal tolerance (deg)",
+                 "Shared estimator: only neighbours whose normal is within this angle of the vertex's pool their "
+                 "rays (AO depends on the normal: its cosine lobe), and the neighbourhood grows only through them, "
+                 "so it stops at creases and never reaches the other side of a thin sheet.",
+                 ParamType::Float, 10.0, 0.0, 90.0});
+  }
   s.push_back({"ray_batching", "Ray batching",
                "How rays are handed to Embree: single rays sharing the vertex as origin (fastest in our "
                "benchmarks: the rays of one vertex diverge too much for packets), 8-wide packets, or streams. "
@@ -90,6 +111,11 @@ AmbientOptions AmbientOptions::fromParams(AmbientMode mode, const ParamValues& v
   o.seed = uint32_t(v.getInt("seed"));
   const int b = v.getInt("ray_batching");
   o.batch = b == 0 ? BatchMode::Single : b == 1 ? BatchMode::Packet8 : BatchMode::Stream;
+  if (mode != AmbientMode::Sky) {
+    o.estimator = v.getInt("estimator") == 1 ? AOEstimator::Shared : AOEstimator::PerVertex;
+    o.shareRings = v.getInt("share_rings");
+    o.shareNormalAngleDeg = float(v.getFloat("share_normal_angle"));
+  }
   auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
   if (mode == AmbientMode::Occlusion) {
     o.bentNormals = v.getBool("bent_normals") || v.getBool("bent_normals_to_vertex_normals");

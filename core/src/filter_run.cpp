@@ -98,9 +98,12 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
                                                                    : AmbientMode::Sky;
   const ParamValues& v = in.values;
   const AmbientOptions opt = AmbientOptions::fromParams(mode, v);
+  const Timer bvh;
   const auto caster = makeEmbreeCaster(in.scene, opt.batch);
+  const double bvhSeconds = bvh.seconds();
   AmbientResult r = computeAmbient(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
+  res.stats.add("bvh_seconds", bvhSeconds);  // building the ray caster, not in "seconds"
   if (mode == AmbientMode::Sky) {
     radiometric(res, in.scene, r.rgb, v.getFloat("exposure"), "Irradiance");
   } else {

@@ -20,7 +20,8 @@ namespace gi {
 
 enum class AmbientMode { Occlusion = 0, Obscurance = 1, Sky = 2 };
 enum class AOColorMapping { Grey = 0, MultiplyColor = 1, KeepColor = 2 };
-// PerVertex: each vertex's own rays only (independent estimates). Shared: see ao_shared.h.
+// PerVertex: each vertex's own rays only (independent estimates, the
+// estimator above). Shared: neighbours' rays pooled where they agree (gi/ao_shared.h).
 enum class AOEstimator { PerVertex = 0, Shared = 1 };
 
 struct AmbientOptions {
@@ -45,6 +46,8 @@ struct AmbientOptions {
   BatchMode batch = BatchMode::Single;
   bool skipOpenVertices = true;  // prove-and-skip vertices with nothing within maxDistance
   bool mergeDuplicates = true;   // same position and normal computed once
+  int shareRings = 3;            // Shared: largest neighbourhood in mesh rings
+  float shareNormalAngleDeg = 10.f;  // Shared: neighbours' normals within this angle
 
   static std::vector<ParamSpec> specs(AmbientMode mode);
   static AmbientOptions fromParams(AmbientMode mode, const ParamValues& v);

@@ -1,0 +1,231 @@
+// The shared AO estimator (gi/ao_shared.h): rays per vertex, pooling by
+// Lepski's rule, adaptive rounds.
+#include "gi/ao_shared.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "ambient_internal.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+VertexGraph VertexGraph::build(const Scene& s) {
+  const size_t nv = s.vertexCount();
+  const auto ok = usableFaceMask(s);
+  VertexGraph g;
+  g.offset.assign(nv + 1, 0);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) g.offset[s.triangles[f][k] + 1] += 2;
+  for (size_t v = 0; v < nv; ++v) g.offset[v + 1] += g.offset[v];
+  std::vector<uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
+  g.nbr.resize(g.offset[nv]);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const auto& t = s.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      g.nbr[fill[t[k]]++] = t[(k + 1) % 3];
+      g.nbr[fill[t[k]]++] = t[(k + 2) % 3];
+    }
+  }
+  // Each neighbour once (a manifold vertex lists each twice).
+  uint32_t out = 0;
+  for (size_t v = 0; v < nv; ++v) {
+    const uint32_t b = g.offset[v], e = g.offset[v + 1];
+    std::sort(g.nbr.begin() + b, g.nbr.begin() + e);
+    const uint32_t start = out;
+    for (uint32_t k = b; k < e; ++k)
+      if (k == b || g.nbr[k] != g.nbr[k - 1]) g.nbr[out++] = g.nbr[k];
+    g.offset[v] = start;
+  }
+  g.offset[nv] = out;
+  g.nbr.resize(out);
+  return g;
+}
+
+Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
+                  const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
+                  PoolScratch& sc) {
+  if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
+  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
+  const uint32_t now = sc.now;
+  const glm::vec3 ni = normals[i];
+  sc.stamp[i] = now;
+  sc.frontier.assign(1, i);
+  constexpr int kMaxScales = 65;
+  double N[kMaxScales], K[kMaxScales];
+  N[0] = rays[i].n;
+  K[0] = rays[i].sum;
+  Pooled p;
+  p.vertices = 1;
+  p.bent = rays[i].bent;
+  int chosen = 0;
+  const int R = std::min(o.maxRings, kMaxScales - 1);
+  for (int h = 1; h <= R && N[chosen] > 0; ++h) {
+    sc.next.clear();
+    double dn = 0, dk = 0;
+    glm::vec3 db(0.f);
+    for (uint32_t v : sc.frontier)
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+        const uint32_t u = g.nbr[k];
+        if (sc.stamp[u] == now) continue;
+        sc.stamp[u] = now;
+        if (!poolable[u] || glm::dot(normals[u], ni) < o.normalCos) continue;
+        sc.next.push_back(u);
+        dn += rays[u].n;
+        dk += rays[u].sum;
+        db += rays[u].bent;
+      }
+    if (sc.next.empty()) break;
+    const double Nh = N[chosen] + dn, Kh = K[chosen] + dk, S = Kh / Nh;
+    const double pt = (Kh + 1.0) / (Nh + 2.0), v = pt * (1.0 - pt);
+    bool agree = true;
+    for (int s = 0; s <= chosen && agree; ++s)
+      agree = std::fabs(S - K[s] / N[s]) <= o.gamma * std::sqrt(v * (1.0 / N[s] - 1.0 / Nh));
+    if (!agree) break;
+    chosen = h;
+    N[h] = Nh;
+    K[h] = Kh;
+    p.vertices += uint32_t(sc.next.size());
+    p.bent += db;
+    sc.frontier.swap(sc.next);
+  }
+  const double Nc = N[chosen], Kc = K[chosen];
+  if (Nc > 0) {
+    const double pt = (Kc + 1.0) / (Nc + 2.0);
+    p.value = float(Kc / Nc);
+    p.stdError = float(std::sqrt(pt * (1.0 - pt) / Nc));
+  }
+  p.rays = uint32_t(Nc);
+  p.rings = chosen;
+  return p;
+}
+
+namespace {
+
+constexpr int kRound = 32;
+
+// Rays [start, start + count) of vertex vi's sequence, the same as the
+// per-vertex estimator's (key, warp and frame), added to r.
+void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint32_t vi, const glm::vec3& org,
+              const glm::vec3& n, uint32_t start, uint32_t count, VertexRays& r) {
+  const Frame frame(n);
+  SobolOwenStream seq(hash3(vi, o.seed, 0x41u));
+  seq.seek(start);
+  float u0[kRound], u1[kRound], lx[kRound], ly[kRound], lz[kRound];
+  glm::vec3 dirs[kRound];
+  uint8_t occ[kRound];
+  Ray rays[kRound];
+  Hit hits[kRound];
+  const bool obscurance = o.mode == AmbientMode::Obscurance;
+  for (uint32_t done = 0; done < count;) {
+    const int m = int(std::min<uint32_t>(kRound, count - done));
+    seq.nextBlock(m, u0, u1);
+    cosineHemisphereBlock(m, u0, u1, lx, ly, lz);
+    for (int j = 0; j < m; ++j) dirs[j] = frame.t * lx[j] + frame.b * ly[j] + frame.n * lz[j];
+    if (obscurance) {
+      for (int j = 0; j < m; ++j) { rays[j].o = org; rays[j].d = dirs[j]; rays[j].tnear = 0.f; rays[j].tfar = tfar; }
+      caster.intersectBatch(rays, size_t(m), hits);
+    } else {
+      caster.occludedFan(org, dirs, size_t(m), tfar, occ);
+    }
+    for (int j = 0; j < m; ++j) {
+      const double f = obscurance ? (hits[j].valid() ? std::pow(std::min(1.0, double(hits[j].t) / o.maxDistance),
+                                                                 double(o.falloffExponent))
+                                                     : 1.0)
+                                  : (occ[j] ? 0.0 : 1.0);
+      r.sum += f;
+      if (o.bentNormals && f > 0.0) r.bent += dirs[j] * float(f);
+    }
+    done += uint32_t(m);
+  }
+  r.n += count;
+}
+
+}  // namespace
+
+SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
+                                 const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
+                                 const std::vector<uint8_t>& trace, AmbientResult& res, const Progress& progress) {
+  const size_t nv = scene.vertexCount();
+  Timer graphTimer;
+  const VertexGraph g = VertexGraph::build(scene);
+  SharedStats st;
+  st.poolSeconds = graphTimer.seconds();
+  PoolOptions po;
+  po.maxRings = o.shareRings;
+  po.normalCos = std::cos(glm::radians(o.shareNormalAngleDeg));
+  const float tfar = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
+  const bool adaptive = o.targetError > 0.0;
+  const uint32_t first = uint32_t(adaptive ? std::min(o.minRays, o.maxRays) : o.raysPerVertex);
+  std::vector<VertexRays> rays(nv);
+  std::vector<uint32_t> want(nv, 0);
+  std::vector<uint8_t> repool(nv, 0);
+  for (size_t i = 0; i < nv; ++i)
+    if (trace[i]) { want[i] = first; repool[i] = 1; }
+  std::vector<Pooled> pooled(nv);
+  tbb::enumerable_thread_specific<PoolScratch> scratch;
+  // Progress: rounds double the ray count, so the last rounds dominate; the
+  // bar follows the rounds' share of the largest possible count.
+  const double total = std::log2(double(adaptive ? std::max(o.maxRays, 1) : 1) / double(std::max(first, 1u))) + 1.0;
+  for (int round = 0;; ++round) {
+    const Progress part = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
+    Timer cast;
+    parallelBlocks(nv, part.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (want[i] > rays[i].n)
+          castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
+    });
+    st.castSeconds += cast.seconds();
+    Timer pool;
+    parallelBlocks(nv, part.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
+      PoolScratch& sc = scratch.local();
+      for (size_t i = b; i < e; ++i)
+        if (repool[i]) pooled[i] = poolVertex(uint32_t(i), g, normals, rays, trace, po, sc);
+    });
+    ++st.rounds;
+    st.poolSeconds += pool.seconds();
+    if (!adaptive) break;
+    // Vertices above the target cast twice their rays; every vertex whose
+    // neighbourhood may contain one of them is pooled again.
+    bool more = false;
+    std::fill(repool.begin(), repool.end(), 0);
+    for (size_t i = 0; i < nv; ++i)
+      if (trace[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays)) {
+        want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
+        repool[i] = 1;
+        more = true;
+      }
+    if (!more) break;
+    for (int ring = 0; ring < po.maxRings; ++ring) {
+      std::vector<uint8_t> grown = repool;
+      for (size_t v = 0; v < nv; ++v)
+        if (repool[v])
+          for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
+      repool.swap(grown);
+    }
+    for (size_t i = 0; i < nv; ++i) repool[i] &= trace[i];
+  }
+  double pooledVertices = 0, rings = 0;
+  size_t traced = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    if (!trace[i]) continue;
+    const Pooled& p = pooled[i];
+    res.value[i] = p.value;
+    res.stdError[i] = p.stdError;
+    res.rays[i] = int(rays[i].n);
+    if (o.bentNormals) res.bentNormal[i] = glm::length(p.bent) > 0.f ? glm::normalize(p.bent) : normals[i];
+    pooledVertices += p.vertices;
+    rings += p.rings;
+    ++traced;
+  }
+  st.meanPooledVertices = traced ? pooledVertices / double(traced) : 0.0;
+  st.meanRings = traced ? rings / double(traced) : 0.0;
+  return st;
+}
+
+}  // namespace gi
