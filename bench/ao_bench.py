@@ -366,6 +366,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--quick", action="store_true", help="fewer settings, single runs (a smoke run)")
     ap.add_argument("--sizes", default="all", choices=["small", "large", "all"])
+    ap.add_argument("--peers-only", action="store_true",
+                    help="only the references and MeshLab's runs (filling the cache), no tables")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     b = Bench(a.build, a.out, a.quick)
@@ -389,6 +391,13 @@ def main():
         targets = [0.04, 0.02, 0.01, 0.005]
         if a.quick:
             per_vertex, shared, targets = [16, 64, 256], [8, 32, 128], [0.01]
+        ml_configs = [(512, 512), (1024, 512), (512, 2048), (1024, 2048)]
+        if not large and not a.quick:
+            ml_configs += [(v, 512) for v in (16, 32, 64, 128, 256)]
+        if a.peers_only:
+            for views, tex in ml_configs:
+                b.meshlab(scene, mesh, nv, ref_ml, views, tex, repeats)
+            continue
         for n in per_vertex:
             b.ours(scene, mesh, nv, ref, "ours, per vertex", ["--rays_per_vertex", str(n), "--seed", "1"],
                    "rays_per_vertex", n, repeats)
@@ -400,9 +409,6 @@ def main():
                    ["--estimator", "1", "--target_error", str(t), "--min_rays", "8", "--seed", "1"], "target_error", t, repeats)
         b.ours(scene, mesh, nv, ref, "ours, shared (meshlabserver)",
                ["--estimator", "1", "--rays_per_vertex", "32", "--seed", "1"], "rays_per_vertex", 32, repeats, server=True)
-        ml_configs = [(512, 512), (1024, 512), (512, 2048), (1024, 2048)]
-        if not large and not a.quick:
-            ml_configs += [(v, 512) for v in (16, 32, 64, 128, 256)]
         for views, tex in ml_configs:
             b.meshlab(scene, mesh, nv, ref_ml, views, tex, repeats)
         rows = [r for r in b.rows if r["scene"] == scene]
@@ -420,6 +426,8 @@ def main():
             throughput[scene] = json.loads(text)
         if scene in ("bunny", "floor_wall") and not a.quick:
             checks.append(b.cross_check(scene, mesh, ref, 1024))
+    if a.peers_only:
+        return
     conditions["load_average_end"] = load_average()
     conditions["finished"] = time.ctime()
     result = {"rows": b.rows, "summary": summary, "throughput": throughput, "reference_cross_check": checks,

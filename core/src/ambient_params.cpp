@@ -76,7 +76,7 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  "'Per vertex': each vertex averages its own rays only (independent, unbiased estimates). 'Shared "
                  "with neighbours': each vertex also counts the rays of the vertices around it whose normals are "
                  "within the tolerance below, as far as (Lepski's rule) their pooled value agrees with its own "
-                 "within two standard errors: on dense meshes neighbours see almost the same hemisphere, so the same "
+                 "within one standard error: on dense meshes neighbours see almost the same hemisphere, so the same "
                  "error needs several times fewer rays; at creases, contact shadows and thin features the "
                  "neighbourhood stays small. The standard error counts every ray pooled. The cone option is always "
                  "per vertex.",

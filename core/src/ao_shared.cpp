@@ -47,60 +47,113 @@ VertexGraph VertexGraph::build(const Scene& s) {
   return g;
 }
 
-Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
-                  const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
-                  PoolScratch& sc) {
+namespace {
+
+// Weighted sums of one pool for the first-order fit f(d) = a + g.d over the
+// tangent-plane offsets d of its vertices (weights: their ray counts).
+struct PoolSums {
+  double W = 0, Y = 0;            // sum n, sum of ray values
+  double X[2] = {0, 0};           // sum n d
+  double XX[3] = {0, 0, 0};       // sum n d d^T (xx, xy, yy)
+  double XY[2] = {0, 0};          // sum d y (y = the vertex's sum of ray values)
+  void add(double n, double y, double dx, double dy) {
+    W += n; Y += y;
+    X[0] += n * dx; X[1] += n * dy;
+    XX[0] += n * dx * dx; XX[1] += n * dx * dy; XX[2] += n * dy * dy;
+    XY[0] += dx * y; XY[1] += dy * y;
+  }
+};
+
+// The fitted value at d = 0 and its variance over v: least squares of the
+// vertices' means with weights n (their variances are v / n), i.e.
+// a = Y/W - g.xbar, Var(a) = v (1/W + xbar^T C^-1 xbar) with C the centred
+// second moments. Too few or collinear vertices for a slope: the mean.
+struct Fit {
+  double a = 0, varOverV = 0;
+};
+Fit fit(const PoolSums& s) {
+  Fit f;
+  f.a = s.Y / s.W;
+  f.varOverV = 1.0 / s.W;
+  const double mx = s.X[0] / s.W, my = s.X[1] / s.W;
+  const double cxx = s.XX[0] - s.W * mx * mx, cxy = s.XX[1] - s.W * mx * my, cyy = s.XX[2] - s.W * my * my;
+  const double det = cxx * cyy - cxy * cxy, tr = cxx + cyy;
+  if (!(tr > 0.0) || det <= 1e-3 * tr * tr) return f;  // no spread in some direction: no slope
+  const double ry = s.XY[0] - mx * s.Y, rz = s.XY[1] - my * s.Y;
+  const double gx = (cyy * ry - cxy * rz) / det, gy = (cxx * rz - cxy * ry) / det;
+  f.a = s.Y / s.W - (gx * mx + gy * my);
+  f.varOverV = 1.0 / s.W + (cyy * mx * mx - 2.0 * cxy * mx * my + cxx * my * my) / det;
+  return f;
+}
+
+}  // namespace
+
+Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
+                  const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
+                  const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& sc) {
   if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
   if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
   const uint32_t now = sc.now;
-  const glm::vec3 ni = normals[i];
+  const glm::vec3 ni = normals[i], pi = positions[i];
+  const Frame frame(ni);
   sc.stamp[i] = now;
   sc.frontier.assign(1, i);
   constexpr int kMaxScales = 65;
-  double N[kMaxScales], K[kMaxScales];
-  N[0] = rays[i].n;
-  K[0] = rays[i].sum;
+  double A[kMaxScales], VarV[kMaxScales], V[kMaxScales];  // estimate, its variance / v, and v, per accepted scale
+  PoolSums sums;
+  sums.add(rays[i].n, rays[i].sum, 0.0, 0.0);
   Pooled p;
   p.vertices = 1;
   p.bent = rays[i].bent;
+  if (rays[i].n == 0) return p;
+  auto vOf = [](const PoolSums& s) {
+    const double pt = (s.Y + 1.0) / (s.W + 2.0);  // Laplace: never 0 after rays that all agreed
+    return pt * (1.0 - pt);
+  };
+  A[0] = sums.Y / sums.W;
+  VarV[0] = 1.0 / sums.W;
+  V[0] = vOf(sums);
   int chosen = 0;
   const int R = std::min(o.maxRings, kMaxScales - 1);
-  for (int h = 1; h <= R && N[chosen] > 0; ++h) {
+  for (int h = 1; h <= R; ++h) {
     sc.next.clear();
-    double dn = 0, dk = 0;
+    PoolSums grown = sums;
     glm::vec3 db(0.f);
     for (uint32_t v : sc.frontier)
       for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
         const uint32_t u = g.nbr[k];
         if (sc.stamp[u] == now) continue;
         sc.stamp[u] = now;
-        if (!poolable[u] || glm::dot(normals[u], ni) < o.normalCos) continue;
+        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
         sc.next.push_back(u);
-        dn += rays[u].n;
-        dk += rays[u].sum;
+        const glm::vec3 d = positions[u] - pi;
+        grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
         db += rays[u].bent;
       }
     if (sc.next.empty()) break;
-    const double Nh = N[chosen] + dn, Kh = K[chosen] + dk, S = Kh / Nh;
-    const double pt = (Kh + 1.0) / (Nh + 2.0), v = pt * (1.0 - pt);
+    const Fit f = fit(grown);
+    const double v = vOf(grown);
+    // Lepski: the new estimate within gamma standard errors of every smaller
+    // scale's. For nested least-squares fits of one model the larger is the
+    // efficient one, so Var(a_h' - a_h) = Var(a_h') - Var(a_h) (Hausman 1978).
     bool agree = true;
-    for (int s = 0; s <= chosen && agree; ++s)
-      agree = std::fabs(S - K[s] / N[s]) <= o.gamma * std::sqrt(v * (1.0 / N[s] - 1.0 / Nh));
+    for (int s = 0; s <= chosen && agree; ++s) {
+      const double var = std::max(0.0, v * (VarV[s] - f.varOverV));
+      agree = std::fabs(f.a - A[s]) <= o.gamma * std::sqrt(var);
+    }
     if (!agree) break;
     chosen = h;
-    N[h] = Nh;
-    K[h] = Kh;
+    A[h] = f.a;
+    VarV[h] = f.varOverV;
+    V[h] = v;
+    sums = grown;
     p.vertices += uint32_t(sc.next.size());
     p.bent += db;
     sc.frontier.swap(sc.next);
   }
-  const double Nc = N[chosen], Kc = K[chosen];
-  if (Nc > 0) {
-    const double pt = (Kc + 1.0) / (Nc + 2.0);
-    p.value = float(Kc / Nc);
-    p.stdError = float(std::sqrt(pt * (1.0 - pt) / Nc));
-  }
-  p.rays = uint32_t(Nc);
+  p.value = float(std::clamp(A[chosen], 0.0, 1.0));
+  p.stdError = float(std::sqrt(V[chosen] * VarV[chosen]));
+  p.rays = uint32_t(sums.W);
   p.rings = chosen;
   return p;
 }
@@ -185,7 +238,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     parallelBlocks(nv, part.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
       PoolScratch& sc = scratch.local();
       for (size_t i = b; i < e; ++i)
-        if (repool[i]) pooled[i] = poolVertex(uint32_t(i), g, normals, rays, trace, po, sc);
+        if (repool[i]) pooled[i] = poolVertex(uint32_t(i), g, scene.positions, normals, rays, trace, po, sc);
     });
     ++st.rounds;
     st.poolSeconds += pool.seconds();
