@@ -260,10 +260,10 @@ class Bench:
                  np.load(c["quality_file"]), ref)
 
 
-def time_to_reach(rows, target):
-    """Filter time at which the RMS error reaches `target` (log-log interpolation between the two settings around
-    it, each curve sorted by time), or None if it never does."""
-    pts = sorted((r["filter_seconds"], r["rms_error"]) for r in rows)
+def time_to_reach(rows, target, key="filter_seconds"):
+    """Filter time (or another cost, `key`) at which the RMS error reaches `target` (log-log interpolation between
+    the two settings around it, each curve sorted by cost), or None if it never does."""
+    pts = sorted((r[key], r["rms_error"]) for r in rows)
     for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
         if e0 >= target >= e1 and min(e0, e1, t0, t1) > 0 and e0 != e1:
             f = (math.log(target) - math.log(e0)) / (math.log(e1) - math.log(e0))
@@ -366,6 +366,14 @@ def main():
     ap.add_argument("--out", default=os.path.join(HERE, "results"))
     ap.add_argument("--quick", action="store_true", help="fewer settings, single runs (a smoke run)")
     ap.add_argument("--sizes", default="all", choices=["small", "large", "all"])
+    ap.add_argument("--scenes", default="", help="comma-separated scene names (default: all of --sizes)")
+    ap.add_argument("--meshlab", default="512x512,1024x512,512x2048,1024x2048",
+                    help="MeshLab settings VIEWSxDEPTHMAP to run on every scene (the first is the goal's)")
+    ap.add_argument("--refs-only", action="store_true", help="only the references (no cache writes: can run beside)")
+    ap.add_argument("--max-rays-total", type=float, default=3e8,
+                    help="largest rays per run on the large meshes (ray counts n with n x vertices above it are left out)")
+    ap.add_argument("--no-cross-check", action="store_true", help="skip the reference's check by the path tracer")
+    ap.add_argument("--no-sweep", action="store_true", help="no sweep of MeshLab's views on the small meshes")
     ap.add_argument("--peers-only", action="store_true",
                     help="only the references and MeshLab's runs (filling the cache), no tables")
     a = ap.parse_args()
@@ -373,6 +381,9 @@ def main():
     b = Bench(a.build, a.out, a.quick)
     conditions = {"cpus": os.cpu_count(), "load_average_start": load_average(), "started": time.ctime()}
     sc = scenes(a.build, a.out, a.sizes)
+    if a.scenes:
+        sc = {k: v for k, v in sc.items() if k in a.scenes.split(",")}
+    main_configs = [tuple(int(x) for x in c.split("x")) for c in a.meshlab.split(",")]
     summary, throughput, checks = [], {}, []
     for scene, mesh in sc.items():
         nv = len(vertex_property(mesh, "x"))
@@ -383,16 +394,18 @@ def main():
             ref_rays = min(ref_rays, 1024)
         ref = b.reference(scene, mesh, "angle", ref_rays)
         ref_ml = b.reference(scene, mesh, "area", ref_rays)
+        if a.refs_only:
+            continue
         print("%s: %d vertices; references (%d rays, two seeds): own RMS error %.5f (angle), %.5f (area)" % (
             scene, nv, 2 * ref_rays, ref["noise"], ref_ml["noise"]), flush=True)
         # Ray counts up to about 3e8 rays per run on the large meshes (the machine has 2 cores).
-        per_vertex = [n for n in (8, 16, 32, 64, 128, 256, 512, 1024, 2048) if n * nv <= max(3e8, 2048 * 5e4)]
-        shared = [n for n in (4, 8, 16, 32, 64, 128, 256, 512) if n * nv <= max(3e8, 512 * 5e4)]
+        per_vertex = [n for n in (8, 16, 32, 64, 128, 256, 512, 1024, 2048) if n * nv <= max(a.max_rays_total, 2048 * 5e4)]
+        shared = [n for n in (4, 8, 16, 32, 64, 128, 256, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
         targets = [0.04, 0.02, 0.01, 0.005]
         if a.quick:
             per_vertex, shared, targets = [16, 64, 256], [8, 32, 128], [0.01]
-        ml_configs = [(512, 512), (1024, 512), (512, 2048), (1024, 2048)]
-        if not large and not a.quick:
+        ml_configs = list(main_configs)
+        if not large and not a.quick and not a.no_sweep:
             ml_configs += [(v, 512) for v in (16, 32, 64, 128, 256)]
         if a.peers_only:
             for views, tex in ml_configs:
@@ -414,19 +427,20 @@ def main():
         rows = [r for r in b.rows if r["scene"] == scene]
         for ours in ("ours, shared", "ours, per vertex", "ours, shared, adaptive"):
             mine = [r for r in rows if r["method"] == ours]
-            for views, tex in ml_configs[:4]:
+            for views, tex in main_configs:
                 ml = [r for r in rows if r["method"] == "MeshLab AO (CPU, depth %d)" % tex and r["value"] == views][0]
                 to = time_to_reach(mine, ml["rms_error"])
                 summary.append({"scene": scene, "vertices": nv, "ours": ours, "views": views, "tex": tex,
                                 "meshlab_rms": ml["rms_error"], "meshlab_seconds": ml["filter_seconds"],
+                                "ours_rays_per_vertex": time_to_reach(mine, ml["rms_error"], "rays_per_vertex"),
                                 "ours_seconds": to, "speedup": ml["filter_seconds"] / to if to else None})
         if scene in ("bunny", "bunny_fine", "scan_118k"):
             text, _ = run([os.path.join(a.build, "bench", "ao_throughput"), mesh, "64" if large else "256",
                            "1" if a.quick else "3"])
             throughput[scene] = json.loads(text)
-        if scene in ("bunny", "floor_wall") and not a.quick:
+        if scene in ("bunny", "floor_wall") and not a.quick and not a.no_cross_check:
             checks.append(b.cross_check(scene, mesh, ref, 1024))
-    if a.peers_only:
+    if a.peers_only or a.refs_only:
         return
     conditions["load_average_end"] = load_average()
     conditions["finished"] = time.ctime()
