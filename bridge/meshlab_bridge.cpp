@@ -15,15 +15,16 @@
 
 namespace gi::ml {
 
-std::vector<MeshModel*> participatingLayers(MeshDocument& md, int sceneExtent) {
+std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent) {
   std::vector<MeshModel*> out;
-  if (sceneExtent == 1) {
+  const bool all = extent == SceneExtent::AllVisibleLayers;
+  if (all) {
     for (MeshModel* m : md.meshList)
       if (m && m->isVisible()) out.push_back(m);
   } else if (md.mm()) {
     out.push_back(md.mm());
   }
-  if (out.empty()) throw std::invalid_argument(sceneExtent == 1 ? "no visible layer to work on" : "no current layer to work on");
+  if (out.empty()) throw std::invalid_argument(all ? "no visible layer to work on" : "no current layer to work on");
   return out;
 }
 
@@ -330,7 +331,8 @@ void addRasters(MeshDocument& md, const FilterResult& r) {
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b) {
   FilterInput in;
   in.values = readParams(par, filterSpecs(kind));
-  const int extent = in.values.has("scene_extent") ? in.values.getInt("scene_extent") : 0;
+  const SceneExtent extent =
+      in.values.has("scene_extent") ? kSceneExtents.get(in.values, "scene_extent") : SceneExtent::CurrentLayer;
   b = toScene(participatingLayers(md, extent));
   in.scene = std::move(b.scene);  // the bridge keeps the layers' indexing, the engine the geometry
   in.attrs = b.attrs;

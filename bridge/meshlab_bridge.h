@@ -32,9 +32,9 @@ struct BridgeScene {
   std::vector<LayerPart> parts;
 };
 
-// Layers taking part: the current one, or every visible one (extent enum of
-// geometrySceneSpecs()). Throws std::invalid_argument if there is none.
-std::vector<MeshModel*> participatingLayers(MeshDocument& md, int sceneExtent);
+// Layers taking part: the current one, or every visible one. Throws
+// std::invalid_argument if there is none.
+std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent);
 // Converts the layers (deleted elements skipped) into one scene. Throws
 // std::invalid_argument when there is nothing to work on (no faces).
 BridgeScene toScene(const std::vector<MeshModel*>& layers);

@@ -17,6 +17,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev libpng-dev
   xvfb xauth imagemagick xdotool x11-utils
   python3 python3-numpy python3-matplotlib
+  openmpi-bin libopenmpi-dev slurm-wlm munge
 )
 
 # 1. Debian packages: install only what is missing.

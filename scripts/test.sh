@@ -5,12 +5,18 @@
 # UndefinedBehaviorSanitizer: unit tests and hostile-input test, label
 # 'sanitize'; the readers' libFuzzer target for a bounded run, label 'fuzz').
 # GI_SANITIZE=0 skips the checking build. Arguments go to both ctest runs.
+# build/ is configured with the MPI option (GI_MPI=0 leaves it off), so that
+# `mpirun -np 1, 2, 4 gi ...` is tested against the plain run; the Slurm test
+# starts its own single-node Slurm (munged, slurmctld, slurmd) and stops it.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="${GI_BUILD_DIR:-$root/build}"
 san="${GI_SAN_BUILD_DIR:-$root/build-san}"
 jobs="${GI_JOBS:-$(nproc)}"
 bash "$root/scripts/setup.sh"
+mpi=$([[ "${GI_MPI:-1}" != 0 ]] && echo ON || echo OFF)
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGI_MPI="$mpi" >/dev/null \
+  || { echo "[test] FAILED: cmake configure with GI_MPI=$mpi" >&2; exit 1; }
 bash "$root/scripts/build.sh"
 if [[ "${GI_SANITIZE:-1}" != 0 ]]; then
   cmake -S "$root" -B "$san" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \

@@ -19,6 +19,9 @@
 #include "gi/filters.h"
 #include "gi/refine.h"
 #include "gi/scene_setup.h"
+#include "gi_batch.h"
+#include "gi_cluster.h"
+#include "gi_output.h"
 #include "mesh_io.h"
 #include "result_file.h"
 
@@ -33,6 +36,7 @@ struct CommonArgs {
   bool json = false, quiet = false;
   int threads = 0;
   std::map<std::string, std::string> raw;  // parameter texts as given
+  cluster::SplitOptions split;             // under mpirun
 };
 
 ProgressFn stderrProgress(bool quiet) {
@@ -149,7 +153,9 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
 
-  const Progress progress(stderrProgress(a.quiet));
+  const bool writer = cluster::rank() == 0;  // under mpirun only rank 0 writes and prints
+  const Progress progress(stderrProgress(a.quiet || !writer));
+  if (cluster::size() > 1 && !a.cacheDir.empty()) throw std::invalid_argument("--cache is for a run in one process, not under mpirun");
   FilterResult r = prepareFilter(kind, in);
   const io::ResultKey key{desc.cliName, a.input, sceneHash(in.scene), describe(specs, in.values)};
   const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
@@ -165,7 +171,8 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     }
   }
   if (!reused) {
-    computeFilter(kind, in, r, progress);
+    cluster::compute(kind, in, r, progress, a.split);
+    if (!writer) return 0;
     if (!cached.empty() && !r.refined) {
       io::writeResultFile(cached, key, r);
       r.stats.note("cached as " + cached);
@@ -173,19 +180,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   }
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
-  // The output: the input mesh (or its refinement) with the result's
-  // properties; what the result leaves alone keeps the input's values.
-  const Scene& out = r.refined ? r.refined->scene : in.scene;
-  MeshAttributes attrs = r.refined ? refineAttributes(mesh.attrs, *r.refined) : mesh.attrs;
-  if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
-  if (!r.faceColor.empty()) {
-    attrs.faceColor.clear();
-    for (const Rgb8& c : r.faceColor) attrs.faceColor.push_back({c.r, c.g, c.b});
-  }
-  io::PlyExtras extras;
-  extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
-  extras.attributes = r.attributes;
-  if (!a.output.empty()) io::writePly(a.output, out, attrs, r.vertexQuality, r.vertexColor, extras);
+  if (!a.output.empty()) writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
   writeImages(r);
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
@@ -205,6 +200,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     j["warnings"] = r.stats.warnings;
     if (!r.setupLog.empty()) j["setup"] = r.setupLog;
     j["log"] = lines;
+    if (const json m = cluster::report(); !m.is_null()) j["mpi"] = m;
     std::cout << j.dump(2) << std::endl;
   } else if (!a.quiet) {
     for (const std::string& l : lines) std::cerr << l << "\n";
@@ -292,9 +288,7 @@ void checkOutputPath(const std::string& path, const std::string& option) {
     throw std::invalid_argument(cannot + "the folder " + parent.string() + " is not writable (" + std::strerror(errno) + ")");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int runCli(int argc, char** argv) {
   CLI::App app{"gi: global illumination on meshes (ambient occlusion, sky lighting, radiosity, photon mapping).\n"
                "Reads PLY/OBJ/OFF/STL, writes PLY with per-vertex colour and quality."};
   app.require_subcommand(1);
@@ -313,6 +307,13 @@ int main(int argc, char** argv) {
     sub->add_option("--threads", a.threads, "worker threads (default: all cores); results do not depend on it")
         ->check(CLI::Range(1, 4096));
     addParamOptions(sub, filterSpecs(d.kind), a, false);
+    sub->add_option_function<std::string>(
+           "--split", [&a](const std::string& m) { a.split.interleaved = m == "interleaved"; },
+           "under mpirun: which vertices each rank computes, chunks dealt round robin or one run of chunks per "
+           "rank [default: interleaved]")
+        ->check(CLI::IsMember({"interleaved", "contiguous"}));
+    sub->add_option("--chunk", a.split.chunk, "under mpirun: vertices per chunk of the split [default: 1024]")
+        ->check(CLI::Range(1, 1 << 30));
     sub->add_option("--cache", a.cacheDir, "folder of cached results: reuse one computed with the same scene and "
                                            "parameters, or store the new one there (e.g. a slow reference)");
     outputs.push_back({sub->add_option("--save-result", a.saveResult, "also write the whole result as JSON (quality, "
@@ -322,18 +323,25 @@ int main(int argc, char** argv) {
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
-  std::string filterName;
-  script->add_option("filter", filterName, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)")->required();
+  std::string filterName, filterNames;  // the catalogue's subcommands, for the help and the error
+  for (const FilterDesc& d : allFilters()) filterNames += (filterNames.empty() ? "" : ", ") + d.cliName;
+  script->add_option("filter", filterName, "filter subcommand name (" + filterNames + ")")->required();
   CLI::Option* scriptOutput = script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
   CLI::App* list = app.add_subcommand("filters", "list the filters (the catalogue MeshLab's plugins and this tool share)");
   list->add_flag("--json", a.json, "as JSON: names, plugin, description, what each writes, parameters");
+  CLI::App* batch = app.add_subcommand("batch", "one filter over many meshes (a manifest, or a folder and a pattern): "
+                                                "resumable, one result and summary per mesh, --shard I/N for cluster "
+                                                "jobs; the filter's parameters follow as --name value (gi FILTER "
+                                                "--help lists them)");
+  batch::Args batchArgs;
+  batch::addOptions(batch, batchArgs);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help: the help text, exit 0
-    return failOneLine(e.what());
+    if (e.get_exit_code() == 0) return cluster::rank() == 0 ? app.exit(e) : 0;  // --help: the help text, exit 0
+    return cluster::abandon() ? failOneLine(e.what()) : 1;
   }
   try {
     for (const auto& [opt, path] : outputs)
@@ -342,11 +350,12 @@ int main(int argc, char** argv) {
     for (auto& [sub, kind] : subs)
       if (sub->parsed()) return runCommand(kind, a);
     if (list->parsed()) return listFilters(a.json);
+    if (batch->parsed()) return batch::run(batchArgs, batch->remaining());
     if (script->parsed()) {
       const FilterDesc* d = nullptr;
       for (const auto& f : allFilters())
         if (f.cliName == filterName) d = &f;
-      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)");
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (" + filterNames + ")");
       // Parameters after the filter name: --name value pairs, checked against the filter's table.
       const auto specs = filterSpecs(d->kind);
       const auto extras = script->remaining();
@@ -364,10 +373,21 @@ int main(int argc, char** argv) {
       }
       return writeScript({d->kind}, a);
     }
+  } catch (const cluster::Quiet&) {
+    return 1;  // another rank failed and said why
   } catch (const std::bad_alloc&) {
-    return failOneLine("out of memory");
+    return cluster::abandon() ? failOneLine("out of memory") : 1;
   } catch (const std::exception& e) {
-    return failOneLine(e.what());
+    return cluster::abandon() ? failOneLine(e.what()) : 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cluster::start(&argc, &argv);
+  const int status = runCli(argc, argv);
+  cluster::stop();
+  return status;
 }

@@ -231,7 +231,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
 
   // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
-  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen };
+  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart };
   std::vector<uint8_t> status(nv, kTrace);
   std::vector<uint32_t> rep_of(nv);
   for (size_t i = 0; i < nv; ++i) {
@@ -256,6 +256,15 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       auto [it, inserted] = first.emplace(k, uint32_t(i));
       if (!inserted) { status[i] = kDuplicate; rep_of[i] = it->second; ++duplicates; }
     }
+  }
+  const VertexPart& part = opt.vertices;
+  if (!part.all()) {
+    // A split run computes its part and the representatives its duplicates copy.
+    std::vector<uint8_t> need(nv, 0);
+    for (size_t i = 0; i < nv; ++i)
+      if (part.contains(i, nv)) need[rep_of[i]] = 1;
+    for (size_t i = 0; i < nv; ++i)
+      if (status[i] == kTrace && !need[i]) status[i] = kOtherPart;
   }
   if (opt.skipOpenVertices && opt.maxDistance > 0.0 && opt.mode != AmbientMode::Sky && !opt.useCone) {
     OpenSpaceTest test(scene, float(rep.rayEpsilon));
@@ -283,15 +292,17 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   Timer traceTimer;
   SharedStats shareStats;
   if (shared) {
-    std::vector<uint8_t> trace(nv, 0);
+    // Pooling reads every vertex that casts rays in the whole run; this part casts its own.
+    std::vector<uint8_t> poolable(nv, 0), mine(nv, 0);
     for (size_t i = 0; i < nv; ++i) {
-      trace[i] = status[i] == kTrace;
+      poolable[i] = status[i] == kTrace || status[i] == kOtherPart;
+      mine[i] = status[i] == kTrace;
       if (status[i] == kOpen) {
         res.value[i] = 1.f;
         if (opt.bentNormals) res.bentNormal[i] = normals[i];
       }
     }
-    shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, trace, res, progress.sub(0.05, 1.0));
+    shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, poolable, mine, res, progress.sub(0.05, 1.0));
   }
   parallelBlocks(shared ? 0 : nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
@@ -321,12 +332,17 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       res.value[i] = 0.f;  // no hemisphere (isolated, NaN, or degenerate-only vertex)
     }
   }
+  if (!part.all()) {  // counts over this part's vertices: the parts' counts add up to the whole's
+    duplicates = open = invalid = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (part.contains(i, nv)) duplicates += status[i] == kDuplicate, open += status[i] == kOpen, invalid += status[i] == kInvalid;
+  }
   // Summary (sequential: deterministic).
   double rays = 0, sum = 0, var = 0;
   size_t counted = 0;
   for (size_t i = 0; i < nv; ++i) {
     rays += res.rays[i];
-    if (status[i] == kInvalid) continue;
+    if (status[i] == kInvalid || !part.contains(i, nv)) continue;
     sum += res.value[i]; var += double(res.stdError[i]) * res.stdError[i]; ++counted;
   }
   auto& st = res.stats;

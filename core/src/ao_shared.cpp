@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -203,8 +204,13 @@ void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint
 
 SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
                                  const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
-                                 const std::vector<uint8_t>& trace, AmbientResult& res, const Progress& progress) {
+                                 const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine,
+                                 AmbientResult& res, const Progress& progress) {
   const size_t nv = scene.vertexCount();
+  const VertexPart& part = o.vertices;
+  const bool split = !part.all();
+  if (split && !part.sumOverParts)
+    throw std::logic_error("the shared AO estimator split over parts needs their sum (VertexPart::sumOverParts)");
   Timer graphTimer;
   const VertexGraph g = VertexGraph::build(scene);
   SharedStats st;
@@ -216,44 +222,48 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   const bool adaptive = o.targetError > 0.0;
   const uint32_t first = uint32_t(adaptive ? std::min(o.minRays, o.maxRays) : o.raysPerVertex);
   std::vector<VertexRays> rays(nv);
-  std::vector<uint32_t> want(nv, 0);
-  std::vector<uint8_t> repool(nv, 0);
+  std::vector<uint32_t> want(nv, 0), pooledWith(nv, 0);  // pooledWith: ray counts at the last pooling
   for (size_t i = 0; i < nv; ++i)
-    if (trace[i]) { want[i] = first; repool[i] = 1; }
+    if (mine[i]) want[i] = first;
+  std::vector<uint8_t> repool(nv, 0);
   std::vector<Pooled> pooled(nv);
+  std::vector<double> exchange;
   tbb::enumerable_thread_specific<PoolScratch> scratch;
   // Progress: rounds double the ray count, so the last rounds dominate; the
   // bar follows the rounds' share of the largest possible count.
   const double total = std::log2(double(adaptive ? std::max(o.maxRays, 1) : 1) / double(std::max(first, 1u))) + 1.0;
   for (int round = 0;; ++round) {
-    const Progress part = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
+    const Progress bar = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
     Timer cast;
-    parallelBlocks(nv, part.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
+    parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (want[i] > rays[i].n)
           castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
     });
+    if (split) {
+      // Every part gets every vertex's rays (each part fills its own entries,
+      // the others stay 0; sums of one nonzero term are exact): the pools
+      // are then the whole run's, bit for bit.
+      exchange.assign(5 * nv, 0.0);
+      for (size_t i = 0; i < nv; ++i)
+        if (mine[i]) {
+          const VertexRays& r = rays[i];
+          double* x = &exchange[5 * i];
+          x[0] = r.n; x[1] = r.sum; x[2] = r.bent.x; x[3] = r.bent.y; x[4] = r.bent.z;
+        }
+      part.sumOverParts(exchange);
+      for (size_t i = 0; i < nv; ++i)
+        if (poolable[i] && !mine[i]) {
+          const double* x = &exchange[5 * i];
+          rays[i] = {uint32_t(x[0]), x[1], glm::vec3(float(x[2]), float(x[3]), float(x[4]))};
+        }
+    }
     st.castSeconds += cast.seconds();
     Timer pool;
-    parallelBlocks(nv, part.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
-      PoolScratch& sc = scratch.local();
-      for (size_t i = b; i < e; ++i)
-        if (repool[i]) pooled[i] = poolVertex(uint32_t(i), g, scene.positions, normals, rays, trace, po, sc);
-    });
-    ++st.rounds;
-    st.poolSeconds += pool.seconds();
-    if (!adaptive) break;
-    // Vertices above the target cast twice their rays; every vertex whose
-    // neighbourhood may contain one of them is pooled again.
-    bool more = false;
+    // Pooled (again): every vertex within reach of one whose rays changed.
     std::fill(repool.begin(), repool.end(), 0);
     for (size_t i = 0; i < nv; ++i)
-      if (trace[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays)) {
-        want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
-        repool[i] = 1;
-        more = true;
-      }
-    if (!more) break;
+      if (rays[i].n != pooledWith[i]) { repool[i] = 1; pooledWith[i] = rays[i].n; }
     for (int ring = 0; ring < po.maxRings; ++ring) {
       std::vector<uint8_t> grown = repool;
       for (size_t v = 0; v < nv; ++v)
@@ -261,12 +271,32 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
           for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
       repool.swap(grown);
     }
-    for (size_t i = 0; i < nv; ++i) repool[i] &= trace[i];
+    parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
+      PoolScratch& sc = scratch.local();
+      for (size_t i = b; i < e; ++i)
+        if (repool[i] && mine[i]) pooled[i] = poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
+    });
+    ++st.rounds;
+    st.poolSeconds += pool.seconds();
+    if (!adaptive) break;
+    // Vertices above the target cast twice their rays (all parts go on while any does).
+    double more = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (mine[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays)) {
+        want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
+        more += 1;
+      }
+    if (split) {
+      std::vector<double> m{more};
+      part.sumOverParts(m);
+      more = m[0];
+    }
+    if (more == 0) break;
   }
   double pooledVertices = 0, rings = 0;
   size_t traced = 0;
   for (size_t i = 0; i < nv; ++i) {
-    if (!trace[i]) continue;
+    if (!mine[i]) continue;
     const Pooled& p = pooled[i];
     res.value[i] = p.value;
     res.stdError[i] = p.stdError;

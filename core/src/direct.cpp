@@ -198,7 +198,7 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
 }
 
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                              const Progress& progress) {
+                                              const Progress& progress, const VertexPart& part) {
   const VertexMaterial mat = vertexMaterial(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   const DirectLight direct(s, caster);
@@ -207,7 +207,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
   const int points = std::max(1, lightSamples / direct.raysPerPoint());
   parallelBlocks(s.vertexCount(), progress, "direct light at vertices", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      if (!mat.valid[i]) continue;
+      if (!mat.valid[i] || !part.contains(i, s.vertexCount())) continue;
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd6u));
       Rng rng(hash3(uint32_t(i), seed, 0xd7u));
       glm::dvec3 sum(0.0);
@@ -221,7 +221,8 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value) {
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
+                                   const VertexPart& part) {
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
     const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -231,7 +232,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
-      if (!mat.valid[v]) continue;
+      if (!mat.valid[v] || !part.contains(v, s.vertexCount())) continue;
       SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
       const Frame frame(mat.n[v]);
       glm::dvec3 sum(0.0);

@@ -60,15 +60,19 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
     throw std::invalid_argument("the mesh has no usable triangles (" + res.report.summary() + ")");
 }
 
-// Radiometric output (quality = luminance, colour = display mapping) and the
-// linear RGB value as the attribute "Radiosity" (what a later pass, such as
-// a ray-traced view, reads back from the mesh).
-void radiometric(FilterResult& res, const Scene& s, const std::vector<glm::vec3>& B, double exposure,
-                 const std::string& attribute) {
-  const VertexOutput out = radiometricOutput(s, B, exposure);
+std::vector<glm::vec3> vectors(const VertexAttribute* a) {
+  std::vector<glm::vec3> v(a ? a->values.size() / 3 : 0);
+  for (size_t i = 0; i < v.size(); ++i) v[i] = {a->values[3 * i], a->values[3 * i + 1], a->values[3 * i + 2]};
+  return v;
+}
+
+// Radiometric output (quality = luminance, colour = display mapping) of the
+// linear RGB value the estimate left as an attribute ("Radiosity": what a
+// later pass, such as a ray-traced view, reads back from the mesh).
+void radiometric(FilterResult& res, const Scene& s, double exposure, const std::string& attribute) {
+  const VertexOutput out = radiometricOutput(s, vectors(res.attribute(attribute)), exposure);
   res.vertexQuality = out.quality;
   res.vertexColor = out.displayColors();
-  res.attributes.push_back(vectorAttribute(attribute, B));
   res.stats.add("exposure", out.exposure);
 }
 
@@ -97,7 +101,8 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
                            : kind == FilterKind::AmbientObscurance ? AmbientMode::Obscurance
                                                                    : AmbientMode::Sky;
   const ParamValues& v = in.values;
-  const AmbientOptions opt = AmbientOptions::fromParams(mode, v);
+  AmbientOptions opt = AmbientOptions::fromParams(mode, v);
+  opt.vertices = in.vertices;
   const Timer bvh;
   const auto caster = makeEmbreeCaster(in.scene, opt.batch);
   const double bvhSeconds = bvh.seconds();
@@ -105,18 +110,23 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
   res.stats = std::move(r.stats);
   res.stats.add("bvh_seconds", bvhSeconds);  // building the ray caster, not in "seconds"
   if (mode == AmbientMode::Sky) {
-    radiometric(res, in.scene, r.rgb, v.getFloat("exposure"), "Irradiance");
+    res.attributes.push_back(vectorAttribute("Irradiance", r.rgb));
   } else {
     res.vertexQuality = r.value;
-    const auto mapping = AOColorMapping(mode == AmbientMode::Occlusion ? v.getInt("color_mapping") : 0);
-    if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(r.value);
-    else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, r.value);
-    if (opt.bentNormals) {
-      res.attributes.push_back(vectorAttribute("BentNormal", r.bentNormal));
-      if (v.getBool("bent_normals_to_vertex_normals")) res.vertexNormal = r.bentNormal;
-    }
+    if (opt.bentNormals) res.attributes.push_back(vectorAttribute("BentNormal", r.bentNormal));
   }
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+}
+
+void outputAmbient(FilterKind kind, FilterInput& in, FilterResult& res) {
+  const ParamValues& v = in.values;
+  if (kind == FilterKind::SkyLighting) return radiometric(res, in.scene, v.getFloat("exposure"), "Irradiance");
+  const AOColorMapping mapping =
+      kind == FilterKind::AmbientOcclusion ? kAOColorMappings.get(v, "color_mapping") : AOColorMapping::Grey;
+  if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(res.vertexQuality);
+  else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, res.vertexQuality);
+  if (const VertexAttribute* bent = res.attribute("BentNormal"); bent && v.getBool("bent_normals_to_vertex_normals"))
+    res.vertexNormal = vectors(bent);
 }
 
 // Values divided by the q-quantile of the positive ones (a display scale
@@ -138,7 +148,6 @@ void runThickness(FilterInput& in, FilterResult& res, const Progress& progress) 
   ThicknessResult r = computeThickness(in.scene, *caster, ThicknessOptions::fromParams(in.values), progress);
   res.stats = std::move(r.stats);
   res.vertexQuality = r.value;
-  res.vertexColor = greyColors(relativeToPercentile(r.value, 0.99));
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
@@ -161,9 +170,11 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
 
 void runReference(FilterInput& in, FilterResult& res, const Progress& progress) {
   const auto caster = makeEmbreeCaster(in.scene);
-  PathTraceResult r = pathTrace(in.scene, *caster, PathTraceOptions::fromParams(in.values, in.scene.origin), progress);
+  PathTraceOptions opt = PathTraceOptions::fromParams(in.values, in.scene.origin);
+  opt.vertices = in.vertices;
+  PathTraceResult r = pathTrace(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
-  radiometric(res, in.scene, r.B, in.values.getFloat("exposure"), "Radiosity");
+  res.attributes.push_back(vectorAttribute("Radiosity", r.B));
   res.attributes.push_back(vectorAttribute("Irradiance", r.H));
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
@@ -171,28 +182,28 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
 }
 
 void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) {
-  const RadiosityOptions opt = RadiosityOptions::fromParams(in.values);
+  RadiosityOptions opt = RadiosityOptions::fromParams(in.values);
+  opt.vertices = in.vertices;
   RadiosityResult r;
-  const Scene* out = &in.scene;
   if (opt.refine) {
     AdaptiveRadiosity ar = solveRadiosityAdaptive(in.scene, opt, progress);
     r = std::move(ar.result);
     res.refined = std::move(ar.mesh);
-    out = &res.refined->scene;
   } else {
     const auto caster = makeEmbreeCaster(in.scene);
     r = solveRadiosity(in.scene, *caster, opt, progress);
   }
   res.stats = std::move(r.stats);
-  radiometric(res, *out, r.Bvertex, in.values.getFloat("exposure"), "Radiosity");
-  if (in.values.getBool("face_output")) faceRadiometric(res, r.B);
+  res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
+  if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
 }
 
 void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) {
   const auto caster = makeEmbreeCaster(in.scene);
   VertexRadiometry r = computePhotonMap(in.scene, *caster, PhotonOptions::fromParams(in.values, in.scene.origin), progress);
   res.stats = std::move(r.stats);
-  radiometric(res, in.scene, r.B, in.values.getFloat("exposure"), "Radiosity");
+  res.attributes.push_back(vectorAttribute("Radiosity", r.B));
+  radiometric(res, in.scene, in.values.getFloat("exposure"), "Radiosity");
   if (r.stdError.size() == r.B.size()) res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
@@ -310,7 +321,27 @@ FilterResult runFilter(FilterKind kind, FilterInput& in, const Progress& progres
   return res;
 }
 
+bool splitsVertices(FilterKind kind) {
+  switch (kind) {
+    case FilterKind::AmbientOcclusion:
+    case FilterKind::AmbientObscurance:
+    case FilterKind::SkyLighting:
+    case FilterKind::PathTracedReference:
+    case FilterKind::Radiosity: return true;
+    default: return false;
+  }
+}
+
 void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress) {
+  estimateFilter(kind, in, res, progress);
+  outputFilter(kind, in, res);
+}
+
+void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress) {
+  in.vertices.check();
+  if (!in.vertices.all() && !splitsVertices(kind))
+    throw std::invalid_argument("'" + filterDesc(kind).meshlabName +
+                                "' computes all vertices together: it cannot be split over processes");
   switch (kind) {
     case FilterKind::AmbientOcclusion:
     case FilterKind::AmbientObscurance:
@@ -322,7 +353,23 @@ void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Pr
     case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
     case FilterKind::RayTracedView: runRender(in, res, progress); break;
   }
-  finish(res, res.refined ? res.refined->scene : in.scene);
+}
+
+void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res) {
+  const Scene& out = res.refined ? res.refined->scene : in.scene;
+  switch (kind) {
+    case FilterKind::AmbientOcclusion:
+    case FilterKind::AmbientObscurance:
+    case FilterKind::SkyLighting: outputAmbient(kind, in, res); break;
+    case FilterKind::Thickness: res.vertexColor = greyColors(relativeToPercentile(res.vertexQuality, 0.99)); break;
+    case FilterKind::PathTracedReference: radiometric(res, out, in.values.getFloat("exposure"), "Radiosity"); break;
+    case FilterKind::Radiosity:
+      radiometric(res, out, in.values.getFloat("exposure"), "Radiosity");
+      if (!res.faceRadiometry.empty()) faceRadiometric(res, res.faceRadiometry);
+      break;
+    default: break;  // the estimate gave the output already
+  }
+  finish(res, out);
 }
 
 }  // namespace gi

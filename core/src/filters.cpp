@@ -39,10 +39,11 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
     case FilterKind::Radiosity:
       add(lightingSceneSpecs());
       add(RadiosityOptions::specs());
-      s.push_back({"face_output", "Also write per-face results",
-                   "Besides the per-vertex result (area-weighted mean of the incident patches), write each patch's "
-                   "radiosity to face quality and face colour: the flat-shaded look of the course's images.",
-                   ParamType::Bool, 0});
+      s.push_back({.name = "face_output", .label = "Also write per-face results",
+                   .help = "Besides the per-vertex result (area-weighted mean of the incident patches), write each "
+                           "patch's radiosity to face quality and face colour: the flat-shaded look of the course's "
+                           "images.",
+                   .type = ParamType::Bool, .def = false});
       add(displaySpecs());
       break;
     case FilterKind::PhotonMapping:
@@ -53,10 +54,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       break;
     case FilterKind::FormFactorsOfFace:
       s.push_back(geometrySceneSpecs().front());  // scene extent
-      s.push_back({"face_index", "Face",
-                   "The face whose form factors are computed: -1 = the one selected face (MeshLab), else its index "
-                   "in the scene (the command-line tool needs it).",
-                   ParamType::Int, -1, -1, 2147483647});
+      s.push_back({.name = "face_index", .label = "Face",
+                   .help = "The face whose form factors are computed: -1 = the one selected face (MeshLab), else its "
+                           "index in the scene (the command-line tool needs it).",
+                   .type = ParamType::Int, .def = -1, .min = -1, .max = 2147483647});
       add(formFactorSpecs());
       s.push_back(seedSpec("form-factor rays"));
       break;

@@ -101,41 +101,46 @@ FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, cons
 
 std::vector<ParamSpec> formFactorSpecs() {
   return {
-      {"form_factor_method", "Form factors",
-       "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
-       "cosine-weighted directions (origins and directions from independent Owen-scrambled Sobol dimensions); the "
-       "fraction that lands on patch j's front is F_ij (visibility included; cost n x rays). Analytic "
-       "point-to-polygon (Wallace et al. 1989): the exact unoccluded factor from points of each patch to every "
-       "other patch, averaged by an adaptive midpoint rule, times one visibility ray per point (none in an empty "
-       "convex room; cost n^2 x points). Hemicube (Cohen and Greenberg 1985): all patches rasterised onto a "
-       "hemicube with a depth buffer, at each patch centre or at several points (cost n^2 x resolution x points; "
-       "aliasing for small or distant patches). Auto: analytic up to 2,000 patches, else Monte Carlo. Light that "
-       "leaves the scene or meets a back face is lost (absorbed).",
-       ParamType::Enum, 0, 0, 0, {"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
-      {"rays_per_patch", "Rays per patch (Monte Carlo)",
-       "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N) or faster; for a small "
-       "F_ij it is about 1/sqrt(N F_ij) of it (3.4% for F = 0.003 at 262,144 rays). The radiosity error averages "
-       "over many patches and falls faster.",
-       ParamType::Int, 1024, 16, 1 << 22},
-      {"analytic_points", "Points per patch (analytic)",
-       "Base points per patch: the patch is split into 4^L similar triangles (this number rounded down to a power "
-       "of 4: 1, 4, 16, 64 ...) and the exact factor taken at each one's centroid (the midpoint rule; its error "
-       "is about (r/d)^2/4 for parts of radius r at distance d). For pairs of patches closer than 4 part radii "
-       "the parts are split further, up to 8 more levels, where a split changes the estimate by more than 1% of "
-       "the pair's factor: large patches at a common edge, where the factor varies fastest, come out within "
-       "0.2% too. One visibility ray per base point and pair.", ParamType::Int, 4, 1, 4096},
-      {"hemicube_resolution", "Hemicube resolution",
-       "Cells across the hemicube's top face (the sides have half as many rows). A patch seen across few cells "
-       "aliases: a 0.1 x 0.1 square one away covers about 6 x 6 cells at 128 and comes out 12% low with one view "
-       "(3% high at 512); several views (hemicube_points) average that out. Cost grows as the square.",
-       ParamType::Int, 128, 4, 4096},
-      {"hemicube_points", "Hemicube views per patch",
-       "1: one hemicube at the patch's centre (Cohen and Greenberg 1985), enough when patches are small against "
-       "their distances (the error of one central view is about (r/d)^2/4 for patch radius r at distance d: "
-       "12% for unit squares one apart). More: the patch is bisected where its views differ most and a hemicube "
-       "placed at each part's centroid (2 views per split), each turned by a random angle about the normal so "
-       "that the cells' aliasing averages out. Cost grows in proportion; 129 views (128 cells) bring two-triangle "
-       "rectangles, even a thin one at a common edge, within 1% of their exact factor.", ParamType::Int, 1, 1, 4096},
+      {.name = "form_factor_method", .label = "Form factors",
+       .help = "How the form factors F_ij are computed. Monte Carlo: from stratified points on each patch, rays in "
+               "cosine-weighted directions (origins and directions from independent Owen-scrambled Sobol "
+               "dimensions); the fraction that lands on patch j's front is F_ij (visibility included; cost n x "
+               "rays). Analytic point-to-polygon (Wallace et al. 1989): the exact unoccluded factor from points of "
+               "each patch to every other patch, averaged by an adaptive midpoint rule, times one visibility ray per "
+               "point (none in an empty convex room; cost n^2 x points). Hemicube (Cohen and Greenberg 1985): all "
+               "patches rasterised onto a hemicube with a depth buffer, at each patch centre or at several points "
+               "(cost n^2 x resolution x points; aliasing for small or distant patches). Auto: analytic up to 2,000 "
+               "patches, else Monte Carlo. Light that leaves the scene or meets a back face is lost (absorbed).",
+       .type = ParamType::Enum, .def = kFormFactorMethods.index(FormFactorMethod::MonteCarlo),
+       .choices = kFormFactorMethods.choices()},
+      {.name = "rays_per_patch", .label = "Rays per patch (Monte Carlo)",
+       .help = "Form-factor rays cast from each patch. The error of each F_ij falls as 1/sqrt(N) or faster; for a "
+               "small F_ij it is about 1/sqrt(N F_ij) of it (3.4% for F = 0.003 at 262,144 rays). The radiosity "
+               "error averages over many patches and falls faster.",
+       .type = ParamType::Int, .def = 1024, .min = 16, .max = 1 << 22},
+      {.name = "analytic_points", .label = "Points per patch (analytic)",
+       .help = "Base points per patch: the patch is split into 4^L similar triangles (this number rounded down to a "
+               "power of 4: 1, 4, 16, 64 ...) and the exact factor taken at each one's centroid (the midpoint rule; "
+               "its error is about (r/d)^2/4 for parts of radius r at distance d). For pairs of patches closer than "
+               "4 part radii the parts are split further, up to 8 more levels, where a split changes the estimate by "
+               "more than 1% of the pair's factor: large patches at a common edge, where the factor varies fastest, "
+               "come out within 0.2% too. One visibility ray per base point and pair.",
+       .type = ParamType::Int, .def = 4, .min = 1, .max = 4096},
+      {.name = "hemicube_resolution", .label = "Hemicube resolution",
+       .help = "Cells across the hemicube's top face (the sides have half as many rows). A patch seen across few "
+               "cells aliases: a 0.1 x 0.1 square one away covers about 6 x 6 cells at 128 and comes out 12% low "
+               "with one view (3% high at 512); several views (hemicube_points) average that out. Cost grows as the "
+               "square.",
+       .type = ParamType::Int, .def = 128, .min = 4, .max = 4096},
+      {.name = "hemicube_points", .label = "Hemicube views per patch",
+       .help = "1: one hemicube at the patch's centre (Cohen and Greenberg 1985), enough when patches are small "
+               "against their distances (the error of one central view is about (r/d)^2/4 for patch radius r at "
+               "distance d: 12% for unit squares one apart). More: the patch is bisected where its views differ most "
+               "and a hemicube placed at each part's centroid (2 views per split), each turned by a random angle "
+               "about the normal so that the cells' aliasing averages out. Cost grows in proportion; 129 views (128 "
+               "cells) bring two-triangle rectangles, even a thin one at a common edge, within 1% of their exact "
+               "factor.",
+       .type = ParamType::Int, .def = 1, .min = 1, .max = 4096},
   };
 }
 
@@ -154,8 +159,12 @@ uint32_t chosenFace(int faceIndex, const std::vector<uint8_t>& selected, size_t 
 }
 
 FormFactors::Settings formFactorSettings(const ParamValues& v) {
-  return {FormFactorMethod(v.getInt("form_factor_method")), v.getInt("rays_per_patch"), v.getInt("analytic_points"),
-          v.getInt("hemicube_resolution"), uint32_t(v.getInt("seed")), v.getInt("hemicube_points")};
+  return {.method = kFormFactorMethods.get(v, "form_factor_method"),
+          .raysPerPatch = v.getInt("rays_per_patch"),
+          .analyticPoints = v.getInt("analytic_points"),
+          .hemicubeResolution = v.getInt("hemicube_resolution"),
+          .seed = uint32_t(v.getInt("seed")),
+          .hemicubePoints = v.getInt("hemicube_points")};
 }
 
 uint64_t FormFactors::raysCast() const {

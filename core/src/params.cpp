@@ -36,9 +36,9 @@ const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string
 }
 
 ParamSpec seedSpec(const std::string& what) {
-  return {"seed", "Random seed",
-          "Seed of the " + what + ". The same seed gives bit-identical results for any thread count.",
-          ParamType::Int, 0, 0, 2147483647};
+  return {.name = "seed", .label = "Random seed",
+          .help = "Seed of the " + what + ". The same seed gives bit-identical results for any thread count.",
+          .type = ParamType::Int, .def = 0, .min = 0, .max = 2147483647};
 }
 
 ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) {

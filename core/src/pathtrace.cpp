@@ -17,38 +17,46 @@ namespace gi {
 
 std::vector<ParamSpec> PathTraceOptions::specs() {
   std::vector<ParamSpec> out = {
-      {"samples_per_vertex", "Paths per vertex",
-       "Paths traced from each vertex when no target error is set. The error falls as 1/sqrt(N) (independent "
-       "random numbers: the reported standard error is an honest error bar).",
-       ParamType::Int, 256, 1, 1 << 24},
-      {"target_relative_error", "Target relative error",
-       "If > 0, each vertex traces paths in rounds of 32 until the standard error of its radiosity is below this "
-       "fraction of it (or of a tenth of the scene's mean, for dark vertices).",
-       ParamType::Float, 0.0, 0.0, 1.0},
-      {"min_samples", "Minimum paths (adaptive)", "Adaptive sampling never stops before this many paths.",
-       ParamType::Int, 64, 2, 1 << 24},
-      {"max_samples", "Maximum paths (adaptive)", "Adaptive sampling never traces more than this many paths.",
-       ParamType::Int, 65536, 2, 1 << 26},
-      {"max_depth", "Maximum bounces",
-       "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the largest "
-       "reflectance channel) ends paths, after about 1 / (1 - rho) bounces; a path still going after 100,000 "
-       "bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths end after k bounces (0 = "
-       "direct light only); the light of more bounces is missing (in a closed room of reflectance rho, a share "
-       "rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: a warning says so when it "
-       "may exceed them.",
-       ParamType::Int, -1, -1, 100000},
-      {"sky_color", "Sky colour", "Colour of a uniform sky around the scene (sRGB).", ParamType::Color, 0, 0, 0, {},
-       glm::vec3(1.f)},
-      {"sky_irradiance", "Sky irradiance (W/m^2)",
-       "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.", ParamType::Float, 0.0, 0.0,
-       1e9},
-      {"sun_direction", "Sun direction", "Direction towards the sun.", ParamType::Direction, 0, 0, 0, {},
-       glm::vec3(0.3f, 1.f, 0.2f)},
-      {"sun_color", "Sun colour", "Colour of the sun (sRGB).", ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)},
-      {"sun_irradiance", "Sun irradiance (W/m^2)", "Irradiance of the sun on a surface facing it; 0 = no sun.",
-       ParamType::Float, 0.0, 0.0, 1e9},
-      {"sun_angular_radius", "Sun angular radius (deg)", "0 gives a sharp directional light.", ParamType::Float,
-       0.27, 0.0, 45},
+      {.name = "samples_per_vertex", .label = "Paths per vertex",
+       .help = "Paths traced from each vertex when no target error is set. The error falls as 1/sqrt(N) (independent "
+               "random numbers: the reported standard error is an honest error bar).",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 24},
+      {.name = "target_relative_error", .label = "Target relative error",
+       .help = "If > 0, each vertex traces paths in rounds of 32 until the standard error of its radiosity is below "
+               "this fraction of it (or of a tenth of the scene's mean, for dark vertices).",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1.0},
+      {.name = "min_samples", .label = "Minimum paths (adaptive)",
+       .help = "Adaptive sampling never stops before this many paths.",
+       .type = ParamType::Int, .def = 64, .min = 2, .max = 1 << 24},
+      {.name = "max_samples", .label = "Maximum paths (adaptive)",
+       .help = "Adaptive sampling never traces more than this many paths.",
+       .type = ParamType::Int, .def = 65536, .min = 2, .max = 1 << 26},
+      {.name = "max_depth", .label = "Maximum bounces",
+       .help = "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the "
+               "largest reflectance channel) ends paths, after about 1 / (1 - rho) bounces; a path still going after "
+               "100,000 bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths end after k "
+               "bounces (0 = direct light only); the light of more bounces is missing (in a closed room of "
+               "reflectance rho, a share rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: "
+               "a warning says so when it may exceed them.",
+       .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
+      {.name = "sky_color", .label = "Sky colour",
+       .help = "Colour of a uniform sky around the scene (sRGB).",
+       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
+      {.name = "sky_irradiance", .label = "Sky irradiance (W/m^2)",
+       .help = "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
+      {.name = "sun_direction", .label = "Sun direction",
+       .help = "Direction towards the sun.",
+       .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)},
+      {.name = "sun_color", .label = "Sun colour",
+       .help = "Colour of the sun (sRGB).",
+       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
+      {.name = "sun_irradiance", .label = "Sun irradiance (W/m^2)",
+       .help = "Irradiance of the sun on a surface facing it; 0 = no sun.",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
+      {.name = "sun_angular_radius", .label = "Sun angular radius (deg)",
+       .help = "0 gives a sharp directional light.",
+       .type = ParamType::Float, .def = 0.27, .min = 0.0, .max = 45},
   };
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
   out.push_back(seedSpec("paths"));
@@ -300,27 +308,36 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     return std::sqrt(std::max(0.0, (a.sumL2 - a.n * m * m) / (a.n - 1)) / a.n);
   };
   const bool adaptive = opt.targetRelativeError > 0;
+  const VertexPart& part = opt.vertices;  // a split run traces its part of the vertices
+  if (adaptive && !part.all() && !part.sumOverParts)
+    throw std::logic_error("an adaptive reference split over parts needs their sum (VertexPart::sumOverParts)");
   Timer traceTimer;
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i]) trace(i, opt.samplesPerVertex);
+        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.samplesPerVertex);
     });
   } else {
     // Pilot pass, then rounds of 32 paths for the vertices still above target.
     parallelBlocks(nv, progress.sub(0.0, 0.2), "tracing paths (pilot)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i]) trace(i, opt.minSamples);
+        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.minSamples);
     });
+    // The pilot's mean B over all vertices, summed in vertex order: the same
+    // bits in one process and in a split run (each part fills its vertices).
+    std::vector<double> pilot(nv, 0.0);
+    for (size_t i = 0; i < nv; ++i)
+      if (mat.valid[i] && part.contains(i, nv)) pilot[i] = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
+    if (!part.all()) part.sumOverParts(pilot);
     double meanB = 0;
     size_t valid = 0;
     for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i]) { meanB += luminance(mat.E[i]) + acc[i].sumL / acc[i].n; ++valid; }
+      if (mat.valid[i]) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
     const double floorB = 0.1 * meanB;
     parallelBlocks(nv, progress.sub(0.2, 1.0), "tracing paths (adaptive)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        if (!mat.valid[i]) continue;
+        if (!mat.valid[i] || !part.contains(i, nv)) continue;
         while (acc[i].n < opt.maxSamples) {
           const double B = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
           if (stdErr(acc[i]) <= opt.targetRelativeError * std::max(B, floorB)) break;
@@ -369,7 +386,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
-  if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
+  if (valid < part.count(nv)) st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirrors or glass only) got 0");
   return res;
 }
 

@@ -24,58 +24,63 @@ namespace gi {
 
 std::vector<ParamSpec> PhotonOptions::specs() {
   std::vector<ParamSpec> out = {
-      {"photons", "Photons emitted",
-       "Number of photon paths shot from the lights (in proportion to their power); per pass when progressive. More "
-       "photons: less noise and blur; memory grows linearly (about 50 bytes per stored photon with its kd-tree, 1-4 stored per path).",
-       ParamType::Int, 200000, 1, 100000000},
-      {"k_nearest", "Photons per estimate",
-       "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side of the "
-       "surface: their power over the area of that surface within their radius (a disk on a plane, half of it at a "
-       "crease). More photons mean less noise (about 1 / sqrt(k)) but more blur; k = 1 or 2 gives an estimate "
-       "without a finite mean or variance.",
-       ParamType::Int, 64, 1, 512},
-      {"caustic_k", "Photons per caustic estimate",
-       "k for the caustic map (photons that reached a diffuse surface through mirrors or glass only). Its cone "
-       "filter (Jensen 1996) keeps caustic edges sharp; smaller k: sharper and noisier (the relative noise is "
-       "about 1 / sqrt(k)).",
-       ParamType::Int, 128, 1, 512},
-      {"caustic_projection", "Aim caustic photons at mirrors and glass",
-       "Shoot the caustic photons only towards the mirror and glass objects (Jensen's projection maps: from each "
-       "light point, directions in the cones their bounding spheres subtend), so that small specular objects get "
-       "many caustic photons. Off: the caustic map keeps the global photons that happened to pass through them.",
-       ParamType::Bool, 1},
-      {"max_radius", "Maximum gather radius",
-       "Photons farther than this from a vertex are ignored (0 = no limit); vertices with no photon within it get "
-       "only their direct light. Keep it well above the photon spacing sqrt(diffuse area / stored photons): below "
-       "it an estimate holds 0 or 1 photon and reads 0 or many times too bright (the log warns). Absolute or % of "
-       "the bbox diagonal.",
-       ParamType::Distance, 0.05, 0.0, 1.0},
-      {"direct_light", "Direct light by light sampling",
-       "Compute the direct light at each vertex by explicit light sampling (shadow rays to points on the emitters: "
-       "soft shadows, no photon noise) and use the photons only for caustics and indirect light. Off: all light "
-       "from the photon map (the classic noisy look).",
-       ParamType::Bool, 1},
-      {"light_samples", "Shadow rays per vertex", "Shadow rays for the direct light at each vertex.", ParamType::Int,
-       256, 1, 1 << 20},
-      {"final_gather", "Final gather",
-       "For the indirect diffuse light, cast cosine-weighted rays from each vertex (through mirrors and glass) and "
-       "read the global photon map where they land (Jensen's final gather): much smoother, at the cost of the "
-       "rays. Caustics still come from the caustic map.",
-       ParamType::Bool, 0},
-      {"gather_rays", "Final-gather rays per vertex", "Rays per vertex for the final gather.", ParamType::Int, 64, 1,
-       1 << 20},
-      {"progressive", "Progressive photon mapping",
-       "Shoot the photons in passes and keep, per vertex, a gather radius and the flux found in it; after each pass "
-       "the radius shrinks so that a fraction alpha = 2/3 of the new photons is kept (Hachisuka, Ogaki and Jensen "
-       "2008). Bias and noise both go to zero as passes grow, with memory for one pass only. Replaces the k-nearest "
-       "estimates and the final gather.",
-       ParamType::Bool, 0},
-      {"passes", "Progressive passes", "Passes of 'Photons emitted' photons each (progressive mode).", ParamType::Int,
-       16, 1, 100000},
-      {"max_depth", "Maximum bounces",
-       "Paths end after this many bounces, diffuse or specular (Russian roulette ends most much earlier; the power "
-       "still carried by cut paths is logged).",
-       ParamType::Int, 32, 1, 1000},
+      {.name = "photons", .label = "Photons emitted",
+       .help = "Number of photon paths shot from the lights (in proportion to their power); per pass when "
+               "progressive. More photons: less noise and blur; memory grows linearly (about 50 bytes per stored "
+               "photon with its kd-tree, 1-4 stored per path).",
+       .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000},
+      {.name = "k_nearest", .label = "Photons per estimate",
+       .help = "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side "
+               "of the surface: their power over the area of that surface within their radius (a disk on a plane, "
+               "half of it at a crease). More photons mean less noise (about 1 / sqrt(k)) but more blur; k = 1 or 2 "
+               "gives an estimate without a finite mean or variance.",
+       .type = ParamType::Int, .def = 64, .min = 1, .max = 512},
+      {.name = "caustic_k", .label = "Photons per caustic estimate",
+       .help = "k for the caustic map (photons that reached a diffuse surface through mirrors or glass only). Its "
+               "cone filter (Jensen 1996) keeps caustic edges sharp; smaller k: sharper and noisier (the relative "
+               "noise is about 1 / sqrt(k)).",
+       .type = ParamType::Int, .def = 128, .min = 1, .max = 512},
+      {.name = "caustic_projection", .label = "Aim caustic photons at mirrors and glass",
+       .help = "Shoot the caustic photons only towards the mirror and glass objects (Jensen's projection maps: from "
+               "each light point, directions in the cones their bounding spheres subtend), so that small specular "
+               "objects get many caustic photons. Off: the caustic map keeps the global photons that happened to "
+               "pass through them.",
+       .type = ParamType::Bool, .def = true},
+      {.name = "max_radius", .label = "Maximum gather radius",
+       .help = "Photons farther than this from a vertex are ignored (0 = no limit); vertices with no photon within "
+               "it get only their direct light. Keep it well above the photon spacing sqrt(diffuse area / stored "
+               "photons): below it an estimate holds 0 or 1 photon and reads 0 or many times too bright (the log "
+               "warns). Absolute or % of the bbox diagonal.",
+       .type = ParamType::Distance, .def = 0.05, .min = 0.0, .max = 1.0},
+      {.name = "direct_light", .label = "Direct light by light sampling",
+       .help = "Compute the direct light at each vertex by explicit light sampling (shadow rays to points on the "
+               "emitters: soft shadows, no photon noise) and use the photons only for caustics and indirect light. "
+               "Off: all light from the photon map (the classic noisy look).",
+       .type = ParamType::Bool, .def = true},
+      {.name = "light_samples", .label = "Shadow rays per vertex",
+       .help = "Shadow rays for the direct light at each vertex.",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      {.name = "final_gather", .label = "Final gather",
+       .help = "For the indirect diffuse light, cast cosine-weighted rays from each vertex (through mirrors and "
+               "glass) and read the global photon map where they land (Jensen's final gather): much smoother, at the "
+               "cost of the rays. Caustics still come from the caustic map.",
+       .type = ParamType::Bool, .def = false},
+      {.name = "gather_rays", .label = "Final-gather rays per vertex",
+       .help = "Rays per vertex for the final gather.",
+       .type = ParamType::Int, .def = 64, .min = 1, .max = 1 << 20},
+      {.name = "progressive", .label = "Progressive photon mapping",
+       .help = "Shoot the photons in passes and keep, per vertex, a gather radius and the flux found in it; after "
+               "each pass the radius shrinks so that a fraction alpha = 2/3 of the new photons is kept (Hachisuka, "
+               "Ogaki and Jensen 2008). Bias and noise both go to zero as passes grow, with memory for one pass "
+               "only. Replaces the k-nearest estimates and the final gather.",
+       .type = ParamType::Bool, .def = false},
+      {.name = "passes", .label = "Progressive passes",
+       .help = "Passes of 'Photons emitted' photons each (progressive mode).",
+       .type = ParamType::Int, .def = 16, .min = 1, .max = 100000},
+      {.name = "max_depth", .label = "Maximum bounces",
+       .help = "Paths end after this many bounces, diffuse or specular (Russian roulette ends most much earlier; the "
+               "power still carried by cut paths is logged).",
+       .type = ParamType::Int, .def = 32, .min = 1, .max = 1000},
   };
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
   out.push_back(seedSpec("photon paths"));
@@ -127,6 +132,225 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
   return H;
 }
 
+// What the estimators need to know of a run.
+struct PhotonRun {
+  const Scene& s;
+  const RayCaster& caster;
+  const PhotonOptions& opt;  // in local units
+  const VertexMaterial& mat;
+  const std::vector<glm::vec3>& origins;  // ray origins lifted off the vertices
+  float eps;
+  bool specular;          // the scene has mirror or glass faces
+  bool projection;        // caustic photons aimed at them
+  unsigned vertexPaths;   // the photon paths the vertex estimates read
+  float r2max;            // squared gather radius cap
+};
+
+// The photons' irradiance at the vertices.
+struct PhotonEstimate {
+  std::vector<glm::vec3> H;
+  std::vector<double> noise;  // Poisson standard error (luminance)
+  size_t verticesWithoutPhotons = 0;
+  PhotonGatherCheck check;
+};
+
+// Direct light by light sampling at every vertex (area emitters and the
+// point or spot light), or none when the photons carry it.
+std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress) {
+  std::vector<glm::vec3> Hd(r.s.vertexCount(), glm::vec3(0.f));
+  if (!r.opt.directLight) return Hd;
+  Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress);
+  const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
+  for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i];
+  return Hd;
+}
+
+PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress, PhotonTraceStats& ts, RunStats& st) {
+  ProgressiveResult pr =
+      progressivePhotonMap(r.s, r.caster, r.opt, r.mat, r.vertexPaths, r.projection, progress.sub(0.15, 1.0), ts);
+  st.add("ppm_passes", double(r.opt.passes));
+  st.add("ppm_mean_final_radius", pr.meanRadius * r.s.unit);
+  st.add("ppm_mean_photons_per_vertex", pr.meanCount);
+  st.add("kdtree_build_seconds", pr.buildSeconds);
+  st.add("query_seconds", pr.querySeconds);
+  st.add("trace_seconds", pr.traceSeconds);
+  st.add("photon_memory_mb", pr.peakBytes / 1048576.0);
+  if (r.opt.finalGather) st.note("final gather not used: progressive photon mapping estimates all photon light");
+  return {std::move(pr.H), std::move(pr.noise), pr.verticesWithoutPhotons, pr.check};
+}
+
+// The kd-trees of a k-nearest run over the traced photons (which must
+// outlive them): the global map read at the vertices, or, with a final
+// gather, `all` read where its rays land; and the caustic map.
+struct PhotonMaps {
+  std::unique_ptr<PhotonMap> global, caustics, all;
+  unsigned globalPaths = 7u;
+  size_t bytes = 0;  // the photons and the trees
+};
+
+PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, const std::vector<Photon>& causticPhotons,
+                     const GatherSurface& surface, const PhotonTraceStats& ts) {
+  PhotonMaps m;
+  m.globalPaths = r.opt.directLight ? (1u << kIndirectPhoton) : 7u;
+  const bool gather = r.opt.directLight && r.opt.finalGather;
+  // Caustic photons (L S+ D) have their own map, shot by projection towards
+  // the mirrors and glass, whenever the direct light is apart; otherwise one
+  // map holds every photon. The (single-threaded) builds run side by side.
+  tbb::parallel_invoke(
+      [&] {
+        // The final gather reads `all` at the points its rays reach, never the global map at the vertices.
+        if (!gather) m.global = std::make_unique<PhotonMap>(photons, m.globalPaths, surface);
+      },
+      [&] {
+        if (r.projection && !causticPhotons.empty())
+          m.caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton, surface);
+        else if (r.opt.directLight && !r.projection && ts.caustic > 0)
+          m.caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
+      },
+      [&] {
+        if (gather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface);
+      });
+  m.bytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
+  for (const auto* map : {m.global.get(), m.caustics.get(), m.all.get()})
+    if (map) m.bytes += map->memoryBytes();
+  return m;
+}
+
+// Density estimates at the vertices: the global map there (or the final
+// gather reading `all`) with k_nearest photons, plus the caustic map with
+// caustic_k; counts the estimates that held some or only a few photons.
+PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const Progress& progress) {
+  const Scene& s = r.s;
+  const PhotonOptions& opt = r.opt;
+  const size_t nv = s.vertexCount();
+  PhotonEstimate e;
+  e.H.assign(nv, glm::vec3(0.f));
+  e.noise.assign(nv, 0.0);
+  std::atomic<size_t> some{0}, few{0};
+  auto count = [&](int used) {
+    if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
+    if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
+  };
+  std::vector<glm::vec3> gathered;
+  if (m.all) {
+    gathered = specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps,
+                                   [&](uint32_t f, const glm::vec3& y, const glm::vec3& side) {
+                                     int used = 0;
+                                     const glm::vec3 H = m.all->irradiance(y, side, opt.kNearest, r.r2max,
+                                                                           PhotonKernel::Uniform, nullptr, &used);
+                                     count(used);
+                                     return s.faceRho(f) * H;
+                                   });
+  }
+  parallelBlocks(nv, progress, "density estimation", [&](size_t b, size_t end) {
+    for (size_t i = b; i < end; ++i) {
+      if (!r.mat.valid[i]) continue;
+      double e1 = 0, e2 = 0;
+      int used = 0;
+      glm::vec3 H = m.all ? gathered[i]
+                          : m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max,
+                                                 PhotonKernel::Uniform, &e1, &used);
+      if (!m.all) count(used);
+      if (m.caustics)
+        H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2);
+      e.H[i] = H;
+      e.noise[i] = std::sqrt(e1 * e1 + e2 * e2);
+    }
+  });
+  for (size_t i = 0; i < nv; ++i)
+    if (r.mat.valid[i] && luminance(e.H[i]) <= 0.f) ++e.verticesWithoutPhotons;
+  e.check.estimates = some.load();
+  e.check.fewEstimates = few.load();
+  return e;
+}
+
+// Photon mapping proper (Jensen 1996): trace, build the maps, estimate at
+// the vertices.
+PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, PhotonTraceStats& ts, RunStats& st) {
+  const PhotonOptions& opt = r.opt;
+  Timer traceTimer;
+  std::vector<Photon> photons =
+      tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts);
+  std::vector<Photon> causticPhotons;
+  if (r.projection)
+    causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
+  const double traceSeconds = traceTimer.seconds();
+  Timer buildTimer;
+  const GatherSurface surface(r.s);
+  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts);
+  const double buildSeconds = buildTimer.seconds();
+  Timer queryTimer;
+  PhotonEstimate e = estimateAtVertices(r, maps, progress.sub(0.55, 1.0));
+  st.add("trace_seconds", traceSeconds);
+  st.add("kdtree_build_seconds", buildSeconds);
+  st.add("query_seconds", queryTimer.seconds());
+  st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
+  size_t globalCount = 0;
+  for (const Photon& p : photons) globalCount += (maps.globalPaths >> p.path) & 1u;
+  st.add("photons_global_map", double(globalCount));
+  e.check.surfaceArea = surface.totalArea();
+  e.check.mapPhotons = maps.all ? maps.all->size() : maps.global->size();
+  e.check.causticPhotons = maps.caustics ? maps.caustics->size() : 0;
+  e.check.kNearestEstimates = true;
+  st.add("photons_caustic_map", maps.caustics ? double(maps.caustics->size()) : 0.0);
+  st.add("photon_memory_mb", maps.bytes / 1048576.0);
+  if (!r.specular) st.note("no caustic map: the scene has no mirror or glass faces");
+  else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
+  if (maps.all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
+  return e;
+}
+
+// The photons' statistics and the warnings for meaningless parameters.
+void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate& e, RunStats& st) {
+  st.add("photons_emitted", double(ts.emitted));
+  if (r.projection) {
+    st.add("caustic_photons_aimed", double(ts.causticEmitted));
+    st.add("caustic_photons_stored", double(ts.causticStored));
+    st.note("caustic photons aimed at the mirrors and glass (projection): " +
+            std::to_string(ts.causticEmitted - ts.causticMissed) + " of " + std::to_string(ts.causticEmitted) +
+            " hit them first");
+  }
+  st.add("photons_stored", double(ts.stored));
+  st.add("diffuse_bounces", double(ts.diffuseBounces));
+  st.add("specular_bounces", double(ts.specularBounces));
+  st.add("total_internal_reflections", double(ts.totalInternal));
+  st.add("emitted_power_W", ts.emittedPower * r.s.unit * r.s.unit);
+  if (ts.lostAtMaxDepth)
+    st.note(std::to_string(ts.lostAtMaxDepth) + " paths cut at max_depth, carrying " +
+            std::to_string(ts.emittedPower > 0 ? 100.0 * ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0) +
+            "% of the emitted power");
+  e.check.lostPowerFraction = ts.emittedPower > 0 ? ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0;
+  warnMeaninglessPhotonParameters(r.opt, e.check, st);
+  if (e.verticesWithoutPhotons)
+    st.note(std::to_string(e.verticesWithoutPhotons) +
+            " vertices reached by no photon within the gather radius: direct light only");
+}
+
+// B = E + rho (H_direct + H_photons) at the vertices, with the photons'
+// noise carried to B; the mean luminance and the rms noise for the log.
+struct Totals {
+  double meanLuminance = 0, rmsNoise = 0;
+};
+Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const PhotonEstimate& e,
+               VertexRadiometry& out) {
+  const size_t nv = Hd.size();
+  out.B.assign(nv, glm::vec3(0.f));
+  out.H.assign(nv, glm::vec3(0.f));
+  out.stdError.assign(nv, 0.f);
+  double lum = 0, err2 = 0;
+  size_t valid = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    if (!mat.valid[i]) continue;
+    out.H[i] = Hd[i] + e.H[i];
+    out.B[i] = mat.E[i] + mat.rho[i] * out.H[i];
+    out.stdError[i] = float(luminance(mat.rho[i]) * e.noise[i]);
+    lum += luminance(out.B[i]);
+    err2 += double(out.stdError[i]) * out.stdError[i];
+    ++valid;
+  }
+  return {valid ? lum / double(valid) : 0.0, valid ? std::sqrt(err2 / double(valid)) : 0.0};
+}
+
 }  // namespace
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
@@ -149,172 +373,35 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   // neither, there is nothing for them to do.
   const bool needPhotons = !opt.directLight || specular || anyDiffuseReflection(s);
   const bool projection = opt.directLight && specular && opt.causticProjection;  // caustic photons aimed at mirrors and glass
-  const float r2max = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
-
-  Timer directTimer;
-  std::vector<glm::vec3> Hd(nv, glm::vec3(0.f));
-  if (opt.directLight) {
-    Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.15));
-    const auto Hp = pointLightAtVertices(s, caster, opt.point, mat, origins);
-    for (size_t i = 0; i < nv; ++i) Hd[i] += Hp[i];
-  }
-  const double directSeconds = directTimer.seconds();
-
-  std::vector<glm::vec3> Hphot(nv, glm::vec3(0.f));
-  std::vector<double> noise(nv, 0.0);
-  PhotonTraceStats ts;
-  size_t noPhotonVertices = 0;
-  PhotonGatherCheck check;
   // Which photons the vertex estimate reads: all, or all but the direct ones.
   const unsigned vertexPaths = opt.directLight ? (1u << kCausticPhoton) | (1u << kIndirectPhoton) : 7u;
+  const float r2max = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
+  const PhotonRun run{s, caster, opt, mat, origins, eps, specular, projection, vertexPaths, r2max};
+
+  Timer directTimer;
+  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15));
+  const double directSeconds = directTimer.seconds();
+  PhotonTraceStats ts;
+  PhotonEstimate photons;
   if (!needPhotons) {
     st.note("no photons traced: the direct light is computed apart and nothing reflects it (rho = 0 everywhere, no "
             "mirror or glass)");
     // Still fail clearly without any light.
     if (EmitterSampler(s).empty() && !opt.point.on())
       throw std::invalid_argument("the scene has no light: no emitter faces and no point or spot light");
+    photons.H.assign(nv, glm::vec3(0.f));
+    photons.noise.assign(nv, 0.0);
   } else if (opt.progressive) {
-    ProgressiveResult pr = progressivePhotonMap(s, caster, opt, mat, vertexPaths, projection, progress.sub(0.15, 1.0), ts);
-    Hphot = std::move(pr.H);
-    noise = std::move(pr.noise);
-    noPhotonVertices = pr.verticesWithoutPhotons;
-    check = pr.check;
-    st.add("ppm_passes", double(opt.passes));
-    st.add("ppm_mean_final_radius", pr.meanRadius * s.unit);
-    st.add("ppm_mean_photons_per_vertex", pr.meanCount);
-    st.add("kdtree_build_seconds", pr.buildSeconds);
-    st.add("query_seconds", pr.querySeconds);
-    st.add("trace_seconds", pr.traceSeconds);
-    st.add("photon_memory_mb", pr.peakBytes / 1048576.0);
-    if (opt.finalGather) st.note("final gather not used: progressive photon mapping estimates all photon light");
+    photons = progressiveEstimate(run, progress, ts, st);
   } else {
-    Timer traceTimer;
-    std::vector<Photon> photons = tracePhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts);
-    // Caustic photons (L S+ D) have their own map, shot by projection towards
-    // the mirrors and glass, whenever the direct light is apart; otherwise
-    // one map holds every photon.
-    std::vector<Photon> causticPhotons;
-    if (projection) causticPhotons = traceCausticPhotons(s, caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
-    const double traceSeconds = traceTimer.seconds();
-    Timer buildTimer;
-    const GatherSurface surface(s);
-    const unsigned globalPaths = opt.directLight ? (1u << kIndirectPhoton) : 7u;
-    // The (single-threaded) kd-tree builds run side by side.
-    std::unique_ptr<PhotonMap> globalMap, caustics, all;
-    const bool gather = opt.directLight && opt.finalGather;
-    tbb::parallel_invoke(
-        [&] {
-          // The final gather reads `all` at the points its rays reach, never the global map at the vertices.
-          if (!gather) globalMap = std::make_unique<PhotonMap>(photons, globalPaths, surface);
-        },
-        [&] {
-          if (projection && !causticPhotons.empty())
-            caustics = std::make_unique<PhotonMap>(causticPhotons, 1u << kCausticPhoton, surface);
-          else if (opt.directLight && !projection && ts.caustic > 0)
-            caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
-        },
-        [&] {
-          if (gather) all = std::make_unique<PhotonMap>(photons, 7u, surface);
-        });
-    const double buildSeconds = buildTimer.seconds();
-    size_t mapBytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
-    if (globalMap) mapBytes += globalMap->memoryBytes();
-    if (caustics) mapBytes += caustics->memoryBytes();
-    if (all) mapBytes += all->memoryBytes();
-    Timer queryTimer;
-    std::vector<glm::vec3> gathered;
-    // Photons per global (or final-gather) estimate: how many held some, how many only a few.
-    std::atomic<size_t> some{0}, few{0};
-    auto count = [&](int used) {
-      if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
-      if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
-    };
-    if (all) {
-      gathered = specularFinalGather(s, caster, mat, origins, opt.gatherRays, opt.seed ^ 0x6au, eps,
-                                     [&](uint32_t f, const glm::vec3& y, const glm::vec3& side) {
-                                       int used = 0;
-                                       const glm::vec3 H = all->irradiance(y, side, opt.kNearest, r2max,
-                                                                           PhotonKernel::Uniform, nullptr, &used);
-                                       count(used);
-                                       return s.faceRho(f) * H;
-                                     });
-    }
-    parallelBlocks(nv, progress.sub(0.55, 1.0), "density estimation", [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        if (!mat.valid[i]) continue;
-        double e1 = 0, e2 = 0;
-        int used = 0;
-        glm::vec3 H = all ? gathered[i]
-                          : globalMap->irradiance(s.positions[i], mat.n[i], opt.kNearest, r2max, PhotonKernel::Uniform, &e1,
-                                                  &used);
-        if (!all) count(used);
-        if (caustics) H += caustics->irradiance(s.positions[i], mat.n[i], opt.causticK, r2max, PhotonKernel::Cone, &e2);
-        Hphot[i] = H;
-        noise[i] = std::sqrt(e1 * e1 + e2 * e2);
-      }
-    });
-    for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i] && luminance(Hphot[i]) <= 0.f) ++noPhotonVertices;
-    st.add("trace_seconds", traceSeconds);
-    st.add("kdtree_build_seconds", buildSeconds);
-    st.add("query_seconds", queryTimer.seconds());
-    st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
-    size_t globalCount = 0;
-    for (const Photon& p : photons) globalCount += (globalPaths >> p.path) & 1u;
-    st.add("photons_global_map", double(globalCount));
-    check.surfaceArea = surface.totalArea();
-    check.mapPhotons = all ? all->size() : globalMap->size();
-    check.causticPhotons = caustics ? caustics->size() : 0;
-    check.estimates = some.load();
-    check.fewEstimates = few.load();
-    check.kNearestEstimates = true;
-    st.add("photons_caustic_map", caustics ? double(caustics->size()) : 0.0);
-    st.add("photon_memory_mb", mapBytes / 1048576.0);
-    if (!specular) st.note("no caustic map: the scene has no mirror or glass faces");
-    else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
-    if (all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
+    photons = kNearestEstimate(run, progress, ts, st);
   }
-  out.B.assign(nv, glm::vec3(0.f));
-  out.H.assign(nv, glm::vec3(0.f));
-  out.stdError.assign(nv, 0.f);
-  double lum = 0, err2 = 0;
-  size_t valid = 0;
-  for (size_t i = 0; i < nv; ++i) {
-    if (!mat.valid[i]) continue;
-    out.H[i] = Hd[i] + Hphot[i];
-    out.B[i] = mat.E[i] + mat.rho[i] * out.H[i];
-    out.stdError[i] = float(luminance(mat.rho[i]) * noise[i]);
-    lum += luminance(out.B[i]);
-    err2 += double(out.stdError[i]) * out.stdError[i];
-    ++valid;
-  }
-  if (needPhotons) {
-    st.add("photons_emitted", double(ts.emitted));
-    if (projection) {
-      st.add("caustic_photons_aimed", double(ts.causticEmitted));
-      st.add("caustic_photons_stored", double(ts.causticStored));
-      st.note("caustic photons aimed at the mirrors and glass (projection): " +
-              std::to_string(ts.causticEmitted - ts.causticMissed) + " of " + std::to_string(ts.causticEmitted) +
-              " hit them first");
-    }
-    st.add("photons_stored", double(ts.stored));
-    st.add("diffuse_bounces", double(ts.diffuseBounces));
-    st.add("specular_bounces", double(ts.specularBounces));
-    st.add("total_internal_reflections", double(ts.totalInternal));
-    st.add("emitted_power_W", ts.emittedPower * s.unit * s.unit);
-    if (ts.lostAtMaxDepth)
-      st.note(std::to_string(ts.lostAtMaxDepth) + " paths cut at max_depth, carrying " +
-              std::to_string(ts.emittedPower > 0 ? 100.0 * ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0) +
-              "% of the emitted power");
-    check.lostPowerFraction = ts.emittedPower > 0 ? ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0;
-    warnMeaninglessPhotonParameters(opt, check, st);
-    if (noPhotonVertices)
-      st.note(std::to_string(noPhotonVertices) + " vertices reached by no photon within the gather radius: direct light only");
-  }
+  const Totals totals = combine(mat, Hd, photons, out);
+  if (needPhotons) photonStats(run, ts, photons, st);
   st.add("direct_light_seconds", directSeconds);
   st.add("seconds", timer.seconds());
-  st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
-  st.add("photon_noise_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
+  st.add("mean_luminance_B", totals.meanLuminance);
+  st.add("photon_noise_estimate", totals.rmsNoise);
   st.note(opt.directLight ? "direct light by explicit light sampling at the vertices; photons give caustics and indirect light"
                           : "all light from the photon map");
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "gi/color.h"
 #include "gi/sampling.h"
@@ -14,89 +16,94 @@
 
 namespace gi {
 
-ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
-                                       const Progress& progress, PhotonTraceStats& stats) {
-  const size_t nv = s.vertexCount();
-  ProgressiveResult r;
-  std::vector<float> R2(nv, 0.f);
-  std::vector<double> N(nv, 0.0);
-  std::vector<glm::dvec3> tau(nv, glm::dvec3(0.0));
-  std::vector<double> A(nv, 0.0);  // area of the counted surface within each radius
-  std::vector<size_t> seen(nv, 0);  // photons gathered over all passes
-  const GatherSurface surface(s);
-  const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
-  // Vertices where the first pass finds fewer than k photons within the cap
-  // start at the cap, or at 1% of the diagonal without one.
-  const float diag = float(sceneScale(s).diagonal);
-  const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
-  const double alpha = opt.alpha;
+namespace {
+
+// Per-vertex state of progressive photon mapping: squared radius R^2,
+// accumulated photon count N, flux tau, the area A(R) of the counted
+// surface within R, and the photons gathered over all passes.
+struct PpmVertices {
+  std::vector<float> R2;
+  std::vector<double> N;
+  std::vector<glm::dvec3> tau;
+  std::vector<double> A;
+  std::vector<size_t> seen;
+  explicit PpmVertices(size_t nv) : R2(nv, 0.f), N(nv, 0.0), tau(nv, glm::dvec3(0.0)), A(nv, 0.0), seen(nv, 0) {}
+};
+
+// The photons of one pass; with projection, its caustic photons are the
+// aimed ones (those of the global pass dropped).
+std::vector<Photon> tracePass(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, int pass,
+                              bool projection, const Progress& pp, PhotonTraceStats& stats) {
   const size_t count = size_t(opt.photons);
-  for (int pass = 0; pass < opt.passes; ++pass) {
-    const Progress pp = progress.sub(double(pass) / opt.passes, double(pass + 1) / opt.passes);
-    Timer tt;
-    std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats);
-    if (projection) {
-      photons.erase(std::remove_if(photons.begin(), photons.end(), [](const Photon& p) { return p.path == kCausticPhoton; }),
-                    photons.end());
-      const auto c = traceCausticPhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
-      photons.insert(photons.end(), c.begin(), c.end());
-    }
-    r.traceSeconds += tt.seconds();
-    Timer bt;
-    // Pass 1 needs the k nearest photons (the first radii): a kd-tree. Later
-    // passes only gather within each vertex's radius: a grid whose cells are
-    // the 90th percentile of the radii (most gathers visit 27 cells).
-    std::unique_ptr<PhotonMap> map;
-    if (pass == 0) {
-      map = std::make_unique<PhotonMap>(photons, pathMask, surface);
-      parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          if (!mat.valid[i]) continue;
-          const float k2 = map->kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
-          // Fewer than k photons returns infinity, which would pass an infinite cap.
-          R2[i] = std::isfinite(k2) && k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
-          A[i] = surface.area(s.positions[i], mat.n[i], std::sqrt(R2[i]));
-        }
-      });
-    }
-    std::vector<float> radii;
-    for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i]) radii.push_back(R2[i]);
-    float cell = std::sqrt(r2fallback);
-    if (!radii.empty()) {
-      const size_t q = radii.size() * 9 / 10;
-      std::nth_element(radii.begin(), radii.begin() + q, radii.end());
-      cell = std::max(std::sqrt(radii[q]), 1e-6f * diag);
-    }
-    const PhotonGrid grid(photons, pathMask, cell);
-    r.check.mapPhotons += grid.size();
-    r.buildSeconds += bt.seconds();
-    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
-                                               (map ? map->memoryBytes() : 0)));
-    map.reset();
-    std::vector<Photon>().swap(photons);
-    Timer qt;
-    parallelBlocks(nv, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        if (!mat.valid[i]) continue;
-        glm::dvec3 flux;
-        size_t M = 0;
-        grid.gather(s.positions[i], mat.n[i], R2[i], flux, M);
-        if (M == 0) continue;
-        seen[i] += M;
-        const double ratio = (N[i] + alpha * double(M)) / (N[i] + double(M));
-        N[i] += alpha * double(M);
-        R2[i] = float(double(R2[i]) * ratio);
-        // The flux scales with the area the radius keeps: ratio on a plane,
-        // not near a crease or border the shrinking disk moves off.
-        const double A1 = surface.area(s.positions[i], mat.n[i], std::sqrt(R2[i]));
-        tau[i] = (tau[i] + flux) * (A[i] > 0.0 && A1 > 0.0 ? A1 / A[i] : ratio);
-        A[i] = A1;
-      }
-    });
-    r.querySeconds += qt.seconds();
+  std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats);
+  if (projection) {
+    auto caustic = [](const Photon& p) { return p.path == kCausticPhoton; };
+    photons.erase(std::remove_if(photons.begin(), photons.end(), caustic), photons.end());
+    const auto c = traceCausticPhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
+    photons.insert(photons.end(), c.begin(), c.end());
   }
+  return photons;
+}
+
+// The first radii: the distance to the k-th nearest photon of the first
+// pass (a kd-tree over it, returned for the memory account), capped at
+// r2cap; r2fallback where fewer than k photons lie within the cap.
+std::unique_ptr<PhotonMap> firstRadii(const Scene& s, const PhotonOptions& opt, const VertexMaterial& mat,
+                                      const std::vector<Photon>& photons, unsigned pathMask,
+                                      const GatherSurface& surface, float r2cap, float r2fallback, PpmVertices& v) {
+  auto map = std::make_unique<PhotonMap>(photons, pathMask, surface);
+  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!mat.valid[i]) continue;
+      const float k2 = map->kthRadius2(s.positions[i], mat.n[i], opt.kNearest);
+      // Fewer than k photons returns infinity, which would pass an infinite cap.
+      v.R2[i] = std::isfinite(k2) && k2 <= r2cap ? std::max(k2, 1e-30f) : r2fallback;
+      v.A[i] = surface.area(s.positions[i], mat.n[i], std::sqrt(v.R2[i]));
+    }
+  });
+  return map;
+}
+
+// Later passes only gather within each vertex's radius: a grid whose cells
+// are the 90th percentile of the radii (most gathers visit 27 cells).
+float gridCell(const VertexMaterial& mat, const PpmVertices& v, float r2fallback, float diag) {
+  std::vector<float> radii;
+  for (size_t i = 0; i < v.R2.size(); ++i)
+    if (mat.valid[i]) radii.push_back(v.R2[i]);
+  if (radii.empty()) return std::sqrt(r2fallback);
+  const size_t q = radii.size() * 9 / 10;
+  std::nth_element(radii.begin(), radii.begin() + q, radii.end());
+  return std::max(std::sqrt(radii[q]), 1e-6f * diag);
+}
+
+// One pass's update at every vertex: M new photons within R give
+// N' = N + alpha M, R'^2 = R^2 (N + alpha M) / (N + M), tau' = (tau + Phi_M) A(R') / A(R).
+void updateVertices(const Scene& s, const VertexMaterial& mat, const PhotonGrid& grid, const GatherSurface& surface,
+                    double alpha, const Progress& progress, const std::string& what, PpmVertices& v) {
+  parallelBlocks(s.vertexCount(), progress, what, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!mat.valid[i]) continue;
+      glm::dvec3 flux;
+      size_t M = 0;
+      grid.gather(s.positions[i], mat.n[i], v.R2[i], flux, M);
+      if (M == 0) continue;
+      v.seen[i] += M;
+      const double ratio = (v.N[i] + alpha * double(M)) / (v.N[i] + double(M));
+      v.N[i] += alpha * double(M);
+      v.R2[i] = float(double(v.R2[i]) * ratio);
+      // The flux scales with the area the radius keeps: ratio on a plane,
+      // not near a crease or border the shrinking disk moves off.
+      const double A1 = surface.area(s.positions[i], mat.n[i], std::sqrt(v.R2[i]));
+      v.tau[i] = (v.tau[i] + flux) * (v.A[i] > 0.0 && A1 > 0.0 ? A1 / v.A[i] : ratio);
+      v.A[i] = A1;
+    }
+  });
+}
+
+// H = tau / (A(R) passes) per vertex, its Poisson noise, and the counts the
+// warnings and the log need.
+void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, ProgressiveResult& r) {
+  const size_t nv = v.R2.size();
   r.H.assign(nv, glm::vec3(0.f));
   r.noise.assign(nv, 0.0);
   double sumR = 0, sumN = 0;
@@ -104,22 +111,58 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   for (size_t i = 0; i < nv; ++i) {
     if (!mat.valid[i]) continue;
     ++valid;
-    if (seen[i] > 0) {
+    if (v.seen[i] > 0) {
       ++r.check.estimates;
-      if (seen[i] < size_t(kFewPhotons)) ++r.check.fewEstimates;
+      if (v.seen[i] < size_t(kFewPhotons)) ++r.check.fewEstimates;
     }
-    sumR += std::sqrt(double(R2[i]));
-    sumN += N[i];
-    if (N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
-    const double area = A[i] > 0.0 ? A[i] : M_PI * double(R2[i]);
-    const glm::dvec3 H = tau[i] / (area * opt.passes);
+    sumR += std::sqrt(double(v.R2[i]));
+    sumN += v.N[i];
+    if (v.N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
+    const double area = v.A[i] > 0.0 ? v.A[i] : M_PI * double(v.R2[i]);
+    const glm::dvec3 H = v.tau[i] / (area * passes);
     r.H[i] = glm::vec3(H);
     // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
-    r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(N[i]);
+    r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(v.N[i]);
   }
-  r.check.surfaceArea = surface.totalArea();
   r.meanRadius = valid ? sumR / double(valid) : 0.0;
   r.meanCount = valid ? sumN / double(valid) : 0.0;
+}
+
+}  // namespace
+
+ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
+                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
+                                       const Progress& progress, PhotonTraceStats& stats) {
+  ProgressiveResult r;
+  PpmVertices v(s.vertexCount());
+  const GatherSurface surface(s);
+  const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
+  // Vertices where the first pass finds fewer than k photons within the cap
+  // start at the cap, or at 1% of the diagonal without one.
+  const float diag = float(sceneScale(s).diagonal);
+  const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
+  for (int pass = 0; pass < opt.passes; ++pass) {
+    const Progress pp = progress.sub(double(pass) / opt.passes, double(pass + 1) / opt.passes);
+    Timer tt;
+    std::vector<Photon> photons = tracePass(s, caster, opt, pass, projection, pp, stats);
+    r.traceSeconds += tt.seconds();
+    Timer bt;
+    std::unique_ptr<PhotonMap> map;
+    if (pass == 0) map = firstRadii(s, opt, mat, photons, pathMask, surface, r2cap, r2fallback, v);
+    const PhotonGrid grid(photons, pathMask, gridCell(mat, v, r2fallback, diag));
+    r.check.mapPhotons += grid.size();
+    r.buildSeconds += bt.seconds();
+    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
+                                               (map ? map->memoryBytes() : 0)));
+    map.reset();
+    std::vector<Photon>().swap(photons);
+    Timer qt;
+    updateVertices(s, mat, grid, surface, opt.alpha, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1),
+                   v);
+    r.querySeconds += qt.seconds();
+  }
+  estimates(mat, v, opt.passes, r);
+  r.check.surfaceArea = surface.totalArea();
   return r;
 }
 

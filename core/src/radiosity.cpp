@@ -23,104 +23,82 @@ namespace gi {
 std::vector<ParamSpec> RadiosityOptions::specs() {
   std::vector<ParamSpec> s = formFactorSpecs();
   const std::vector<ParamSpec> more = {
-      {"light_samples", "Shadow rays per patch",
-       "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to 256 "
-       "emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter face, "
-       "times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the emitters "
-       "sampled in proportion to power with a shadow ray each.",
-       ParamType::Int, 256, 1, 1 << 20},
-      {"solver", "Solver",
-       "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses new values "
-       "as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): repeatedly shoots the "
-       "unshot power of the brightest patch; useful images early. Auto: Gauss-Seidel, or progressive refinement "
-       "when the form factors do not fit the memory budget.",
-       ParamType::Enum, 0, 0, 0, {"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement"}},
-      {"bounces", "Bounces",
-       "-1: iterate until the tolerance is met (all bounces). 0: direct light only (B = E + rho H_direct); k: "
-       "light after k further diffuse inter-reflections (exactly k Jacobi sweeps, as in the course's progressive "
-       "images).",
-       ParamType::Int, -1, -1, 100000},
-      {"tolerance", "Tolerance",
-       "Stop when the change of a sweep (Jacobi, Gauss-Seidel) or the unshot power (progressive), as power "
-       "relative to the emitted power, is below this.",
-       ParamType::Float, 1e-4, 1e-12, 1.0},
-      {"max_iterations", "Maximum iterations",
-       "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
-       "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
-       "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
-       "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A run stopped by this "
-       "bound before the tolerance is met logs a warning with the possible error.",
-       ParamType::Int, 0, 0, 1000000},
-      {"memory_budget_mb", "Memory budget (MB)",
-       "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
-       "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch of "
-       "the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; beyond "
-       "that, progressive refinement computes each shooter's row on the fly (more rays, memory linear in the "
-       "patch count). A run that cannot fit even so is refused before it starts.",
-       ParamType::Float, 1024, 1, 1e7},
-      {"vertex_output", "Vertex values",
-       "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
-       "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is gathered "
-       "from the patch solution with rays from the vertex (no light leaking under objects that cut through "
-       "patches). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of the incident "
-       "patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity (the classical look "
-       "of the course's images).",
-       ParamType::Enum, 0, 0, 0, {"Final gather", "Interpolated indirect", "Patch average"}},
-      {"gather_rays", "Final-gather rays per vertex",
-       "Rays per vertex for the final gather of the indirect light (cosine-weighted).", ParamType::Int, 256, 1,
-       1 << 20},
-      seedSpec("form-factor rays"),
-      {"refine", "Adaptive mesh refinement",
-       "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
-       "midpoints where its reflected radiosity jumps across an edge (staircase artefacts) or where a shadow "
-       "boundary crosses it (its vertices see the lights differently: shadow leaks); neighbours are bisected or "
-       "split too, so the mesh stays free of T-junctions (red-green refinement). The refined mesh replaces the "
-       "layer's geometry (faces keep colour, quality and selection). Off: the geometry is never changed.",
-       ParamType::Bool, 0},
-      {"refine_max_depth", "Refinement: maximum depth",
-       "Levels of refinement: each level splits the marked patches once (a patch of depth d is 4^d times smaller "
-       "than its original triangle) and solves again, so the cost grows with the levels.",
-       ParamType::Int, 3, 1, 12},
-      {"refine_max_patches", "Refinement: patch budget",
-       "Never more patches than this; when a level would exceed it, the patches that need refinement most "
-       "(largest jump or visibility difference times area) are split first.",
-       ParamType::Int, 200000, 1, 100000000},
-      {"refine_threshold", "Refinement: radiosity jump",
-       "Split the two patches on either side of an edge when their reflected radiosity differs by more than this "
-       "fraction of the larger one (ignoring differences below 1% of the scene's mean). Smaller: more patches. "
-       "Edges sharper than 30 degrees are not tested: B jumps there for real.",
-       ParamType::Float, 0.1, 1e-4, 100.0},
-      {"refine_shadow_threshold", "Refinement: shadow boundary",
-       "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) differs "
-       "by more than this between two of its vertices: a shadow boundary crosses it. 1 turns this test off.",
-       ParamType::Float, 0.3, 0.0, 1.0},
+      {.name = "light_samples", .label = "Shadow rays per patch",
+       .help = "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to "
+               "256 emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter "
+               "face, times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the "
+               "emitters sampled in proportion to power with a shadow ray each.",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      {.name = "solver", .label = "Solver",
+       .help = "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses "
+               "new values as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): "
+               "repeatedly shoots the unshot power of the brightest patch; useful images early. Auto: Gauss-Seidel, "
+               "or progressive refinement when the form factors do not fit the memory budget.",
+       .type = ParamType::Enum, .def = kRadiositySolvers.index(RadiositySolver::Auto),
+       .choices = kRadiositySolvers.choices()},
+      {.name = "bounces", .label = "Bounces",
+       .help = "-1: iterate until the tolerance is met (all bounces). 0: direct light only (B = E + rho H_direct); "
+               "k: light after k further diffuse inter-reflections (exactly k Jacobi sweeps, as in the course's "
+               "progressive images).",
+       .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
+      {.name = "tolerance", .label = "Tolerance",
+       .help = "Stop when the change of a sweep (Jacobi, Gauss-Seidel) or the unshot power (progressive), as power "
+               "relative to the emitted power, is below this.",
+       .type = ParamType::Float, .def = 1e-4, .min = 1e-12, .max = 1.0},
+      {.name = "max_iterations", .label = "Maximum iterations",
+       .help = "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
+               "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
+               "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
+               "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A "
+               "run stopped by this bound before the tolerance is met logs a warning with the possible error.",
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 1000000},
+      {.name = "memory_budget_mb", .label = "Memory budget (MB)",
+       .help = "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
+               "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch "
+               "of the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; "
+               "beyond that, progressive refinement computes each shooter's row on the fly (more rays, memory linear "
+               "in the patch count). A run that cannot fit even so is refused before it starts.",
+       .type = ParamType::Float, .def = 1024, .min = 1, .max = 1e7},
+      {.name = "vertex_output", .label = "Vertex values",
+       .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
+               "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
+               "gathered from the patch solution with rays from the vertex (no light leaking under objects that cut "
+               "through patches). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of "
+               "the incident patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity "
+               "(the classical look of the course's images).",
+       .type = ParamType::Enum, .def = kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather),
+       .choices = kRadiosityVertexOutputs.choices()},
+      {.name = "gather_rays", .label = "Final-gather rays per vertex",
+       .help = "Rays per vertex for the final gather of the indirect light (cosine-weighted).",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      seedSpec("form-factor, shadow and final-gather rays"),
+      {.name = "refine", .label = "Adaptive mesh refinement",
+       .help = "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
+               "midpoints where its reflected radiosity jumps across an edge (staircase artefacts) or where a shadow "
+               "boundary crosses it (its vertices see the lights differently: shadow leaks); neighbours are bisected "
+               "or split too, so the mesh stays free of T-junctions (red-green refinement). The refined mesh "
+               "replaces the layer's geometry (faces keep colour, quality and selection). Off: the geometry is never "
+               "changed.",
+       .type = ParamType::Bool, .def = false},
   };
   s.insert(s.end(), more.begin(), more.end());
+  for (const ParamSpec& p : RefineOptions::specs()) s.push_back(p);
   return s;
 }
 
 RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   RadiosityOptions o;
-  o.formFactorMethod = FormFactorMethod(v.getInt("form_factor_method"));
-  o.raysPerPatch = v.getInt("rays_per_patch");
-  o.analyticPoints = v.getInt("analytic_points");
-  o.hemicubeResolution = v.getInt("hemicube_resolution");
-  o.hemicubePoints = v.getInt("hemicube_points");
+  o.formFactors = formFactorSettings(v);
   o.lightSamples = v.getInt("light_samples");
-  o.solver = RadiositySolver(v.getInt("solver"));
+  o.solver = kRadiositySolvers.get(v, "solver");
   o.bounces = v.getInt("bounces");
   o.tolerance = v.getFloat("tolerance");
   o.maxIterations = v.getInt("max_iterations");
   o.memoryBudgetMB = v.getFloat("memory_budget_mb");
-  o.seed = uint32_t(v.getInt("seed"));
-  o.vertexOutput = RadiosityVertexOutput(v.getInt("vertex_output"));
+  o.vertexOutput = kRadiosityVertexOutputs.get(v, "vertex_output");
   o.gatherRays = v.getInt("gather_rays");
   o.refine = v.getBool("refine");
-  o.refinement.maxDepth = v.getInt("refine_max_depth");
-  o.refinement.maxPatches = v.getInt("refine_max_patches");
-  o.refinement.threshold = v.getFloat("refine_threshold");
-  o.refinement.shadowThreshold = v.getFloat("refine_shadow_threshold");
-  o.refinement.seed = o.seed;
+  o.refinement = RefineOptions::fromParams(v);
   return o;
 }
 
@@ -230,134 +208,197 @@ void warnIfNotConverged(const Setup& u, const std::vector<glm::vec3>& R, double 
   st.warn(b);
 }
 
-RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
-                      int bounces, double tol, int maxIter, const Progress& progress) {
-  RadiosityResult res;
-  std::vector<glm::vec3> prevR;   // fixed bounces: the iterate before the last sweep
-  std::vector<glm::vec3> S(u.n);  // source: once-reflected direct light
-  for (size_t i = 0; i < u.n; ++i) S[i] = u.rho[i] * u.Hd[i];
-  std::vector<glm::vec3> B = S;   // the reflected radiosity R while solving
-  size_t skippedBlack = 0;
-  for (size_t i = 0; i < u.n; ++i) skippedBlack += (u.A[i] > 0 && u.rho[i] == glm::vec3(0.f)) ? 1 : 0;
-  const bool fixedBounces = bounces >= 0;
-  if (fixedBounces) solver = RadiositySolver::Jacobi;
-  const char* names[] = {"auto", "Jacobi", "Gauss-Seidel", "progressive refinement"};
-  res.stats.note(std::string("solver ") + names[int(solver)] +
-                 (fixedBounces ? " (" + std::to_string(bounces) + " bounces requested)" : ""));
-  const double rBound = fixedBounces ? 0.0 : spectralBound(u, row, transpose);
-  if (!fixedBounces && maxIter <= 0) {
-    maxIter = autoIterations(rBound, tol);
-    res.stats.add("max_iterations_auto", maxIter);
+// When a solver stops: after exactly `bounces` Jacobi sweeps (fixed, bounces
+// >= 0), or when the residual falls below tol, after at most maxIter sweeps
+// (shots per patch for progressive refinement); r bounds the spectral
+// radius of rho F (for the warning when maxIter stops it first).
+struct Stopping {
+  bool fixed = false;
+  int bounces = -1;
+  double tol = 1e-4;
+  int maxIter = 0;
+  double r = 0;
+};
+
+// Books one sweep that changed the reflected power by `change`; true when
+// the solve has converged.
+bool endSweep(const Setup& u, const Stopping& stop, int it, double change, const Progress& progress,
+              RadiosityResult& res) {
+  res.residual = change / u.P;
+  res.residualHistory.push_back(res.residual);
+  res.iterations = it + 1;
+  const int sweeps = stop.fixed ? stop.bounces : stop.maxIter;
+  progress.report(stop.fixed ? double(it + 1) / sweeps
+                             : std::min(1.0, std::log(res.residual + 1e-300) / std::log(stop.tol)),
+                  "solving");
+  return !stop.fixed && res.residual < stop.tol;
+}
+
+// Jacobi: R <- S + rho F R for all patches from the last iterate (sweep k
+// adds bounce k). With a fixed bounce count, *prevR gets the iterate before
+// the last sweep (zero for no sweep at all: no indirect light at vertices).
+void jacobi(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& S, const Stopping& stop,
+            const Progress& progress, std::vector<glm::vec3>& R, std::vector<glm::vec3>* prevR, RadiosityResult& res) {
+  const int sweeps = stop.fixed ? stop.bounces : stop.maxIter;
+  std::vector<glm::vec3> Rn = R;
+  if (prevR) prevR->assign(u.n, glm::vec3(0.f));
+  for (int it = 0; it < sweeps; ++it) {
+    if (prevR) *prevR = R;
+    parallelBlocks(u.n, Progress(nullptr), "", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        Rn[i] = (u.A[i] > 0 && u.rho[i] != glm::vec3(0.f)) ? S[i] + u.rho[i] * gather(row(uint32_t(i)), R) : S[i];
+    });
+    double change = 0;
+    for (size_t i = 0; i < u.n; ++i) change += u.A[i] * std::fabs(luminance(Rn[i] - R[i]));
+    R.swap(Rn);
+    if (endSweep(u, stop, it, change, progress, res)) break;
   }
-  if (solver == RadiositySolver::Jacobi || solver == RadiositySolver::GaussSeidel) {
-    const int sweeps = fixedBounces ? bounces : maxIter;
-    std::vector<glm::vec3> Bn = B;
-    if (fixedBounces) prevR.assign(u.n, glm::vec3(0.f));  // bounces = 0: no indirect light at vertices
-    for (int it = 0; it < sweeps; ++it) {
-      if (fixedBounces) prevR = B;
-      double change = 0;
-      if (solver == RadiositySolver::Jacobi) {
-        parallelBlocks(u.n, Progress(nullptr), "", [&](size_t b, size_t e) {
-          for (size_t i = b; i < e; ++i)
-            Bn[i] = (u.A[i] > 0 && u.rho[i] != glm::vec3(0.f)) ? S[i] + u.rho[i] * gather(row(uint32_t(i)), B) : S[i];
-        });
-        for (size_t i = 0; i < u.n; ++i) change += u.A[i] * std::fabs(luminance(Bn[i] - B[i]));
-        B.swap(Bn);
-      } else {
-        for (size_t i = 0; i < u.n; ++i) {
-          if (u.A[i] == 0 || u.rho[i] == glm::vec3(0.f)) continue;
-          const glm::vec3 nb = S[i] + u.rho[i] * gather(row(uint32_t(i)), B);
-          change += u.A[i] * std::fabs(luminance(nb - B[i]));
-          B[i] = nb;
-        }
-      }
-      res.residual = change / u.P;
-      res.residualHistory.push_back(res.residual);
-      res.iterations = it + 1;
-      progress.report(fixedBounces ? double(it + 1) / sweeps : std::min(1.0, std::log(res.residual + 1e-300) / std::log(tol)),
-                      "solving");
-      if (!fixedBounces && res.residual < tol) break;
+  if (!stop.fixed) warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "sweeps", res.stats);
+}
+
+// Gauss-Seidel: the same update in place, each patch reading the values
+// already updated in this sweep (fewer sweeps; sequential).
+void gaussSeidel(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& S, const Stopping& stop,
+                 const Progress& progress, std::vector<glm::vec3>& R, RadiosityResult& res) {
+  for (int it = 0; it < stop.maxIter; ++it) {
+    double change = 0;
+    for (size_t i = 0; i < u.n; ++i) {
+      if (u.A[i] == 0 || u.rho[i] == glm::vec3(0.f)) continue;
+      const glm::vec3 nb = S[i] + u.rho[i] * gather(row(uint32_t(i)), R);
+      change += u.A[i] * std::fabs(luminance(nb - R[i]));
+      R[i] = nb;
     }
-    if (!fixedBounces) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "sweeps", res.stats);
-  } else {
-    // Progressive refinement: shoot the unshot radiosity dB of the patch with
-    // the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
-    // the receivers' gain is read from their own rows, dB_j = rho_j F_ji dB_i
-    // (Southwell relaxation of the very system Jacobi and Gauss-Seidel solve,
-    // so all solvers agree); with rows on the fly, from the shooter's row by
-    // reciprocity, dB_j = rho_j dB_i F_ij A_i / A_j (the classical form; Monte
-    // Carlo rows are reciprocal only in expectation).
-    std::vector<std::vector<std::pair<uint32_t, float>>> columns;
+    if (endSweep(u, stop, it, change, progress, res)) break;
+  }
+  warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "sweeps", res.stats);
+}
+
+// Ambient term for display (Cohen et al. 1988): the unshot radiosity dB
+// spread evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
+double ambientTerm(const Setup& u, const std::vector<glm::vec3>& dB) {
+  double Atot = 0, rhoA = 0;
+  glm::dvec3 unshotSum(0.0);
+  for (size_t i = 0; i < u.n; ++i) {
+    Atot += u.A[i];
+    rhoA += u.A[i] * luminance(u.rho[i]);
+    unshotSum += u.A[i] * glm::dvec3(dB[i]);
+  }
+  const double rhoAvg = Atot > 0 ? rhoA / Atot : 0;
+  const glm::dvec3 ambient = Atot > 0 ? unshotSum / Atot / (1.0 - rhoAvg) : glm::dvec3(0.0);
+  return luminance(glm::vec3(ambient));
+}
+
+// Progressive refinement: shoot the unshot radiosity dB of the patch with
+// the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
+// (transpose) the receivers' gain is read from their own rows, dB_j = rho_j
+// F_ji dB_i (Southwell relaxation of the very system Jacobi and Gauss-Seidel
+// solve, so all solvers agree); with rows on the fly, from the shooter's row
+// by reciprocity, dB_j = rho_j dB_i F_ij A_i / A_j (the classical form; Monte
+// Carlo rows are reciprocal only in expectation).
+void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, const std::vector<glm::vec3>& S,
+                           const Stopping& stop, const Progress& progress, std::vector<glm::vec3>& R,
+                           RadiosityResult& res) {
+  std::vector<std::vector<std::pair<uint32_t, float>>> columns;
+  if (transpose) {
+    columns.resize(u.n);
+    for (size_t j = 0; j < u.n; ++j) {
+      const FormFactorRow& r = row(uint32_t(j));
+      for (size_t k = 0; k < r.j.size(); ++k) columns[r.j[k]].push_back({uint32_t(j), r.F[k]});
+    }
+  }
+  std::vector<glm::vec3> dB = S;
+  std::vector<double> unshot(u.n);
+  double U = 0;
+  for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * luminance(dB[i]); U += unshot[i]; }
+  const long maxShots = long(stop.maxIter) * long(std::max<size_t>(u.n, 1));
+  long shots = 0;
+  auto receive = [&](uint32_t j, const glm::vec3& d) {
+    R[j] += d;
+    dB[j] += d;
+    const double nu = u.A[j] * luminance(dB[j]);
+    U += nu - unshot[j];
+    unshot[j] = nu;
+  };
+  while (U / u.P > stop.tol && shots < maxShots) {
+    const size_t i = size_t(std::max_element(unshot.begin(), unshot.end()) - unshot.begin());
+    if (!(unshot[i] > 0)) break;
+    const glm::vec3 shoot = dB[i];
+    dB[i] = glm::vec3(0.f);
+    U -= unshot[i];
+    unshot[i] = 0;
     if (transpose) {
-      columns.resize(u.n);
-      for (size_t j = 0; j < u.n; ++j) {
-        const FormFactorRow& r = row(uint32_t(j));
-        for (size_t k = 0; k < r.j.size(); ++k) columns[r.j[k]].push_back({uint32_t(j), r.F[k]});
+      for (const auto& [j, F] : columns[i])
+        if (u.rho[j] != glm::vec3(0.f)) receive(j, u.rho[j] * shoot * F);
+    } else {
+      const FormFactorRow& r = row(uint32_t(i));
+      for (size_t k = 0; k < r.j.size(); ++k) {
+        const uint32_t j = r.j[k];
+        if (u.rho[j] == glm::vec3(0.f)) continue;  // black receivers reflect nothing
+        receive(j, u.rho[j] * shoot * float(double(r.F[k]) * u.A[i] / u.A[j]));
       }
     }
-    std::vector<glm::vec3> dB = S;
-    std::vector<double> unshot(u.n);
-    double U = 0;
-    for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * luminance(dB[i]); U += unshot[i]; }
-    const long maxShots = long(maxIter) * long(std::max<size_t>(u.n, 1));
-    long shots = 0;
-    auto receive = [&](uint32_t j, const glm::vec3& d) {
-      B[j] += d;
-      dB[j] += d;
-      const double nu = u.A[j] * luminance(dB[j]);
-      U += nu - unshot[j];
-      unshot[j] = nu;
-    };
-    while (U / u.P > tol && shots < maxShots) {
-      const size_t i = size_t(std::max_element(unshot.begin(), unshot.end()) - unshot.begin());
-      if (!(unshot[i] > 0)) break;
-      const glm::vec3 shoot = dB[i];
-      dB[i] = glm::vec3(0.f);
-      U -= unshot[i];
-      unshot[i] = 0;
-      if (transpose) {
-        for (const auto& [j, F] : columns[i])
-          if (u.rho[j] != glm::vec3(0.f)) receive(j, u.rho[j] * shoot * F);
-      } else {
-        const FormFactorRow& r = row(uint32_t(i));
-        for (size_t k = 0; k < r.j.size(); ++k) {
-          const uint32_t j = r.j[k];
-          if (u.rho[j] == glm::vec3(0.f)) continue;  // black receivers reflect nothing
-          receive(j, u.rho[j] * shoot * float(double(r.F[k]) * u.A[i] / u.A[j]));
-        }
-      }
-      ++shots;
-      if (shots % long(std::max<size_t>(u.n, 1)) == 0) {  // re-sum: no drift
-        U = 0;
-        for (double x : unshot) U += x;
-      }
-      res.residualHistory.push_back(U / u.P);
-      if ((shots & 255) == 0) progress.report(std::min(1.0, std::log(U / u.P + 1e-300) / std::log(tol)), "shooting");
+    ++shots;
+    if (shots % long(std::max<size_t>(u.n, 1)) == 0) {  // re-sum: no drift
+      U = 0;
+      for (double x : unshot) U += x;
     }
-    res.iterations = int(shots);
-    res.residual = U / u.P;
-    if (shots >= maxShots) warnIfNotConverged(u, B, res.residual, tol, rBound, maxIter, "shots per patch", res.stats);
-    // Ambient term for display (Cohen et al. 1988): the unshot power spread
-    // evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
-    double Atot = 0, rhoA = 0;
-    glm::dvec3 unshotSum(0.0);
-    for (size_t i = 0; i < u.n; ++i) { Atot += u.A[i]; rhoA += u.A[i] * luminance(u.rho[i]); unshotSum += u.A[i] * glm::dvec3(dB[i]); }
-    const double rhoAvg = Atot > 0 ? rhoA / Atot : 0;
-    const glm::dvec3 ambient = Atot > 0 ? unshotSum / Atot / (1.0 - rhoAvg) : glm::dvec3(0.0);
-    res.stats.add("ambient_term", luminance(glm::vec3(ambient)));
+    res.residualHistory.push_back(U / u.P);
+    if ((shots & 255) == 0) progress.report(std::min(1.0, std::log(U / u.P + 1e-300) / std::log(stop.tol)), "shooting");
   }
-  energyStats(u, row, B, res.stats);
-  // What vertices gather their indirect light from: the reflected radiosity,
-  // one sweep behind when a bounce count is fixed (the gather adds that bounce).
-  res.Rgather = fixedBounces ? prevR : B;
+  res.iterations = int(shots);
+  res.residual = U / u.P;
+  if (shots >= maxShots)
+    warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "shots per patch", res.stats);
+  res.stats.add("ambient_term", ambientTerm(u, dB));
+}
+
+// After any solver: the energy account, what vertices gather from (the
+// reflected radiosity Rgather, one sweep behind R when a bounce count is
+// fixed: the gather adds that bounce), B = E + R per face and per vertex.
+void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R,
+                    std::vector<glm::vec3> Rgather, RadiosityResult& res) {
+  energyStats(u, row, R, res.stats);
+  res.Rgather = std::move(Rgather);
   res.Hindirect.assign(u.n, glm::vec3(0.f));
   for (size_t i = 0; i < u.n; ++i)
     if (u.A[i] > 0) res.Hindirect[i] = gather(row(uint32_t(i)), res.Rgather);
-  for (size_t i = 0; i < u.n; ++i) B[i] += u.E[i];
-  res.B = B;
-  res.Bvertex = faceToVertex(s, B);
+  res.B = R;
+  for (size_t i = 0; i < u.n; ++i) res.B[i] += u.E[i];
+  res.Bvertex = faceToVertex(s, res.B);
   res.stats.add("iterations", res.iterations);
   res.stats.add("residual", res.residual);
+}
+
+// Solves R = S + rho F R for the reflected radiosity R, with the source S =
+// rho H_direct, by the chosen solver (Jacobi whenever a bounce count is
+// fixed); rows from `row`, held in memory when `transpose` (progressive
+// refinement may then read columns).
+RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
+                      int bounces, double tol, int maxIter, const Progress& progress) {
+  RadiosityResult res;
+  std::vector<glm::vec3> S(u.n);  // source: once-reflected direct light
+  for (size_t i = 0; i < u.n; ++i) S[i] = u.rho[i] * u.Hd[i];
+  size_t skippedBlack = 0;
+  for (size_t i = 0; i < u.n; ++i) skippedBlack += (u.A[i] > 0 && u.rho[i] == glm::vec3(0.f)) ? 1 : 0;
+  Stopping stop{bounces >= 0, bounces, tol, maxIter, 0.0};
+  if (stop.fixed) solver = RadiositySolver::Jacobi;
+  res.stats.note(std::string("solver ") + kRadiositySolvers.logName(solver) +
+                 (stop.fixed ? " (" + std::to_string(bounces) + " bounces requested)" : ""));
+  if (!stop.fixed) {
+    stop.r = spectralBound(u, row, transpose);
+    if (maxIter <= 0) {
+      stop.maxIter = autoIterations(stop.r, tol);
+      res.stats.add("max_iterations_auto", stop.maxIter);
+    }
+  }
+  std::vector<glm::vec3> R = S;  // the reflected radiosity while solving
+  std::vector<glm::vec3> prevR;  // fixed bounces: the iterate before the last sweep
+  switch (solver) {
+    case RadiositySolver::Jacobi: jacobi(u, row, S, stop, progress, R, stop.fixed ? &prevR : nullptr, res); break;
+    case RadiositySolver::GaussSeidel: gaussSeidel(u, row, S, stop, progress, R, res); break;
+    default: progressiveRefinement(u, row, transpose, S, stop, progress, R, res); break;
+  }
+  finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, res);
   if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");
   return res;
 }
@@ -390,6 +431,92 @@ MemoryPlan planMemory(size_t n, const FormFactors& ff, const RadiosityOptions& o
   return m;
 }
 
+
+std::string megabytes(double bytes) { return std::to_string(int(bytes / 1048576.0 + 0.5)); }
+
+// The whole sparse matrix computed first (in parallel) and kept for the solve.
+RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors& ff, const MemoryPlan& mem,
+                              RadiositySolver solver, const RadiosityOptions& opt, const Progress& progress) {
+  std::vector<FormFactorRow> rows(u.n);
+  Timer ffTimer;
+  parallelBlocks(u.n, progress.sub(0.1, 0.8), "form factors", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) rows[i] = ff.row(uint32_t(i));
+  });
+  const double ffSeconds = ffTimer.seconds();
+  size_t entries = 0;
+  for (const auto& r : rows) entries += r.j.size();
+  RadiosityResult res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver,
+                              opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.8, 1.0));
+  res.stats.add("form_factor_seconds", ffSeconds);
+  res.stats.add("form_factor_entries", double(entries));
+  res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
+  res.stats.note("full sparse form-factor matrix (estimated " + megabytes(mem.matrix) + " MB, with the rest " +
+                 megabytes(mem.matrix + mem.rest) + " MB <= budget)");
+  return res;
+}
+
+// Beyond the budget: each row computed when the solver reads it, so
+// progressive refinement unless a bounce count is fixed (Jacobi).
+RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors& ff, const MemoryPlan& mem,
+                              RadiositySolver solver, const RadiosityOptions& opt, const Progress& progress) {
+  if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
+  thread_local FormFactorRow scratch;
+  RadiosityResult res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; },
+                              false, solver, opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
+  res.stats.note("form factors on the fly: the matrix (estimated " + megabytes(mem.matrix) + " MB) and the rest (" +
+                 megabytes(mem.rest) + " MB) exceed the memory budget");
+  return res;
+}
+
+// The indirect irradiance at each vertex by a final gather of the patch
+// solution: cosine-weighted rays, so the estimate is the mean of the
+// reflected radiosity seen. Near hits (within two patch edges) see the
+// patch up close, where its average hides how the direct light varies
+// across it (the shadow of an object standing on it, a shadow edge): there
+// the direct light is evaluated at the hit point itself and the patch's
+// indirect light added (a two-level gather). Only for the converged
+// solution: with a fixed bounce count the patch values are what the count
+// asks for.
+std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
+                                      const RadiosityOptions& opt, RadiosityResult& res) {
+  const uint32_t seed = opt.formFactors.seed;
+  const bool refineNear = opt.bounces < 0;
+  const DirectLightAt directAt(s, caster, 4);
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  std::vector<float> nearT(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
+  std::atomic<uint64_t> nearHits{0};
+  auto seen = [&](uint32_t f, const glm::vec3& y, float t) {
+    if (!refineNear || t > nearT[f]) return res.Rgather[f];
+    nearHits.fetch_add(1, std::memory_order_relaxed);
+    uint32_t bits[3];
+    std::memcpy(bits, &y, sizeof bits);
+    const uint32_t key = hash3(bits[0] ^ seed, bits[1], bits[2] ^ f);
+    return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
+  };
+  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices);
+  res.stats.add("gather_rays", double(opt.vertices.count(s.vertexCount())) * opt.gatherRays);
+  if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
+  return Hi;
+}
+
+// Vertex values B = E + rho (H_direct + H_indirect) with the exact direct
+// light at each vertex and the indirect light gathered (final gather:
+// visibility at the vertex itself, no leaks under objects that cut through
+// patches) or interpolated from the incident patches.
+void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res) {
+  Timer vt;
+  const VertexMaterial mat = vertexMaterial(s);
+  const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, Progress(nullptr), opt.vertices);
+  const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
+  const std::vector<glm::vec3> Hi = gather ? gatherIndirect(s, caster, mat, opt, res) : faceToVertex(s, res.Hindirect);
+  for (size_t v = 0; v < s.vertexCount(); ++v)
+    res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v]) : glm::vec3(0.f);
+  res.stats.add("vertex_output_seconds", vt.seconds());
+  res.stats.note(gather ? "vertices: direct light and a final gather of the patch solution at each vertex"
+                        : "vertices: direct light at each vertex, indirect interpolated from the patches");
+}
+
 }  // namespace
 
 int workerThreads() {
@@ -400,8 +527,9 @@ int workerThreads() {
 double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
   const double n = double(patches);
   double row = 8.0 * n;  // a dense row (analytic, hemicube), at least the sparse one of Monte Carlo
-  if (opt.formFactorMethod == FormFactorMethod::Hemicube) row += hemicubeBufferBytes(opt.hemicubeResolution);
-  if (opt.formFactorMethod == FormFactorMethod::MonteCarlo) row = 12.0 * opt.raysPerPatch;
+  const FormFactors::Settings& ff = opt.formFactors;
+  if (ff.method == FormFactorMethod::Hemicube) row += hemicubeBufferBytes(ff.hemicubeResolution);
+  if (ff.method == FormFactorMethod::MonteCarlo) row = 12.0 * ff.raysPerPatch;
   return n * kSolverBytesPerPatch + workerThreads() * row;
 }
 
@@ -422,99 +550,31 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 }
 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
-  if (opt.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
+  const FormFactors::Settings& ffs = opt.formFactors;
+  if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   Timer timer;
-  const FormFactors ff(s, caster, {opt.formFactorMethod, opt.raysPerPatch, opt.analyticPoints, opt.hemicubeResolution, opt.seed, opt.hemicubePoints});
+  const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.seed, progress.sub(0.0, 0.1)));
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.1)));
   const double directSeconds = directTimer.seconds();
-  const double bytes = mem.matrix;
-  const bool fits = mem.fits;
   RadiositySolver solver = opt.solver;
-  if (solver == RadiositySolver::Auto) solver = fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
-  RadiosityResult res;
-  const auto slow = ff.method() == FormFactorMethod::Hemicube ? hemicubeCostWarning(u.n, opt.hemicubeResolution)
+  if (solver == RadiositySolver::Auto) solver = mem.fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
+  const auto slow = ff.method() == FormFactorMethod::Hemicube ? hemicubeCostWarning(u.n, ffs.hemicubeResolution)
                                                               : std::nullopt;
-  if (fits) {
-    std::vector<FormFactorRow> rows(u.n);
-    Timer ffTimer;
-    parallelBlocks(u.n, progress.sub(0.1, 0.8), "form factors", [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) rows[i] = ff.row(uint32_t(i));
-    });
-    const double ffSeconds = ffTimer.seconds();
-    size_t entries = 0;
-    for (const auto& r : rows) entries += r.j.size();
-    res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, opt.bounces,
-                opt.tolerance, opt.maxIterations, progress.sub(0.8, 1.0));
-    res.stats.add("form_factor_seconds", ffSeconds);
-    res.stats.add("form_factor_entries", double(entries));
-    res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
-    res.stats.note("full sparse form-factor matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB, with the rest " + std::to_string(int((bytes + mem.rest) / 1048576.0 + 0.5)) + " MB <= budget)");
-  } else {
-    if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
-    thread_local FormFactorRow scratch;
-    res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; }, false, solver,
-                opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
-    res.stats.note("form factors on the fly: the matrix (estimated " + std::to_string(int(bytes / 1048576.0 + 0.5)) +
-                   " MB) and the rest (" + std::to_string(int(mem.rest / 1048576.0 + 0.5)) +
-                   " MB) exceed the memory budget");
-  }
-  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) {
-    // Per vertex: exact direct light there; the indirect light either
-    // gathered from the patch solution with rays from the vertex (final
-    // gather: visibility at the vertex itself, no leaks under objects that
-    // cut through patches) or interpolated from the incident patches.
-    Timer vt;
-    const VertexMaterial mat = vertexMaterial(s);
-    const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.seed);
-    std::vector<glm::vec3> Hi;
-    if (opt.vertexOutput == RadiosityVertexOutput::FinalGather) {
-      // Cosine-weighted: the irradiance estimate is the mean of the reflected radiosity seen.
-      // Near hits (within two patch edges) see the patch up close, where its
-      // average hides how the direct light varies across it (the shadow of an
-      // object standing on it, a shadow edge): there the direct light is
-      // evaluated at the hit point itself and the patch's indirect light
-      // added (a two-level gather). Only for the converged solution: with a
-      // fixed bounce count the patch values are what the count asks for.
-      const bool refineNear = opt.bounces < 0;
-      const DirectLightAt directAt(s, caster, 4);
-      const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-      std::vector<float> nearT(s.faceCount());
-      for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
-      std::atomic<uint64_t> nearHits{0};
-      Hi = finalGather(s, caster, mat, opt.gatherRays, opt.seed, [&](uint32_t f, const glm::vec3& y, float t) {
-        if (!refineNear || t > nearT[f]) return res.Rgather[f];
-        nearHits.fetch_add(1, std::memory_order_relaxed);
-        uint32_t bits[3];
-        std::memcpy(bits, &y, sizeof bits);
-        const uint32_t key = hash3(bits[0] ^ opt.seed, bits[1], bits[2] ^ f);
-        return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
-      });
-      res.stats.add("gather_rays", double(s.vertexCount()) * opt.gatherRays);
-      if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
-    } else {
-      Hi = faceToVertex(s, res.Hindirect);
-    }
-    for (size_t v = 0; v < s.vertexCount(); ++v)
-      res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v]) : glm::vec3(0.f);
-    res.stats.add("vertex_output_seconds", vt.seconds());
-    res.stats.note(opt.vertexOutput == RadiosityVertexOutput::FinalGather
-                       ? "vertices: direct light and a final gather of the patch solution at each vertex"
-                       : "vertices: direct light at each vertex, indirect interpolated from the patches");
-  }
+  RadiosityResult res = mem.fits ? solveInMemory(s, u, ff, mem, solver, opt, progress)
+                                 : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
+  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
   res.stats.add("direct_light_seconds", directSeconds);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
-  const char* methodName[] = {"Monte Carlo", "analytic point-to-polygon", "hemicube", "auto"};
-  res.stats.note(std::string("form factors: ") + methodName[int(ff.method())] +
-                 (opt.formFactorMethod == FormFactorMethod::Auto ? " (auto)" : "") +
+  res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
+                 (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));
   if (ff.farPairsSkipped())
     res.stats.note(std::to_string(ff.farPairsSkipped()) + " negligible far pairs skipped (F < 1e-7 proved by distance)");
   res.stats.add("patches", double(u.n));
   if (slow) res.stats.warn(*slow);
-  res.stats.add("memory_estimate_MB", (mem.rest + (fits ? bytes : 0.0)) / 1048576.0);
+  res.stats.add("memory_estimate_MB", (mem.rest + (mem.fits ? mem.matrix : 0.0)) / 1048576.0);
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());
   return res;

@@ -26,15 +26,14 @@ constexpr double kRefinerBytesPerPatch = 624;
 double reachablePatches(size_t inputFaces, const RefineOptions& ro) {
   return std::min(double(ro.maxPatches), double(inputFaces) * std::pow(4.0, double(ro.maxDepth)));
 }
-}  // namespace
 
-AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
-                                         const CasterFactory& makeCaster) {
+// Refuses unusable limits, and at once a refinement whose mesh cannot fit
+// the memory budget, not after hours of refining.
+void checkRefinement(const Scene& s, const RadiosityOptions& opt) {
   const RefineOptions& ro = opt.refinement;
   if (ro.maxDepth < 0) throw std::invalid_argument("refine_max_depth must be >= 0");
   if (ro.maxPatches < 1) throw std::invalid_argument("refine_max_patches must be >= 1");
   if (!(ro.threshold > 0)) throw std::invalid_argument("refine_threshold must be > 0");
-  // Refuse at once, not after hours of refining into a mesh that cannot fit.
   const double MB = 1048576.0, reach = reachablePatches(s.faceCount(), ro);
   const double need = reach * kRefinerBytesPerPatch + solverBaseBytes(size_t(reach), opt);
   if (need > opt.memoryBudgetMB * MB) {
@@ -46,10 +45,68 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
                   reach, ro.maxPatches, s.faceCount(), ro.maxDepth, need / MB, opt.memoryBudgetMB);
     throw std::invalid_argument(b);
   }
+}
+
+// How many of the marked faces (most needing first) can be refined within
+// the patch budget: the prefix is shrunk until its conforming closure fits;
+// 0 when not even a small one does.
+size_t facesWithinBudget(const MeshRefiner& refiner, const std::vector<uint32_t>& marked, size_t budget) {
+  const size_t n = refiner.mesh().scene.faceCount();
+  size_t take = marked.size(), after = refiner.faceCountAfter(marked);
+  for (int tries = 0; after > budget && take > 0 && tries < 40; ++tries) {
+    const double room = n < budget ? double(budget - n) : 0.0;
+    const size_t shrunk = size_t(double(take) * room / double(after - n) * 0.9);
+    take = std::min(take - 1, shrunk);
+    after = refiner.faceCountAfter({marked.begin(), marked.begin() + long(take)});
+  }
+  return after > budget ? 0 : take;
+}
+
+}  // namespace
+
+std::vector<ParamSpec> RefineOptions::specs() {
+  return {
+      {.name = "refine_max_depth", .label = "Refinement: maximum depth",
+       .help = "Levels of refinement: each level splits the marked patches once (a patch of depth d is 4^d times "
+               "smaller than its original triangle) and solves again, so the cost grows with the levels.",
+       .type = ParamType::Int, .def = 3, .min = 1, .max = 12},
+      {.name = "refine_max_patches", .label = "Refinement: patch budget",
+       .help = "Never more patches than this; when a level would exceed it, the patches that need refinement most "
+               "(largest jump or visibility difference times area) are split first.",
+       .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000},
+      {.name = "refine_threshold", .label = "Refinement: radiosity jump",
+       .help = "Split the two patches on either side of an edge when their reflected radiosity differs by more than "
+               "this fraction of the larger one (ignoring differences below 1% of the scene's mean). Smaller: more "
+               "patches. Edges sharper than 30 degrees are not tested: B jumps there for real.",
+       .type = ParamType::Float, .def = 0.1, .min = 1e-4, .max = 100.0},
+      {.name = "refine_shadow_threshold", .label = "Refinement: shadow boundary",
+       .help = "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) "
+               "differs by more than this between two of its vertices: a shadow boundary crosses it. 1 turns this "
+               "test off.",
+       .type = ParamType::Float, .def = 0.3, .min = 0.0, .max = 1.0},
+  };
+}
+
+RefineOptions RefineOptions::fromParams(const ParamValues& v) {
+  RefineOptions o;
+  o.maxDepth = v.getInt("refine_max_depth");
+  o.maxPatches = v.getInt("refine_max_patches");
+  o.threshold = v.getFloat("refine_threshold");
+  o.shadowThreshold = v.getFloat("refine_shadow_threshold");
+  o.seed = uint32_t(v.getInt("seed"));
+  return o;
+}
+
+AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions& opt, const Progress& progress,
+                                         const CasterFactory& makeCaster) {
+  const RefineOptions& ro = opt.refinement;
+  checkRefinement(s, opt);
+  const double MB = 1048576.0;
   const CasterFactory caster = makeCaster ? makeCaster : [](const Scene& sc) { return makeEmbreeCaster(sc); };
   Timer timer;
   MeshRefiner refiner(s);
   RadiosityOptions levelOpt = opt;
+  levelOpt.vertices = VertexPart();  // where to refine depends on every vertex's value
   // Intermediate levels: direct light at the vertices, indirect interpolated (no gather rays).
   if (levelOpt.vertexOutput == RadiosityVertexOutput::FinalGather)
     levelOpt.vertexOutput = RadiosityVertexOutput::InterpolatedIndirect;
@@ -75,16 +132,8 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
       why = "nothing left above the thresholds";
       break;
     }
-    // Within the budget: the most needing faces first; shrink the marked
-    // prefix until the conforming closure fits.
-    size_t take = marks.faces.size(), after = refiner.faceCountAfter(marks.faces);
-    for (int tries = 0; after > budget && take > 0 && tries < 40; ++tries) {
-      const double room = n < budget ? double(budget - n) : 0.0;
-      const size_t shrunk = size_t(double(take) * room / double(after - n) * 0.9);
-      take = std::min(take - 1, shrunk);
-      after = refiner.faceCountAfter({marks.faces.begin(), marks.faces.begin() + long(take)});
-    }
-    if (after > budget || take == 0) {
+    const size_t take = facesWithinBudget(refiner, marks.faces, budget);
+    if (take == 0) {
       why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(marks.faces.size()) +
             " faces still above the thresholds)";
       break;

@@ -18,15 +18,7 @@
 
 namespace gi {
 
-const char* renderModeName(RenderMode m) {
-  switch (m) {
-    case RenderMode::Whitted: return "Whitted";
-    case RenderMode::Distributed: return "Distributed";
-    case RenderMode::TwoPass: return "Two-pass";
-    case RenderMode::PathTraced: return "Path traced";
-  }
-  return "?";
-}
+const char* renderModeName(RenderMode m) { return kRenderModes.logName(m); }
 
 namespace {
 

@@ -12,104 +12,107 @@ namespace gi {
 
 std::vector<ParamSpec> geometrySceneSpecs() {
   std::vector<ParamSpec> s;
-  s.push_back({"scene_extent", "Scene extent",
-               "Which meshes form the scene. 'Current layer': only the selected layer casts and receives. "
-               "'All visible layers': every visible layer occludes (and reflects) as one scene and every one of them "
-               "receives the result, e.g. a Cornell box built from several meshes.",
-               ParamType::Enum, 0, 0, 0, {"Current layer", "All visible layers"}, {}, true});
-  s.push_back({"reflectance_source", "Reflectance from",
-               "Where the diffuse reflectance (albedo) rho of each face comes from. 'Auto': face colour if the mesh has "
-               "face colours, else the mean of its vertex colours, else the constant below. Colours are sRGB and are "
-               "converted to linear reflectance. Every channel must stay below 1 (energy conservation).",
-               ParamType::Enum, 0, 0, 0, {"Auto", "Face color", "Vertex color", "Constant"}});
-  s.push_back({"reflectance", "Constant reflectance",
-               "Reflectance used when the mesh has no colours or 'Constant' is chosen (sRGB colour; 0.5 linear is "
-               "sRGB 188).",
-               ParamType::Color, 0, 0, 0, {}, glm::vec3(188.f / 255.f)});
+  s.push_back({.name = "scene_extent", .label = "Scene extent",
+               .help = "Which meshes form the scene. 'Current layer': only the selected layer casts and receives. "
+                       "'All visible layers': every visible layer occludes (and reflects) as one scene and every one "
+                       "of them receives the result, e.g. a Cornell box built from several meshes.",
+               .type = ParamType::Enum, .def = kSceneExtents.index(SceneExtent::CurrentLayer),
+               .choices = kSceneExtents.choices(), .meshlabOnly = true});
+  s.push_back({.name = "reflectance_source", .label = "Reflectance from",
+               .help = "Where the diffuse reflectance (albedo) rho of each face comes from. 'Auto': face colour if "
+                       "the mesh has face colours, else the mean of its vertex colours, else the constant below. "
+                       "Colours are sRGB and are converted to linear reflectance. Every channel must stay below 1 "
+                       "(energy conservation).",
+               .type = ParamType::Enum, .def = kReflectanceSources.index(ReflectanceSource::Auto),
+               .choices = kReflectanceSources.choices()});
+  s.push_back({.name = "reflectance", .label = "Constant reflectance",
+               .help = "Reflectance used when the mesh has no colours or 'Constant' is chosen (sRGB colour; 0.5 "
+                       "linear is sRGB 188).",
+               .type = ParamType::Color, .defVec = glm::vec3(188.f / 255.f)});
   return s;
 }
 
 std::vector<ParamSpec> lightingSceneSpecs() {
   auto s = geometrySceneSpecs();
-  s.push_back({"emitter_source", "Emitters",
-               "Which faces emit light. 'Selected faces': select the light in MeshLab (or with a selection filter in "
-               "a script). 'Face quality above threshold': faces whose quality exceeds the threshold below. "
-               "'None': only for scenes lit otherwise. 'Auto' (the default): the selected faces if any face is "
-               "selected, else the faces with quality above the threshold (the log says which).",
-               ParamType::Enum, 3, 0, 0, {"Selected faces", "Face quality above threshold", "None", "Auto"}});
-  s.push_back({"emitter_quality_threshold", "Emitter quality threshold",
-               "With 'Face quality above threshold', faces with quality strictly above this value emit.",
-               ParamType::Float, 0.5, -1e30, 1e30});
-  s.push_back({"emitter_color", "Emitter colour",
-               "Chromaticity of the emitted light (sRGB colour, converted to linear).", ParamType::Color, 0, 0, 0, {},
-               glm::vec3(1.f, 219.f / 255.f, 133.f / 255.f)});
-  s.push_back({"emitter_intensity", "Emitter radiosity (W/m^2)",
-               "Emitted radiosity E (exitance, one-sided, towards the face normal) = intensity x linear colour. The "
-               "default reproduces the Cornell box light of radiance (17, 12, 4): E = pi x 17 for red.",
-               ParamType::Float, 53.407, 0.0, 1e12});
+  s.push_back({.name = "emitter_source", .label = "Emitters",
+               .help = "Which faces emit light. 'Selected faces': select the light in MeshLab (or with a selection "
+                       "filter in a script). 'Face quality above threshold': faces whose quality exceeds the "
+                       "threshold below. 'None': only for scenes lit otherwise. 'Auto' (the default): the selected "
+                       "faces if any face is selected, else the faces with quality above the threshold (the log says "
+                       "which).",
+               .type = ParamType::Enum, .def = kEmitterSources.index(EmitterSource::Auto),
+               .choices = kEmitterSources.choices()});
+  s.push_back({.name = "emitter_quality_threshold", .label = "Emitter quality threshold",
+               .help = "With 'Face quality above threshold', faces with quality strictly above this value emit.",
+               .type = ParamType::Float, .def = 0.5, .min = -1e30, .max = 1e30});
+  s.push_back({.name = "emitter_color", .label = "Emitter colour",
+               .help = "Chromaticity of the emitted light (sRGB colour, converted to linear).",
+               .type = ParamType::Color, .defVec = glm::vec3(1.f, 219.f / 255.f, 133.f / 255.f)});
+  s.push_back({.name = "emitter_intensity", .label = "Emitter radiosity (W/m^2)",
+               .help = "Emitted radiosity E (exitance, one-sided, towards the face normal) = intensity x linear "
+                       "colour. The default reproduces the Cornell box light of radiance (17, 12, 4): E = pi x 17 "
+                       "for red.",
+               .type = ParamType::Float, .def = 53.407, .min = 0.0, .max = 1e12});
   return s;
 }
 
 std::vector<ParamSpec> materialSpecs() {
   std::vector<ParamSpec> s;
-  ParamSpec mirror{"mirror_layers", "Mirror layers",
-                   "Layers that are perfect mirrors: comma-separated layer names as the Layer dialog shows them (the "
-                   "file name unless renamed; double-click a layer to rename it), with * matching any text, e.g. "
-                   "'mirror*, *.stl'. Case does not matter. Empty: no mirrors.",
-                   ParamType::String};
-  mirror.defText = "*mirror*";
-  s.push_back(mirror);
-  ParamSpec glass{"glass_layers", "Glass layers",
-                  "Layers made of glass (a smooth dielectric: Fresnel reflection, refraction, total internal "
-                  "reflection). Give each glass object as a closed mesh with outward normals. Same patterns as for "
-                  "mirrors; empty: no glass.",
-                  ParamType::String};
-  glass.defText = "*glass*";
-  s.push_back(glass);
-  s.push_back({"ior", "Index of refraction",
-               "Index of refraction of the glass (1.5: window glass, 1.33: water, 2.42: diamond; 1.0 makes the glass "
-               "vanish).",
-               ParamType::Float, 1.5, 1.0, 4.0});
-  s.push_back({"specular_color", "Mirror and glass colour",
-               "Reflectance of the mirrors and transmittance tint of the glass (sRGB; white = a perfect mirror and "
-               "clear glass).",
-               ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)});
+  s.push_back({.name = "mirror_layers", .label = "Mirror layers",
+               .help = "Layers that are perfect mirrors: comma-separated layer names as the Layer dialog shows them "
+                       "(the file name unless renamed; double-click a layer to rename it), with * matching any text, "
+                       "e.g. 'mirror*, *.stl'. Case does not matter. Empty: no mirrors.",
+               .type = ParamType::String, .defText = "*mirror*"});
+  s.push_back({.name = "glass_layers", .label = "Glass layers",
+               .help = "Layers made of glass (a smooth dielectric: Fresnel reflection, refraction, total internal "
+                       "reflection). Give each glass object as a closed mesh with outward normals. Same patterns as "
+                       "for mirrors; empty: no glass.",
+               .type = ParamType::String, .defText = "*glass*"});
+  s.push_back({.name = "ior", .label = "Index of refraction",
+               .help = "Index of refraction of the glass (1.5: window glass, 1.33: water, 2.42: diamond; 1.0 makes "
+                       "the glass vanish).",
+               .type = ParamType::Float, .def = 1.5, .min = 1.0, .max = 4.0});
+  s.push_back({.name = "specular_color", .label = "Mirror and glass colour",
+               .help = "Reflectance of the mirrors and transmittance tint of the glass (sRGB; white = a perfect "
+                       "mirror and clear glass).",
+               .type = ParamType::Color, .defVec = glm::vec3(1.f)});
   return s;
 }
 
 std::vector<ParamSpec> glossySpecs() {
-  ParamSpec layers{"glossy_layers", "Glossy layers",
-                   "Layers with a glossy (rough metal) surface: a GGX microfacet reflector (Walter et al. 2007) that "
+  return {{.name = "glossy_layers", .label = "Glossy layers",
+           .help = "Layers with a glossy (rough metal) surface: a GGX microfacet reflector (Walter et al. 2007) that "
                    "blurs reflections more as its roughness grows. Same patterns as for mirrors; empty: none.",
-                   ParamType::String};
-  layers.defText = "*glossy*";
-  return {layers,
-          {"glossy_roughness", "Glossy roughness (alpha)",
-           "Width alpha of the GGX distribution of microfacet normals: 0.01 nearly a mirror, 0.1 polished, 0.3 "
-           "brushed, 1 very rough (the reflected highlight spreads over roughly alpha radians).",
-           ParamType::Float, 0.2, 0.001, 1.0},
-          {"glossy_color", "Glossy colour",
-           "Reflectance of the glossy surfaces at normal incidence (F0 of Schlick's Fresnel term, sRGB); towards "
-           "grazing angles every colour tends to white. White: no light absorbed by the microfacets.",
-           ParamType::Color, 0, 0, 0, {}, glm::vec3(1.f)}};
+           .type = ParamType::String, .defText = "*glossy*"},
+          {.name = "glossy_roughness", .label = "Glossy roughness (alpha)",
+           .help = "Width alpha of the GGX distribution of microfacet normals: 0.01 nearly a mirror, 0.1 polished, "
+                   "0.3 brushed, 1 very rough (the reflected highlight spreads over roughly alpha radians).",
+           .type = ParamType::Float, .def = 0.2, .min = 0.001, .max = 1.0},
+          {.name = "glossy_color", .label = "Glossy colour",
+           .help = "Reflectance of the glossy surfaces at normal incidence (F0 of Schlick's Fresnel term, sRGB); "
+                   "towards grazing angles every colour tends to white. White: no light absorbed by the microfacets.",
+           .type = ParamType::Color, .defVec = glm::vec3(1.f)}};
 }
 
 std::vector<ParamSpec> pointLightSpecs() {
   return {
-      {"point_position", "Point light position", "Position of an optional point or spot light (absolute coordinates).",
-       ParamType::Point, 0, 0, 0, {}, glm::vec3(0.f)},
-      {"point_intensity", "Point light intensity (W/sr)",
-       "Radiant intensity of the point or spot light; 0 = none. Its power is 4 pi I (point) or 2 pi (1 - cos a) I "
-       "(spot of half angle a).",
-       ParamType::Float, 0.0, 0.0, 1e12},
-      {"point_color", "Point light colour", "Colour of the point or spot light (sRGB).", ParamType::Color, 0, 0, 0, {},
-       glm::vec3(1.f)},
-      {"spot_direction", "Spot direction", "Axis of the spot light's cone.", ParamType::Direction, 0, 0, 0, {},
-       glm::vec3(0.f, -1.f, 0.f)},
-      {"spot_angle", "Spot half angle (deg)",
-       "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining every "
-       "way.",
-       ParamType::Float, 180.0, 0.0, 180.0},
+      {.name = "point_position", .label = "Point light position",
+       .help = "Position of an optional point or spot light (absolute coordinates).",
+       .type = ParamType::Point, .defVec = glm::vec3(0.f)},
+      {.name = "point_intensity", .label = "Point light intensity (W/sr)",
+       .help = "Radiant intensity of the point or spot light; 0 = none. Its power is 4 pi I (point) or 2 pi (1 - cos "
+               "a) I (spot of half angle a).",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e12},
+      {.name = "point_color", .label = "Point light colour",
+       .help = "Colour of the point or spot light (sRGB).",
+       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
+      {.name = "spot_direction", .label = "Spot direction",
+       .help = "Axis of the spot light's cone.",
+       .type = ParamType::Direction, .defVec = glm::vec3(0.f, -1.f, 0.f)},
+      {.name = "spot_angle", .label = "Spot half angle (deg)",
+       .help = "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining "
+               "every way.",
+       .type = ParamType::Float, .def = 180.0, .min = 0.0, .max = 180.0},
   };
 }
 
@@ -197,16 +200,19 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
 }
 
 std::vector<ParamSpec> displaySpecs() {
-  return {{"exposure", "Exposure",
-           "Vertex colour = sRGB(exposure x linear value); 0 chooses it automatically so that the 99th percentile of "
-           "the luminance maps to white. Quality always holds the physical value.",
-           ParamType::Float, 0.0, 0.0, 1e12}};
+  return {{.name = "exposure", .label = "Exposure",
+           .help = "Vertex colour = sRGB(exposure x linear value); 0 chooses it automatically so that the 99th "
+                   "percentile of the luminance maps to white. Quality always holds the physical value.",
+           .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e12}};
 }
 
-std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
-                                                 bool withEmitters, std::string* log) {
+namespace {
+
+// rho per face from the chosen source, *msg the log's part ("reflectance
+// from ..."); the error sentence when the mesh lacks that source.
+std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg) {
   const size_t nf = s.faceCount();
-  auto src = ReflectanceSource(v.getInt("reflectance_source"));
+  auto src = kReflectanceSources.get(v, "reflectance_source");
   const glm::vec3 constant = v.getVec("reflectance");
   const glm::vec3 constantLin(srgbToLinear(constant.r), srgbToLinear(constant.g), srgbToLinear(constant.b));
   const bool hasFace = a.faceColor.size() == nf && nf > 0;
@@ -235,32 +241,47 @@ std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes&
   for (auto& r : s.rho)
     for (int k = 0; k < 3; ++k)
       if (r[k] > 0.999f) { r[k] = 0.999f; ++clamped; }
-  const char* srcName[] = {"auto", "face colour", "vertex colour", "constant"};
-  std::string msg = std::string("reflectance from ") + srcName[int(src)];
-  if (clamped) msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
-  if (withEmitters) {
-    const auto es = EmitterSource(v.getInt("emitter_source"));
-    const glm::vec3 col = v.getVec("emitter_color");
-    const glm::vec3 E = float(v.getFloat("emitter_intensity")) * glm::vec3(srgbToLinear(col.r), srgbToLinear(col.g), srgbToLinear(col.b));
-    s.emission.assign(nf, glm::vec3(0.f));
-    size_t count = 0;
-    const bool anySelected = a.faceSelected.size() == nf &&
-                             std::any_of(a.faceSelected.begin(), a.faceSelected.end(), [](uint8_t x) { return x != 0; });
-    const EmitterSource chosen = es != EmitterSource::Auto ? es
-                                 : anySelected        ? EmitterSource::SelectedFaces
-                                                      : EmitterSource::QualityAbove;
-    if (es == EmitterSource::Auto)
-      msg += std::string("; emitters: ") + (anySelected ? "the selected faces" : "faces with quality above the threshold (nothing selected)");
-    if (chosen == EmitterSource::SelectedFaces && a.faceSelected.size() == nf) {
-      for (size_t f = 0; f < nf; ++f)
-        if (a.faceSelected[f]) { s.emission[f] = E; ++count; }
-    } else if (chosen == EmitterSource::QualityAbove && a.faceQuality.size() == nf) {
-      const float th = float(v.getFloat("emitter_quality_threshold"));
-      for (size_t f = 0; f < nf; ++f)
-        if (a.faceQuality[f] > th) { s.emission[f] = E; ++count; }
-    }
-    msg += "; " + std::to_string(count) + " emitter faces";
+  *msg = std::string("reflectance from ") + kReflectanceSources.logName(src);
+  if (clamped) *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
+  return std::nullopt;
+}
+
+// E per face from the chosen source (Auto: the selection if any face is
+// selected, else face quality); the log's part.
+std::string setEmission(Scene& s, const MeshAttributes& a, const ParamValues& v) {
+  const size_t nf = s.faceCount();
+  const auto es = kEmitterSources.get(v, "emitter_source");
+  const glm::vec3 col = v.getVec("emitter_color");
+  const glm::vec3 E =
+      float(v.getFloat("emitter_intensity")) * glm::vec3(srgbToLinear(col.r), srgbToLinear(col.g), srgbToLinear(col.b));
+  s.emission.assign(nf, glm::vec3(0.f));
+  size_t count = 0;
+  const bool anySelected = a.faceSelected.size() == nf &&
+                           std::any_of(a.faceSelected.begin(), a.faceSelected.end(), [](uint8_t x) { return x != 0; });
+  const EmitterSource chosen = es != EmitterSource::Auto ? es
+                               : anySelected        ? EmitterSource::SelectedFaces
+                                                    : EmitterSource::QualityAbove;
+  std::string msg;
+  if (es == EmitterSource::Auto)
+    msg = std::string("; emitters: ") + kEmitterSources.logName(chosen) + (anySelected ? "" : " (nothing selected)");
+  if (chosen == EmitterSource::SelectedFaces && a.faceSelected.size() == nf) {
+    for (size_t f = 0; f < nf; ++f)
+      if (a.faceSelected[f]) { s.emission[f] = E; ++count; }
+  } else if (chosen == EmitterSource::QualityAbove && a.faceQuality.size() == nf) {
+    const float th = float(v.getFloat("emitter_quality_threshold"));
+    for (size_t f = 0; f < nf; ++f)
+      if (a.faceQuality[f] > th) { s.emission[f] = E; ++count; }
   }
+  return msg + "; " + std::to_string(count) + " emitter faces";
+}
+
+}  // namespace
+
+std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
+                                                 bool withEmitters, std::string* log) {
+  std::string msg;
+  if (auto err = setReflectance(s, a, v, &msg)) return err;
+  if (withEmitters) msg += setEmission(s, a, v);
   if (log) *log = msg;
   return std::nullopt;
 }

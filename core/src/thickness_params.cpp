@@ -5,29 +5,33 @@ namespace gi {
 
 std::vector<ParamSpec> ThicknessOptions::specs() {
   std::vector<ParamSpec> s;
-  s.push_back({"rays_per_vertex", "Rays per vertex",
-               "Rays cast into the object from each vertex when no target error is set. Shapira et al. (2008) used "
-               "30; our scrambled Sobol directions make 64 smooth on most meshes. Cost is linear in it.",
-               ParamType::Int, 64, 1, 1 << 20});
-  s.push_back({"target_error", "Target relative error",
-               "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until the standard error of its "
-               "mean length is below this fraction of the mean (0.01 = 1%), between the minimum and maximum ray "
-               "counts. 0 = fixed ray count.",
-               ParamType::Float, 0.0, 0.0, 0.5});
-  s.push_back({"min_rays", "Minimum rays (adaptive)", "Adaptive sampling never stops before this many rays.",
-               ParamType::Int, 32, 1, 1 << 20});
-  s.push_back({"max_rays", "Maximum rays (adaptive)", "Adaptive sampling never casts more than this many rays.",
-               ParamType::Int, 4096, 1, 1 << 22});
-  s.push_back({"cone_angle", "Cone half-angle (deg)",
-               "Rays go into the object within this angle of the inward normal (cosine-distributed). A wider cone "
-               "averages over more of the opposite side (robust on noisy meshes) but reads longer, slanted chords: "
-               "a sphere of radius r gives (4r/3)(1 + c + c^2)/(1 + c) with c = cos(angle), a slab of thickness t "
-               "gives 2t/(1 + c), a cylinder exactly its diameter. Shapira et al. (2008): 60 (a 120 degree cone).",
-               ParamType::Float, 60.0, 0.5, 89.0});
-  s.push_back({"reject_outliers", "Reject outliers",
-               "Average only the lengths within one standard deviation of their median (Shapira et al. 2008), so "
-               "that rays slipping through a gap or along a fin do not count. Off: the plain mean.",
-               ParamType::Bool, 1});
+  s.push_back({.name = "rays_per_vertex", .label = "Rays per vertex",
+               .help = "Rays cast into the object from each vertex when no target error is set. Shapira et al. "
+                       "(2008) used 30; our scrambled Sobol directions make 64 smooth on most meshes. Cost is linear "
+                       "in it.",
+               .type = ParamType::Int, .def = 64, .min = 1, .max = 1 << 20});
+  s.push_back({.name = "target_error", .label = "Target relative error",
+               .help = "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until the standard error "
+                       "of its mean length is below this fraction of the mean (0.01 = 1%), between the minimum and "
+                       "maximum ray counts. 0 = fixed ray count.",
+               .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 0.5});
+  s.push_back({.name = "min_rays", .label = "Minimum rays (adaptive)",
+               .help = "Adaptive sampling never stops before this many rays.",
+               .type = ParamType::Int, .def = 32, .min = 1, .max = 1 << 20});
+  s.push_back({.name = "max_rays", .label = "Maximum rays (adaptive)",
+               .help = "Adaptive sampling never casts more than this many rays.",
+               .type = ParamType::Int, .def = 4096, .min = 1, .max = 1 << 22});
+  s.push_back({.name = "cone_angle", .label = "Cone half-angle (deg)",
+               .help = "Rays go into the object within this angle of the inward normal (cosine-distributed). A "
+                       "wider cone averages over more of the opposite side (robust on noisy meshes) but reads longer, "
+                       "slanted chords: a sphere of radius r gives (4r/3)(1 + c + c^2)/(1 + c) with c = cos(angle), "
+                       "a slab of thickness t gives 2t/(1 + c), a cylinder exactly its diameter. Shapira et al. "
+                       "(2008): 60 (a 120 degree cone).",
+               .type = ParamType::Float, .def = 60.0, .min = 0.5, .max = 89.0});
+  s.push_back({.name = "reject_outliers", .label = "Reject outliers",
+               .help = "Average only the lengths within one standard deviation of their median (Shapira et al. "
+                       "2008), so that rays slipping through a gap or along a fin do not count. Off: the plain mean.",
+               .type = ParamType::Bool, .def = true});
   s.push_back(seedSpec("ray directions"));
   return s;
 }

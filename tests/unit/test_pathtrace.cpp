@@ -164,7 +164,7 @@ TEST(PathTracer, AgreesWithRadiosityOnCornellBox) {
   const Scene& s = sf.scene;
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions ro;
-  ro.raysPerPatch = 4096;
+  ro.formFactors.raysPerPatch = 4096;
   ro.lightSamples = 1024;
   ro.tolerance = 1e-7;
   const auto rad = solveRadiosity(s, *caster, ro);
@@ -247,7 +247,7 @@ TEST(PathTracer, RadiosityFinalGatherAtTheFootOfABlock) {
   quad({-0.8, 2, -0.8}, {0.8, 2, -0.8}, {0.8, 2, 0.8}, {-0.8, 2, 0.8}, 2, none, glm::vec3(5.f));  // light, facing down
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions ro;
-  ro.raysPerPatch = 4096;
+  ro.formFactors.raysPerPatch = 4096;
   ro.lightSamples = 1024;
   ro.gatherRays = 1024;
   const auto r = solveRadiosity(s, *caster, ro);
@@ -276,9 +276,9 @@ TEST(PathTracer, RadiosityZeroBouncesAtVerticesIsDirectLight) {
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions o;
   o.bounces = 0;
-  o.raysPerPatch = 64;
+  o.formFactors.raysPerPatch = 64;
   const auto r = solveRadiosity(s, *caster, o);
-  const auto Hd = vertexDirectIrradiance(s, *caster, o.lightSamples, o.seed);
+  const auto Hd = vertexDirectIrradiance(s, *caster, o.lightSamples, o.formFactors.seed);
   const VertexMaterial m = vertexMaterial(s);
   for (size_t v = 0; v < s.vertexCount(); ++v)
     EXPECT_NEAR(luminance(r.Bvertex[v]), luminance(m.E[v] + m.rho[v] * Hd[v]), 1e-5f * (1 + luminance(r.Bvertex[v])));

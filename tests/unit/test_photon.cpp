@@ -568,7 +568,7 @@ TEST(PhotonMap, DiffuseCornellBoxAgreesWithRadiosityAndPathTracer) {
   const Scene& s = sf.scene;
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions ro;
-  ro.raysPerPatch = 4096;
+  ro.formFactors.raysPerPatch = 4096;
   ro.lightSamples = 1024;
   ro.tolerance = 1e-7;
   const auto rad = solveRadiosity(s, *caster, ro);

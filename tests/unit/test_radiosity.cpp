@@ -197,10 +197,10 @@ TEST(Radiosity, FormFactorMethodsAgreeOnCornellBox) {
   auto caster = makeEmbreeCaster(sf.scene);
   auto mean = [&](FormFactorMethod m) {
     RadiosityOptions o;
-    o.formFactorMethod = m;
-    o.raysPerPatch = 4096;
-    o.analyticPoints = 8;
-    o.hemicubeResolution = 128;
+    o.formFactors.method = m;
+    o.formFactors.raysPerPatch = 4096;
+    o.formFactors.analyticPoints = 8;
+    o.formFactors.hemicubeResolution = 128;
     o.tolerance = 1e-7;
     const auto r = solveRadiosity(sf.scene, *caster, o);
     double num = 0, den = 0;
@@ -256,7 +256,7 @@ TEST(Radiosity, DeterministicAcrossThreadCountsAndMemoryPaths) {
   auto sf = scenes::cornellBox(100.0);
   auto caster = makeEmbreeCaster(sf.scene);
   RadiosityOptions o;
-  o.raysPerPatch = 128;
+  o.formFactors.raysPerPatch = 128;
   o.solver = RadiositySolver::Progressive;
   o.tolerance = 1e-6;
   RadiosityResult a, b;
@@ -458,7 +458,7 @@ TEST(Radiosity, StressAreasDuplicatesAndRhoNearOne) {
   s.emission.push_back(s.emission[10]);
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions o;
-  o.raysPerPatch = 4096;
+  o.formFactors.raysPerPatch = 4096;
   const auto r = solveRadiosity(s, *caster, o);
   double maxArea = 0, minArea = HUGE_VAL;
   for (size_t f = 0; f < s.faceCount(); ++f) {
@@ -590,8 +590,8 @@ TEST(Radiosity, MemoryBudgetRefusesBeforeTheWork) {
 
   auto caster = makeEmbreeCaster(box.scene);
   RadiosityOptions hemi;
-  hemi.formFactorMethod = FormFactorMethod::Hemicube;
-  hemi.hemicubeResolution = 4096;
+  hemi.formFactors.method = FormFactorMethod::Hemicube;
+  hemi.formFactors.hemicubeResolution = 4096;
   hemi.memoryBudgetMB = 100;
   why = refusal([&](const Progress& p) { solveRadiosity(box.scene, *caster, hemi, p); }, &reports);
   EXPECT_NE(why.find("hemicube"), std::string::npos) << why;

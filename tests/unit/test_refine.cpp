@@ -124,7 +124,7 @@ double floorError(const RefinedMesh& m, const std::vector<glm::vec3>& Bvertex, c
 
 RadiosityOptions cheapOptions() {
   RadiosityOptions o;
-  o.raysPerPatch = 64;     // nothing to gather: every surface the floor sees is black
+  o.formFactors.raysPerPatch = 64;     // nothing to gather: every surface the floor sees is black
   o.lightSamples = 1024;   // direct light at the vertices: noise below 1% in the penumbra
   o.gatherRays = 16;
   o.refine = true;

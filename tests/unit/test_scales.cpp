@@ -119,7 +119,7 @@ TEST(Scales, RadiosityFurnace) {
     const Scene s = box(k, 0.5f);
     auto caster = makeEmbreeCaster(s);
     RadiosityOptions o;
-    o.formFactorMethod = FormFactorMethod::Analytic;
+    o.formFactors.method = FormFactorMethod::Analytic;
     o.gatherRays = 64;
     const RadiosityResult r = solveRadiosity(s, *caster, o);
     ASSERT_TRUE(allFinite(r.B) && allFinite(r.Bvertex)) << k;

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <regex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -589,7 +591,7 @@ TEST(Filters, MlxScriptListsEveryParameterInOrder) {
   const double diag = 7.5;
   std::vector<gi::ScriptStep> steps;
   for (const auto& d : gi::allFilters()) steps.push_back({d.kind, gi::defaultValues(gi::filterSpecs(d.kind), diag)});
-  ASSERT_EQ(steps.size(), 7u);  // one per filter of allFilters()
+  ASSERT_GE(steps.size(), 8u);  // one per filter of allFilters()
   const std::string x = gi::mlxScript(steps, diag);
   std::string why;
   EXPECT_TRUE(wellFormed(x, &why)) << why << "\n" << x;
@@ -679,4 +681,34 @@ TEST(EnumTable, ChoicesLogNamesAndValuesFromOneList) {
   EXPECT_EQ(table.get(v, "fruit"), Fruit::Apple);
   v.set("fruit", 2);
   EXPECT_THROW(table.get(v, "fruit"), std::invalid_argument);
+}
+
+// .mlx scripts store an enumeration's index: every filter's choices keep
+// their order (new ones may only be appended). The lists as scripts know them.
+TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
+  using L = std::vector<std::string>;
+  const std::map<std::string, L> expected = {
+      {"scene_extent", L{"Current layer", "All visible layers"}},
+      {"reflectance_source", L{"Auto", "Face color", "Vertex color", "Constant"}},
+      {"emitter_source", L{"Selected faces", "Face quality above threshold", "None", "Auto"}},
+      {"color_mapping", L{"Grey", "Multiply colour", "Keep colour"}},
+      {"ray_batching", L{"Single", "Packet8", "Stream"}},
+      {"form_factor_method", L{"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
+      {"solver", L{"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement"}},
+      {"vertex_output", L{"Final gather", "Interpolated indirect", "Patch average"}},
+      {"mode", L{"Whitted", "Distributed", "Two-pass", "Path traced"}},
+      {"camera", L{"Frame the scene", "Look at", "The layer's camera"}},
+      {"two_pass_diffuse", L{"First pass alone", "Ray-traced direct + stored indirect",
+                             "Direct + caustic map + stored indirect", "Direct + caustic map + final gather"}},
+  };
+  std::set<std::string> seen;
+  for (const gi::FilterDesc& d : gi::allFilters())
+    for (const gi::ParamSpec& p : gi::filterSpecs(d.kind)) {
+      if (p.type != gi::ParamType::Enum) continue;
+      SCOPED_TRACE(d.cliName + " --" + p.name);
+      ASSERT_EQ(expected.count(p.name), 1u) << "a new enumeration: add its choices above";
+      EXPECT_EQ(p.choices, expected.at(p.name));
+      seen.insert(p.name);
+    }
+  EXPECT_EQ(seen.size(), expected.size());
 }

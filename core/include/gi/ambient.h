@@ -11,18 +11,35 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/color.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
 enum class AmbientMode { Occlusion = 0, Obscurance = 1, Sky = 2 };
-enum class AOColorMapping { Grey = 0, MultiplyColor = 1, KeepColor = 2 };
+enum class AOColorMapping { Grey, MultiplyColor, KeepColor };
+inline constexpr auto kAOColorMappings = makeEnumTable<AOColorMapping>({
+    {AOColorMapping::Grey, "Grey", "grey"},
+    {AOColorMapping::MultiplyColor, "Multiply colour", "multiply colour"},
+    {AOColorMapping::KeepColor, "Keep colour", "keep colour"},
+});
+// The "ray_batching" parameter (BatchMode is the ray caster's).
+inline constexpr auto kBatchModes = makeEnumTable<BatchMode>({
+    {BatchMode::Single, "Single", "single rays"},
+    {BatchMode::Packet8, "Packet8", "8-wide packets"},
+    {BatchMode::Stream, "Stream", "streams"},
+});
 // PerVertex: each vertex's own rays only (independent estimates, the
 // estimator above). Shared: neighbours' rays pooled where they agree (gi/ao_shared.h).
-enum class AOEstimator { PerVertex = 0, Shared = 1 };
+enum class AOEstimator { PerVertex, Shared };
+inline constexpr auto kAOEstimators = makeEnumTable<AOEstimator>({
+    {AOEstimator::PerVertex, "Per vertex", "per vertex"},
+    {AOEstimator::Shared, "Shared with neighbours", "shared with neighbours"},
+});
 
 struct AmbientOptions {
   AmbientMode mode = AmbientMode::Occlusion;
@@ -37,10 +54,12 @@ struct AmbientOptions {
   glm::vec3 coneDirection{0.f, 1.f, 0.f};
   float coneAngleDeg = 45.f;     // half-angle
   float falloffExponent = 1.f;   // obscurance
-  glm::vec3 skyRadiantColor{1.f}, sunColor{1.f};  // linear
+  glm::vec3 skyRadiantColor{1.f};  // linear
+  // Linear; the dialog's default, sRGB (255, 244, 214).
+  glm::vec3 sunColor{srgbToLinear(1.f), srgbToLinear(244.f / 255.f), srgbToLinear(214.f / 255.f)};
   float skyIrradiance = 1.f;     // W/m^2 on an unoccluded surface
   float sunIrradiance = 3.f;     // W/m^2 on a surface facing the sun
-  glm::vec3 sunDirection{0.3f, 1.f, 0.2f};  // towards the sun
+  glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length
   float sunAngularRadiusDeg = 0.27f;
   int sunRays = 64;
   BatchMode batch = BatchMode::Single;
@@ -48,6 +67,7 @@ struct AmbientOptions {
   bool mergeDuplicates = true;   // same position and normal computed once
   int shareRings = 3;            // Shared: largest neighbourhood in mesh rings
   float shareNormalAngleDeg = 10.f;  // Shared: neighbours' normals within this angle
+  VertexPart vertices;           // which vertices to compute (a split run); the others are left 0
 
   static std::vector<ParamSpec> specs(AmbientMode mode);
   static AmbientOptions fromParams(AmbientMode mode, const ParamValues& v);

@@ -14,6 +14,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -41,16 +42,18 @@ VertexMaterial vertexMaterial(const Scene& s);
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                              const Progress& progress = Progress(nullptr));
 
-// The same at every vertex (used for the per-vertex output).
+// The same at every vertex (used for the per-vertex output), or at the vertices of one part (the others 0).
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                              const Progress& progress = Progress(nullptr));
+                                              const Progress& progress = Progress(nullptr),
+                                              const VertexPart& part = VertexPart());
 
 // Final gather at every vertex: the mean over `rays` cosine-weighted rays of
 // value(face hit, point hit, distance), for hits on a face's front (0
 // otherwise) — an irradiance estimate when value is the radiosity leaving
-// the hit point.
+// the hit point. Only the vertices of `part` (the others 0).
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value);
+                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
+                                   const VertexPart& part = VertexPart());
 
 namespace detail {
 class DirectLight;

@@ -27,6 +27,7 @@
 #include "gi/run.h"
 #include "gi/scene.h"
 #include "gi/scene_setup.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -49,6 +50,9 @@ struct FilterInput {
   // The camera stored with the current layer (MeshLab: Filters > Camera >
   // Set Mesh Camera takes the current view), if it has one.
   std::optional<ShotData> layerCamera;
+  // The per-vertex estimators compute only this part of the vertices (a run
+  // split over processes, see estimateFilter); all of them by default.
+  VertexPart vertices;
   const VertexAttribute* attribute(const std::string& name) const;
 };
 
@@ -74,6 +78,9 @@ struct FilterResult {
   std::vector<VertexAttribute> attributes;
   std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
   std::vector<FilterImage> images;
+  // Per face, the linear RGB value the estimate leaves for the output step
+  // to map to faceQuality and faceColor (radiosity's face output).
+  std::vector<glm::vec3> faceRadiometry;
 
   SceneReport report;    // the scene the algorithm saw (after the conventions)
   std::string setupLog;  // reflectance, emitters, materials: what the conventions chose
@@ -96,6 +103,18 @@ FilterResult runFilter(FilterKind kind, FilterInput& in, const Progress& progres
 // the set-up log), then steps 3-4.
 FilterResult prepareFilter(FilterKind kind, FilterInput& in);
 void computeFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress = Progress(nullptr));
+
+// Steps 3 and 4 apart, for one mesh split over processes (docs/design.md,
+// "Split runs"): estimateFilter computes the physical per-vertex values of
+// the vertices in `in.vertices` (vertexQuality, vertexNormal and the
+// attributes; the other vertices' entries are 0), the front end gathers the
+// parts' values into one result, and outputFilter maps them to the output
+// convention (the automatic exposure needs every vertex) and checks them.
+// computeFilter is the two in a row. Only the per-vertex estimators can be
+// split (splitsVertices); estimateFilter refuses a part for the others.
+bool splitsVertices(FilterKind kind);
+void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const Progress& progress = Progress(nullptr));
+void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res);
 
 // Writes each image that has a path: the PNG there (sRGB at its exposure)
 // and the linear values beside it as PFM (same name, .pfm). Throws

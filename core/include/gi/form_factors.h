@@ -27,7 +27,13 @@
 
 namespace gi {
 
-enum class FormFactorMethod { MonteCarlo = 0, Analytic = 1, Hemicube = 2, Auto = 3 };
+enum class FormFactorMethod { MonteCarlo, Analytic, Hemicube, Auto };
+inline constexpr auto kFormFactorMethods = makeEnumTable<FormFactorMethod>({
+    {FormFactorMethod::MonteCarlo, "Monte Carlo", "Monte Carlo"},
+    {FormFactorMethod::Analytic, "Analytic point-to-polygon", "analytic point-to-polygon"},
+    {FormFactorMethod::Hemicube, "Hemicube", "hemicube"},
+    {FormFactorMethod::Auto, "Auto", "auto"},
+});
 
 // Sparse form-factor row of patch i: F_ij for the patches j its rays reached.
 struct FormFactorRow {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -78,7 +79,8 @@ const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string
 
 // One table per enumeration: each value with the choice the dialog shows (and
 // scripts and the CLI accept) and the short name the log uses, so that the
-// three cannot drift apart. A value's dialog index is its place in the table.
+// three cannot drift apart. A value's dialog index is its place in the table,
+// which .mlx scripts store: append new values, never reorder.
 template <class E>
 struct EnumChoice {
   E value;
@@ -93,7 +95,7 @@ struct EnumTable {
     for (const auto& e : entries) c.push_back(e.choice);
     return c;
   }
-  int index(E v) const {
+  constexpr int index(E v) const {
     for (size_t i = 0; i < N; ++i)
       if (entries[i].value == v) return int(i);
     throw std::logic_error("enumeration value missing from its table");
@@ -109,6 +111,17 @@ struct EnumTable {
 template <class E, class... C>
 constexpr EnumTable<E, sizeof...(C)> makeEnumTable(C... c) {
   return {{{c...}}};
+}
+namespace detail {
+template <class E, size_t N, size_t... I>
+constexpr EnumTable<E, N> enumTableFromArray(const EnumChoice<E> (&c)[N], std::index_sequence<I...>) {
+  return {{{c[I]...}}};
+}
+}  // namespace detail
+// The same from a braced list: makeEnumTable<E>({{E::A, "A", "a"}, {E::B, "B", "b"}}).
+template <class E, size_t N>
+constexpr EnumTable<E, N> makeEnumTable(const EnumChoice<E> (&c)[N]) {
+  return detail::enumTableFromArray(c, std::make_index_sequence<N>{});
 }
 // The "seed" parameter every stochastic filter has; `what` names what it seeds.
 ParamSpec seedSpec(const std::string& what);

@@ -25,6 +25,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -36,10 +37,11 @@ struct PathTraceOptions {
                                    // roulette alone ends paths: unbiased; a safety cap of 100,000)
   uint32_t seed = 0;
   glm::vec3 skyRadiance{0.f};      // uniform sky over the whole sphere, W/(m^2 sr)
-  glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
+  glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
+  VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

@@ -22,18 +22,29 @@
 #include "gi/refine.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
-enum class RadiositySolver { Auto = 0, Jacobi = 1, GaussSeidel = 2, Progressive = 3 };
-enum class RadiosityVertexOutput { FinalGather = 0, InterpolatedIndirect = 1, PatchAverage = 2 };
+enum class RadiositySolver { Auto, Jacobi, GaussSeidel, Progressive };
+inline constexpr auto kRadiositySolvers = makeEnumTable<RadiositySolver>({
+    {RadiositySolver::Auto, "Auto", "auto"},
+    {RadiositySolver::Jacobi, "Jacobi", "Jacobi"},
+    {RadiositySolver::GaussSeidel, "Gauss-Seidel", "Gauss-Seidel"},
+    {RadiositySolver::Progressive, "Progressive refinement", "progressive refinement"},
+});
+enum class RadiosityVertexOutput { FinalGather, InterpolatedIndirect, PatchAverage };
+inline constexpr auto kRadiosityVertexOutputs = makeEnumTable<RadiosityVertexOutput>({
+    {RadiosityVertexOutput::FinalGather, "Final gather", "final gather"},
+    {RadiosityVertexOutput::InterpolatedIndirect, "Interpolated indirect", "interpolated indirect"},
+    {RadiosityVertexOutput::PatchAverage, "Patch average", "patch average"},
+});
 
 struct RadiosityOptions {
-  FormFactorMethod formFactorMethod = FormFactorMethod::MonteCarlo;
-  int raysPerPatch = 1024;        // form-factor rays per patch (Monte Carlo)
-  int analyticPoints = 4;         // points per patch (analytic point-to-polygon)
-  int hemicubeResolution = 128;   // cells across the top face (hemicube)
-  int hemicubePoints = 1;         // hemicube views per patch (1: the centre)
+  // Method, rays, points, resolution and views (formFactorSettings), and the
+  // filter's one seed: it keys the form-factor rays and also the shadow rays
+  // and the final gather.
+  FormFactors::Settings formFactors;
   int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
@@ -41,11 +52,12 @@ struct RadiosityOptions {
   int maxIterations = 0;          // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive);
                                   // 0: automatic, from the largest reflectance (autoIterations)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
-  uint32_t seed = 0;
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
   bool refine = false;            // adaptive mesh refinement (solveRadiosityAdaptive)
-  RefineOptions refinement;       // its limits and thresholds
+  RefineOptions refinement;       // its limits, thresholds and seed (RefineOptions::fromParams)
+  VertexPart vertices;            // which vertices' final gather to compute (a split run; the patch
+                                  // solution is computed whole); the others are left 0
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };

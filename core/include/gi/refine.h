@@ -21,6 +21,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/scene.h"
 #include "gi/scene_setup.h"
@@ -66,6 +67,10 @@ struct RefineOptions {
   int visibilityRays = 64;      // shadow rays per vertex for that visibility
   double creaseDegrees = 30.0;  // no B-jump test across sharper creases (a true discontinuity)
   uint32_t seed = 0;
+  // The refine_* parameters of the radiosity filter (after its "refine"
+  // switch); fromParams also reads the filter's "seed".
+  static std::vector<ParamSpec> specs();
+  static RefineOptions fromParams(const ParamValues& v);
 };
 
 // Per vertex: the fraction of shadow rays to power-sampled emitter points

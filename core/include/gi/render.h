@@ -49,7 +49,13 @@
 
 namespace gi {
 
-enum class RenderMode { Whitted = 0, Distributed = 1, TwoPass = 2, PathTraced = 3 };
+enum class RenderMode { Whitted, Distributed, TwoPass, PathTraced };
+inline constexpr auto kRenderModes = makeEnumTable<RenderMode>({
+    {RenderMode::Whitted, "Whitted", "Whitted"},
+    {RenderMode::Distributed, "Distributed", "Distributed"},
+    {RenderMode::TwoPass, "Two-pass", "Two-pass"},
+    {RenderMode::PathTraced, "Path traced", "Path traced"},
+});
 
 // How the two-pass mode lights a diffuse hit (reflected light; its own
 // emission E / pi is added in every case).
@@ -60,6 +66,12 @@ enum class TwoPassDiffuse {
                        //   own caustics removed from its indirect part when it has them
   FinalGather = 3,     // direct + caustic map + gather rays reading the first pass's reflected radiosity
 };
+inline constexpr auto kTwoPassDiffuse = makeEnumTable<TwoPassDiffuse>({
+    {TwoPassDiffuse::Map, "First pass alone", "first pass alone"},
+    {TwoPassDiffuse::DirectIndirect, "Ray-traced direct + stored indirect", "direct + stored indirect"},
+    {TwoPassDiffuse::Caustics, "Direct + caustic map + stored indirect", "direct + caustic map + stored indirect"},
+    {TwoPassDiffuse::FinalGather, "Direct + caustic map + final gather", "direct + caustic map + final gather"},
+});
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Distributed;
@@ -81,7 +93,7 @@ struct RenderOptions {
   bool vertexRadiance = false;  // also the radiance each vertex sends towards the camera
   // Lights besides the emitting faces (as in the path-traced reference).
   glm::vec3 skyRadiance{0.f};
-  glm::vec3 sunDirection{0.3f, 1.f, 0.2f};
+  glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length
   glm::vec3 sunIrradiance{0.f};
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;

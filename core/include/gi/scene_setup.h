@@ -24,8 +24,26 @@ struct MeshAttributes {
   std::vector<uint8_t> faceSelected;
 };
 
-enum class EmitterSource { SelectedFaces = 0, QualityAbove = 1, None = 2, Auto = 3 };
-enum class ReflectanceSource { Auto = 0, FaceColor = 1, VertexColor = 2, Constant = 3 };
+enum class EmitterSource { SelectedFaces, QualityAbove, None, Auto };
+inline constexpr auto kEmitterSources = makeEnumTable<EmitterSource>({
+    {EmitterSource::SelectedFaces, "Selected faces", "the selected faces"},
+    {EmitterSource::QualityAbove, "Face quality above threshold", "faces with quality above the threshold"},
+    {EmitterSource::None, "None", "none"},
+    {EmitterSource::Auto, "Auto", "auto"},
+});
+enum class ReflectanceSource { Auto, FaceColor, VertexColor, Constant };
+inline constexpr auto kReflectanceSources = makeEnumTable<ReflectanceSource>({
+    {ReflectanceSource::Auto, "Auto", "auto"},
+    {ReflectanceSource::FaceColor, "Face color", "face colour"},
+    {ReflectanceSource::VertexColor, "Vertex color", "vertex colour"},
+    {ReflectanceSource::Constant, "Constant", "constant"},
+});
+// Which meshes form the scene (MeshLab only: the CLI's scene is its files).
+enum class SceneExtent { CurrentLayer, AllVisibleLayers };
+inline constexpr auto kSceneExtents = makeEnumTable<SceneExtent>({
+    {SceneExtent::CurrentLayer, "Current layer", "current layer"},
+    {SceneExtent::AllVisibleLayers, "All visible layers", "all visible layers"},
+});
 
 // Scene parameters shared by radiosity, photon mapping and the reference.
 std::vector<ParamSpec> lightingSceneSpecs();

@@ -1,0 +1,52 @@
+// A part of a mesh's vertices, for splitting one per-vertex computation over
+// several processes (MPI ranks, docs/design.md "Split runs"). The vertices
+// are cut into chunks of `chunk` consecutive indices, K = ceil(n / chunk)
+// chunks in all; part p of P takes chunk k when
+//   interleaved:  k mod P == p             (round robin: costly regions are shared out)
+//   contiguous:   floor(k P / K) == p      (one run of chunks per part)
+// Each vertex's random numbers are keyed by its index and the seed, never by
+// who computes it, so the union of the parts' values is bit-identical to
+// computing all vertices in one process.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "gi/run.h"
+
+namespace gi {
+
+struct VertexPart {
+  uint32_t part = 0, parts = 1;
+  uint32_t chunk = 1024;
+  bool interleaved = true;
+  // Sums `values` element by element over all parts, where each part has
+  // filled its own entries and left the others 0 (MPI_Allreduce in a split
+  // run), so that a quantity coupling all vertices (the adaptive reference's
+  // mean B) is the same in every part. Unset: one part, nothing to do.
+  std::function<void(std::vector<double>&)> sumOverParts;
+
+  bool all() const { return parts <= 1; }
+  // Whether vertex v of n belongs to this part.
+  bool contains(size_t v, size_t n) const;
+  // This part's vertices of n, ascending.
+  std::vector<uint32_t> vertices(size_t n) const;
+  size_t count(size_t n) const;
+  // The same split for another part.
+  VertexPart other(uint32_t p) const;
+  // Throws std::invalid_argument with a sentence if the split is unusable.
+  void check() const;
+};
+
+// The statistics of a split run from its parts' statistics: a number every
+// part reports alike (the scene, a replicated patch solution) is kept; a
+// count of work done (rays, paths, skipped vertices) is summed; a time is
+// the slowest part's; a rate is summed (the parts ran at once). Other
+// numbers that differ between parts (means and error estimates over a part's
+// vertices) cannot be combined exactly from the parts: they are left out and
+// a note names them. Notes and warnings are kept once; those of only some
+// parts say which part.
+RunStats mergePartStats(const std::vector<RunStats>& parts);
+
+}  // namespace gi

@@ -1,0 +1,250 @@
+#!/usr/bin/env python3
+"""`gi batch` on a collection of meshes: every mesh baked once, results next
+to their names with a summary, a failing mesh reported without stopping the
+others, resumable after a kill, shards that share the collection without
+overlap, and a report that adds up.
+
+Cases (all by default):
+  basic   manifest with per-line overrides, a missing and a damaged mesh, a
+          rerun that recomputes nothing, a parameter change that recomputes all
+  kill    killed half-way (SIGKILL) and rerun: nothing done is recomputed,
+          nothing is lost, every mesh counted once
+  shards  --shard I/N and a Slurm array's environment: each mesh in exactly
+          one shard; --report-only over all of them
+  inputs  --dir/--glob, a JSON parameter file, and one-line errors
+
+usage: batch_test.py --gi GI --meshes TEST_MESHES_DIR [case ...]
+"""
+import argparse
+import glob
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+FAILED = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what, flush=True)
+    if not cond:
+        FAILED.append(what)
+
+
+def run(cmd, env=None, expect=None):
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    if expect is not None and p.returncode != expect:
+        print("command:", " ".join(cmd), "\nstdout:", p.stdout[-2000:], "\nstderr:", p.stderr[-2000:])
+    return p
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def stamp(path):
+    st = os.stat(path)
+    return (st.st_ino, st.st_mtime_ns)
+
+
+# Meshes that bake in well under a second with a few rays.
+SMALL = ["cornell_box", "closed_box", "floor_wall", "bowl", "cylinder_hole", "open_plane", "parallel_plates",
+         "perpendicular_plates"]
+
+
+def copy_meshes(src, dst, names, copies=1):
+    os.makedirs(dst, exist_ok=True)
+    out = []
+    for k in range(copies):
+        for n in names:
+            name = n if copies == 1 else "%s_%d" % (n, k)
+            shutil.copy(os.path.join(src, n + ".ply"), os.path.join(dst, name + ".ply"))
+            out.append(name)
+    return out
+
+
+def case_basic(a, tmp):
+    meshes = os.path.join(tmp, "basic_meshes")
+    names = copy_meshes(a.meshes, meshes, SMALL)
+    with open(os.path.join(meshes, "damaged.ply"), "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n0\n")
+    manifest = os.path.join(meshes, "list.txt")
+    with open(manifest, "w") as f:
+        f.write("# one mesh a line, relative to this file; parameters after the name\n\n")
+        for n in names:
+            f.write(n + ".ply" + ("  --rays_per_vertex 8 --seed=3" if n == "bowl" else "") + "\n")
+        f.write("damaged.ply\n")
+        f.write("'not there.ply'\n")
+    out = os.path.join(tmp, "basic_out")
+    cmd = [a.gi, "batch", "ao", "--manifest", manifest, "-o", out, "--rays_per_vertex", "16", "--json"]
+    p = run(cmd)
+    check(p.returncode == 1, "a batch with failing meshes exits 1 (%d)" % p.returncode)
+    rep = json.loads(p.stdout)
+    total = len(names) + 2
+    check(rep["meshes"] == total and rep["baked"] == len(names) and rep["failed"] == 2 and rep["done_before"] == 0,
+          "report counts: %d meshes, %d baked, 2 failed (%s)" % (total, len(names), {k: rep[k] for k in ("meshes", "baked", "failed", "done_before")}))
+    reasons = {os.path.basename(f["input"]): f["error"] for f in rep["failures"]}
+    check("damaged.ply" in reasons and "\n" not in reasons["damaged.ply"] and "damaged.ply" in reasons["damaged.ply"],
+          "the damaged mesh's one-line reason names it: %s" % reasons.get("damaged.ply"))
+    check("not there.ply" in reasons, "the missing mesh is reported: %s" % reasons.get("not there.ply"))
+    rays = 0
+    for n in names:
+        s = load(os.path.join(out, n + ".json"))
+        rays += s["rays"]
+        check(s["status"] == "ok" and os.path.getsize(os.path.join(out, n + ".ply")) > 0 and s["rays"] > 0,
+              "%s: PLY and summary (%g rays)" % (n, s["rays"]))
+    bowl = load(os.path.join(out, "bowl.json"))
+    check(bowl["parameters"]["rays_per_vertex"] == "8" and "seed=3" in bowl["resolved"],
+          "a manifest line's parameters override the command line's (%s)" % bowl["parameters"])
+    check(abs(rep["rays"] - rays) <= 1e-6 * rays, "report's rays are the meshes' sum (%g)" % rays)
+    check(load(os.path.join(out, "damaged.json"))["status"] == "failed", "a failed mesh has a summary saying so")
+    check(os.path.exists(os.path.join(out, "report-0-of-1.json")), "report file written")
+
+    stamps = {n: stamp(os.path.join(out, n + ".ply")) for n in names}
+    p = run(cmd)
+    rep = json.loads(p.stdout)
+    check(rep["baked"] == 0 and rep["done_before"] == len(names) and rep["failed"] == 2,
+          "rerun: nothing recomputed, failures retried (%s)" % {k: rep[k] for k in ("baked", "done_before", "failed")})
+    check(all(stamp(os.path.join(out, n + ".ply")) == stamps[n] for n in names), "rerun: no PLY rewritten")
+    check(abs(rep["rays_all"] - rays) <= 1e-6 * rays, "rerun: rays of the results done before still counted")
+
+    cmd[cmd.index("16")] = "12"
+    rep = json.loads(run(cmd).stdout)
+    check(rep["baked"] == len(names) - 1 and rep["done_before"] == 1,
+          "another value of a common parameter recomputes every mesh but bowl, whose line sets its own (%s)" %
+          {k: rep[k] for k in ("baked", "done_before")})
+
+
+def case_kill(a, tmp):
+    meshes = os.path.join(tmp, "kill_meshes")
+    names = copy_meshes(a.meshes, meshes, ["bunny"], copies=8)
+    manifest = os.path.join(meshes, "list.txt")
+    with open(manifest, "w") as f:
+        f.write("\n".join(n + ".ply" for n in names) + "\n")
+    out = os.path.join(tmp, "kill_out")
+    cmd = [a.gi, "batch", "ao", "--manifest", manifest, "-o", out, "--rays_per_vertex", "1024", "--threads", "1", "--json"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 300
+    done = []
+    while time.time() < deadline and proc.poll() is None:
+        done = glob.glob(os.path.join(out, "bunny_*.json"))
+        if len(done) >= 2:
+            break
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    done = sorted(os.path.basename(p)[:-5] for p in glob.glob(os.path.join(out, "bunny_*.json")))
+    check(2 <= len(done) < len(names), "killed half-way: %d of %d meshes finished" % (len(done), len(names)))
+    stamps = {n: (stamp(os.path.join(out, n + ".ply")), stamp(os.path.join(out, n + ".json"))) for n in done}
+    p = run(cmd)
+    rep = json.loads(p.stdout)
+    check(p.returncode == 0, "rerun after the kill succeeds")
+    check(rep["done_before"] == len(done) and rep["baked"] == len(names) - len(done) and rep["failed"] == 0
+          and rep["meshes"] == len(names),
+          "rerun counts every mesh once: %d done before + %d baked = %d" % (rep["done_before"], rep["baked"], len(names)))
+    check(all((stamp(os.path.join(out, n + ".ply")), stamp(os.path.join(out, n + ".json"))) == stamps[n] for n in done),
+          "nothing finished before the kill was recomputed or rewritten")
+    check(all(load(os.path.join(out, n + ".json"))["status"] == "ok" for n in names), "every mesh has its result")
+    check(not glob.glob(os.path.join(out, "*.part")), "no partial files left")
+    # The results equal a batch that was never interrupted.
+    clean = os.path.join(tmp, "kill_clean")
+    run(cmd[:cmd.index(out)] + [clean] + cmd[cmd.index(out) + 1:])
+    same = all(open(os.path.join(out, n + ".ply"), "rb").read() == open(os.path.join(clean, n + ".ply"), "rb").read()
+               for n in names)
+    check(same, "results after kill and rerun are bit-identical to an uninterrupted batch")
+
+
+def case_shards(a, tmp):
+    meshes = os.path.join(tmp, "shard_meshes")
+    names = copy_meshes(a.meshes, meshes, SMALL)
+    manifest = os.path.join(meshes, "list.txt")
+    with open(manifest, "w") as f:
+        f.write("\n".join(n + ".ply" for n in names) + "\n")
+    out = os.path.join(tmp, "shard_out")
+    base = [a.gi, "batch", "ao", "--manifest", manifest, "-o", out, "--rays_per_vertex", "8", "--json"]
+    n = 3
+    counts = 0
+    for i in range(n):
+        if i == 1:  # as a Slurm array task would see it: --array=4-6, task 5 is the second shard
+            env = dict(os.environ, SLURM_ARRAY_TASK_ID="5", SLURM_ARRAY_TASK_MIN="4", SLURM_ARRAY_TASK_COUNT="3")
+            rep = json.loads(run(base, env=env).stdout)
+        else:
+            rep = json.loads(run(base + ["--shard", "%d/%d" % (i, n)]).stdout)
+        check(rep["shard"] == "%d/%d" % (i, n), "shard %d/%d chosen (%s)" % (i, n, rep["shard"]))
+        counts += rep["baked"]
+    check(counts == len(names), "the shards baked %d meshes, each once (%d)" % (len(names), counts))
+    for k, name in enumerate(names):
+        s = load(os.path.join(out, name + ".json"))
+        check(s["shard"] == "%d/%d" % (k % n, n), "%s baked by shard %d" % (name, k % n))
+    rep = json.loads(run(base + ["--report-only"]).stdout)
+    check(rep["meshes"] == len(names) and rep["done"] == len(names) and rep["failed"] == 0 and rep["missing"] == 0,
+          "--report-only over all shards: %d done" % rep["done"])
+    env = dict(os.environ, SLURM_ARRAY_TASK_ID="3", SLURM_ARRAY_TASK_MIN="0", SLURM_ARRAY_TASK_COUNT="3")
+    p = run(base, env=env)
+    check(p.returncode == 1 and p.stderr.count("\n") == 1 and "--array=0-2" in p.stderr,
+          "a task id outside the array's count: one line (%s)" % p.stderr.strip())
+
+
+def case_inputs(a, tmp):
+    meshes = os.path.join(tmp, "input_meshes")
+    names = copy_meshes(a.meshes, meshes, SMALL[:4])
+    shutil.copy(os.path.join(a.meshes, "bowl.ply"), os.path.join(meshes, "ignored.off.txt"))
+    params = os.path.join(tmp, "params.json")
+    with open(params, "w") as f:
+        json.dump({"filter": "GI: Ambient Obscurance", "parameters": {"rays_per_vertex": 8, "max_distance": "5%"}}, f)
+    out = os.path.join(tmp, "input_out")
+    p = run([a.gi, "batch", "--dir", meshes, "--glob", "*.ply", "--params", params, "-o", out, "--json"])
+    rep = json.loads(p.stdout)
+    check(p.returncode == 0 and rep["meshes"] == len(names) and rep["baked"] == len(names),
+          "--dir/--glob and a parameter file naming the filter: %d baked" % rep.get("baked", -1))
+    s = load(os.path.join(out, "bowl.json"))
+    check(s["filter"] == "GI: Ambient Obscurance" and "rays_per_vertex=8" in s["resolved"], "parameter file applied")
+
+    def one_line(args, needle, what):
+        p = run([a.gi, "batch"] + args)
+        check(p.returncode == 1 and p.stderr.count("\n") == 1 and needle in p.stderr,
+              "%s: one line (%s)" % (what, p.stderr.strip()))
+
+    bad = os.path.join(tmp, "bad_list.txt")
+    with open(bad, "w") as f:
+        f.write("bowl.ply\nbowl.ply --no_such 3\n")
+    one_line(["ao", "--manifest", bad, "-o", out], "line 2", "an unknown parameter in a manifest line")
+    with open(bad, "w") as f:
+        f.write(os.path.join(meshes, "bowl.ply") + "\n" + os.path.join(a.meshes, "bowl.ply") + "\n")
+    one_line(["ao", "--manifest", bad, "-o", out], "bowl.ply", "two meshes of one name")
+    one_line(["ao", "-o", out], "--manifest", "neither manifest nor folder")
+    one_line(["ao", "--dir", meshes, "-o", out, "--shard", "3/3"], "--shard", "a shard outside 0..N-1")
+    one_line(["render", "--dir", meshes, "-o", out], "image", "a filter that writes an image")
+    one_line(["ao", "--dir", meshes, "-o", out, "--rays_per_vertex"], "needs a value", "a parameter without value")
+    one_line(["ao", "--dir", meshes, "-o", meshes], "overwrite", "results that would overwrite their inputs")
+
+
+CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--gi", required=True)
+    ap.add_argument("--meshes", required=True)
+    ap.add_argument("cases", nargs="*")
+    a = ap.parse_args()
+    tmp = tempfile.mkdtemp(prefix="gi_batch_")
+    try:
+        for c in a.cases or CASES:
+            print("== " + c, flush=True)
+            CASES[c](a, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if FAILED:
+        print("%d checks failed" % len(FAILED))
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,432 @@
+#include "gi_batch.h"
+
+#include <fnmatch.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <tbb/global_control.h>
+
+#include "gi/filter_run.h"
+#include "gi/filters.h"
+#include "gi_cluster.h"
+#include "gi_output.h"
+#include "mesh_io.h"
+
+namespace gi::batch {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using Texts = std::map<std::string, std::string>;  // parameter name -> value as the CLI takes it
+
+namespace {
+
+struct Job {
+  std::string input;  // path
+  Texts overrides;    // this manifest line's parameters
+  std::string where;  // "manifest line 7" (for messages)
+  std::string stem;   // output name: OUT/stem.ply, OUT/stem.json
+};
+
+std::string oneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
+// Whitespace-separated words; "double" or 'single' quotes keep spaces.
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  bool in = false;
+  char quote = 0;
+  for (char c : line) {
+    if (quote) {
+      if (c == quote) quote = 0;
+      else cur += c;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+      in = true;
+    } else if (c == ' ' || c == '\t' || c == '\r') {
+      if (in) out.push_back(cur), cur.clear(), in = false;
+    } else {
+      cur += c;
+      in = true;
+    }
+  }
+  if (quote) throw std::invalid_argument("unclosed quote");
+  if (in) out.push_back(cur);
+  return out;
+}
+
+// "--name value" and "--name=value" pairs, each name one of the filter's parameters.
+Texts parameterPairs(const std::vector<std::string>& w, size_t from, const std::vector<ParamSpec>& specs,
+                     const std::string& filter, const std::string& where) {
+  Texts out;
+  for (size_t i = from; i < w.size(); ++i) {
+    std::string k = w[i];
+    if (k.rfind("--", 0) != 0) throw std::invalid_argument(where + "unexpected '" + k + "' (parameters are --name value)");
+    k = k.substr(2);
+    std::string v;
+    const size_t eq = k.find('=');
+    if (eq != std::string::npos) v = k.substr(eq + 1), k = k.substr(0, eq);
+    else if (i + 1 < w.size()) v = w[++i];
+    else throw std::invalid_argument(where + "--" + k + " needs a value");
+    const ParamSpec* p = findSpec(specs, k);
+    if (!p || p->meshlabOnly) throw std::invalid_argument(where + "'" + filter + "' has no parameter --" + k);
+    out[k] = v;
+  }
+  return out;
+}
+
+// A parameter file: {"filter": "ao" or its MeshLab name, "parameters": {name: value}};
+// values as the CLI takes them ("10%", "255,255,255"), or JSON numbers, booleans and [x, y, z].
+std::pair<std::string, Texts> readParamsFile(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::invalid_argument("cannot read the parameter file " + path);
+  json j;
+  try {
+    j = json::parse(f);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
+  }
+  if (!j.is_object()) throw std::invalid_argument("the parameter file " + path + " must hold a JSON object");
+  std::string filter = j.value("filter", "");
+  Texts t;
+  const json p = j.value("parameters", json::object());
+  if (!p.is_object()) throw std::invalid_argument("\"parameters\" in " + path + " must be an object");
+  for (const auto& [k, v] : p.items()) {
+    if (v.is_string()) t[k] = v.get<std::string>();
+    else if (v.is_boolean()) t[k] = v.get<bool>() ? "true" : "false";
+    else if (v.is_number()) t[k] = v.dump();
+    else if (v.is_array() && v.size() == 3) t[k] = v[0].dump() + "," + v[1].dump() + "," + v[2].dump();
+    else throw std::invalid_argument("parameter " + k + " in " + path + ": expected a string, number, boolean or [x, y, z]");
+  }
+  return {filter, t};
+}
+
+const FilterDesc& findFilter(const std::string& name) {
+  for (const FilterDesc& d : allFilters())
+    if (d.cliName == name || d.meshlabName == name) return d;
+  throw std::invalid_argument("unknown filter '" + name + "' (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)");
+}
+
+std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSpec>& specs, const std::string& filter) {
+  std::ifstream f(path);
+  if (!f) throw std::invalid_argument("cannot read the manifest " + path);
+  const fs::path base = fs::path(path).parent_path();
+  std::vector<Job> jobs;
+  std::string line;
+  for (int n = 1; std::getline(f, line); ++n) {
+    const std::string where = "manifest " + path + " line " + std::to_string(n) + ": ";
+    std::vector<std::string> w;
+    try {
+      w = words(line);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(where + e.what());
+    }
+    if (w.empty() || w[0][0] == '#') continue;
+    Job j;
+    j.input = fs::path(w[0]).is_absolute() || base.empty() ? w[0] : (base / w[0]).string();
+    j.overrides = parameterPairs(w, 1, specs, filter, where);
+    j.where = where;
+    jobs.push_back(j);
+  }
+  return jobs;
+}
+
+std::vector<Job> readFolder(const std::string& dir, const std::string& pattern) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw std::invalid_argument("--dir " + dir + " is not a folder");
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.is_regular_file() && fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0)
+      names.push_back(e.path().filename().string());
+  if (ec) throw std::invalid_argument("cannot list " + dir + ": " + ec.message());
+  std::sort(names.begin(), names.end());
+  std::vector<Job> jobs;
+  for (const std::string& n : names) jobs.push_back({(fs::path(dir) / n).string(), {}, n + ": ", ""});
+  return jobs;
+}
+
+// "I/N" from --shard, else a Slurm job array's task (id - min) / step of count, else 0/1.
+std::pair<size_t, size_t> chooseShard(const std::string& text) {
+  long long i = 0, n = 1;
+  if (!text.empty()) {
+    char slash = 0, rest = 0;
+    if (std::sscanf(text.c_str(), "%lld %c %lld %c", &i, &slash, &n, &rest) != 3 || slash != '/')
+      throw std::invalid_argument("--shard '" + text + "': expected I/N, e.g. 0/16");
+  } else if (const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT")) {
+    auto num = [](const char* name, long long fallback) {
+      const char* v = std::getenv(name);
+      return v && *v ? std::atoll(v) : fallback;
+    };
+    n = std::atoll(count);
+    const long long step = std::max(1LL, num("SLURM_ARRAY_TASK_STEP", 1));
+    i = (num("SLURM_ARRAY_TASK_ID", 0) - num("SLURM_ARRAY_TASK_MIN", 0)) / step;
+    if (n < 1 || i < 0 || i >= n)
+      throw std::invalid_argument("SLURM_ARRAY_TASK_ID " + std::string(std::getenv("SLURM_ARRAY_TASK_ID") ? std::getenv("SLURM_ARRAY_TASK_ID") : "?") +
+                                  " is not one of " + std::to_string(n) +
+                                  " evenly spaced tasks: submit with --array=0-" + std::to_string(n - 1) + " or pass --shard I/N");
+  }
+  if (n < 1 || i < 0 || i >= n) throw std::invalid_argument("--shard " + text + ": needs 0 <= I < N");
+  return {size_t(i), size_t(n)};
+}
+
+// FNV-1a, 64 bits, as 16 hex digits.
+std::string hashText(const std::string& s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  char b[17];
+  std::snprintf(b, sizeof b, "%016llx", (unsigned long long)h);
+  return b;
+}
+
+// What decides a mesh's result: the program's version, the filter, every
+// parameter given, and the input file (name, size, modification time).
+std::string jobHash(const std::string& filter, const Texts& params, const std::string& input) {
+  std::ostringstream o;
+  o << "gi " << GI_VERSION << "\nfilter " << filter << "\n";
+  for (const auto& [k, v] : params) o << k << "=" << v << "\n";
+  std::error_code ec;
+  const auto size = fs::file_size(input, ec);
+  const auto time = fs::last_write_time(input, ec).time_since_epoch().count();
+  o << "input " << fs::path(input).filename().string() << " " << (ec ? 0 : size) << " " << (ec ? 0 : time) << "\n";
+  return hashText(o.str());
+}
+
+json readJson(const fs::path& p) {
+  std::ifstream f(p);
+  if (!f) return nullptr;
+  try {
+    return json::parse(f);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+// Written beside and renamed into place: a file that exists is complete.
+void writeJson(const fs::path& p, const json& j) {
+  const fs::path tmp = p.string() + ".part";
+  {
+    std::ofstream f(tmp);
+    if (!(f << j.dump(2) << "\n")) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, p);
+}
+
+json statsJson(const RunStats& s) {
+  json j = json::object();
+  for (const auto& [k, v] : s.numbers) j[k] = v;
+  return j;
+}
+
+// Loads, computes, writes OUT/stem.ply; returns the summary.
+json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::path& ply) {
+  Timer timer;
+  const auto specs = filterSpecs(d.kind);
+  io::LoadedMesh mesh = io::loadMesh(job.input);
+  const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);
+  mesh.scene.vertexNormals.clear();
+  const double diag = analyzeScene(mesh.scene).diagonal;
+  FilterInput in;
+  in.values = defaultValues(specs, diag);
+  for (const auto& [k, v] : params) in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+  if (auto err = validate(specs, in.values, diag)) throw std::invalid_argument(*err);
+  in.layers.push_back({fs::path(job.input).filename().string(), 0, mesh.scene.faceCount()});
+  in.scene = std::move(mesh.scene);
+  in.attrs = mesh.attrs;
+  FilterResult r = runFilter(d.kind, in);
+  const fs::path tmp = ply.string() + ".part";
+  writeResultPly(tmp.string(), in.scene, mesh.attrs, fileNormals, r);
+  fs::rename(tmp, ply);
+  json s;
+  s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
+  s["resolved"] = describe(specs, in.values);
+  s["stats"] = statsJson(r.stats);
+  s["rays"] = r.stats.get("rays");
+  s["warnings"] = r.stats.warnings;
+  s["notes"] = r.stats.notes;
+  s["log"] = r.logLines(d.meshlabName);
+  s["seconds"] = timer.seconds();
+  return s;
+}
+
+}  // namespace
+
+void addOptions(CLI::App* sub, Args& a) {
+  sub->add_option("filter", a.filter, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, "
+                                      "formfactors); optional with --params naming it");
+  sub->add_option("--manifest", a.manifest, "file listing one mesh a line, each optionally followed by its own "
+                                            "parameters (--name value); relative paths are relative to the "
+                                            "manifest; # starts a comment line");
+  sub->add_option("--dir", a.dir, "folder whose meshes matching --glob are the batch (instead of --manifest)");
+  sub->add_option("--glob", a.glob, "file-name pattern in --dir [default: *.ply]");
+  sub->add_option("-o,--output-dir", a.outDir, "folder for NAME.ply, NAME.json per mesh and the report (created if "
+                                               "missing)")->required();
+  sub->add_option("--params", a.paramsFile, "JSON parameter file {\"filter\": \"ao\", \"parameters\": {\"rays_per_vertex\": "
+                                            "64, \"max_distance\": \"5%\"}}; command-line parameters override it, a "
+                                            "manifest line's override both");
+  sub->add_option("--shard", a.shard, "I/N: take every N-th mesh from the I-th (0-based); default: a Slurm job "
+                                      "array's task (SLURM_ARRAY_TASK_ID - MIN of COUNT) if set, else all");
+  sub->add_option("--threads", a.threads, "worker threads of this process (default: SLURM_CPUS_PER_TASK if set, "
+                                          "else all cores); several processes may share a node")
+      ->check(CLI::Range(1, 4096));
+  sub->add_flag("--report-only", a.reportOnly, "compute nothing: count the results and failures the summaries record "
+                                               "(all shards unless --shard is given) and write report.json");
+  sub->add_flag("--json", a.json, "print the report as JSON on stdout");
+  sub->add_flag("-q,--quiet", a.quiet, "no progress lines on stderr");
+  sub->allow_extras();
+}
+
+int run(const Args& a, const std::vector<std::string>& extras) {
+  if (cluster::size() > 1)
+    throw std::invalid_argument("gi batch is one process per shard: start it with --shard I/N or in a Slurm job array, not under mpirun");
+  std::string filter = a.filter;
+  Texts fileParams;
+  if (!a.paramsFile.empty()) {
+    auto [f, t] = readParamsFile(a.paramsFile);
+    if (!f.empty() && !filter.empty() && findFilter(f).cliName != findFilter(filter).cliName)
+      throw std::invalid_argument("the parameter file is for '" + f + "', not '" + filter + "'");
+    if (filter.empty()) filter = f;
+    fileParams = t;
+  }
+  if (filter.empty()) throw std::invalid_argument("name the filter (gi batch ao ...) or give it in --params");
+  const FilterDesc& d = findFilter(filter);
+  if (d.writes & WritesImage)
+    throw std::invalid_argument("'" + d.cliName + "' writes an image at one path: run it per mesh, not in a batch");
+  const auto specs = filterSpecs(d.kind);
+  Texts common;  // the parameter file's, then the command line's
+  for (const auto& [k, v] : fileParams) {
+    const ParamSpec* p = findSpec(specs, k);
+    if (!p || p->meshlabOnly) throw std::invalid_argument(a.paramsFile + ": '" + d.cliName + "' has no parameter " + k);
+    common[k] = v;
+  }
+  for (const auto& [k, v] : parameterPairs(extras, 0, specs, d.cliName, "")) common[k] = v;
+
+  if (a.manifest.empty() == a.dir.empty()) throw std::invalid_argument("give either --manifest FILE or --dir DIR");
+  std::vector<Job> jobs = a.manifest.empty() ? readFolder(a.dir, a.glob) : readManifest(a.manifest, specs, d.cliName);
+  std::map<std::string, std::string> byStem;
+  for (Job& j : jobs) {
+    j.stem = fs::path(j.input).stem().string();
+    auto [it, fresh] = byStem.emplace(j.stem, j.input);
+    if (!fresh)
+      throw std::invalid_argument(it->second + " and " + j.input + " would both write " + j.stem +
+                                  ".ply: give them different names");
+  }
+  const bool explicitShard = !a.shard.empty();
+  const auto [shard, shards] = a.reportOnly && !explicitShard ? std::pair<size_t, size_t>{0, 1} : chooseShard(a.shard);
+  std::error_code ec;
+  fs::create_directories(a.outDir, ec);
+  if (!fs::is_directory(a.outDir)) throw std::invalid_argument("cannot create the output folder " + a.outDir);
+  for (const Job& j : jobs) {
+    const fs::path ply = fs::path(a.outDir) / (j.stem + ".ply");
+    if (fs::exists(ply, ec) && fs::exists(j.input, ec) && fs::equivalent(ply, j.input, ec))
+      throw std::invalid_argument("the result " + ply.string() + " would overwrite its input: choose another output folder");
+  }
+  int threads = a.threads;
+  if (threads == 0 && std::getenv("SLURM_CPUS_PER_TASK")) threads = std::max(1, std::atoi(std::getenv("SLURM_CPUS_PER_TASK")));
+  std::unique_ptr<tbb::global_control> cap;
+  if (threads > 0) cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
+
+  Timer timer;
+  size_t meshes = 0, baked = 0, before = 0, failed = 0, missing = 0;
+  double rays = 0, raysAll = 0, computeAll = 0;
+  json failures = json::array();
+  for (size_t k = shard; k < jobs.size(); k += shards) {
+    const Job& job = jobs[k];
+    ++meshes;
+    Texts params = common;
+    for (const auto& [n, v] : job.overrides) params[n] = v;
+    const std::string hash = jobHash(d.cliName, params, job.input);
+    const fs::path ply = fs::path(a.outDir) / (job.stem + ".ply"), sum = fs::path(a.outDir) / (job.stem + ".json");
+    const json old = readJson(sum);
+    const bool same = old.is_object() && old.value("params_hash", "") == hash;
+    const std::string tag = "[" + std::to_string(k + 1) + "/" + std::to_string(jobs.size()) + "] " + job.input + ": ";
+    if (same && old.value("status", "") == "ok" && fs::exists(ply)) {
+      ++before;
+      raysAll += old.value("rays", 0.0);
+      computeAll += old.value("seconds", 0.0);
+      if (!a.quiet && !a.reportOnly) std::cerr << tag << "done before\n";
+      continue;
+    }
+    if (a.reportOnly) {
+      if (same && old.value("status", "") == "failed") {
+        ++failed;
+        failures.push_back({{"input", job.input}, {"error", old.value("error", "")}});
+      } else {
+        ++missing;
+      }
+      continue;
+    }
+    json s;
+    s["gi_batch"] = 1;
+    s["input"] = job.input;
+    s["filter"] = d.meshlabName;
+    s["params_hash"] = hash;
+    s["parameters"] = params;
+    s["shard"] = std::to_string(shard) + "/" + std::to_string(shards);
+    try {
+      json r = bake(d, params, job, ply);
+      s.update(r);
+      s["status"] = "ok";
+      s["output"] = ply.string();
+      ++baked;
+      rays += r.value("rays", 0.0);
+      raysAll += r.value("rays", 0.0);
+      computeAll += r.value("seconds", 0.0);
+      if (!a.quiet) std::cerr << tag << "baked in " << r.value("seconds", 0.0) << " s\n";
+    } catch (const std::bad_alloc&) {
+      s["status"] = "failed", s["error"] = "out of memory";
+    } catch (const std::exception& e) {
+      s["status"] = "failed", s["error"] = oneLine(e.what());
+    }
+    if (s["status"] == "failed") {
+      ++failed;
+      fs::remove(ply, ec);  // no result from other parameters beside a failure
+      failures.push_back({{"input", job.input}, {"error", s["error"]}});
+      if (!a.quiet) std::cerr << tag << "FAILED: " << s["error"].get<std::string>() << "\n";
+    }
+    writeJson(sum, s);
+  }
+  json rep;
+  rep["filter"] = d.meshlabName;
+  rep["shard"] = std::to_string(shard) + "/" + std::to_string(shards);
+  rep["meshes"] = meshes;
+  if (a.reportOnly) {
+    rep["done"] = before, rep["failed"] = failed, rep["missing"] = missing;
+  } else {
+    rep["baked"] = baked, rep["done_before"] = before, rep["failed"] = failed;
+    rep["rays"] = rays;
+    rep["seconds"] = timer.seconds();
+  }
+  rep["failures"] = failures;
+  rep["rays_all"] = raysAll;
+  rep["compute_seconds_all"] = computeAll;
+  const std::string part = std::to_string(shard) + "-of-" + std::to_string(shards) + ".json";
+  const std::string name = !a.reportOnly ? "report-" + part : explicitShard ? "report-only-" + part : "report.json";
+  writeJson(fs::path(a.outDir) / name, rep);
+  if (a.json) std::cout << rep.dump(2) << std::endl;
+  if (!a.quiet) {
+    char b[300];
+    if (a.reportOnly)
+      std::snprintf(b, sizeof b, "gi batch: %zu meshes: %zu done, %zu failed, %zu missing; %.4g rays in %.4g s of computing",
+                    meshes, before, failed, missing, raysAll, computeAll);
+    else
+      std::snprintf(b, sizeof b, "gi batch: %zu meshes (shard %zu/%zu): %zu baked, %zu done before, %zu failed; %.4g rays in %.4g s",
+                    meshes, shard, shards, baked, before, failed, rays, timer.seconds());
+    std::cerr << b << "\n";
+    for (const json& f : failures) std::cerr << "  FAILED " << f["input"].get<std::string>() << ": " << f["error"].get<std::string>() << "\n";
+    std::cerr << "wrote " << (fs::path(a.outDir) / name).string() << "\n";
+  }
+  return failed || missing ? 1 : 0;
+}
+
+}  // namespace gi::batch

@@ -1,0 +1,23 @@
+#include "gi_output.h"
+
+#include "gi/refine.h"
+#include "mesh_io.h"
+
+namespace gi {
+
+void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
+                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r) {
+  const Scene& out = r.refined ? r.refined->scene : input;
+  MeshAttributes attrs = r.refined ? refineAttributes(inputAttrs, *r.refined) : inputAttrs;
+  if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
+  if (!r.faceColor.empty()) {
+    attrs.faceColor.clear();
+    for (const Rgb8& c : r.faceColor) attrs.faceColor.push_back({c.r, c.g, c.b});
+  }
+  io::PlyExtras extras;
+  extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
+  extras.attributes = r.attributes;
+  io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);
+}
+
+}  // namespace gi

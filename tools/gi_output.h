@@ -1,0 +1,17 @@
+// The PLY file a run of `gi` writes (one filter on one mesh, or each mesh
+// of `gi batch`).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "gi/filter_run.h"
+
+namespace gi {
+
+// The input mesh (or its refinement) with the result's properties: what the
+// result leaves alone keeps the input's values (colours, face quality and
+// the file's own normals, which the engine does not use).
+void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
+                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r);
+
+}  // namespace gi
