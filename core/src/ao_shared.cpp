@@ -241,19 +241,20 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
           castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
     });
     if (split) {
-      // Every part gets every vertex's rays (each part fills its own entries,
-      // the others stay 0; sums of one nonzero term are exact): the pools
-      // are then the whole run's, bit for bit.
+      // Every part gets every vertex's rays (each vertex's from the part it
+      // belongs to; a representative another part's duplicates need is cast
+      // there too, alike, but not sent twice; sums of one nonzero term are
+      // exact): the pools are then the whole run's, bit for bit.
       exchange.assign(5 * nv, 0.0);
       for (size_t i = 0; i < nv; ++i)
-        if (mine[i]) {
+        if (mine[i] && part.contains(i, nv)) {
           const VertexRays& r = rays[i];
           double* x = &exchange[5 * i];
           x[0] = r.n; x[1] = r.sum; x[2] = r.bent.x; x[3] = r.bent.y; x[4] = r.bent.z;
         }
       part.sumOverParts(exchange);
       for (size_t i = 0; i < nv; ++i)
-        if (poolable[i] && !mine[i]) {
+        if (poolable[i] && !(mine[i] && part.contains(i, nv))) {
           const double* x = &exchange[5 * i];
           rays[i] = {uint32_t(x[0]), x[1], glm::vec3(float(x[2]), float(x[3]), float(x[4]))};
         }
