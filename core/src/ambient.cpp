@@ -1,5 +1,7 @@
 #include "gi/ambient.h"
 
+#include "ambient_internal.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -283,8 +285,26 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (opt.bentNormals) res.bentNormal = normals;
   const AmbientKernel kernel(caster, opt);
   const std::vector<glm::vec3> origins = vertexRayOrigins(scene, normals, float(rep.rayEpsilon));
+  // The shared estimator pools neighbours' rays; the cone's ratio estimator and sky lighting stay per vertex.
+  const bool shared = opt.estimator == AOEstimator::Shared && opt.mode != AmbientMode::Sky && !opt.useCone;
+  if (opt.estimator == AOEstimator::Shared && !shared)
+    res.stats.note("the cone's ratio estimator is computed per vertex (not shared)");
   Timer traceTimer;
-  parallelBlocks(nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
+  SharedStats shareStats;
+  if (shared) {
+    // Pooling reads every vertex that casts rays in the whole run; this part casts its own.
+    std::vector<uint8_t> poolable(nv, 0), mine(nv, 0);
+    for (size_t i = 0; i < nv; ++i) {
+      poolable[i] = status[i] == kTrace || status[i] == kOtherPart;
+      mine[i] = status[i] == kTrace;
+      if (status[i] == kOpen) {
+        res.value[i] = 1.f;
+        if (opt.bentNormals) res.bentNormal[i] = normals[i];
+      }
+    }
+    shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, poolable, mine, res, progress.sub(0.05, 1.0));
+  }
+  parallelBlocks(shared ? 0 : nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (status[i] == kOpen) {
         res.value[i] = 1.f;  // provably nothing within reach above the tangent plane
@@ -329,12 +349,20 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   st.add("vertices", double(nv));
   st.add("rays", rays);
   st.add("seconds", timer.seconds());
-  st.add("rays_per_second", traceSeconds > 0 ? rays / traceSeconds : 0.0);
+  const double castSeconds = shared ? shareStats.castSeconds : traceSeconds;
+  st.add("rays_per_second", castSeconds > 0 ? rays / castSeconds : 0.0);
   st.add("mean", counted ? sum / double(counted) : 0.0);
   st.add("rms_error_estimate", counted ? std::sqrt(var / double(counted)) : 0.0);
   st.add("skipped_open", double(open));
   st.add("skipped_duplicates", double(duplicates));
   st.add("skipped_invalid", double(invalid));
+  if (shared) {
+    st.add("rays_per_vertex", nv ? rays / double(nv) : 0.0);
+    st.add("shared_vertices_mean", shareStats.meanPooledVertices);
+    st.add("shared_rings_mean", shareStats.meanRings);
+    st.add("rounds", shareStats.rounds);
+    st.add("pooling_seconds", shareStats.poolSeconds);
+  }
   if (open) st.note(std::to_string(open) + " vertices provably open within max_distance got 1 without rays");
   if (duplicates) st.note(std::to_string(duplicates) + " duplicate vertices (same position and normal) computed once");
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");

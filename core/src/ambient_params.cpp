@@ -87,6 +87,29 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  .help = "Shadow rays towards the sun's disk per vertex.",
                  .type = ParamType::Int, .def = 64, .min = 1, .max = 1 << 20});
   }
+  if (mode != AmbientMode::Sky) {
+    s.push_back({.name = "estimator", .label = "Estimator",
+                 .help = "'Per vertex': each vertex averages its own rays only (independent, unbiased estimates). "
+                         "'Shared with neighbours': each vertex also counts the rays of the vertices around it whose "
+                         "normals are within the tolerance below (a first-order fit over their positions, so a "
+                         "gradient does not bias it), as far as (Lepski's rule) the fitted value agrees with the "
+                         "smaller neighbourhoods' within one standard error: on dense meshes neighbours see almost "
+                         "the same hemisphere, so the same error needs fewer rays; at creases, contact shadows and "
+                         "thin features the neighbourhood stays small. The standard error counts every ray pooled. "
+                         "The cone option is always per vertex.",
+                 .type = ParamType::Enum, .def = kAOEstimators.index(AOEstimator::PerVertex),
+                 .choices = kAOEstimators.choices()});
+    s.push_back({.name = "share_rings", .label = "Sharing: largest neighbourhood (rings)",
+                 .help = "Shared estimator: how far a vertex may pool, in mesh rings (1 = its direct neighbours, "
+                         "about 7 vertices; 3 = about 37; 5 = about 91). Larger pools more rays where the occlusion "
+                         "varies slowly; the cost of pooling grows with the square of it.",
+                 .type = ParamType::Int, .def = 3, .min = 1, .max = 16});
+    s.push_back({.name = "share_normal_angle", .label = "Sharing: normal tolerance (deg)",
+                 .help = "Shared estimator: only neighbours whose normal is within this angle of the vertex's pool "
+                         "their rays (AO depends on the normal: its cosine lobe), and the neighbourhood grows only "
+                         "through them, so it stops at creases and never reaches the other side of a thin sheet.",
+                 .type = ParamType::Float, .def = 10.0, .min = 0.0, .max = 90.0});
+  }
   s.push_back({.name = "ray_batching", .label = "Ray batching",
                .help = "How rays are handed to Embree: single rays sharing the vertex as origin (fastest in our "
                        "benchmarks: the rays of one vertex diverge too much for packets), 8-wide packets, or "
@@ -105,6 +128,11 @@ AmbientOptions AmbientOptions::fromParams(AmbientMode mode, const ParamValues& v
   o.maxDistance = v.getFloat("max_distance");
   o.seed = uint32_t(v.getInt("seed"));
   o.batch = kBatchModes.get(v, "ray_batching");
+  if (mode != AmbientMode::Sky) {
+    o.estimator = kAOEstimators.get(v, "estimator");
+    o.shareRings = v.getInt("share_rings");
+    o.shareNormalAngleDeg = float(v.getFloat("share_normal_angle"));
+  }
   auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
   if (mode == AmbientMode::Occlusion) {
     o.bentNormals = v.getBool("bent_normals") || v.getBool("bent_normals_to_vertex_normals");

@@ -36,6 +36,23 @@ const std::vector<FilterDesc>& allFilters() {
        "from shadow rays spread over the sun's disk (distributed ray tracing). Quality = luminance of E; "
        "colour = sRGB(exposure &times; E), exposure 0 = automatic.",
        WritesVertexQuality | WritesVertexColor},
+      {FilterKind::Thickness, "GI: Thickness (Shape Diameter)", "thickness", "filter_ambient",
+       "per-vertex thickness: the shape diameter function",
+       "Per-vertex <b>thickness</b> by the <b>shape diameter function</b> (Shapira, Shamir and Cohen-Or 2008): "
+       "rays from each vertex into the object, cosine-distributed in a cone around the inward normal, each "
+       "measuring the distance to where it leaves the object through the opposite side; the value is their "
+       "mean, made robust by keeping only the lengths within one standard deviation of their median.<br>"
+       "<i>SDF(p) = E[L(&omega;)]</i>, &omega; in the cone of half-angle &alpha; around -n. A cylinder gives "
+       "exactly its diameter for any cone; a slab of thickness t gives 2t/(1 + cos&alpha;), a sphere of radius r "
+       "(4r/3)(1 + c + c<sup>2</sup>)/(1 + c), c = cos&alpha; (a narrow cone: t and 2r).<br>"
+       "Ray casting on the CPU (Embree): no GPU needed (MeshLab's own shape-diameter filter needs one). "
+       "Directions come from an Owen-scrambled Sobol sequence per vertex, seeded and deterministic; with a "
+       "target error each vertex stops when the standard error of its mean is that fraction of the mean. "
+       "Rays that miss or meet the front of a face (open meshes, inward normals) are left out; a vertex with no "
+       "valid ray gets 0.<br>"
+       "Output: vertex <b>quality</b> = thickness (mesh units), vertex <b>colour</b> = grey (white = the 99th "
+       "percentile), per-vertex attribute <i>StdError</i>. Needs a closed mesh with outward normals.",
+       WritesVertexQuality | WritesVertexColor},
       {FilterKind::Radiosity, "GI: Radiosity", "radiosity", "filter_radiosity",
        "the radiosity method: form factors and a solver",
        "<b>Radiosity</b> of diffuse (Lambertian) surfaces: the radiosity equation "

@@ -14,6 +14,7 @@
 #include "gi/photon.h"
 #include "gi/radiosity.h"
 #include "gi/render.h"
+#include "gi/thickness.h"
 
 namespace gi {
 
@@ -102,9 +103,12 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
   const ParamValues& v = in.values;
   AmbientOptions opt = AmbientOptions::fromParams(mode, v);
   opt.vertices = in.vertices;
+  const Timer bvh;
   const auto caster = makeEmbreeCaster(in.scene, opt.batch);
+  const double bvhSeconds = bvh.seconds();
   AmbientResult r = computeAmbient(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
+  res.stats.add("bvh_seconds", bvhSeconds);  // building the ray caster, not in "seconds"
   if (mode == AmbientMode::Sky) {
     res.attributes.push_back(vectorAttribute("Irradiance", r.rgb));
   } else {
@@ -123,6 +127,28 @@ void outputAmbient(FilterKind kind, FilterInput& in, FilterResult& res) {
   else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, res.vertexQuality);
   if (const VertexAttribute* bent = res.attribute("BentNormal"); bent && v.getBool("bent_normals_to_vertex_normals"))
     res.vertexNormal = vectors(bent);
+}
+
+// Values divided by the q-quantile of the positive ones (a display scale
+// that one outlier cannot wash out); unchanged if none is positive.
+std::vector<float> relativeToPercentile(const std::vector<float>& v, double q) {
+  std::vector<float> pos;
+  for (float x : v)
+    if (std::isfinite(x) && x > 0.f) pos.push_back(x);
+  if (pos.empty()) return v;
+  const size_t k = std::min(pos.size() - 1, size_t(q * double(pos.size())));
+  std::nth_element(pos.begin(), pos.begin() + long(k), pos.end());
+  std::vector<float> out(v.size());
+  for (size_t i = 0; i < v.size(); ++i) out[i] = v[i] / pos[k];
+  return out;
+}
+
+void runThickness(FilterInput& in, FilterResult& res, const Progress& progress) {
+  const auto caster = makeEmbreeCaster(in.scene);
+  ThicknessResult r = computeThickness(in.scene, *caster, ThicknessOptions::fromParams(in.values), progress);
+  res.stats = std::move(r.stats);
+  res.vertexQuality = r.value;
+  res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
 void runFormFactors(FilterInput& in, FilterResult& res) {
@@ -326,6 +352,7 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
     case FilterKind::AmbientOcclusion:
     case FilterKind::AmbientObscurance:
     case FilterKind::SkyLighting: runAmbient(kind, in, res, progress); break;
+    case FilterKind::Thickness: runThickness(in, res, progress); break;
     case FilterKind::FormFactorsOfFace: runFormFactors(in, res); break;
     case FilterKind::PathTracedReference: runReference(in, res, progress); break;
     case FilterKind::Radiosity: runRadiosity(in, res, progress); break;
@@ -340,6 +367,7 @@ void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res) {
     case FilterKind::AmbientOcclusion:
     case FilterKind::AmbientObscurance:
     case FilterKind::SkyLighting: outputAmbient(kind, in, res); break;
+    case FilterKind::Thickness: res.vertexColor = greyColors(relativeToPercentile(res.vertexQuality, 0.99)); break;
     case FilterKind::PathTracedReference: radiometric(res, out, in.values.getFloat("exposure"), "Radiosity"); break;
     case FilterKind::Radiosity:
       radiometric(res, out, in.values.getFloat("exposure"), "Radiosity");

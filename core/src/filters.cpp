@@ -13,6 +13,7 @@
 #include "gi/radiosity.h"
 #include "gi/render.h"
 #include "gi/scene_setup.h"
+#include "gi/thickness.h"
 
 namespace gi {
 
@@ -31,6 +32,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       if (m == AmbientMode::Sky) add(displaySpecs());
       break;
     }
+    case FilterKind::Thickness:
+      s.push_back(geometrySceneSpecs().front());  // scene extent
+      add(ThicknessOptions::specs());
+      break;
     case FilterKind::Radiosity:
       add(lightingSceneSpecs());
       add(RadiosityOptions::specs());

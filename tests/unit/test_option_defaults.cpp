@@ -17,6 +17,7 @@
 #include "gi/refine.h"
 #include "gi/render.h"
 #include "gi/scenes.h"
+#include "gi/thickness.h"
 
 using namespace gi;
 
@@ -88,9 +89,23 @@ TEST(OptionDefaults, AmbientEveryMode) {
     SAME(batch);
     SAME(skipOpenVertices);
     SAME(mergeDuplicates);
+    SAME(estimator);
+    SAME(shareRings);
+    SAME(shareNormalAngleDeg);
   }
   // The colour output is the filter's (not an option of the computation): grey.
   EXPECT_EQ(kAOColorMappings.get(defaults(FilterKind::AmbientOcclusion), "color_mapping"), AOColorMapping::Grey);
+}
+
+TEST(OptionDefaults, Thickness) {
+  const ThicknessOptions got = ThicknessOptions::fromParams(defaults(FilterKind::Thickness)), want;
+  SAME(raysPerVertex);
+  SAME(targetError);
+  SAME(minRays);
+  SAME(maxRays);
+  SAME(coneAngleDeg);
+  SAME(rejectOutliers);
+  SAME(seed);
 }
 
 TEST(OptionDefaults, FormFactorSettings) {

@@ -704,6 +704,7 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
       {"emitter_source", L{"Selected faces", "Face quality above threshold", "None", "Auto"}},
       {"color_mapping", L{"Grey", "Multiply colour", "Keep colour"}},
       {"ray_batching", L{"Single", "Packet8", "Stream"}},
+      {"estimator", L{"Per vertex", "Shared with neighbours"}},
       {"form_factor_method", L{"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
       {"solver", L{"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement"}},
       {"vertex_output", L{"Final gather", "Interpolated indirect", "Patch average"}},

@@ -217,6 +217,31 @@ TEST(SplitRun, AmbientOcclusionWithDuplicatesOpenVerticesAndBentNormals) {
   expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion, {{"target_error", "0.05"}, {"max_rays", "256"}}, 3, 16, true);
 }
 
+// The shared estimator pools neighbours' rays across the parts' borders:
+// each round the parts exchange their vertices' rays (sumOverParts), so the
+// pools, the adaptive rounds and every value are the whole run's. Welded
+// (pools span many vertices) and unwelded (duplicates, computed once by
+// their representative's part); fixed and adaptive; with open vertices.
+TEST(SplitRun, SharedAmbientOcclusion) {
+  const io::LoadedMesh welded = cornell();
+  const std::map<std::string, std::string> fixed = {{"estimator", "1"}, {"rays_per_vertex", "16"}, {"max_distance", "20%"},
+                                                    {"bent_normals_to_vertex_normals", "true"}};
+  const std::map<std::string, std::string> adaptive = {{"estimator", "1"}, {"target_error", "0.03"}, {"min_rays", "8"},
+                                                       {"max_rays", "512"}};
+  expectSplitEqualsWhole(welded, FilterKind::AmbientOcclusion, fixed, 3, 7, true);
+  expectSplitEqualsWhole(welded, FilterKind::AmbientOcclusion, adaptive, 4, 50, false);
+  expectSplitEqualsWhole(welded, FilterKind::AmbientObscurance, {{"estimator", "1"}, {"rays_per_vertex", "16"}}, 2, 13, true);
+  expectSplitEqualsWhole(unwelded(welded), FilterKind::AmbientOcclusion, adaptive, 3, 16, true);
+}
+
+// Without the parts' sum a split shared run cannot see its neighbours' rays: refused.
+TEST(SplitRun, SharedAmbientOcclusionNeedsThePartsSum) {
+  FilterInput in = inputOf(cornell(), FilterKind::AmbientOcclusion, {{"estimator", "1"}, {"rays_per_vertex", "8"}});
+  FilterResult r = prepareFilter(FilterKind::AmbientOcclusion, in);
+  in.vertices = VertexPart{0, 2, 64, true, nullptr};
+  EXPECT_THROW(estimateFilter(FilterKind::AmbientOcclusion, in, r), std::logic_error);
+}
+
 TEST(SplitRun, ObscuranceAndSky) {
   const io::LoadedMesh m = cornell();
   expectSplitEqualsWhole(m, FilterKind::AmbientObscurance, {{"rays_per_vertex", "32"}}, 3, 5, true);

@@ -33,9 +33,17 @@ inline constexpr auto kBatchModes = makeEnumTable<BatchMode>({
     {BatchMode::Packet8, "Packet8", "8-wide packets"},
     {BatchMode::Stream, "Stream", "streams"},
 });
+// PerVertex: each vertex's own rays only (independent estimates, the
+// estimator above). Shared: neighbours' rays pooled where they agree (gi/ao_shared.h).
+enum class AOEstimator { PerVertex, Shared };
+inline constexpr auto kAOEstimators = makeEnumTable<AOEstimator>({
+    {AOEstimator::PerVertex, "Per vertex", "per vertex"},
+    {AOEstimator::Shared, "Shared with neighbours", "shared with neighbours"},
+});
 
 struct AmbientOptions {
   AmbientMode mode = AmbientMode::Occlusion;
+  AOEstimator estimator = AOEstimator::PerVertex;
   int raysPerVertex = 256;       // fixed count when targetError == 0
   double targetError = 0.0;      // adaptive: stop at this standard error per vertex
   int minRays = 32, maxRays = 4096;
@@ -57,6 +65,8 @@ struct AmbientOptions {
   BatchMode batch = BatchMode::Single;
   bool skipOpenVertices = true;  // prove-and-skip vertices with nothing within maxDistance
   bool mergeDuplicates = true;   // same position and normal computed once
+  int shareRings = 3;            // Shared: largest neighbourhood in mesh rings
+  float shareNormalAngleDeg = 10.f;  // Shared: neighbours' normals within this angle
   VertexPart vertices;           // which vertices to compute (a split run); the others are left 0
 
   static std::vector<ParamSpec> specs(AmbientMode mode);

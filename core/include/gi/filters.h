@@ -16,6 +16,7 @@ enum class FilterKind {
   AmbientOcclusion,
   AmbientObscurance,
   SkyLighting,
+  Thickness,
   Radiosity,
   PhotonMapping,
   PathTracedReference,

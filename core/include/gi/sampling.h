@@ -150,6 +150,14 @@ class SobolOwenStream {
       u1[j] = toUnitFloat(reverseBits(laineKarrasPermutation(b[j], s1_)));
     }
   }
+  // Jumps to point i: the Gray code of i in dimension 1 (bit-reversed
+  // domain), the XOR of the direction numbers of its set bits in dimension 2.
+  void seek(uint32_t i) {
+    i_ = i;
+    r0_ = i ^ (i >> 1);
+    r1_ = 0;
+    for (uint32_t g = r0_; g; g &= g - 1) r1_ ^= kSobolRevDir1.v[__builtin_ctz(g)];
+  }
   glm::vec2 next() {
     const glm::vec2 p{toUnitFloat(reverseBits(laineKarrasPermutation(r0_, s0_))),
                       toUnitFloat(reverseBits(laineKarrasPermutation(r1_, s1_)))};

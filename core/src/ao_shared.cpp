@@ -1,0 +1,315 @@
+// The shared AO estimator (gi/ao_shared.h): rays per vertex, pooling by
+// Lepski's rule, adaptive rounds.
+#include "gi/ao_shared.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "ambient_internal.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+VertexGraph VertexGraph::build(const Scene& s) {
+  const size_t nv = s.vertexCount();
+  const auto ok = usableFaceMask(s);
+  VertexGraph g;
+  g.offset.assign(nv + 1, 0);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) g.offset[s.triangles[f][k] + 1] += 2;
+  for (size_t v = 0; v < nv; ++v) g.offset[v + 1] += g.offset[v];
+  std::vector<uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
+  g.nbr.resize(g.offset[nv]);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const auto& t = s.triangles[f];
+    for (int k = 0; k < 3; ++k) {
+      g.nbr[fill[t[k]]++] = t[(k + 1) % 3];
+      g.nbr[fill[t[k]]++] = t[(k + 2) % 3];
+    }
+  }
+  // Each neighbour once (a manifold vertex lists each twice).
+  uint32_t out = 0;
+  for (size_t v = 0; v < nv; ++v) {
+    const uint32_t b = g.offset[v], e = g.offset[v + 1];
+    std::sort(g.nbr.begin() + b, g.nbr.begin() + e);
+    const uint32_t start = out;
+    for (uint32_t k = b; k < e; ++k)
+      if (k == b || g.nbr[k] != g.nbr[k - 1]) g.nbr[out++] = g.nbr[k];
+    g.offset[v] = start;
+  }
+  g.offset[nv] = out;
+  g.nbr.resize(out);
+  return g;
+}
+
+namespace {
+
+// Weighted sums of one pool for the first-order fit f(d) = a + g.d over the
+// tangent-plane offsets d of its vertices (weights: their ray counts).
+struct PoolSums {
+  double W = 0, Y = 0;            // sum n, sum of ray values
+  double X[2] = {0, 0};           // sum n d
+  double XX[3] = {0, 0, 0};       // sum n d d^T (xx, xy, yy)
+  double XY[2] = {0, 0};          // sum d y (y = the vertex's sum of ray values)
+  void add(double n, double y, double dx, double dy) {
+    W += n; Y += y;
+    X[0] += n * dx; X[1] += n * dy;
+    XX[0] += n * dx * dx; XX[1] += n * dx * dy; XX[2] += n * dy * dy;
+    XY[0] += dx * y; XY[1] += dy * y;
+  }
+};
+
+// The fitted value at d = 0 and its variance over v: least squares of the
+// vertices' means with weights n (their variances are v / n), i.e.
+// a = Y/W - g.xbar, Var(a) = v (1/W + xbar^T C^-1 xbar) with C the centred
+// second moments. Too few or collinear vertices for a slope: the mean.
+struct Fit {
+  double a = 0, varOverV = 0;
+};
+Fit fit(const PoolSums& s) {
+  Fit f;
+  f.a = s.Y / s.W;
+  f.varOverV = 1.0 / s.W;
+  const double mx = s.X[0] / s.W, my = s.X[1] / s.W;
+  const double cxx = s.XX[0] - s.W * mx * mx, cxy = s.XX[1] - s.W * mx * my, cyy = s.XX[2] - s.W * my * my;
+  const double det = cxx * cyy - cxy * cxy, tr = cxx + cyy;
+  if (!(tr > 0.0) || det <= 1e-3 * tr * tr) return f;  // no spread in some direction: no slope
+  const double ry = s.XY[0] - mx * s.Y, rz = s.XY[1] - my * s.Y;
+  const double gx = (cyy * ry - cxy * rz) / det, gy = (cxx * rz - cxy * ry) / det;
+  f.a = s.Y / s.W - (gx * mx + gy * my);
+  f.varOverV = 1.0 / s.W + (cyy * mx * mx - 2.0 * cxy * mx * my + cxx * my * my) / det;
+  return f;
+}
+
+}  // namespace
+
+Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
+                  const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
+                  const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& sc) {
+  if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
+  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
+  const uint32_t now = sc.now;
+  const glm::vec3 ni = normals[i], pi = positions[i];
+  const Frame frame(ni);
+  sc.stamp[i] = now;
+  sc.frontier.assign(1, i);
+  constexpr int kMaxScales = 65;
+  double A[kMaxScales], VarV[kMaxScales], V[kMaxScales];  // estimate, its variance / v, and v, per accepted scale
+  PoolSums sums;
+  sums.add(rays[i].n, rays[i].sum, 0.0, 0.0);
+  Pooled p;
+  p.vertices = 1;
+  p.bent = rays[i].bent;
+  if (rays[i].n == 0) return p;
+  auto vOf = [](const PoolSums& s) {
+    const double pt = (s.Y + 1.0) / (s.W + 2.0);  // Laplace: never 0 after rays that all agreed
+    return pt * (1.0 - pt);
+  };
+  A[0] = sums.Y / sums.W;
+  VarV[0] = 1.0 / sums.W;
+  V[0] = vOf(sums);
+  int chosen = 0;
+  const int R = std::min(o.maxRings, kMaxScales - 1);
+  for (int h = 1; h <= R; ++h) {
+    sc.next.clear();
+    PoolSums grown = sums;
+    glm::vec3 db(0.f);
+    for (uint32_t v : sc.frontier)
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+        const uint32_t u = g.nbr[k];
+        if (sc.stamp[u] == now) continue;
+        sc.stamp[u] = now;
+        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
+        sc.next.push_back(u);
+        const glm::vec3 d = positions[u] - pi;
+        grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+        db += rays[u].bent;
+      }
+    if (sc.next.empty()) break;
+    const Fit f = fit(grown);
+    const double v = vOf(grown);
+    // Lepski: the new estimate within gamma standard errors of every smaller
+    // scale's. For nested least-squares fits of one model the larger is the
+    // efficient one, so Var(a_h' - a_h) = Var(a_h') - Var(a_h) (Hausman 1978).
+    bool agree = true;
+    for (int s = 0; s <= chosen && agree; ++s) {
+      const double var = std::max(0.0, v * (VarV[s] - f.varOverV));
+      agree = std::fabs(f.a - A[s]) <= o.gamma * std::sqrt(var);
+    }
+    if (!agree) break;
+    chosen = h;
+    A[h] = f.a;
+    VarV[h] = f.varOverV;
+    V[h] = v;
+    sums = grown;
+    p.vertices += uint32_t(sc.next.size());
+    p.bent += db;
+    sc.frontier.swap(sc.next);
+  }
+  p.value = float(std::clamp(A[chosen], 0.0, 1.0));
+  p.stdError = float(std::sqrt(V[chosen] * VarV[chosen]));
+  p.rays = uint32_t(sums.W);
+  p.rings = chosen;
+  return p;
+}
+
+namespace {
+
+constexpr int kRound = 32;
+
+// Rays [start, start + count) of vertex vi's sequence, the same as the
+// per-vertex estimator's (key, warp and frame), added to r.
+void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint32_t vi, const glm::vec3& org,
+              const glm::vec3& n, uint32_t start, uint32_t count, VertexRays& r) {
+  const Frame frame(n);
+  SobolOwenStream seq(hash3(vi, o.seed, 0x41u));
+  seq.seek(start);
+  float u0[kRound], u1[kRound], lx[kRound], ly[kRound], lz[kRound];
+  glm::vec3 dirs[kRound];
+  uint8_t occ[kRound];
+  Ray rays[kRound];
+  Hit hits[kRound];
+  const bool obscurance = o.mode == AmbientMode::Obscurance;
+  for (uint32_t done = 0; done < count;) {
+    const int m = int(std::min<uint32_t>(kRound, count - done));
+    seq.nextBlock(m, u0, u1);
+    cosineHemisphereBlock(m, u0, u1, lx, ly, lz);
+    for (int j = 0; j < m; ++j) dirs[j] = frame.t * lx[j] + frame.b * ly[j] + frame.n * lz[j];
+    if (obscurance) {
+      for (int j = 0; j < m; ++j) { rays[j].o = org; rays[j].d = dirs[j]; rays[j].tnear = 0.f; rays[j].tfar = tfar; }
+      caster.intersectBatch(rays, size_t(m), hits);
+    } else {
+      caster.occludedFan(org, dirs, size_t(m), tfar, occ);
+    }
+    for (int j = 0; j < m; ++j) {
+      const double f = obscurance ? (hits[j].valid() ? std::pow(std::min(1.0, double(hits[j].t) / o.maxDistance),
+                                                                 double(o.falloffExponent))
+                                                     : 1.0)
+                                  : (occ[j] ? 0.0 : 1.0);
+      r.sum += f;
+      if (o.bentNormals && f > 0.0) r.bent += dirs[j] * float(f);
+    }
+    done += uint32_t(m);
+  }
+  r.n += count;
+}
+
+}  // namespace
+
+SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
+                                 const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
+                                 const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine,
+                                 AmbientResult& res, const Progress& progress) {
+  const size_t nv = scene.vertexCount();
+  const VertexPart& part = o.vertices;
+  const bool split = !part.all();
+  if (split && !part.sumOverParts)
+    throw std::logic_error("the shared AO estimator split over parts needs their sum (VertexPart::sumOverParts)");
+  Timer graphTimer;
+  const VertexGraph g = VertexGraph::build(scene);
+  SharedStats st;
+  st.poolSeconds = graphTimer.seconds();
+  PoolOptions po;
+  po.maxRings = o.shareRings;
+  po.normalCos = std::cos(glm::radians(o.shareNormalAngleDeg));
+  const float tfar = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
+  const bool adaptive = o.targetError > 0.0;
+  const uint32_t first = uint32_t(adaptive ? std::min(o.minRays, o.maxRays) : o.raysPerVertex);
+  std::vector<VertexRays> rays(nv);
+  std::vector<uint32_t> want(nv, 0), pooledWith(nv, 0);  // pooledWith: ray counts at the last pooling
+  for (size_t i = 0; i < nv; ++i)
+    if (mine[i]) want[i] = first;
+  std::vector<uint8_t> repool(nv, 0);
+  std::vector<Pooled> pooled(nv);
+  std::vector<double> exchange;
+  tbb::enumerable_thread_specific<PoolScratch> scratch;
+  // Progress: rounds double the ray count, so the last rounds dominate; the
+  // bar follows the rounds' share of the largest possible count.
+  const double total = std::log2(double(adaptive ? std::max(o.maxRays, 1) : 1) / double(std::max(first, 1u))) + 1.0;
+  for (int round = 0;; ++round) {
+    const Progress bar = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
+    Timer cast;
+    parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (want[i] > rays[i].n)
+          castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
+    });
+    if (split) {
+      // Every part gets every vertex's rays (each vertex's from the part it
+      // belongs to; a representative another part's duplicates need is cast
+      // there too, alike, but not sent twice; sums of one nonzero term are
+      // exact): the pools are then the whole run's, bit for bit.
+      exchange.assign(5 * nv, 0.0);
+      for (size_t i = 0; i < nv; ++i)
+        if (mine[i] && part.contains(i, nv)) {
+          const VertexRays& r = rays[i];
+          double* x = &exchange[5 * i];
+          x[0] = r.n; x[1] = r.sum; x[2] = r.bent.x; x[3] = r.bent.y; x[4] = r.bent.z;
+        }
+      part.sumOverParts(exchange);
+      for (size_t i = 0; i < nv; ++i)
+        if (poolable[i] && !(mine[i] && part.contains(i, nv))) {
+          const double* x = &exchange[5 * i];
+          rays[i] = {uint32_t(x[0]), x[1], glm::vec3(float(x[2]), float(x[3]), float(x[4]))};
+        }
+    }
+    st.castSeconds += cast.seconds();
+    Timer pool;
+    // Pooled (again): every vertex within reach of one whose rays changed.
+    std::fill(repool.begin(), repool.end(), 0);
+    for (size_t i = 0; i < nv; ++i)
+      if (rays[i].n != pooledWith[i]) { repool[i] = 1; pooledWith[i] = rays[i].n; }
+    for (int ring = 0; ring < po.maxRings; ++ring) {
+      std::vector<uint8_t> grown = repool;
+      for (size_t v = 0; v < nv; ++v)
+        if (repool[v])
+          for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
+      repool.swap(grown);
+    }
+    parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
+      PoolScratch& sc = scratch.local();
+      for (size_t i = b; i < e; ++i)
+        if (repool[i] && mine[i]) pooled[i] = poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
+    });
+    ++st.rounds;
+    st.poolSeconds += pool.seconds();
+    if (!adaptive) break;
+    // Vertices above the target cast twice their rays (all parts go on while any does).
+    double more = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (mine[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays)) {
+        want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
+        more += 1;
+      }
+    if (split) {
+      std::vector<double> m{more};
+      part.sumOverParts(m);
+      more = m[0];
+    }
+    if (more == 0) break;
+  }
+  double pooledVertices = 0, rings = 0;
+  size_t traced = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    if (!mine[i]) continue;
+    const Pooled& p = pooled[i];
+    res.value[i] = p.value;
+    res.stdError[i] = p.stdError;
+    res.rays[i] = int(rays[i].n);
+    if (o.bentNormals) res.bentNormal[i] = glm::length(p.bent) > 0.f ? glm::normalize(p.bent) : normals[i];
+    pooledVertices += p.vertices;
+    rings += p.rings;
+    ++traced;
+  }
+  st.meanPooledVertices = traced ? pooledVertices / double(traced) : 0.0;
+  st.meanRings = traced ? rings / double(traced) : 0.0;
+  return st;
+}
+
+}  // namespace gi

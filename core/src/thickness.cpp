@@ -1,0 +1,211 @@
+#include "gi/thickness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "gi/sampling.h"
+
+namespace gi {
+namespace {
+
+constexpr int kRound = 32;  // rays per adaptive round, as AO
+
+void checkOptions(const ThicknessOptions& o) {
+  if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
+  if (o.targetError > 0.0 && o.minRays > o.maxRays)
+    throw std::invalid_argument("min_rays (" + std::to_string(o.minRays) + ") exceeds max_rays (" +
+                                std::to_string(o.maxRays) + ")");
+  if (!(o.coneAngleDeg > 0.f && o.coneAngleDeg < 90.f))
+    throw std::invalid_argument("cone_angle must lie between 0 and 90 degrees");
+}
+
+struct VertexThickness {
+  float value = 0.f, stdError = 0.f;
+  int rays = 0, hits = 0;
+};
+
+class ThicknessKernel {
+ public:
+  ThicknessKernel(const RayCaster& c, const ThicknessOptions& o)
+      : caster_(c), o_(o), sinAlpha_(std::sin(glm::radians(o.coneAngleDeg))) {}
+
+  // Rays from origin `org` (just inside the surface at vertex p) in the cone around -n.
+  VertexThickness run(uint32_t vi, const glm::vec3& p, const glm::vec3& org, const glm::vec3& n,
+                      std::vector<float>& lengths, std::vector<float>& scratch) const {
+    VertexThickness out;
+    const Frame frame(-n);
+    SobolOwenStream seq(hash3(vi, o_.seed, 0x5dfu));
+    const bool adaptive = o_.targetError > 0.0;
+    const int maxN = adaptive ? o_.maxRays : o_.raysPerVertex;
+    float u0[kRound], u1[kRound], lx[kRound], ly[kRound], lz[kRound];
+    Ray rays[kRound];
+    Hit hits[kRound];
+    lengths.clear();
+    RobustMean rm;
+    int done = 0;
+    while (done < maxN) {
+      const int m = std::min(kRound, maxN - done);
+      seq.nextBlock(m, u0, u1);
+      // Cosine-weighted in the cone: the concentric disk point scaled by sin(alpha), lifted to the sphere.
+      cosineHemisphereBlock(m, u0, u1, lx, ly, lz);
+      for (int j = 0; j < m; ++j) {
+        const float x = lx[j] * sinAlpha_, y = ly[j] * sinAlpha_;
+        const float z = std::sqrt(std::max(0.f, 1.f - x * x - y * y));
+        rays[j].o = org;
+        rays[j].d = frame.t * x + frame.b * y + frame.n * z;
+        rays[j].tnear = 0.f;
+        rays[j].tfar = std::numeric_limits<float>::infinity();
+      }
+      caster_.intersectBatch(rays, size_t(m), hits);
+      for (int j = 0; j < m; ++j) {
+        // Leaving the object: the face met faces along the ray (its back is seen).
+        if (!hits[j].valid() || glm::dot(hits[j].ng, rays[j].d) <= 0.f) continue;
+        const glm::vec3 q = rays[j].o + hits[j].t * rays[j].d;
+        lengths.push_back(glm::length(q - p));  // from the vertex itself, not the lifted origin
+      }
+      done += m;
+      if (!adaptive || done < o_.minRays) continue;
+      scratch = lengths;
+      rm = robustMean(scratch, o_.rejectOutliers);
+      if (rm.count >= 2 && rm.stdError <= o_.targetError * rm.mean) break;
+    }
+    scratch = lengths;
+    rm = robustMean(scratch, o_.rejectOutliers);
+    out.rays = done;
+    out.hits = int(lengths.size());
+    out.value = float(rm.mean);
+    out.stdError = float(rm.stdError);
+    return out;
+  }
+
+ private:
+  const RayCaster& caster_;
+  const ThicknessOptions& o_;
+  float sinAlpha_;
+};
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+}  // namespace
+
+RobustMean robustMean(std::vector<float>& L, bool reject) {
+  RobustMean r;
+  const size_t n = L.size();
+  if (n == 0) return r;
+  auto meanOf = [](const float* b, const float* e, double& mean, double& sd) {
+    const double k = double(e - b);
+    double s = 0, ss = 0;
+    for (const float* x = b; x != e; ++x) s += *x;
+    mean = s / k;
+    for (const float* x = b; x != e; ++x) ss += (*x - mean) * (*x - mean);
+    sd = k > 1 ? std::sqrt(ss / (k - 1)) : 0.0;
+  };
+  double mean, sd;
+  meanOf(L.data(), L.data() + n, mean, sd);
+  const float* b = L.data();
+  const float* e = L.data() + n;
+  if (reject && n >= 3) {
+    std::sort(L.begin(), L.end());
+    const double median = n % 2 ? L[n / 2] : 0.5 * (double(L[n / 2 - 1]) + L[n / 2]);
+    const float* lo = L.data() + (std::lower_bound(L.begin(), L.end(), float(median - sd)) - L.begin());
+    const float* hi = L.data() + (std::upper_bound(L.begin(), L.end(), float(median + sd)) - L.begin());
+    if (hi - lo >= 1) {
+      b = lo;
+      e = hi;
+      meanOf(b, e, mean, sd);
+    }
+  }
+  r.count = size_t(e - b);
+  r.mean = mean;
+  r.stdError = r.count > 1 ? sd / std::sqrt(double(r.count)) : 0.0;
+  return r;
+}
+
+ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, const ThicknessOptions& opt,
+                                 const Progress& progress) {
+  checkOptions(opt);
+  Timer timer;
+  const SceneReport rep = analyzeScene(scene);
+  if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
+  const size_t nv = scene.vertexCount();
+  const std::vector<glm::vec3> normals =
+      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
+  std::vector<glm::vec3> inward(nv);
+  for (size_t i = 0; i < nv; ++i) inward[i] = -normals[i];
+  // Origins just inside the surface (and into the incident faces at borders).
+  const std::vector<glm::vec3> origins = vertexRayOrigins(scene, inward, float(rep.rayEpsilon));
+  ThicknessResult res;
+  res.value.assign(nv, 0.f);
+  res.stdError.assign(nv, 0.f);
+  res.rays.assign(nv, 0);
+  res.hits.assign(nv, 0);
+  std::vector<uint8_t> valid(nv, 0);
+  for (size_t i = 0; i < nv; ++i) {
+    const glm::vec3& p = scene.positions[i];
+    const glm::vec3& n = normals[i];
+    valid[i] = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(n.x) &&
+               glm::dot(n, n) > 0.5f;
+  }
+  const ThicknessKernel kernel(caster, opt);
+  Timer traceTimer;
+  parallelBlocks(nv, progress, "casting rays", [&](size_t b, size_t e) {
+    std::vector<float> lengths, scratch;
+    for (size_t i = b; i < e; ++i) {
+      if (!valid[i]) continue;
+      const VertexThickness t = kernel.run(uint32_t(i), scene.positions[i], origins[i], normals[i], lengths, scratch);
+      res.value[i] = float(t.value * scene.unit);  // world units (Scene::unit)
+      res.stdError[i] = float(t.stdError * scene.unit);
+      res.rays[i] = t.rays;
+      res.hits[i] = t.hits;
+    }
+  });
+  const double traceSeconds = traceTimer.seconds();
+  // Summary (sequential: deterministic).
+  double rays = 0, sum = 0, relVar = 0;
+  size_t counted = 0, invalid = 0, noHit = 0, few = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    rays += res.rays[i];
+    if (!valid[i]) { ++invalid; continue; }
+    if (res.hits[i] == 0) { ++noHit; continue; }
+    if (res.hits[i] * 2 < res.rays[i]) ++few;
+    sum += res.value[i];
+    if (res.value[i] > 0.f) relVar += double(res.stdError[i]) * res.stdError[i] / (double(res.value[i]) * res.value[i]);
+    ++counted;
+  }
+  auto& st = res.stats;
+  st.add("vertices", double(nv));
+  st.add("rays", rays);
+  st.add("seconds", timer.seconds());
+  st.add("rays_per_second", traceSeconds > 0 ? rays / traceSeconds : 0.0);
+  st.add("mean", counted ? sum / double(counted) : 0.0);
+  st.add("rms_relative_error_estimate", counted ? std::sqrt(relVar / double(counted)) : 0.0);
+  st.add("no_opposite_side", double(noHit));
+  st.add("skipped_invalid", double(invalid));
+  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
+  if (noHit) st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0");
+  const size_t traced = nv - invalid;
+  if (traced && (noHit + few) * 10 > traced)
+    st.warn(std::to_string(noHit + few) + " of " + std::to_string(traced) +
+            " vertices found the opposite side with fewer than half their rays (" + std::to_string(noHit) +
+            " with none): the mesh is open, its normals point inwards, or it has inner shells; thickness is "
+            "measured only where rays leave through the back of a face");
+  if (opt.targetError > 0.0) {
+    size_t unmet = 0;
+    for (size_t i = 0; i < nv; ++i)
+      if (res.hits[i] && res.rays[i] >= opt.maxRays && res.stdError[i] > opt.targetError * res.value[i]) ++unmet;
+    if (unmet * 10 > counted)
+      st.warn(std::to_string(unmet) + " of " + std::to_string(counted) + " vertices stopped at max_rays " +
+              std::to_string(opt.maxRays) + " with their relative standard error above target_error " +
+              num(opt.targetError) + ": raise max_rays or the target");
+  }
+  return res;
+}
+
+}  // namespace gi

@@ -1,0 +1,341 @@
+// The shared AO estimator (gi/ao_shared.h) is honest: its values against an
+// independent per-vertex reference over all vertices and in the places where
+// pooling neighbours is wrong (a crease with a contact shadow, a sphere
+// resting on the floor, a thin disc hovering over it), its adaptive target
+// held per vertex, its reported standard errors, and the pooling rules
+// themselves (normal tolerance, Lepski's stop, the first-order fit).
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <string>
+
+#include "gi/ambient.h"
+#include "gi/ao_shared.h"
+#include "gi/scenes.h"
+#include "test_helpers.h"
+
+using namespace gi;
+
+namespace {
+
+// Appends `part` with x -> x * scale + offset (scale per axis) to `s`.
+void appendScaled(Scene& s, const Scene& part, const glm::dvec3& scale, const glm::dvec3& offset) {
+  std::vector<glm::dvec3> pts;
+  for (const auto& p : part.positions) pts.push_back(part.toWorld(p) * scale + offset);
+  const Scene t = Scene::fromAbsolute(pts, part.triangles);
+  if (s.positions.empty()) s = t;
+  else s.append(t);
+}
+
+// The test scene, 2 x 2 units of floor (z = 0, 80 x 80 patches), a wall
+// 0.5 high along its x = 0 edge (80 x 20 patches, a crease with a contact
+// shadow), a sphere of radius 0.25 resting on the floor (icosphere, 2562
+// vertices: its contact point), and a thin disc (an icosphere flattened to
+// half-thickness 0.01, radius 0.35) hovering 0.04 above the floor: its two
+// sides see the sky and the floor, 0.02 apart, joined by a sharp rim.
+struct TestScene {
+  Scene s;
+  size_t floor0 = 0, wall0 = 0, sphere0 = 0, disc0 = 0, end = 0;
+};
+
+const glm::dvec3 kSphereCentre{1.45, 0.55, 0.25};
+const glm::dvec3 kDiscCentre{1.2, 1.4, 0.05};
+
+TestScene makeScene() {
+  TestScene t;
+  t.floor0 = 0;
+  appendScaled(t.s, scenes::openPlane(2.0, 80).scene, {1, 1, 1}, {1.0, 1.0, 0.0});
+  t.wall0 = t.s.vertexCount();
+  // openPlane faces +z; the wall faces +x: (x, y, z) -> (z', y, x') rotates +z onto +x
+  // with counter-clockwise order kept (a proper rotation about y).
+  {
+    Scene w = scenes::openPlane(1.0, 20).scene;
+    std::vector<glm::dvec3> pts;
+    for (const auto& p : w.positions) {
+      const glm::dvec3 q = w.toWorld(p);  // q in [-0.5, 0.5]^2 x {0}
+      pts.push_back({q.z, 1.0 + 2.0 * q.y, 0.25 - 0.5 * q.x});
+    }
+    t.s.append(Scene::fromAbsolute(pts, w.triangles));
+  }
+  t.sphere0 = t.s.vertexCount();
+  appendScaled(t.s, scenes::sphere(1.0, 4, false).scene, {0.25, 0.25, 0.25}, kSphereCentre);
+  t.disc0 = t.s.vertexCount();
+  appendScaled(t.s, scenes::sphere(1.0, 4, false).scene, {0.35, 0.35, 0.01}, kDiscCentre);
+  t.end = t.s.vertexCount();
+  return t;
+}
+
+// The places where pooling neighbours is wrong, and everything.
+struct Region {
+  std::string name;
+  std::vector<size_t> v;
+};
+
+std::vector<Region> regions(const TestScene& t) {
+  Region crease{"crease and its contact shadow (floor within 0.15 of the wall, wall below 0.15)", {}},
+      contact{"sphere resting on the floor (floor within 0.3 of the contact point, sphere below z = 0.1)", {}},
+      thin{"thin disc (both sides and the rim) and the floor under it", {}}, all{"all vertices", {}};
+  for (size_t i = 0; i < t.end; ++i) {
+    const glm::dvec3 p = t.s.toWorld(t.s.positions[i]);
+    all.v.push_back(i);
+    if ((i < t.wall0 && p.x < 0.15) || (i >= t.wall0 && i < t.sphere0 && p.z < 0.15)) crease.v.push_back(i);
+    const double dContact = glm::length(glm::dvec2(p.x - kSphereCentre.x, p.y - kSphereCentre.y));
+    if ((i < t.wall0 && dContact < 0.3) || (i >= t.sphere0 && i < t.disc0 && p.z < 0.1)) contact.v.push_back(i);
+    const double dDisc = glm::length(glm::dvec2(p.x - kDiscCentre.x, p.y - kDiscCentre.y));
+    if (i >= t.disc0 || (i < t.wall0 && dDisc < 0.45)) thin.v.push_back(i);
+  }
+  return {crease, contact, thin, all};
+}
+
+AmbientResult run(const Scene& s, const AmbientOptions& o) {
+  auto caster = makeEmbreeCaster(s, BatchMode::Single);
+  return computeAmbient(s, *caster, o);
+}
+
+AmbientOptions shared(double target, float normalDeg = 10.f, int rings = 3) {
+  AmbientOptions o;
+  o.estimator = AOEstimator::Shared;
+  o.targetError = target;
+  o.minRays = 8;
+  o.maxRays = 4096;
+  o.shareNormalAngleDeg = normalDeg;
+  o.shareRings = rings;
+  o.seed = 1;
+  return o;
+}
+
+// The reference: the per-vertex estimator (tested against analytic values in
+// test_ambient.cpp) with 2048 rays per vertex and another seed. Its standard
+// error is at most sqrt(p(1-p)/2048) <= 0.011 (binomial; its scrambled Sobol
+// directions do better, about N^-3/4).
+const AmbientResult& reference(const Scene& s) {
+  static const AmbientResult r = [&] {
+    AmbientOptions o;
+    o.raysPerVertex = 2048;
+    o.seed = 987654;
+    return run(s, o);
+  }();
+  return r;
+}
+
+const TestScene& scene() {
+  static const TestScene t = makeScene();
+  return t;
+}
+
+struct Errors {
+  double rms = 0;     // RMS of (shared - reference)
+  double meanZ2 = 0;  // mean of (shared - reference)^2 / se_shared^2
+  double tail = 0;    // fraction with |shared - reference| > 4 max(target, se_shared)
+  double worst = 0;   // largest |shared - reference|
+};
+
+// The reference's own error is left in (it only makes the checks harder to
+// pass): with 2048 scrambled Sobol rays it is about 0.003 or less, small
+// against the errors checked (0.01 and up).
+Errors errors(const AmbientResult& a, const AmbientResult& ref, const std::vector<size_t>& v, double target) {
+  Errors e;
+  size_t far = 0;
+  for (size_t i : v) {
+    const double d = double(a.value[i]) - double(ref.value[i]), sa = a.stdError[i];
+    e.rms += d * d;
+    e.meanZ2 += d * d / std::max(1e-12, sa * sa);
+    if (std::fabs(d) > 4.0 * std::max(target, sa)) ++far;
+    e.worst = std::max(e.worst, std::fabs(d));
+  }
+  const double m = double(v.size());
+  e.rms = std::sqrt(e.rms / m);
+  e.meanZ2 /= m;
+  e.tail = double(far) / m;
+  return e;
+}
+
+}  // namespace
+
+// Error against the independent reference with an adaptive target of 0.02,
+// over all vertices and in each hard place. Why these bounds:
+//  - RMS <= 1.25 target: the adaptive rounds stop a vertex when its reported
+//    standard error is <= target, so an honest estimate has RMS error <=
+//    target; 25% leaves room for the error of the RMS itself (regions of 300+
+//    vertices whose errors are correlated through pooling over about 37
+//    vertices: >= 8 independent groups, relative error of an RMS sqrt(1/16)).
+//  - Tail: |error| > 4 max(target, se) for at most 1% of the vertices (a
+//    normal error: 6e-5; the margin covers the heavier tails of few pooled
+//    rays and the reference's own error).
+//  - mean z^2 <= 2, z = error / reported standard error: the reported
+//    standard errors cover the errors (about 1 for honest ones, less for the
+//    binomial upper bound; the reference's error adds < 0.1). With Lepski's
+//    threshold at 2 standard errors instead of 1 the thin disc's region gives
+//    2.5 here (the pooling bias it lets through under the disc's rim).
+// Pooling across the rim of the disc (normal tolerance ignored) or across the
+// crease breaks these bounds: see SharingCarelesslyFails below.
+TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
+  const TestScene& t = scene();
+  const AmbientResult& ref = reference(t.s);
+  const double target = 0.02;
+  const AmbientResult a = run(t.s, shared(target));
+  for (const Region& r : regions(t)) {
+    ASSERT_GE(r.v.size(), 300u) << r.name;
+    const Errors e = errors(a, ref, r.v, target);
+    EXPECT_LE(e.rms, 1.25 * target) << r.name;
+    EXPECT_LE(e.tail, 0.01) << r.name;
+    EXPECT_LE(e.meanZ2, 2.0) << r.name;
+    // Every vertex reports meeting the target or the maximum ray count.
+    for (size_t i : r.v)
+      ASSERT_TRUE(a.stdError[i] <= target + 1e-6 || a.rays[i] >= 4096) << r.name << " vertex " << i;
+  }
+}
+
+// Fixed ray counts: the pooled estimate's error against the reference is
+// covered by its reported standard error (mean z^2 <= 2 as above) in every
+// region, at 16 and 64 rays per vertex.
+TEST(AOShared, ReportedStandardErrorsCoverTheErrors) {
+  const TestScene& t = scene();
+  const AmbientResult& ref = reference(t.s);
+  for (int n : {16, 64}) {
+    AmbientOptions o = shared(0.0);
+    o.raysPerVertex = n;
+    const AmbientResult a = run(t.s, o);
+    for (const Region& r : regions(t)) {
+      const Errors e = errors(a, ref, r.v, 0.0);
+      EXPECT_LE(e.meanZ2, 2.0) << r.name << ", " << n << " rays";
+    }
+  }
+}
+
+// The checks above have power: sharing made careless (the normal tolerance
+// ignored, so pools cross the disc's rim and reach its other side, and
+// neighbourhoods of 8 rings) fails them where interpolation is wrong
+// (measured: mean z^2 2.4 at the sphere's contact, 1.8 at the thin disc).
+TEST(AOShared, SharingCarelesslyFails) {
+  const TestScene& t = scene();
+  const AmbientResult& ref = reference(t.s);
+  const double target = 0.02;
+  const AmbientResult a = run(t.s, shared(target, 180.f, 8));
+  const auto rs = regions(t);
+  bool fails = false;
+  std::string seen;
+  for (size_t k = 0; k < 3; ++k) {
+    const Errors e = errors(a, ref, rs[k].v, target);
+    fails = fails || e.rms > 1.25 * target || e.tail > 0.01 || e.meanZ2 > 2.0;
+    seen += rs[k].name + ": rms " + std::to_string(e.rms) + ", mean z^2 " + std::to_string(e.meanZ2) + "\n";
+  }
+  EXPECT_TRUE(fails) << seen;
+}
+
+// Sharing saves rays: at the same target the shared estimator casts fewer
+// rays per vertex than the per-vertex one on this dense scene.
+TEST(AOShared, SavesRaysAtTheSameTarget) {
+  const TestScene& t = scene();
+  AmbientOptions pv;
+  pv.targetError = 0.02;
+  pv.minRays = 8;
+  pv.maxRays = 4096;
+  pv.seed = 1;
+  const AmbientResult a = run(t.s, shared(0.02)), b = run(t.s, pv);
+  double ra = 0, rb = 0;
+  for (size_t i = 0; i < t.end; ++i) { ra += a.rays[i]; rb += b.rays[i]; }
+  EXPECT_LT(ra, 0.5 * rb) << "shared " << ra / double(t.end) << " per vertex " << rb / double(t.end);
+}
+
+// Bit-identical for any thread count.
+TEST(AOShared, DeterministicForAnyThreadCount) {
+  const TestScene& t = scene();
+  AmbientResult one, many;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = run(t.s, shared(0.03));
+  }
+  many = run(t.s, shared(0.03));
+  ASSERT_EQ(one.value.size(), many.value.size());
+  for (size_t i = 0; i < one.value.size(); ++i) {
+    ASSERT_EQ(one.value[i], many.value[i]) << i;
+    ASSERT_EQ(one.stdError[i], many.stdError[i]) << i;
+    ASSERT_EQ(one.rays[i], many.rays[i]) << i;
+  }
+}
+
+// With a normal tolerance of 0 no vertex of a curved mesh pools anything:
+// the shared estimator gives the per-vertex estimator's values (its own rays
+// are the per-vertex estimator's first rays).
+TEST(AOShared, NoSharingIsThePerVertexEstimator) {
+  auto sf = scenes::sphere(1.0, 3, false);
+  Scene s = sf.scene;
+  appendScaled(s, scenes::openPlane(4.0, 8).scene, {1, 1, 1}, {0, 0, -1.0});
+  AmbientOptions pv;
+  pv.raysPerVertex = 64;
+  pv.seed = 3;
+  AmbientOptions sh = pv;
+  sh.estimator = AOEstimator::Shared;
+  sh.shareNormalAngleDeg = 0.f;
+  const AmbientResult a = run(s, pv), b = run(s, sh);
+  for (size_t i = 0; i < sf.scene.vertexCount(); ++i) EXPECT_NEAR(a.value[i], b.value[i], 1e-6) << i;
+}
+
+// poolVertex on a hand-made fan: vertex 0 at the centre of a ring of six.
+namespace {
+struct Fan {
+  VertexGraph g;
+  std::vector<glm::vec3> p, n;
+  std::vector<VertexRays> rays;
+  std::vector<uint8_t> poolable;
+  Fan() {
+    g.offset = {0, 6, 9, 12, 15, 18, 21, 24};
+    g.nbr = {1, 2, 3, 4, 5, 6, 0, 2, 6, 0, 1, 3, 0, 2, 4, 0, 3, 5, 0, 4, 6, 0, 5, 1};
+    p.push_back(glm::vec3(0.f));
+    for (int k = 0; k < 6; ++k) p.push_back(glm::vec3(std::cos(k * 1.0471976f), std::sin(k * 1.0471976f), 0.f));
+    n.assign(7, glm::vec3(0, 0, 1));
+    rays.resize(7);
+    poolable.assign(7, 1);
+  }
+  void set(size_t i, uint32_t count, double mean) { rays[i].n = count; rays[i].sum = count * mean; }
+  Pooled pool(float normalCos = 0.9848f) {
+    PoolScratch sc;
+    PoolOptions o;
+    o.normalCos = normalCos;
+    return poolVertex(0, g, p, n, rays, poolable, o, sc);
+  }
+};
+}  // namespace
+
+// Neighbours whose normals differ by more than the tolerance are never
+// pooled, even when their rays agree exactly (Lepski's rule cannot see them).
+TEST(AOShared, NormalToleranceKeepsOutTiltedNeighbours) {
+  Fan f;
+  for (size_t i = 0; i < 7; ++i) f.set(i, 64, 0.5);
+  for (size_t i = 1; i < 7; ++i) f.n[i] = glm::normalize(glm::vec3(0.f, 0.3f, 1.f));  // 16.7 degrees
+  const Pooled p = f.pool();
+  EXPECT_EQ(p.vertices, 1u);
+  EXPECT_EQ(p.rays, 64u);
+  EXPECT_NEAR(p.value, 0.5f, 1e-6f);
+  const Pooled q = f.pool(0.9f);  // 25.8 degrees: now they are pooled
+  EXPECT_EQ(q.vertices, 7u);
+  EXPECT_EQ(q.rays, 7u * 64u);
+}
+
+// A step the rays can see stops the neighbourhood (Lepski): the centre at 1,
+// the ring at 0 with 256 rays each.
+TEST(AOShared, LepskiStopsAtAStep) {
+  Fan f;
+  f.set(0, 256, 1.0);
+  for (size_t i = 1; i < 7; ++i) f.set(i, 256, 0.0);
+  const Pooled p = f.pool();
+  EXPECT_EQ(p.vertices, 1u);
+  EXPECT_EQ(p.value, 1.f);
+}
+
+// A linear field is pooled and the first-order fit returns the centre's value
+// (not the pool's mean, which a lopsided neighbourhood would bias): centre
+// 0.5, ring values 0.5 + 0.2 x, rays agree exactly with the field.
+TEST(AOShared, FirstOrderFitFollowsAGradient) {
+  Fan f;
+  f.set(0, 1024, 0.5);
+  for (size_t i = 1; i < 7; ++i) f.set(i, 1024, 0.5 + 0.2 * f.p[i].x);
+  f.poolable[4] = 0;  // x = -1 left out: the pool's mean is above 0.5
+  const Pooled p = f.pool();
+  EXPECT_EQ(p.vertices, 6u);
+  EXPECT_NEAR(p.value, 0.5f, 1e-5f);
+  // Its standard error: the fit's variance at the centre over v = p~(1 - p~).
+  EXPECT_GT(p.stdError, std::sqrt(0.25f / (6.f * 1024.f)) * 0.9f);
+}

@@ -1,0 +1,354 @@
+// Thickness (shape diameter function) against its exact values for a
+// sphere, a slab and a cylinder (derivations in gi/thickness.h and below),
+// with and without the robust mean, plus determinism, adaptivity and bad input.
+//
+// Directions are cosine-distributed in the cone of half-angle alpha around
+// -n, so c = cos(theta) has c^2 uniform on [a, 1], a = cos^2(alpha):
+//   sphere r:    L = 2 r c                   (chord at angle theta to the diameter)
+//   slab t:      L = t / c
+//   cylinder R:  L = 2 R c / (c^2 + s^2 cos^2 phi), phi uniform, s = sin(theta)
+// Robust mean (Shapira et al. 2008): the mean of the lengths within one
+// standard deviation sd of the median m. For the sphere and the slab L is a
+// monotone function of U = c^2, so the kept set is an interval of U and
+//   sphere: E[2r sqrt(U) | U in [u1, u2]] = 2r (2/3)(u2^1.5 - u1^1.5)/(u2 - u1)
+//   slab:   E[t / sqrt(U) | U in [u1, u2]] = 2t (sqrt(u2) - sqrt(u1))/(u2 - u1)
+// with m, sd of L from E[L], E[L^2] (sphere: E[L^2] = 4r^2 (1 + a)/2; slab:
+// E[L^2] = t^2 ln(1/a)/(1 - a)). The cylinder's robust mean is computed by
+// quadrature over (U, phi).
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "gi/scenes.h"
+#include "gi/thickness.h"
+#include "test_helpers.h"
+
+using namespace gi;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+ThicknessResult runThickness(const Scene& s, int rays, double coneDeg, bool robust, uint32_t seed = 0) {
+  auto caster = makeEmbreeCaster(s);
+  ThicknessOptions o;
+  o.raysPerVertex = rays;
+  o.coneAngleDeg = float(coneDeg);
+  o.rejectOutliers = robust;
+  o.seed = seed;
+  return computeThickness(s, *caster, o);
+}
+
+// Appends an nu x nv grid over the quad p00 p10 p11 p01, triangles facing `out`.
+void grid(std::vector<glm::dvec3>& P, std::vector<glm::uvec3>& T, glm::dvec3 p00, glm::dvec3 p10, glm::dvec3 p11,
+          glm::dvec3 p01, int nu, int nv, glm::dvec3 out) {
+  const uint32_t base = uint32_t(P.size());
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double u = double(i) / nu, v = double(j) / nv;
+      P.push_back((1 - u) * (1 - v) * p00 + u * (1 - v) * p10 + u * v * p11 + (1 - u) * v * p01);
+    }
+  auto id = [&](int i, int j) { return base + uint32_t(j * (nu + 1) + i); };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+    if (glm::dot(glm::cross(P[b] - P[a], P[c] - P[a]), out) < 0) std::swap(b, c);
+    T.push_back({a, b, c});
+  };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      tri(id(i, j), id(i + 1, j), id(i + 1, j + 1));
+      tri(id(i, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+}
+
+// Closed box [-W/2, W/2]^2 x [0, t]: top and bottom n x n, sides 1 cell high.
+// (Separate grids per side: the sides' vertices do not disturb the top's normals.)
+Scene slab(double W, double t, int n) {
+  std::vector<glm::dvec3> P;
+  std::vector<glm::uvec3> T;
+  const double h = W / 2;
+  grid(P, T, {-h, -h, t}, {h, -h, t}, {h, h, t}, {-h, h, t}, n, n, {0, 0, 1});
+  grid(P, T, {-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}, n, n, {0, 0, -1});
+  grid(P, T, {-h, -h, 0}, {h, -h, 0}, {h, -h, t}, {-h, -h, t}, n, 1, {0, -1, 0});
+  grid(P, T, {-h, h, 0}, {h, h, 0}, {h, h, t}, {-h, h, t}, n, 1, {0, 1, 0});
+  grid(P, T, {-h, -h, 0}, {-h, h, 0}, {-h, h, t}, {-h, -h, t}, n, 1, {-1, 0, 0});
+  grid(P, T, {h, -h, 0}, {h, h, 0}, {h, h, t}, {h, -h, t}, n, 1, {1, 0, 0});
+  return Scene::fromAbsolute(P, T);
+}
+
+// Closed cylinder of radius R around z, z in [0, H]: m segments, k rings, fan caps.
+Scene cylinder(double R, double H, int m, int k) {
+  std::vector<glm::dvec3> P;
+  std::vector<glm::uvec3> T;
+  for (int j = 0; j <= k; ++j)
+    for (int i = 0; i < m; ++i) {
+      const double phi = 2 * kPi * i / m;
+      P.push_back({R * std::cos(phi), R * std::sin(phi), H * j / k});
+    }
+  auto id = [&](int i, int j) { return uint32_t(j * m + (i % m)); };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c, glm::dvec3 out) {
+    if (glm::dot(glm::cross(P[b] - P[a], P[c] - P[a]), out) < 0) std::swap(b, c);
+    T.push_back({a, b, c});
+  };
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < m; ++i) {
+      const glm::dvec3 c = (P[id(i, j)] + P[id(i + 1, j + 1)]) * 0.5;
+      const glm::dvec3 out(c.x, c.y, 0.0);
+      tri(id(i, j), id(i + 1, j), id(i + 1, j + 1), out);
+      tri(id(i, j), id(i + 1, j + 1), id(i, j + 1), out);
+    }
+  for (int cap = 0; cap < 2; ++cap) {
+    const uint32_t centre = uint32_t(P.size());
+    P.push_back({0, 0, cap ? H : 0.0});
+    const int j = cap ? k : 0;
+    for (int i = 0; i < m; ++i) tri(centre, id(i, j), id(i + 1, j), {0, 0, cap ? 1.0 : -1.0});
+  }
+  return Scene::fromAbsolute(P, T);
+}
+
+// Mean of `value` over the chosen vertices and its standard error (the
+// vertices' rays are independent: the variances add).
+struct Mean {
+  double mean = 0, se = 0;
+  size_t n = 0;
+};
+Mean meanOver(const ThicknessResult& r, const std::vector<size_t>& v) {
+  Mean m;
+  double var = 0;
+  for (size_t i : v) { m.mean += r.value[i]; var += double(r.stdError[i]) * r.stdError[i]; }
+  m.n = v.size();
+  m.mean /= double(m.n);
+  m.se = std::sqrt(var) / double(m.n);
+  return m;
+}
+
+double sphereMean(double r, double alpha) {
+  const double c = std::cos(alpha);
+  return 4.0 * r / 3.0 * (1 + c + c * c) / (1 + c);
+}
+double slabMean(double t, double alpha) { return 2.0 * t / (1 + std::cos(alpha)); }
+
+// Robust means of the sphere and the slab: L = f(U) monotone, U uniform on [a, 1].
+double sphereRobust(double r, double alpha) {
+  const double a = std::pow(std::cos(alpha), 2);
+  const double mean = sphereMean(r, alpha), m = 2 * r * std::sqrt((1 + a) / 2);
+  const double sd = std::sqrt(4 * r * r * (1 + a) / 2 - mean * mean);
+  auto U = [&](double L) { return std::clamp(std::pow(L / (2 * r), 2), a, 1.0); };
+  const double u1 = U(m - sd), u2 = U(m + sd);
+  return 2 * r * (2.0 / 3.0) * (std::pow(u2, 1.5) - std::pow(u1, 1.5)) / (u2 - u1);
+}
+double slabRobust(double t, double alpha) {
+  const double a = std::pow(std::cos(alpha), 2);
+  const double mean = slabMean(t, alpha), m = t / std::sqrt((1 + a) / 2);
+  const double sd = std::sqrt(t * t * std::log(1 / a) / (1 - a) - mean * mean);
+  auto U = [&](double L) { return std::clamp(std::pow(t / L, 2), a, 1.0); };
+  const double u1 = U(m + sd), u2 = U(std::max(m - sd, t));
+  return 2 * t * (std::sqrt(u2) - std::sqrt(u1)) / (u2 - u1);
+}
+// The cylinder's robust mean by midpoint quadrature over (U, phi): 2000^2
+// equally likely directions (error of the quadrature well below 1e-4 R).
+double cylinderRobust(double R, double alpha) {
+  const double a = std::pow(std::cos(alpha), 2);
+  const int n = 2000;
+  std::vector<float> L;
+  L.reserve(size_t(n) * n);
+  for (int i = 0; i < n; ++i) {
+    const double U = a + (1 - a) * (i + 0.5) / n, c = std::sqrt(U), s2 = 1 - U;
+    for (int j = 0; j < n; ++j) {
+      const double cp = std::cos(2 * kPi * (j + 0.5) / n);
+      L.push_back(float(2 * R * c / (U + s2 * cp * cp)));
+    }
+  }
+  return robustMean(L, true).mean;
+}
+
+std::vector<size_t> sideMiddle(const Scene& s, double zlo, double zhi) {
+  std::vector<size_t> v;
+  for (size_t i = 0; i < s.vertexCount(); ++i) {
+    const glm::dvec3 p = s.toWorld(s.positions[i]);
+    if (p.z > zlo && p.z < zhi && std::hypot(p.x, p.y) > 0.5) v.push_back(i);
+  }
+  return v;
+}
+
+std::vector<size_t> slabTopCentre(const Scene& s, double t, double half) {
+  const auto n = computeVertexNormals(s);
+  std::vector<size_t> v;
+  for (size_t i = 0; i < s.vertexCount(); ++i) {
+    const glm::dvec3 p = s.toWorld(s.positions[i]);
+    if (std::fabs(p.z - t) < 1e-9 && std::fabs(p.x) < half && std::fabs(p.y) < half && n[i].z > 0.9999f) v.push_back(i);
+  }
+  return v;
+}
+
+}  // namespace
+
+// The exact values themselves: the quadrature of the plain cylinder mean is
+// 2R (the azimuthal mean of L is 2R at every theta), which checks the
+// formula for L and the quadrature used for the robust value.
+TEST(Thickness, ExactValuesAreConsistent) {
+  const double a = std::pow(std::cos(kPi / 3), 2);
+  double sum = 0;
+  const int n = 1000;
+  for (int i = 0; i < n; ++i) {
+    const double U = a + (1 - a) * (i + 0.5) / n;
+    for (int j = 0; j < n; ++j) {
+      const double cp = std::cos(2 * kPi * (j + 0.5) / n);
+      sum += 2 * std::sqrt(U) / (U + (1 - U) * cp * cp);
+    }
+  }
+  EXPECT_NEAR(sum / (double(n) * n), 2.0, 1e-9);
+  // Narrow cones: a sphere's diameter and a slab's thickness.
+  EXPECT_NEAR(sphereMean(1.0, 1e-3), 2.0, 1e-6);
+  EXPECT_NEAR(slabMean(1.0, 1e-3), 1.0, 1e-6);
+  // At the paper's 60 degrees: sphere 14r/9, slab 4t/3.
+  EXPECT_NEAR(sphereMean(1.0, kPi / 3), 14.0 / 9.0, 1e-12);
+  EXPECT_NEAR(slabMean(1.0, kPi / 3), 4.0 / 3.0, 1e-12);
+}
+
+TEST(Thickness, RobustMeanKeepsOneStandardDeviationAroundTheMedian) {
+  std::vector<float> L = {1.f, 1.f, 1.f, 1.f, 100.f};
+  const RobustMean r = robustMean(L, true);
+  EXPECT_EQ(r.count, 4u);  // sd = 44.3, |100 - median| = 99 > sd
+  EXPECT_FLOAT_EQ(float(r.mean), 1.f);
+  std::vector<float> all = {1.f, 1.f, 1.f, 1.f, 100.f};
+  EXPECT_NEAR(robustMean(all, false).mean, 20.8, 1e-9);
+  std::vector<float> none;
+  EXPECT_EQ(robustMean(none, true).count, 0u);
+}
+
+// Sphere of radius 1 (icosphere, 2,562 vertices) at the 60 degree cone.
+// Tolerance: 5 standard errors of the mean over the vertices (each vertex's
+// error estimate is the iid one, conservative for our scrambled Sobol
+// directions) plus the faceting: chords end on the inscribed facets, up to
+// 1 - cos(edge / sqrt 3) ~ 0.1% short.
+TEST(Thickness, SphereGivesTheConeWeightedChord) {
+  auto sf = scenes::sphere(1.0, 4, false);
+  const Scene& s = sf.scene;
+  std::vector<size_t> all(s.vertexCount());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  for (bool robust : {false, true}) {
+    const ThicknessResult r = runThickness(s, 256, 60.0, robust);
+    const Mean m = meanOver(r, all);
+    const double exact = robust ? sphereRobust(1.0, kPi / 3) : sphereMean(1.0, kPi / 3);
+    EXPECT_NEAR(m.mean, exact, 5 * m.se + 2e-3) << (robust ? "robust" : "plain") << ", se " << m.se;
+    // Every vertex on its own within 5 of its standard errors (plus the faceting).
+    size_t outliers = 0;
+    for (size_t i : all)
+      if (std::fabs(r.value[i] - exact) > 5 * r.stdError[i] + 2e-3) ++outliers;
+    EXPECT_EQ(outliers, 0u);
+  }
+  // Uniform instead of cosine-weighted directions would give 2r (1 + c)/2 = 1.5:
+  // 3.6% below 14/9, far outside the tolerance (about 0.3%).
+  EXPECT_GT(std::fabs(sphereMean(1.0, kPi / 3) - 1.5), 20 * 2e-3);
+}
+
+// Slab 0.1 thick, 4 wide: from the top's central vertices a ray at 60 degrees
+// travels 0.17 sideways, far from the sides. Plain mean 2t/(1 + cos alpha);
+// a narrow (2 degree) cone gives t itself within 0.03%.
+TEST(Thickness, SlabGivesItsThickness) {
+  const double t = 0.1;
+  const Scene s = slab(4.0, t, 40);
+  const auto centre = slabTopCentre(s, t, 1.0);
+  ASSERT_GT(centre.size(), 300u);
+  const double deg2 = 2.0 * kPi / 180;
+  struct Case { double alpha; bool robust; double exact; };
+  for (const Case c : {Case{kPi / 3, false, slabMean(t, kPi / 3)}, Case{kPi / 3, true, slabRobust(t, kPi / 3)},
+                       Case{deg2, false, slabMean(t, deg2)}, Case{deg2, true, slabRobust(t, deg2)}}) {
+    const ThicknessResult r = runThickness(s, 256, c.alpha * 180 / kPi, c.robust);
+    const Mean m = meanOver(r, centre);
+    // The flat slab has no faceting error: only the sampling (5 standard errors).
+    EXPECT_NEAR(m.mean, c.exact, 5 * m.se + 1e-7)
+        << "alpha " << c.alpha << (c.robust ? " robust" : " plain");
+  }
+  // Every length lies in [t, t / cos 2 deg]: both means within 0.061% of t.
+  EXPECT_NEAR(slabMean(t, deg2), t, 3.1e-4 * t);
+  EXPECT_NEAR(slabRobust(t, deg2), t, 6.1e-4 * t);
+}
+
+// Cylinder of radius 1, 10 long: vertices on the side within 0.6 of
+// mid-height (rays travel at most 2/cos(60) sin(60) = 3.5 along the axis at
+// 60 degrees). Plain mean: the diameter 2 for any cone. 128 segments: the
+// opposite side's facets lie up to 1 - cos(pi / 128) = 3.0e-4 inside the circle.
+TEST(Thickness, CylinderGivesItsDiameter) {
+  const Scene s = cylinder(1.0, 10.0, 128, 20);
+  const auto middle = sideMiddle(s, 4.4, 5.6);
+  ASSERT_EQ(middle.size(), 3u * 128u);
+  for (double deg : {60.0, 30.0}) {
+    const ThicknessResult r = runThickness(s, 256, deg, false);
+    const Mean m = meanOver(r, middle);
+    EXPECT_NEAR(m.mean, 2.0, 5 * m.se + 3e-4) << deg << " degrees";
+  }
+  const ThicknessResult r = runThickness(s, 256, 60.0, true);
+  const Mean m = meanOver(r, middle);
+  EXPECT_NEAR(m.mean, cylinderRobust(1.0, kPi / 3), 5 * m.se + 3e-4);
+}
+
+TEST(Thickness, DeterministicForAnyThreadCount) {
+  auto sf = scenes::sphere(1.0, 3, false);
+  ThicknessResult one, two;
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+    one = runThickness(sf.scene, 64, 60.0, true, 5);
+  }
+  {
+    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+    two = runThickness(sf.scene, 64, 60.0, true, 5);
+  }
+  for (size_t i = 0; i < one.value.size(); ++i) ASSERT_EQ(one.value[i], two.value[i]) << i;
+  EXPECT_GT(test::rms(runThickness(sf.scene, 64, 60.0, true, 6).value, one.value), 0.0);
+}
+
+// Adaptive: every vertex stops once its standard error is 1% of its mean (or
+// at max_rays), and the result still matches the exact value.
+TEST(Thickness, AdaptiveMeetsItsTarget) {
+  auto sf = scenes::sphere(1.0, 3, false);
+  auto caster = makeEmbreeCaster(sf.scene);
+  ThicknessOptions o;
+  o.targetError = 0.01;
+  o.rejectOutliers = false;
+  const ThicknessResult r = computeThickness(sf.scene, *caster, o);
+  int fewer = 0;
+  for (size_t i = 0; i < r.value.size(); ++i) {
+    EXPECT_TRUE(r.stdError[i] <= 0.01 * r.value[i] || r.rays[i] >= o.maxRays) << i;
+    EXPECT_NEAR(r.value[i], sphereMean(1.0, kPi / 3), 5 * r.stdError[i] + 4e-3) << i;
+    fewer += r.rays[i] < o.maxRays;
+  }
+  EXPECT_EQ(fewer, int(r.value.size()));
+  EXPECT_TRUE(r.stats.warnings.empty());
+}
+
+// A mesh whose normals point inwards (the furnace sphere) or an open plane:
+// no ray finds an opposite side; every vertex gets 0 and the log says why.
+TEST(Thickness, NoOppositeSideWarns) {
+  for (auto sf : {scenes::sphere(1.0, 2, true), scenes::openPlane(1.0, 4)}) {
+    const ThicknessResult r = runThickness(sf.scene, 32, 60.0, true);
+    for (float v : r.value) EXPECT_EQ(v, 0.f);
+    ASSERT_EQ(r.stats.warnings.size(), 1u);
+    EXPECT_NE(r.stats.warnings[0].find("opposite side"), std::string::npos);
+  }
+  auto sf = scenes::sphere(1.0, 2, false);
+  auto caster = makeEmbreeCaster(sf.scene);
+  ThicknessOptions o;
+  o.coneAngleDeg = 90.f;
+  EXPECT_THROW(computeThickness(sf.scene, *caster, o), std::invalid_argument);
+}
+
+// Any scale: a sphere 1e-12 across gives the same thickness relative to its
+// size. Not bit for bit: the re-centred coordinates round differently, and a
+// normal whose z is +-4e-18 (a vertex on the equator) flips the tangent frame
+// (Duff et al. 2017 branch on the sign of z), i.e. another, equally valid set
+// of directions. So each vertex agrees within 5 standard errors of the
+// difference of two independent estimates.
+TEST(Thickness, ScaleInvariant) {
+  auto sf = scenes::sphere(1.0, 2, false);
+  const Scene tiny = test::transformed(sf.scene, 1e-12, glm::dvec3(0.0));
+  for (bool robust : {false, true}) {
+    const ThicknessResult a = runThickness(sf.scene, 64, 60.0, robust), b = runThickness(tiny, 64, 60.0, robust);
+    for (size_t i = 0; i < a.value.size(); ++i)
+      EXPECT_NEAR(b.value[i] / 1e-12, a.value[i], 5.0 * std::hypot(a.stdError[i], b.stdError[i] / 1e-12)) << i;
+  }
+}
