@@ -69,7 +69,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "1991), exceeds this fraction of the power leaving all surfaces (emitted and reflected), or while their "
                "bounding spheres overlap. Smaller: "
                "more links, closer to the flat solution (0: every patch pair, the flat solution at its cost).",
-       .type = ParamType::Float, .def = 1e-5, .min = 0, .max = 1.0},
+       .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0},
       {.name = "link_rays", .label = "Hierarchical: visibility rays per link",
        .help = "Hierarchical solver only. Rays between paired points of a link's two nodes; the fraction that "
                "passes scales the link's unoccluded form factor (cost: links x rays).",

@@ -31,7 +31,7 @@
 namespace gi {
 
 struct HierarchySettings {
-  double epsilon = 1e-5;      // BF refinement threshold, fraction of the power leaving all surfaces
+  double epsilon = 1e-4;      // BF refinement threshold, fraction of the power leaving all surfaces
   int linkRays = 4;           // visibility rays per link
   double memoryBytes = 1e18;  // the links stop being refined beyond this (with a warning)
 };

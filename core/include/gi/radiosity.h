@@ -56,7 +56,7 @@ struct RadiosityOptions {
   int maxIterations = 0;          // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive);
                                   // 0: automatic, from the largest reflectance (autoIterations)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
-  double hierarchyEpsilon = 1e-5; // hierarchical: BF refinement threshold (fraction of the power leaving surfaces)
+  double hierarchyEpsilon = 1e-4; // hierarchical: BF refinement threshold (fraction of the power leaving surfaces)
   int linkRays = 4;               // hierarchical: visibility rays per link
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
