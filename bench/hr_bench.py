@@ -99,8 +99,8 @@ def run(gi, mesh, out, solver, extra):
     return json.loads(stdout), wall, ru.ru_maxrss / 1024.0
 
 
-def patch_values(path):
-    """Face radiosity luminance from the output PLY's face quality."""
+def vertex_values(path):
+    """Vertex radiosity luminance (vertex quality; patch averages here) from the output PLY."""
     with open(path, "rb") as f:
         header = b""
         while not header.endswith(b"end_header\n"):
@@ -115,17 +115,11 @@ def patch_values(path):
             elif t[0] == "property" and cur is not None: cur.append(t[1:])
         sizes = {"float": 4, "uchar": 1, "int": 4, "double": 8, "uint": 4}
         fmt = {"float": "f", "uchar": "B", "int": "i", "double": "d", "uint": "I"}
-        vsize = sum(sizes[p[0]] for p in vprops)
-        f.read(nv * vsize)
         out = []
-        for _ in range(nf):
+        for _ in range(nv):
             vals = {}
-            for p in fprops:
-                if p[0] == "list":
-                    (n,) = struct.unpack("<" + fmt[p[1]], f.read(sizes[p[1]]))
-                    f.read(n * sizes[p[2]])
-                else:
-                    (vals[p[1]],) = struct.unpack("<" + fmt[p[0]], f.read(sizes[p[0]]))
+            for p in vprops:
+                (vals[p[1]],) = struct.unpack("<" + fmt[p[0]], f.read(sizes[p[0]]))
             out.append(vals.get("quality", 0.0))
         return out
 
@@ -157,7 +151,7 @@ def main():
                 st = j.get("stats", j)
                 key = "hierarchical" if solver == "Hierarchical" else "flat"
                 row[key] = {"seconds": wall, "peak_MB": rss, "stats": st}
-                vals[key] = patch_values(out)
+                vals[key] = vertex_values(out)
                 print("%8d triangles %-12s %7.2f s %7.0f MB" % (n, key, wall, rss), file=sys.stderr, flush=True)
             if "flat" in vals:
                 h, fl = vals["hierarchical"], vals["flat"]

@@ -406,7 +406,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   };
   // The links refined against the current R: new ones get their F computed
   // (in parallel; each link's rays are fixed by its nodes: deterministic).
-  auto refineLinks = [&](bool first, const std::vector<glm::vec3>& Rcur) {
+  auto refineLinks = [&](bool first, const std::vector<glm::vec3>& Rcur, const Progress& pr) {
     std::vector<Link> next;
     std::vector<uint8_t> nextFresh;
     // Power relative to all the light leaving surfaces (emitted and reflected:
@@ -427,7 +427,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     budgetHit |= ref.budgetHit;
     Timer ft;
     std::vector<uint64_t> blockRays(next.size(), 0);
-    parallelBlocks(next.size(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    parallelBlocks(next.size(), pr, "link form factors", [&](size_t b, size_t e) {
       for (size_t k = b; k < e; ++k)
         if (nextFresh[k]) next[k].F = linkFormFactor(g, t, caster, next[k].p, next[k].q, set.linkRays, unoccluded, eps, blockRays[k]);
     });
@@ -489,18 +489,21 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   };
 
   pull(S);
-  refineLinks(true, S);
+  // Progress: round r (at most 4) takes [r / 4, (r + 1) / 4): its links'
+  // form factors the first 70%, its sweeps the rest.
+  auto part = [&](int round, double a, double b) { return progress.sub((round + a) / 4.0, (round + b) / 4.0); };
+  refineLinks(true, S, fixed ? progress.sub(0.0, 0.7) : part(0, 0.0, 0.7));
   int rounds = 1;
   if (fixed) {
-    solveSweeps(maxSweeps, progress.sub(0.3, 1.0));
+    solveSweeps(maxSweeps, progress.sub(0.7, 1.0));
   } else {
     // Refine again with the solved R (a brighter source needs finer links)
     // until no link is split; at most 4 rounds.
-    solveSweeps(maxSweeps, progress.sub(0.3, 0.625));
+    solveSweeps(maxSweeps, part(0, 0.7, 1.0));
     for (; rounds < 4; ++rounds) {
       pull(sol.R);
-      if (refineLinks(false, sol.R) == 0) break;
-      solveSweeps(maxSweeps, progress.sub(0.5 + 0.125 * rounds, 0.625 + 0.125 * rounds));
+      if (refineLinks(false, sol.R, part(rounds, 0.0, 0.7)) == 0) break;
+      solveSweeps(maxSweeps, part(rounds, 0.7, 1.0));
     }
     sol.Rprev = sol.R;
   }

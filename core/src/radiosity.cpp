@@ -577,6 +577,9 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
                    std::to_string(kHierarchicalAutoPatches) + ")");
   res.stats.add("iterations", res.iterations);
   res.stats.add("residual", res.residual);
+  if (opt.hierarchyEpsilon == 0 && n > 20000)
+    res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
+                   " patches (the flat solution at quadratic cost); 1e-4 is the default");
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
   res.stats.add("direct_light_seconds", directSeconds);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
