@@ -488,6 +488,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     }
   };
 
+  sol.Rprev.assign(nf, glm::vec3(0.f));  // bounces = 0: no sweep, nothing indirect to gather
   pull(S);
   // Progress: round r (at most 4) takes [r / 4, (r + 1) / 4): its links'
   // form factors the first 70%, its sweeps the rest.

@@ -546,7 +546,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (base > budget) {
     char b[300];
     std::snprintf(b, sizeof b,
-                  "memory_budget_mb = %g is too small: %zu patches need about %.0f MB for the scene, the ray-casting "
+                  "memory_budget_mb = %g is too small: %zu patches need about %.1f MB for the scene, the ray-casting "
                   "structure and the cluster hierarchy before any link; raise memory_budget_mb",
                   opt.memoryBudgetMB, n, base / MB);
     throw std::invalid_argument(b);

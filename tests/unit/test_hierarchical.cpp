@@ -164,3 +164,29 @@ TEST(HierarchicalRadiosity, DeterministicAndRefusesTinyBudget) {
   o.memoryBudgetMB = 0.01;
   EXPECT_THROW(solveRadiosity(sf.scene, *caster, o), std::invalid_argument);
 }
+
+// bounces = 0 is the direct light only, B = E + rho H_direct, whatever the
+// solver: the same bits as the flat solver's (the same direct-light code);
+// one bounce adds light.
+TEST(HierarchicalRadiosity, FixedBouncesMatchTheFlatDefinition) {
+  auto sf = scenes::cornellBox(100.0);
+  auto caster = makeEmbreeCaster(sf.scene);
+  RadiosityOptions o;
+  o.bounces = 0;
+  o.gatherRays = 16;
+  o.solver = RadiositySolver::GaussSeidel;
+  const RadiosityResult flat = solveRadiosity(sf.scene, *caster, o);
+  o.solver = RadiositySolver::Hierarchical;
+  const RadiosityResult h0 = solveRadiosity(sf.scene, *caster, o);
+  o.bounces = 1;
+  const RadiosityResult h1 = solveRadiosity(sf.scene, *caster, o);
+  ASSERT_EQ(flat.Bvertex.size(), h0.Bvertex.size());
+  double sum0 = 0, sum1 = 0;
+  for (size_t v = 0; v < h0.Bvertex.size(); ++v) {
+    ASSERT_EQ(flat.Bvertex[v], h0.Bvertex[v]) << "vertex " << v;
+    sum0 += luminance(h0.Bvertex[v]);
+    sum1 += luminance(h1.Bvertex[v]);
+  }
+  EXPECT_GT(sum1, sum0 * 1.05);
+  EXPECT_EQ(h1.iterations, 1);
+}
