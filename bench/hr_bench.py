@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Hierarchical against flat radiosity on a generated, subdivided Cornell-like
 room (README, "Hierarchical radiosity"): time and peak memory against the
-triangle count, the log-log slope, and the difference of the two solutions'
-patch values where both run.
+triangle count, the log-log slope, and the relative RMS difference of the
+two solutions' vertex values (patch averages) where both run.
 
 The room: floor, ceiling, back and side walls of a 1 x 1 x 1 box (open at the
 front, like the Cornell box; red left wall, green right wall, white rest),
