@@ -113,9 +113,8 @@ std::pair<std::string, Texts> readParamsFile(const std::string& path) {
 }
 
 const FilterDesc& findFilter(const std::string& name) {
-  for (const FilterDesc& d : allFilters())
-    if (d.cliName == name || d.meshlabName == name) return d;
-  throw std::invalid_argument("unknown filter '" + name + "' (ao, obscurance, sky, radiosity, photonmap, reference, formfactors)");
+  if (const FilterDesc* d = gi::findFilter(name)) return *d;
+  throw std::invalid_argument("unknown filter '" + name + "' (" + cliFilterNames() + ")");
 }
 
 std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSpec>& specs, const std::string& filter) {
@@ -262,8 +261,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
 }  // namespace
 
 void addOptions(CLI::App* sub, Args& a) {
-  sub->add_option("filter", a.filter, "filter subcommand name (ao, obscurance, sky, radiosity, photonmap, reference, "
-                                      "formfactors); optional with --params naming it");
+  sub->add_option("filter", a.filter, "filter subcommand name (" + cliFilterNames() + "); optional with --params naming it");
   sub->add_option("--manifest", a.manifest, "file listing one mesh a line, each optionally followed by its own "
                                             "parameters (--name value); relative paths are relative to the "
                                             "manifest; # starts a comment line");

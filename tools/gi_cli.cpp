@@ -323,9 +323,8 @@ int runCli(int argc, char** argv) {
     subs[sub] = d.kind;
   }
   CLI::App* script = app.add_subcommand("script", "write a complete .mlx script for meshlabserver (every parameter, in dialog order)");
-  std::string filterName, filterNames;  // the catalogue's subcommands, for the help and the error
-  for (const FilterDesc& d : allFilters()) filterNames += (filterNames.empty() ? "" : ", ") + d.cliName;
-  script->add_option("filter", filterName, "filter subcommand name (" + filterNames + ")")->required();
+  std::string filterName;
+  script->add_option("filter", filterName, "filter subcommand name (" + cliFilterNames() + ")")->required();
   CLI::Option* scriptOutput = script->add_option("-o,--output", a.output, "output .mlx (default: stdout)");
   script->add_option("--mesh", a.mesh, "mesh whose bounding box scales distance defaults");
   script->allow_extras();
@@ -352,10 +351,8 @@ int runCli(int argc, char** argv) {
     if (list->parsed()) return listFilters(a.json);
     if (batch->parsed()) return batch::run(batchArgs, batch->remaining());
     if (script->parsed()) {
-      const FilterDesc* d = nullptr;
-      for (const auto& f : allFilters())
-        if (f.cliName == filterName) d = &f;
-      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (" + filterNames + ")");
+      const FilterDesc* d = findFilter(filterName);
+      if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (" + cliFilterNames() + ")");
       // Parameters after the filter name: --name value pairs, checked against the filter's table.
       const auto specs = filterSpecs(d->kind);
       const auto extras = script->remaining();

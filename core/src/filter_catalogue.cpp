@@ -143,6 +143,18 @@ const FilterDesc& filterDesc(FilterKind k) {
   throw std::logic_error("unknown filter");
 }
 
+const FilterDesc* findFilter(const std::string& name) {
+  for (const auto& d : allFilters())
+    if (d.cliName == name || d.meshlabName == name) return &d;
+  return nullptr;
+}
+
+std::string cliFilterNames() {
+  std::string names;
+  for (const auto& d : allFilters()) names += (names.empty() ? "" : ", ") + d.cliName;
+  return names;
+}
+
 std::vector<FilterKind> pluginFilters(const std::string& plugin) {
   std::vector<FilterKind> out;
   for (const auto& d : allFilters())

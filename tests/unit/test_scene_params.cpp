@@ -577,6 +577,17 @@ bool wellFormed(const std::string& x, std::string* why) {
   return true;
 }
 
+TEST(Filters, FoundByEitherNameAndListed) {
+  const std::string names = gi::cliFilterNames();
+  for (const auto& d : gi::allFilters()) {
+    ASSERT_EQ(gi::findFilter(d.cliName), &d);
+    ASSERT_EQ(gi::findFilter(d.meshlabName), &d);
+    EXPECT_NE(names.find(d.cliName), std::string::npos) << d.cliName;
+  }
+  EXPECT_EQ(gi::findFilter("no such filter"), nullptr);
+  EXPECT_EQ(gi::findFilter(""), nullptr);
+}
+
 TEST(Filters, XmlCheckerRejectsBrokenXml) {
   std::string why;
   EXPECT_TRUE(wellFormed("<a><b x=\"1\"/></a>", &why)) << why;

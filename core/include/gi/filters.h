@@ -46,6 +46,10 @@ struct FilterDesc {
 
 const std::vector<FilterDesc>& allFilters();
 const FilterDesc& filterDesc(FilterKind k);
+// The filter whose CLI subcommand or MeshLab name is `name`; nullptr if none.
+const FilterDesc* findFilter(const std::string& name);
+// Every CLI subcommand of the catalogue, comma-separated (help texts and errors).
+std::string cliFilterNames();
 // The filters of one plugin, in catalogue order.
 std::vector<FilterKind> pluginFilters(const std::string& plugin);
 std::vector<ParamSpec> filterSpecs(FilterKind k);
