@@ -33,7 +33,11 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        .help = "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses "
                "new values as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): "
                "repeatedly shoots the unshot power of the brightest patch; useful images early. Auto: Gauss-Seidel, "
-               "or progressive refinement when the form factors do not fit the memory budget.",
+               "or progressive refinement when the form factors do not fit the memory budget; hierarchical from 50,000 "
+               "patches on. Hierarchical with clustering (Hanrahan, Salzman and Aupperle 1991; Smits, Arvo and "
+               "Greenberg 1994): light travels on links between clusters of triangles where little power flows and "
+               "between triangles where much does, so time and memory grow about as n log n instead of n^2; the "
+               "form-factor method then applies to nothing (links have their own factors).",
        .type = ParamType::Enum, .def = kRadiositySolvers.index(RadiositySolver::Auto),
        .choices = kRadiositySolvers.choices()},
       {.name = "bounces", .label = "Bounces",
@@ -59,6 +63,17 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "beyond that, progressive refinement computes each shooter's row on the fly (more rays, memory linear "
                "in the patch count). A run that cannot fit even so is refused before it starts.",
        .type = ParamType::Float, .def = 1024, .min = 1, .max = 1e7},
+      {.name = "hierarchy_epsilon", .label = "Hierarchical: link tolerance",
+       .help = "Hierarchical solver only. A link between two clusters (or patches) is split into links between "
+               "their children while the power it may carry, A_p F_max B_q (the BF criterion of Hanrahan et al. "
+               "1991), exceeds this fraction of the power leaving all surfaces (emitted and reflected), or while their "
+               "bounding spheres overlap. Smaller: "
+               "more links, closer to the flat solution (0: every patch pair, the flat solution at its cost).",
+       .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0},
+      {.name = "link_rays", .label = "Hierarchical: visibility rays per link",
+       .help = "Hierarchical solver only. Rays between paired points of a link's two nodes; the fraction that "
+               "passes scales the link's unoccluded form factor (cost: links x rays).",
+       .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
       {.name = "vertex_output", .label = "Vertex values",
        .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
                "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
@@ -95,6 +110,8 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.tolerance = v.getFloat("tolerance");
   o.maxIterations = v.getInt("max_iterations");
   o.memoryBudgetMB = v.getFloat("memory_budget_mb");
+  o.hierarchyEpsilon = v.getFloat("hierarchy_epsilon");
+  o.linkRays = v.getInt("link_rays");
   o.vertexOutput = kRadiosityVertexOutputs.get(v, "vertex_output");
   o.gatherRays = v.getInt("gather_rays");
   o.refine = v.getBool("refine");
@@ -517,6 +534,60 @@ void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOption
                         : "vertices: direct light at each vertex, indirect interpolated from the patches");
 }
 
+// The hierarchical solver (gi/hierarchical.h) on the patches, then the same
+// vertex values as the flat solvers: the hierarchy gives each triangle its
+// reflected radiosity and indirect irradiance.
+RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
+                                           const Progress& progress) {
+  Timer timer;
+  const double MB = 1048576.0, budget = opt.memoryBudgetMB * MB;
+  const size_t n = s.faceCount();
+  const double base = double(n) * (kSolverBytesPerPatch + 2.0 * kHierarchyBytesPerNode);
+  if (base > budget) {
+    char b[300];
+    std::snprintf(b, sizeof b,
+                  "memory_budget_mb = %g is too small: %zu patches need about %.1f MB for the scene, the ray-casting "
+                  "structure and the cluster hierarchy before any link; raise memory_budget_mb",
+                  opt.memoryBudgetMB, n, base / MB);
+    throw std::invalid_argument(b);
+  }
+  Timer directTimer;
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.2)));
+  const double directSeconds = directTimer.seconds();
+  HierarchySettings hs;
+  hs.epsilon = opt.hierarchyEpsilon;
+  hs.linkRays = opt.linkRays;
+  hs.memoryBytes = budget - double(n) * kSolverBytesPerPatch;
+  HierarchicalSolution h = solveHierarchical(s, caster, u.Hd, hs, opt.bounces, opt.tolerance, opt.maxIterations,
+                                             progress.sub(0.2, 0.9));
+  RadiosityResult res;
+  res.stats = std::move(h.stats);
+  res.iterations = h.iterations;
+  res.residual = h.residual;
+  res.residualHistory = std::move(h.residualHistory);
+  res.Rgather = std::move(h.Rprev);
+  res.Hindirect = std::move(h.H);
+  res.B = h.R;
+  for (size_t i = 0; i < n; ++i) res.B[i] += u.E[i];
+  res.Bvertex = faceToVertex(s, res.B);
+  res.stats.note("solver hierarchical with clustering" +
+                 (opt.bounces >= 0 ? " (" + std::to_string(opt.bounces) + " bounces requested)" : std::string()));
+  if (opt.solver == RadiositySolver::Auto)
+    res.stats.note("auto: hierarchical for " + std::to_string(n) + " patches (>= " +
+                   std::to_string(kHierarchicalAutoPatches) + ")");
+  res.stats.add("iterations", res.iterations);
+  res.stats.add("residual", res.residual);
+  if (opt.hierarchyEpsilon == 0 && n > 20000)
+    res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
+                   " patches (the flat solution at quadratic cost); 1e-4 is the default");
+  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
+  res.stats.add("direct_light_seconds", directSeconds);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
+  res.stats.add("patches", double(u.n));
+  res.stats.add("seconds", timer.seconds());
+  return res;
+}
+
 }  // namespace
 
 int workerThreads() {
@@ -545,6 +616,8 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
                               const Progress& progress) {
   const Setup u = setup(s, Hd);
   if (solver == RadiositySolver::Auto) solver = RadiositySolver::GaussSeidel;
+  if (solver == RadiositySolver::Hierarchical)
+    throw std::invalid_argument("the hierarchical solver builds its own links: use solveHierarchical");
   return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, bounces,
                tolerance, maxIterations, progress);
 }
@@ -552,6 +625,9 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
   const FormFactors::Settings& ffs = opt.formFactors;
   if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
+  if (opt.solver == RadiositySolver::Hierarchical ||
+      (opt.solver == RadiositySolver::Auto && s.faceCount() >= kHierarchicalAutoPatches))
+    return solveHierarchicalRadiosity(s, caster, opt, progress);
   Timer timer;
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits

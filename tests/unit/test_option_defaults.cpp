@@ -122,6 +122,8 @@ TEST(OptionDefaults, Radiosity) {
   SAME(tolerance);
   SAME(maxIterations);
   SAME(memoryBudgetMB);
+  SAME(hierarchyEpsilon);
+  SAME(linkRays);
   SAME(vertexOutput);
   SAME(gatherRays);
   SAME(refine);

@@ -706,7 +706,7 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
       {"ray_batching", L{"Single", "Packet8", "Stream"}},
       {"estimator", L{"Per vertex", "Shared with neighbours"}},
       {"form_factor_method", L{"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
-      {"solver", L{"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement"}},
+      {"solver", L{"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement", "Hierarchical"}},
       {"vertex_output", L{"Final gather", "Interpolated indirect", "Patch average"}},
       {"mode", L{"Whitted", "Distributed", "Two-pass", "Path traced"}},
       {"camera", L{"Frame the scene", "Look at", "The layer's camera"}},

@@ -17,6 +17,7 @@
 
 #include "gi/direct.h"
 #include "gi/form_factors.h"
+#include "gi/hierarchical.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/refine.h"
@@ -26,13 +27,16 @@
 
 namespace gi {
 
-enum class RadiositySolver { Auto, Jacobi, GaussSeidel, Progressive };
+enum class RadiositySolver { Auto, Jacobi, GaussSeidel, Progressive, Hierarchical };
 inline constexpr auto kRadiositySolvers = makeEnumTable<RadiositySolver>({
     {RadiositySolver::Auto, "Auto", "auto"},
     {RadiositySolver::Jacobi, "Jacobi", "Jacobi"},
     {RadiositySolver::GaussSeidel, "Gauss-Seidel", "Gauss-Seidel"},
     {RadiositySolver::Progressive, "Progressive refinement", "progressive refinement"},
+    {RadiositySolver::Hierarchical, "Hierarchical", "hierarchical with clustering"},
 });
+// Auto takes the hierarchical solver (gi/hierarchical.h) from this many patches on.
+inline constexpr size_t kHierarchicalAutoPatches = 50000;
 enum class RadiosityVertexOutput { FinalGather, InterpolatedIndirect, PatchAverage };
 inline constexpr auto kRadiosityVertexOutputs = makeEnumTable<RadiosityVertexOutput>({
     {RadiosityVertexOutput::FinalGather, "Final gather", "final gather"},
@@ -52,6 +56,8 @@ struct RadiosityOptions {
   int maxIterations = 0;          // sweeps (Jacobi, Gauss-Seidel) or shots per patch count (progressive);
                                   // 0: automatic, from the largest reflectance (autoIterations)
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
+  double hierarchyEpsilon = 1e-4; // hierarchical: BF refinement threshold (fraction of the power leaving surfaces)
+  int linkRays = 4;               // hierarchical: visibility rays per link
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
   bool refine = false;            // adaptive mesh refinement (solveRadiosityAdaptive)

@@ -1,0 +1,549 @@
+// Hierarchical radiosity with clustering (see gi/hierarchical.h for the
+// equation and the citations): the cluster tree, BF link refinement, link
+// form factors with visibility rays, and the push-pull Jacobi sweeps.
+#include "gi/hierarchical.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <stdexcept>
+
+#include "gi/color.h"
+#include "gi/form_factor_analytic.h"
+#include "gi/radiosity.h"
+#include "gi/scene_setup.h"
+
+namespace gi {
+namespace {
+
+// A node of the cluster tree: a triangle (leaf) or the triangles of
+// order[first, first + count). Nodes are stored in preorder, so a parent's
+// index is below its children's (push: forward loop; pull: backward loop).
+struct Node {
+  glm::dvec3 c{0.0};   // bounding-sphere centre (bbox centre)
+  double r = 0;        // bounding-sphere radius (half the bbox diagonal)
+  double A = 0;        // area
+  uint32_t first = 0, count = 0;
+  uint32_t left = 0, right = 0;  // children (leaves: 0)
+  uint32_t parent = 0;
+  glm::vec3 lo{0.f}, hi{0.f};    // bbox (plane culling)
+  bool planar = false;           // all its triangles in one plane (x0, n), facing n
+  glm::dvec3 x0{0.0};
+  glm::vec3 n{0.f};
+  glm::vec3 axis{0.f};           // normal cone: unit axis and the cosine of its half-angle
+  float coneCos = 1.f;
+  bool leaf() const { return count == 1; }
+};
+
+struct Link {
+  uint32_t p, q;  // receiver, source
+  float F;        // area-mean form factor F_pq
+};
+
+struct Tree {
+  std::vector<Node> nodes;
+  std::vector<uint32_t> order;      // triangle of each leaf position
+  std::vector<double> Acum;         // prefix sums of the leaves' areas in `order`
+  std::vector<uint32_t> leafOf;     // node of each face (kNoHit: unusable)
+  int depth = 0;
+};
+
+struct Geometry {
+  const Scene& s;
+  std::vector<double> A;
+  std::vector<glm::vec3> n;  // unit face normals
+  std::vector<glm::dvec3> centroid;
+};
+
+Tree buildTree(const Geometry& g) {
+  Tree t;
+  const size_t nf = g.s.faceCount();
+  for (uint32_t f = 0; f < nf; ++f)
+    if (g.A[f] > 0) t.order.push_back(f);
+  t.leafOf.assign(nf, kNoHit);
+  if (t.order.empty()) return t;
+  t.nodes.assign(2 * t.order.size() - 1, Node{});
+  struct Job { uint32_t node, first, count; int level; };
+  std::vector<Job> stack;
+  stack.push_back({0, 0, uint32_t(t.order.size()), 1});
+  while (!stack.empty()) {
+    const Job j = stack.back();
+    stack.pop_back();
+    t.depth = std::max(t.depth, j.level);
+    glm::dvec3 lo(1e300), hi(-1e300), clo(1e300), chi(-1e300);
+    double A = 0;
+    for (uint32_t k = j.first; k < j.first + j.count; ++k) {
+      const uint32_t f = t.order[k];
+      const glm::uvec3 tri = g.s.triangles[f];
+      for (int v = 0; v < 3; ++v) {
+        lo = glm::min(lo, glm::dvec3(g.s.positions[tri[v]]));
+        hi = glm::max(hi, glm::dvec3(g.s.positions[tri[v]]));
+      }
+      clo = glm::min(clo, g.centroid[f]);
+      chi = glm::max(chi, g.centroid[f]);
+      A += g.A[f];
+    }
+    Node& nd = t.nodes[j.node];
+    nd.c = 0.5 * (lo + hi);
+    nd.r = 0.5 * glm::length(hi - lo);
+    nd.A = A;
+    nd.lo = glm::vec3(lo);
+    nd.hi = glm::vec3(hi);
+    nd.first = j.first;
+    nd.count = j.count;
+    if (j.count == 1) {
+      t.leafOf[t.order[j.first]] = j.node;
+      continue;
+    }
+    // Median split of the centroids along the longest axis.
+    const glm::dvec3 ext = chi - clo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const uint32_t mid = j.first + j.count / 2;
+    std::nth_element(t.order.begin() + j.first, t.order.begin() + mid, t.order.begin() + j.first + j.count,
+                     [&](uint32_t a, uint32_t b) {
+                       return g.centroid[a][axis] < g.centroid[b][axis] ||
+                              (g.centroid[a][axis] == g.centroid[b][axis] && a < b);
+                     });
+    // Preorder: a subtree of c triangles holds the 2c - 1 nodes from its
+    // root on; the left subtree follows the parent, the right follows it.
+    const uint32_t nl = mid - j.first, nr = j.count - nl;
+    const uint32_t left = j.node + 1;
+    const uint32_t right = left + 2 * nl - 1;
+    Node& parent = t.nodes[j.node];
+    parent.left = left;
+    parent.right = right;
+    t.nodes[left].parent = t.nodes[right].parent = j.node;
+    stack.push_back({right, mid, nr, j.level + 1});
+    stack.push_back({left, j.first, nl, j.level + 1});
+  }
+  // Planar nodes, bottom-up: a whole wall's clusters exchange no light with
+  // each other, and are culled without descending to their triangles.
+  for (size_t k = t.nodes.size(); k-- > 0;) {
+    Node& nd = t.nodes[k];
+    if (nd.leaf()) {
+      const uint32_t f = t.order[nd.first];
+      nd.planar = true;
+      nd.x0 = g.centroid[f];
+      nd.n = nd.axis = g.n[f];
+      continue;
+    }
+    const Node &l = t.nodes[nd.left], &r = t.nodes[nd.right];
+    const glm::vec3 sum = float(l.A) * l.axis + float(r.A) * r.axis;
+    nd.axis = glm::length(sum) > 1e-12f ? glm::normalize(sum) : l.axis;
+    auto half = [&](const Node& c) {  // the child's cone seen from the new axis
+      return std::acos(std::clamp(glm::dot(nd.axis, c.axis), -1.f, 1.f)) + std::acos(std::clamp(c.coneCos, -1.f, 1.f));
+    };
+    nd.coneCos = std::cos(std::min(float(M_PI), std::max(half(l), half(r))));
+    nd.planar = l.planar && r.planar && glm::dot(l.n, r.n) > 1.f - 1e-6f &&
+                std::fabs(glm::dot(glm::dvec3(l.n), r.x0 - l.x0)) <= 1e-6 * (nd.r + glm::length(nd.c)) &&
+                std::fabs(glm::dot(glm::dvec3(r.n), l.x0 - r.x0)) <= 1e-6 * (nd.r + glm::length(nd.c));
+    nd.x0 = l.x0;
+    nd.n = l.n;
+  }
+  t.Acum.resize(t.order.size() + 1, 0.0);
+  for (size_t k = 0; k < t.order.size(); ++k) t.Acum[k + 1] = t.Acum[k] + g.A[t.order[k]];
+  return t;
+}
+
+// The centroid of sub-triangle k (0..15) of (a, b, c) split twice at its
+// edge midpoints; k's low base-4 digit picks the first split's quarter, so
+// any four consecutive k lie in four different quarters.
+glm::dvec3 subCentroid(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, int k) {
+  for (int level = 0; level < 2; ++level, k /= 4) {
+    const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+    switch (k % 4) {
+      case 0: b = ab; c = ca; break;
+      case 1: a = ab; c = bc; break;
+      case 2: a = ca; b = bc; break;
+      default: a = ab; b = bc; c = ca; break;
+    }
+  }
+  return (a + b + c) / 3.0;
+}
+
+// The node's 16 quadrature points, stratified by area: point k lies at the
+// area fraction (k + 1/2) / 16 of the node's triangles in tree order, at the
+// centroid of the sub-triangle holding that fraction of its triangle (a
+// triangle: its 16 sub-triangle centroids), with its triangle's normal.
+constexpr int kPoints = 16;
+void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[kPoints], glm::vec3 n[kPoints]) {
+  const double base = t.Acum[nd.first];
+  for (int k = 0; k < kPoints; ++k) {
+    const int stratum = (k % 4) * 4 + k / 4;  // consecutive k spread over the node
+    const double target = base + nd.A * (stratum + 0.5) / kPoints;
+    auto it = std::upper_bound(t.Acum.begin() + nd.first + 1, t.Acum.begin() + nd.first + nd.count + 1, target);
+    size_t pos = size_t(it - t.Acum.begin()) - 1;
+    pos = std::min<size_t>(pos, nd.first + nd.count - 1);
+    const uint32_t f = t.order[pos];
+    const double w = std::clamp((target - t.Acum[pos]) / g.A[f], 0.0, 0.999999);
+    const glm::uvec3 tri = g.s.triangles[f];
+    const int sub = int(w * kPoints);
+    x[k] = subCentroid(glm::dvec3(g.s.positions[tri.x]), glm::dvec3(g.s.positions[tri.y]),
+                       glm::dvec3(g.s.positions[tri.z]), (sub % 4) * 4 + sub / 4);
+    n[k] = g.n[f];
+  }
+}
+
+// True when no point of the box lies strictly in front of the plane (x0, n):
+// nothing in the box can exchange light with the front of that plane.
+bool boxBehind(const Node& box, const glm::dvec3& x0, const glm::vec3& n) {
+  double best = -1e300;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z);
+    best = std::max(best, glm::dot(glm::dvec3(n), corner - x0));
+  }
+  return best <= 1e-6 * (box.r + glm::length(box.c)) + 1e-30;  // float positions: relative rounding
+}
+
+constexpr float kReceiverConeCos = 0.985f;  // 10 degrees
+constexpr double kSeparation = 0.5;
+
+struct Refiner {
+  const Geometry& g;
+  const Tree& t;
+  const std::vector<double>& Rmax;  // per node: max luminance of R over its triangles
+  double threshold;                  // epsilon x emitted power
+  size_t maxLinks;
+  std::vector<Link>& out;
+  std::vector<uint8_t>& fresh;       // 1: F still to compute
+  uint64_t splits = 0;
+  bool budgetHit = false;
+
+  // Whether a link p <- q may stay as it is (BF criterion and separation).
+  // A receiving cluster spreads what it gathers evenly over its triangles,
+  // which is right only for triangles facing alike: receivers are
+  // triangles or clusters whose normals lie within kReceiverCone of their
+  // axis (a wall, a gently curved piece of a scan); sources may be any
+  // cluster, their triangles keep their own orientation in F.
+  static bool wideReceiver(const Node& n) { return !n.leaf() && n.coneCos < kReceiverConeCos; }
+  bool acceptable(uint32_t p, uint32_t q) const {
+    const Node &np = t.nodes[p], &nq = t.nodes[q];
+    if (np.leaf() && nq.leaf()) return true;
+    if (wideReceiver(np)) return false;
+    const double dist = glm::length(np.c - nq.c), d = dist - np.r - nq.r;
+    // Clusters far enough apart that the kernel varies little over them
+    // (the 16-point rule's error falls as ((r_p + r_q) / dist)^2).
+    if (!(d > 0) || np.r + nq.r > kSeparation * dist) return false;
+    const double Fmax = std::min(1.0, nq.A / (M_PI * d * d));
+    return np.A * Fmax * Rmax[q] <= threshold;
+  }
+
+  // A planar node (a triangle, or a flat piece of a wall) sees nothing of a
+  // node wholly behind or in its plane, and vice versa.
+  bool culled(uint32_t p, uint32_t q) const {
+    const Node &np = t.nodes[p], &nq = t.nodes[q];
+    return (np.planar && boxBehind(nq, np.x0, np.n)) || (nq.planar && boxBehind(np, nq.x0, nq.n));
+  }
+
+  void add(uint32_t p, uint32_t q, float F, bool isFresh) {
+    out.push_back({p, q, F});
+    fresh.push_back(isFresh ? 1 : 0);
+  }
+
+  // Links covering every triangle pair of (p, q), split where needed.
+  void refine(uint32_t p, uint32_t q) {
+    if (p == q) {  // a node with itself: a flat triangle sees nothing of itself
+      const Node& n = t.nodes[p];
+      if (n.leaf()) return;
+      refine(n.left, n.left);
+      refine(n.left, n.right);
+      refine(n.right, n.left);
+      refine(n.right, n.right);
+      return;
+    }
+    if (culled(p, q)) return;
+    if (acceptable(p, q) || out.size() >= maxLinks) {
+      budgetHit |= !acceptable(p, q);
+      add(p, q, 0.f, true);
+      return;
+    }
+    ++splits;
+    const Node &np = t.nodes[p], &nq = t.nodes[q];
+    const bool splitP = !np.leaf() && (wideReceiver(np) || nq.leaf() || np.r >= nq.r);
+    if (splitP) {
+      refine(np.left, q);
+      refine(np.right, q);
+    } else {
+      refine(p, nq.left);
+      refine(p, nq.right);
+    }
+  }
+};
+
+// F_pq for one link: the exact unoccluded triangle-to-triangle factor for
+// two triangles (gi/form_factor_analytic.h); between a cluster and a
+// triangle, the exact point-to-triangle factor from the cluster's 16 points
+// (by reciprocity when the cluster is the source); between two clusters the
+// mean of the point kernel cos cos / (pi r^2) A_q over the 16 x 16 point pairs
+// (the cluster's elements keep their own orientation: Smits et al. 1994); times
+// the fraction of linkRays visibility rays between paired points that pass.
+float linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, uint32_t p, uint32_t q, int linkRays,
+                     bool unoccluded, float eps, uint64_t& rays) {
+  const Node &np = t.nodes[p], &nq = t.nodes[q];
+  glm::dvec3 xp[kPoints], xq[kPoints];
+  glm::vec3 npn[kPoints], nqn[kPoints];
+  nodePoints(g, t, np, xp, npn);
+  nodePoints(g, t, nq, xq, nqn);
+  auto corners = [&](const Node& nd, glm::dvec3 v[3]) {
+    const glm::uvec3 tri = g.s.triangles[t.order[nd.first]];
+    for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(g.s.positions[tri[k]]);
+  };
+  // From points x (normals n) of a cluster to a triangle: the exact
+  // point-to-triangle factor, 0 where the triangle turns its back on x.
+  auto toTriangle = [&](const glm::dvec3 x[kPoints], const glm::vec3 n[kPoints], const Node& tri) {
+    glm::dvec3 v[3];
+    corners(tri, v);
+    const glm::dvec3 tn(g.n[t.order[tri.first]]);
+    double sum = 0;
+    for (int k = 0; k < kPoints; ++k)
+      if (glm::dot(tn, x[k] - v[0]) > 0) sum += pointToTriangleFormFactor(x[k], glm::dvec3(n[k]), v[0], v[1], v[2]);
+    return sum / kPoints;
+  };
+  double F = 0;
+  if (np.leaf() && nq.leaf()) {
+    glm::dvec3 a[3], b[3];
+    corners(np, a);
+    corners(nq, b);
+    F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
+  } else if (nq.leaf()) {
+    F = toTriangle(xp, npn, nq);  // exact over the source triangle, 16 points of the receiving cluster
+  } else if (np.leaf()) {
+    F = nq.A / np.A * toTriangle(xq, nqn, np);  // reciprocity: A_p F_pq = A_q F_qp
+  } else {
+    for (int i = 0; i < kPoints; ++i)
+      for (int j = 0; j < kPoints; ++j) {
+        const glm::dvec3 d = xq[j] - xp[i];
+        const double r2 = glm::dot(d, d);
+        if (!(r2 > 0)) continue;
+        const double ci = glm::dot(glm::dvec3(npn[i]), d), cj = -glm::dot(glm::dvec3(nqn[j]), d);
+        if (ci <= 0 || cj <= 0) continue;
+        F += ci * cj / (M_PI * r2 * r2);
+      }
+    F *= nq.A / double(kPoints * kPoints);
+  }
+  F = std::min(F, 1.0);
+  if (!(F > 0)) return 0.f;
+  if (unoccluded) return float(F);
+  int pass = 0, cast = 0;
+  for (int k = 0; k < linkRays; ++k) {
+    // Point pairs walk both point sets in different orders.
+    const int i = k % kPoints, j = (5 * k + 3 + k / kPoints) % kPoints;
+    const glm::vec3 o = glm::vec3(xp[i]) + npn[i] * eps;
+    const glm::vec3 e = glm::vec3(xq[j]) + nqn[j] * eps;
+    const glm::vec3 d = e - o;
+    const float len = glm::length(d);
+    if (!(len > 0)) continue;
+    if (glm::dot(npn[i], d) <= 0 || glm::dot(nqn[j], d) >= 0) continue;  // this pair exchanges nothing
+    Ray r;
+    r.o = o;
+    r.d = d / len;
+    r.tfar = len * (1.f - 1e-4f) - eps;
+    ++cast;
+    pass += caster.occluded(r) ? 0 : 1;
+  }
+  rays += uint64_t(cast);
+  return cast ? float(F * double(pass) / double(cast)) : float(F);
+}
+
+}  // namespace
+
+HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, const std::vector<glm::vec3>& Hd,
+                                       const HierarchySettings& set, int bounces, double tolerance, int maxIterations,
+                                       const Progress& progress) {
+  Timer timer;
+  const size_t nf = s.faceCount();
+  if (Hd.size() != nf) throw std::logic_error("direct irradiance has the wrong size");
+  Geometry g{s, {}, unitFaceNormals(s), {}};
+  const auto ok = usableFaceMask(s);
+  g.A.resize(nf);
+  g.centroid.resize(nf);
+  double P = 0, rhoMax = 0;
+  std::vector<glm::vec3> S(nf, glm::vec3(0.f));
+  for (size_t f = 0; f < nf; ++f) {
+    const glm::uvec3 tri = s.triangles[f];
+    g.A[f] = ok[f] ? faceArea(s, f) : 0.0;
+    if (ok[f])
+      g.centroid[f] = (glm::dvec3(s.positions[tri.x]) + glm::dvec3(s.positions[tri.y]) + glm::dvec3(s.positions[tri.z])) / 3.0;
+    P += g.A[f] * luminance(s.faceEmission(f));
+    const glm::vec3 rho = s.faceRho(f);
+    if (g.A[f] > 0) rhoMax = std::max({rhoMax, double(rho.r), double(rho.g), double(rho.b)});
+    S[f] = g.A[f] > 0 ? rho * Hd[f] : glm::vec3(0.f);
+  }
+  HierarchicalSolution sol;
+  const Tree t = buildTree(g);
+  const size_t nn = t.nodes.size();
+  sol.R = S;
+  sol.H.assign(nf, glm::vec3(0.f));
+  if (nn == 0 || !(P > 0)) return sol;
+  const double baseBytes = double(nn) * kHierarchyBytesPerNode;
+  const size_t maxLinks = size_t(std::max(1.0, (set.memoryBytes - baseBytes) / kHierarchyBytesPerLink));
+  const bool unoccluded = pairwiseUnoccluded(s);
+  const float eps = float(sceneScale(s).rayEpsilon);
+
+  std::vector<Link> links;
+  std::vector<uint8_t> fresh;
+  std::vector<double> Rmax(nn, 0.0);
+  std::vector<glm::dvec3> Rbar(nn, glm::dvec3(0.0)), Hg(nn, glm::dvec3(0.0)), Hacc(nn, glm::dvec3(0.0));
+  uint64_t rays = 0, splits = 0;
+  double ffSeconds = 0;
+  bool budgetHit = false;
+
+  // Pull: area means of R and maxima of its luminance, bottom-up.
+  auto pull = [&](const std::vector<glm::vec3>& R) {
+    for (size_t k = nn; k-- > 0;) {
+      const Node& nd = t.nodes[k];
+      if (nd.leaf()) {
+        const uint32_t f = t.order[nd.first];
+        Rbar[k] = glm::dvec3(R[f]);
+        Rmax[k] = luminance(R[f]);
+      } else {
+        const Node &l = t.nodes[nd.left], &r = t.nodes[nd.right];
+        Rbar[k] = (l.A * Rbar[nd.left] + r.A * Rbar[nd.right]) / nd.A;
+        Rmax[k] = std::max(Rmax[nd.left], Rmax[nd.right]);
+      }
+    }
+  };
+  // The links refined against the current R: new ones get their F computed
+  // (in parallel; each link's rays are fixed by its nodes: deterministic).
+  auto refineLinks = [&](bool first, const std::vector<glm::vec3>& Rcur, const Progress& pr) {
+    std::vector<Link> next;
+    std::vector<uint8_t> nextFresh;
+    // Power relative to all the light leaving surfaces (emitted and reflected:
+    // in a bright room the reflected power is many times the emitted).
+    double leaving = P;
+    for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
+    Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, nextFresh};
+    if (first) {
+      ref.refine(0, 0);
+    } else {
+      for (size_t k = 0; k < links.size(); ++k) {
+        if (ref.acceptable(links[k].p, links[k].q) || next.size() >= maxLinks) ref.add(links[k].p, links[k].q, links[k].F, false);
+        else ref.refine(links[k].p, links[k].q);
+      }
+    }
+    const uint64_t newSplits = ref.splits;
+    splits += newSplits;
+    budgetHit |= ref.budgetHit;
+    Timer ft;
+    std::vector<uint64_t> blockRays(next.size(), 0);
+    parallelBlocks(next.size(), pr, "link form factors", [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k)
+        if (nextFresh[k]) next[k].F = linkFormFactor(g, t, caster, next[k].p, next[k].q, set.linkRays, unoccluded, eps, blockRays[k]);
+    });
+    for (uint64_t r : blockRays) rays += r;
+    ffSeconds += ft.seconds();
+    // Grouped by receiver (a stable order: deterministic sums).
+    std::vector<size_t> idx(next.size());
+    std::iota(idx.begin(), idx.end(), size_t(0));
+    std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return next[a].p < next[b].p; });
+    links.resize(next.size());
+    for (size_t k = 0; k < idx.size(); ++k) links[k] = next[idx[k]];
+    return newSplits;
+  };
+
+  // One Jacobi sweep: gather on the links, push down, R <- S + rho H.
+  std::vector<size_t> start;  // links of receiver node k: [start[k], start[k + 1])
+  auto index = [&] {
+    start.assign(nn + 1, 0);
+    for (const Link& l : links) ++start[l.p + 1];
+    for (size_t k = 0; k < nn; ++k) start[k + 1] += start[k];
+  };
+  auto sweep = [&](const std::vector<glm::vec3>& R, std::vector<glm::vec3>& H) {
+    pull(R);
+    parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        glm::dvec3 h(0.0);
+        for (size_t m = start[k]; m < start[k + 1]; ++m) h += double(links[m].F) * Rbar[links[m].q];
+        Hg[k] = h;
+      }
+    });
+    for (size_t k = 0; k < nn; ++k) {  // preorder: parents first
+      const Node& nd = t.nodes[k];
+      Hacc[k] = Hg[k] + (k ? Hacc[nd.parent] : glm::dvec3(0.0));
+      if (nd.leaf()) H[t.order[nd.first]] = glm::vec3(Hacc[k]);
+    }
+  };
+
+  const bool fixed = bounces >= 0;
+  const int maxSweeps = fixed ? bounces : (maxIterations > 0 ? maxIterations : autoIterations(rhoMax, tolerance));
+  std::vector<glm::vec3> Rn(nf), H(nf, glm::vec3(0.f));
+  auto solveSweeps = [&](int sweeps, const Progress& pr) {
+    index();
+    for (int it = 0; it < sweeps; ++it) {
+      sol.Rprev = sol.R;
+      sweep(sol.R, H);
+      double change = 0;
+      for (size_t f = 0; f < nf; ++f) {
+        Rn[f] = g.A[f] > 0 ? S[f] + s.faceRho(f) * H[f] : glm::vec3(0.f);
+        change += g.A[f] * std::fabs(luminance(Rn[f] - sol.R[f]));
+      }
+      sol.R.swap(Rn);
+      sol.residual = change / P;
+      sol.residualHistory.push_back(sol.residual);
+      ++sol.iterations;
+      pr.report(fixed ? double(it + 1) / std::max(1, sweeps)
+                      : std::min(1.0, std::log(sol.residual + 1e-300) / std::log(tolerance)), "solving");
+      if (!fixed && sol.residual < tolerance) break;
+    }
+  };
+
+  sol.Rprev.assign(nf, glm::vec3(0.f));  // bounces = 0: no sweep, nothing indirect to gather
+  pull(S);
+  // Progress: round r (at most 4) takes [r / 4, (r + 1) / 4): its links'
+  // form factors the first 70%, its sweeps the rest.
+  auto part = [&](int round, double a, double b) { return progress.sub((round + a) / 4.0, (round + b) / 4.0); };
+  refineLinks(true, S, fixed ? progress.sub(0.0, 0.7) : part(0, 0.0, 0.7));
+  int rounds = 1;
+  if (fixed) {
+    solveSweeps(maxSweeps, progress.sub(0.7, 1.0));
+  } else {
+    // Refine again with the solved R (a brighter source needs finer links)
+    // until no link is split; at most 4 rounds.
+    solveSweeps(maxSweeps, part(0, 0.7, 1.0));
+    for (; rounds < 4; ++rounds) {
+      pull(sol.R);
+      if (refineLinks(false, sol.R, part(rounds, 0.0, 0.7)) == 0) break;
+      solveSweeps(maxSweeps, part(rounds, 0.7, 1.0));
+    }
+    sol.Rprev = sol.R;
+  }
+  // What the vertices gather from, and the indirect irradiance it gives.
+  sweep(sol.Rprev, sol.H);
+  if (!fixed && sol.residual >= tolerance) {
+    char b[200];
+    std::snprintf(b, sizeof b, "not converged: hierarchical solve stopped at %d sweeps with the residual %.3g above the tolerance %.3g",
+                  maxSweeps, sol.residual, tolerance);
+    sol.stats.warn(b);
+  }
+  if (budgetHit)
+    sol.stats.warn("link refinement stopped at the memory budget (" + std::to_string(links.size()) +
+                   " links): some links carry more than epsilon of the power; raise memory_budget_mb");
+  // Energy account: emitted power = absorbed + escaped; absorbed from the
+  // total irradiance (direct + indirect) of every triangle.
+  double absorbed = 0, reflected = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    if (!(g.A[f] > 0)) continue;
+    absorbed += g.A[f] * luminance((glm::vec3(1.f) - s.faceRho(f)) * (Hd[f] + sol.H[f]));
+    reflected += g.A[f] * luminance(sol.R[f]);
+  }
+  size_t leafLinks = 0;
+  for (const Link& l : links) leafLinks += (t.nodes[l.p].leaf() && t.nodes[l.q].leaf()) ? 1 : 0;
+  const double unit2 = s.unit * s.unit;
+  sol.stats.add("emitted_power_W", P * unit2);
+  sol.stats.add("absorbed_power_W", absorbed * unit2);
+  sol.stats.add("reflected_power_W", reflected * unit2);
+  sol.stats.add("hierarchy_nodes", double(nn));
+  sol.stats.add("hierarchy_levels", double(t.depth));
+  sol.stats.add("links", double(links.size()));
+  sol.stats.add("links_patch_to_patch", double(leafLinks));
+  sol.stats.add("link_splits", double(splits));
+  sol.stats.add("refinement_rounds", double(rounds));
+  sol.stats.add("link_rays", double(rays));
+  sol.stats.add("link_form_factor_seconds", ffSeconds);
+  sol.stats.add("hierarchy_MB", (baseBytes + double(links.size()) * kHierarchyBytesPerLink) / 1048576.0);
+  sol.stats.add("hierarchy_seconds", timer.seconds());
+  return sol;
+}
+
+}  // namespace gi
