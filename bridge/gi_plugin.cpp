@@ -71,7 +71,7 @@ bool GiFilterPlugin::applyFilter(QAction* a, MeshDocument& md, const RichParamet
     FilterInput in = gatherInput(md, par, kind, b);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
     // Everything is computed: only now does the document change.
-    writeImages(r);
+    writeOutputFiles(r);
     writeResult(b, r);
     addRasters(md, r);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);

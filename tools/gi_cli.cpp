@@ -181,7 +181,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
   if (!a.output.empty()) writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
-  writeImages(r);
+  writeOutputFiles(r);
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -58,6 +59,13 @@ struct RadiosityOptions {
   RefineOptions refinement;       // its limits, thresholds and seed (RefineOptions::fromParams)
   VertexPart vertices;            // which vertices' final gather to compute (a split run; the patch
                                   // solution is computed whole); the others are left 0
+  // Course outputs (radiosity_course.cpp). The ambient term of progressive
+  // refinement (Cohen et al. 1988) for display: B_i + rho_i A, with A the
+  // unshot radiosity spread over all patches and reflected 1 / (1 - rho_avg)
+  // times; off, B is the physical value of the shots made so far.
+  bool ambientTerm = false;
+  std::vector<int> snapshotSteps;  // steps (sweeps; shots for progressive) after which B is kept per vertex
+  std::string residualCsv;         // where runFilter writes the residual per step (empty: not written)
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
@@ -70,6 +78,16 @@ struct RadiosityResult {
   int iterations = 0;
   double residual = 0.0;            // relative, at the end
   std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
+  glm::vec3 ambient{0.f};           // the ambient term added to B (RadiosityOptions::ambientTerm), else 0
+  // B per vertex (patch average, with the ambient term when it is on) after
+  // each requested step; a step the solve did not reach holds the final state.
+  struct Snapshot {
+    int step = 0;          // as requested
+    int reached = 0;       // the step the values are from
+    double residual = 0;   // after that step (step 0: before any; progressive: the unshot fraction)
+    std::vector<glm::vec3> Bvertex;
+  };
+  std::vector<Snapshot> snapshots;
   RunStats stats;
 };
 
@@ -97,6 +115,19 @@ int autoIterations(double r, double tolerance);
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress);
+// The same with the solver, bounces, tolerance, maximum iterations, ambient
+// term and snapshot steps of `opt`.
+RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
+                              const RadiosityOptions& opt, const Progress& progress);
+
+// The residual per step as CSV ("step,residual"; progressive refinement: the
+// unshot power, else the change of a sweep, both relative to the emitted
+// power), and its log line: the residual after steps 1, 2, 4, 8, ... and the last.
+std::string residualCsv(const RadiosityResult& r);
+std::string residualLogNote(const RadiosityResult& r);
+// Parses snapshot_steps ("0, 10, 100"): at most 64 steps >= 0; throws
+// std::invalid_argument with one sentence otherwise.
+std::vector<int> parseSnapshotSteps(const std::string& text);
 
 // Adaptive mesh refinement (refine.h): solve, mark the faces where the
 // reflected radiosity jumps across an edge or a shadow boundary crosses,
