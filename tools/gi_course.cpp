@@ -67,7 +67,9 @@ int formFactorTable(const TableArgs& a) {
         std::snprintf(cell, sizeof cell, "%.6f %+6.2f%%%s", m.F, 100 * m.relError, m.within() ? "" : " (!)");
       else
         std::snprintf(cell, sizeof cell, "%.6f %+6.2f%%", m.F, 100 * m.relError);
-      line += " " + std::string(cell) + std::string(cell[0] ? std::max(0, 22 - int(std::string(cell).size())) : 0, ' ');
+      char padded[80];
+      std::snprintf(padded, sizeof padded, " %-22s", cell);
+      line += padded;
     }
     j.push_back(row);
     if (!a.json) std::printf("%-44s %.6f %s\n", t.name.c_str(), t.closed, line.c_str());

@@ -176,6 +176,7 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
     res.attributes.push_back(vectorAttribute("Radiosity_step_" + std::to_string(sn.step), sn.Bvertex));
   if (!opt.snapshotSteps.empty() || !opt.residualCsv.empty()) res.stats.note(residualLogNote(r));
   if (!opt.residualCsv.empty()) res.files.push_back({opt.residualCsv, residualCsv(r)});
+  for (auto& [suffix, text] : r.exports) res.files.push_back({opt.exportSystem + suffix, std::move(text)});
 }
 
 void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) {

@@ -104,6 +104,7 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.ambientTerm = v.getBool("ambient_term");
   o.snapshotSteps = parseSnapshotSteps(v.getString("snapshot_steps"));
   o.residualCsv = v.getString("residual_csv");
+  o.exportSystem = v.getString("export_system");
   return o;
 }
 
@@ -465,6 +466,11 @@ RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors&
   for (const auto& r : rows) entries += r.j.size();
   RadiosityResult res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver,
                               opt, progress.sub(0.8, 1.0));
+  if (!opt.exportSystem.empty()) {
+    std::vector<double> area(u.A);
+    for (double& a : area) a *= u.unit2;
+    res.exports = linearSystemFiles(rows, area, u.E, u.rho, u.Hd, res.B);
+  }
   res.stats.add("form_factor_seconds", ffSeconds);
   res.stats.add("form_factor_entries", double(entries));
   res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
@@ -481,6 +487,8 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
   thread_local FormFactorRow scratch;
   RadiosityResult res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; },
                               false, solver, opt, progress.sub(0.1, 1.0));
+  if (!opt.exportSystem.empty())
+    res.stats.warn("export_system needs the form-factor matrix in memory (raise memory_budget_mb): nothing exported");
   res.stats.note("form factors on the fly: the matrix (estimated " + megabytes(mem.matrix) + " MB) and the rest (" +
                  megabytes(mem.rest) + " MB) exceed the memory budget");
   return res;

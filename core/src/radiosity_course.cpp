@@ -35,7 +35,66 @@ std::vector<ParamSpec> radiosityCourseSpecs() {
                "reflected power, per shot (progressive refinement) the unshot power, both relative to the "
                "emitted power. The log shows the residual after steps 1, 2, 4, 8, ... and the last.",
        .type = ParamType::String, .defText = ""},
+      {.name = "export_system", .label = "Export the linear system (path prefix)",
+       .help = "If not empty, a path prefix: the system solved is written as Matrix Market files (1-based) so that "
+               "B = E + rho F B can be solved elsewhere: PREFIX_F.mtx (form factors, sparse), PREFIX_E.mtx, "
+               "PREFIX_rho.mtx, PREFIX_Esys.mtx (E + rho (H_direct - F E): with it the system has the filter's "
+               "exact direct light), PREFIX_B.mtx (the filter's patch radiosity, to check against) and "
+               "PREFIX_area.mtx. Needs the form-factor matrix in memory (memory budget).",
+       .type = ParamType::String, .defText = ""},
   };
+}
+
+namespace {
+
+std::string denseMatrix(const std::vector<glm::vec3>& v, const char* what) {
+  std::string out = "%%MatrixMarket matrix array real general\n% " + std::string(what) + "\n";
+  out += std::to_string(v.size()) + " 3\n";
+  char line[32];
+  for (int c = 0; c < 3; ++c)  // column-major: all R, then G, then B
+    for (const glm::vec3& x : v) {
+      std::snprintf(line, sizeof line, "%.9g\n", double(x[c]));
+      out += line;
+    }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> linearSystemFiles(const std::vector<FormFactorRow>& rows,
+                                                                   const std::vector<double>& area,
+                                                                   const std::vector<glm::vec3>& E,
+                                                                   const std::vector<glm::vec3>& rho,
+                                                                   const std::vector<glm::vec3>& Hd,
+                                                                   const std::vector<glm::vec3>& B) {
+  const size_t n = rows.size();
+  size_t nnz = 0;
+  for (const FormFactorRow& r : rows) nnz += r.j.size();
+  std::string F = "%%MatrixMarket matrix coordinate real general\n"
+                  "% form factors F_ij: row i, column j (patches = the mesh's triangles, 1-based)\n";
+  F += std::to_string(n) + " " + std::to_string(n) + " " + std::to_string(nnz) + "\n";
+  char line[64];
+  std::vector<glm::vec3> Esys(n);
+  for (size_t i = 0; i < n; ++i) {
+    glm::dvec3 FE(0.0);
+    for (size_t k = 0; k < rows[i].j.size(); ++k) {
+      std::snprintf(line, sizeof line, "%zu %u %.9g\n", i + 1, rows[i].j[k] + 1, double(rows[i].F[k]));
+      F += line;
+      FE += double(rows[i].F[k]) * glm::dvec3(E[rows[i].j[k]]);
+    }
+    Esys[i] = glm::vec3(glm::dvec3(E[i]) + glm::dvec3(rho[i]) * (glm::dvec3(Hd[i]) - FE));
+  }
+  std::string A = "%%MatrixMarket matrix array real general\n% patch areas\n" + std::to_string(n) + " 1\n";
+  for (double a : area) {
+    std::snprintf(line, sizeof line, "%.9g\n", a);
+    A += line;
+  }
+  return {{"_F.mtx", F},
+          {"_E.mtx", denseMatrix(E, "emitted radiosity E (W/m^2), columns R, G, B")},
+          {"_rho.mtx", denseMatrix(rho, "reflectance rho, columns R, G, B")},
+          {"_Esys.mtx", denseMatrix(Esys, "E + rho (H_direct - F E): B = Esys + rho F B has the filter's B")},
+          {"_B.mtx", denseMatrix(B, "the filter's patch radiosity B (W/m^2), columns R, G, B")},
+          {"_area.mtx", A}};
 }
 
 std::vector<int> parseSnapshotSteps(const std::string& text) {

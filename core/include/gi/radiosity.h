@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -66,6 +67,7 @@ struct RadiosityOptions {
   bool ambientTerm = false;
   std::vector<int> snapshotSteps;  // steps (sweeps; shots for progressive) after which B is kept per vertex
   std::string residualCsv;         // where runFilter writes the residual per step (empty: not written)
+  std::string exportSystem;        // path prefix of the exported linear system (empty: none)
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
@@ -88,6 +90,9 @@ struct RadiosityResult {
     std::vector<glm::vec3> Bvertex;
   };
   std::vector<Snapshot> snapshots;
+  // The linear system as Matrix Market files (RadiosityOptions::exportSystem):
+  // (file name suffix, text), see linearSystemFiles.
+  std::vector<std::pair<std::string, std::string>> exports;
   RunStats stats;
 };
 
@@ -125,6 +130,20 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 // power), and its log line: the residual after steps 1, 2, 4, 8, ... and the last.
 std::string residualCsv(const RadiosityResult& r);
 std::string residualLogNote(const RadiosityResult& r);
+// The system the filter solved, for a solver of one's own (Matrix Market,
+// 1-based): _F.mtx the form factors F (coordinate, n x n, F_ij in row i),
+// _E.mtx the emitted radiosity E, _rho.mtx the reflectance, _Esys.mtx the
+// source with the direct light exact, E + rho (H_direct - F E), _B.mtx the
+// filter's patch radiosity (each dense, n x 3, RGB in W/m^2), _area.mtx the
+// patch areas (n x 1, the mesh's units squared). B = Esys + rho F B has the
+// filter's B as its solution; B = E + rho F B is the classical system, with
+// the direct light from F as well.
+std::vector<std::pair<std::string, std::string>> linearSystemFiles(const std::vector<FormFactorRow>& rows,
+                                                                   const std::vector<double>& area,
+                                                                   const std::vector<glm::vec3>& E,
+                                                                   const std::vector<glm::vec3>& rho,
+                                                                   const std::vector<glm::vec3>& Hd,
+                                                                   const std::vector<glm::vec3>& B);
 // Parses snapshot_steps ("0, 10, 100"): at most 64 steps >= 0; throws
 // std::invalid_argument with one sentence otherwise.
 std::vector<int> parseSnapshotSteps(const std::string& text);
