@@ -16,7 +16,7 @@ CLI::App* addFormFactorTable(CLI::App& app, TableArgs& a) {
       "point-to-polygon, hemicube) with their errors: parallel rectangles, perpendicular rectangles with a common "
       "edge, coaxial disks, for the dimensions given");
   auto dims = [&](const char* name, std::vector<double>& v, const char* help) {
-    t->add_option(name, v, help)->expected(3)->delimiter(',')->check(CLI::PositiveNumber);
+    t->add_option(name, v, help)->expected(3)->delimiter(',');  // checked by the engine (one sentence)
   };
   dims("--parallel", a.parallel, "A,B,C: directly opposed rectangles A x B at distance C (Howell C-11) [1,1,1]");
   dims("--perpendicular", a.perpendicular,
