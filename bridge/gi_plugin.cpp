@@ -67,7 +67,7 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
     FilterInput in = gatherInput(md, par, kind, b);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
     // Everything is computed: only now does the document change.
-    writeImages(r);
+    writeOutputFiles(r);
     writeResult(b, r);
     addRasters(md, r);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);

@@ -17,6 +17,11 @@ m="$root/test_meshes"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 -o "$ex/radiosity_cornell.mlx"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --bounces 1 --emitter_source 1 --vertex_output "Patch average" \
   -o "$ex/radiosity_cornell_one_bounce.mlx"
+# Progressive refinement as the course shows it: the ambient term on, the patch-average B after 0, 10, 100
+# and 1000 shots kept as the attributes Radiosity_step_0 ... Radiosity_step_1000.
+"$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 --solver "Progressive refinement" \
+  --ambient_term true --snapshot_steps "0, 10, 100, 1000" --vertex_output "Patch average" \
+  -o "$ex/radiosity_cornell_progressive.mlx"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source "Selected faces" -o "$ex/radiosity_selected_faces.mlx"
 "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 --refine true --refine_max_depth 2 \
   -o "$ex/radiosity_cornell_refined.mlx"

@@ -59,6 +59,9 @@ void writeResultFile(const std::string& path, const ResultKey& key, const Filter
   json attrs = json::object();
   for (const VertexAttribute& a : r.attributes) attrs[a.name] = {{"components", a.components}, {"values", a.values}};
   j["attributes"] = attrs;
+  json files = json::array();  // text outputs (radiosity's residual CSV, exported system): rewritten on reuse
+  for (const FilterFile& x : r.files) files.push_back({{"path", x.path}, {"text", x.text}});
+  j["files"] = files;
   json numbers = json::object();
   for (const auto& [k, v] : r.stats.numbers) numbers[k] = v;
   j["stats"] = numbers;
@@ -93,6 +96,9 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
     }
     if (r.vertexQuality.size() != nv || (!r.vertexColor.empty() && r.vertexColor.size() != nv))
       throw std::runtime_error("array sizes do not match the vertex count");
+    r.files.clear();
+    if (j.contains("files"))
+      for (const auto& x : j.at("files")) r.files.push_back({x.at("path"), x.at("text")});
     r.stats = RunStats();
     for (const auto& [k, v] : j.at("stats").items()) r.stats.add(k, v.get<double>());
     r.stats.notes = j.at("notes").get<std::vector<std::string>>();

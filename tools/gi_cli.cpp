@@ -21,6 +21,7 @@
 #include "gi/scene_setup.h"
 #include "gi_batch.h"
 #include "gi_cluster.h"
+#include "gi_course.h"
 #include "gi_output.h"
 #include "mesh_io.h"
 #include "result_file.h"
@@ -182,7 +183,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
   if (!a.output.empty()) writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
-  writeImages(r);
+  writeOutputFiles(r);
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {
@@ -337,6 +338,8 @@ int runCli(int argc, char** argv) {
                                                 "--help lists them)");
   batch::Args batchArgs;
   batch::addOptions(batch, batchArgs);
+  course::TableArgs tableArgs;
+  CLI::App* table = course::addFormFactorTable(app, tableArgs);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -351,6 +354,7 @@ int runCli(int argc, char** argv) {
       if (sub->parsed()) return runCommand(kind, a);
     if (list->parsed()) return listFilters(a.json);
     if (batch->parsed()) return batch::run(batchArgs, batch->remaining());
+    if (table->parsed()) return course::formFactorTable(tableArgs);
     if (script->parsed()) {
       const FilterDesc* d = findFilter(filterName);
       if (!d) throw std::invalid_argument("unknown filter '" + filterName + "' (" + cliFilterNames() + ")");

@@ -79,7 +79,11 @@ const std::vector<FilterDesc>& allFilters() {
        "radiosity jumps across an edge or differs from its corners' values, or where a shadow boundary crosses "
        "(the vertices see the lights differently), solve again, up to a depth or a patch budget. Red-green "
        "subdivision keeps the mesh free of T-junctions. The refined mesh replaces the layer's geometry; faces keep "
-       "their colour, quality and selection, so the filter can be applied again.",
+       "their colour, quality and selection, so the filter can be applied again.<br>"
+       "<b>For the course</b>: 'Ambient term' adds progressive refinement's estimate of the light not yet shot "
+       "(Cohen et al. 1988) for display; 'Snapshot steps' keeps B after chosen sweeps or shots as attributes "
+       "Radiosity_step_N; 'Residual per step' writes a CSV; 'Export the linear system' writes F, E, rho and B as "
+       "Matrix Market files.",
        WritesVertexQuality | WritesVertexColor | WritesFaceQuality | WritesFaceColor | WritesGeometry},
       {FilterKind::PhotonMapping, "GI: Photon Mapping", "photonmap", "filter_photonmap",
        "photon-mapped radiosity: caustics through mirrors and glass, indirect light",

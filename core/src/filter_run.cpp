@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <vector>
 #include <stdexcept>
 #include <string>
@@ -196,6 +197,12 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.stats = std::move(r.stats);
   res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
   if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
+  // Course outputs: snapshots as attributes, the residual per step in the log and a CSV.
+  for (const RadiosityResult::Snapshot& sn : r.snapshots)
+    res.attributes.push_back(vectorAttribute("Radiosity_step_" + std::to_string(sn.step), sn.Bvertex));
+  if (!opt.snapshotSteps.empty() || !opt.residualCsv.empty()) res.stats.note(residualLogNote(r));
+  if (!opt.residualCsv.empty()) res.files.push_back({opt.residualCsv, residualCsv(r)});
+  for (auto& [suffix, text] : r.exports) res.files.push_back({opt.exportSystem + suffix, std::move(text)});
 }
 
 void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) {
@@ -279,7 +286,13 @@ const VertexAttribute* FilterInput::attribute(const std::string& name) const {
   return nullptr;
 }
 
-void writeImages(const FilterResult& r) {
+void writeOutputFiles(const FilterResult& r) {
+  for (const FilterFile& f : r.files) {
+    std::ofstream out(f.path, std::ios::binary);
+    out << f.text;
+    out.close();
+    if (!out) throw std::runtime_error("cannot write " + f.path);
+  }
   for (const FilterImage& img : r.images) {
     if (img.path.empty()) continue;
     writePng(img.path, img.image, img.exposure);

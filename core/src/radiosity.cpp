@@ -16,6 +16,7 @@
 #include "gi/emitters.h"
 #include "gi/form_factor_analytic.h"
 #include "gi/sampling.h"
+#include "radiosity_course.h"
 #include "gi/scene_setup.h"
 
 namespace gi {
@@ -98,6 +99,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
   };
   s.insert(s.end(), more.begin(), more.end());
   for (const ParamSpec& p : RefineOptions::specs()) s.push_back(p);
+  for (const ParamSpec& p : radiosityCourseSpecs()) s.push_back(p);
   return s;
 }
 
@@ -116,6 +118,10 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.gatherRays = v.getInt("gather_rays");
   o.refine = v.getBool("refine");
   o.refinement = RefineOptions::fromParams(v);
+  o.ambientTerm = v.getBool("ambient_term");
+  o.snapshotSteps = parseSnapshotSteps(v.getString("snapshot_steps"));
+  o.residualCsv = v.getString("residual_csv");
+  o.exportSystem = v.getString("export_system");
   return o;
 }
 
@@ -235,6 +241,9 @@ struct Stopping {
   double tol = 1e-4;
   int maxIter = 0;
   double r = 0;
+  // Called after each step (sweep or shot) with the step count, R and, for
+  // progressive refinement, the unshot dB: the snapshots.
+  std::function<void(long, const std::vector<glm::vec3>&, const std::vector<glm::vec3>*)> observe;
 };
 
 // Books one sweep that changed the reflected power by `change`; true when
@@ -268,7 +277,9 @@ void jacobi(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& S, c
     double change = 0;
     for (size_t i = 0; i < u.n; ++i) change += u.A[i] * std::fabs(luminance(Rn[i] - R[i]));
     R.swap(Rn);
-    if (endSweep(u, stop, it, change, progress, res)) break;
+    const bool done = endSweep(u, stop, it, change, progress, res);
+    if (stop.observe) stop.observe(it + 1, R, nullptr);
+    if (done) break;
   }
   if (!stop.fixed) warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "sweeps", res.stats);
 }
@@ -285,25 +296,16 @@ void gaussSeidel(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
       change += u.A[i] * std::fabs(luminance(nb - R[i]));
       R[i] = nb;
     }
-    if (endSweep(u, stop, it, change, progress, res)) break;
+    const bool done = endSweep(u, stop, it, change, progress, res);
+    if (stop.observe) stop.observe(it + 1, R, nullptr);
+    if (done) break;
   }
   warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "sweeps", res.stats);
 }
 
 // Ambient term for display (Cohen et al. 1988): the unshot radiosity dB
 // spread evenly, amplified by the mean inter-reflection 1 / (1 - rho_avg).
-double ambientTerm(const Setup& u, const std::vector<glm::vec3>& dB) {
-  double Atot = 0, rhoA = 0;
-  glm::dvec3 unshotSum(0.0);
-  for (size_t i = 0; i < u.n; ++i) {
-    Atot += u.A[i];
-    rhoA += u.A[i] * luminance(u.rho[i]);
-    unshotSum += u.A[i] * glm::dvec3(dB[i]);
-  }
-  const double rhoAvg = Atot > 0 ? rhoA / Atot : 0;
-  const glm::dvec3 ambient = Atot > 0 ? unshotSum / Atot / (1.0 - rhoAvg) : glm::dvec3(0.0);
-  return luminance(glm::vec3(ambient));
-}
+glm::vec3 ambientTerm(const Setup& u, const std::vector<glm::vec3>& dB) { return ambientRadiosity(u.A, u.rho, dB); }
 
 // Progressive refinement: shoot the unshot radiosity dB of the patch with
 // the most unshot power A_i dB_i (Cohen et al. 1988). With rows in memory
@@ -329,6 +331,7 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
   for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * luminance(dB[i]); U += unshot[i]; }
   const long maxShots = long(stop.maxIter) * long(std::max<size_t>(u.n, 1));
   long shots = 0;
+  if (stop.observe) stop.observe(0, R, &dB);
   auto receive = [&](uint32_t j, const glm::vec3& d) {
     R[j] += d;
     dB[j] += d;
@@ -360,13 +363,15 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
       for (double x : unshot) U += x;
     }
     res.residualHistory.push_back(U / u.P);
+    if (stop.observe) stop.observe(shots, R, &dB);
     if ((shots & 255) == 0) progress.report(std::min(1.0, std::log(U / u.P + 1e-300) / std::log(stop.tol)), "shooting");
   }
   res.iterations = int(shots);
   res.residual = U / u.P;
   if (shots >= maxShots)
     warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "shots per patch", res.stats);
-  res.stats.add("ambient_term", ambientTerm(u, dB));
+  res.ambient = ambientTerm(u, dB);
+  res.stats.add("ambient_term", luminance(res.ambient));
 }
 
 // After any solver: the energy account, what vertices gather from (the
@@ -380,7 +385,7 @@ void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std:
   for (size_t i = 0; i < u.n; ++i)
     if (u.A[i] > 0) res.Hindirect[i] = gather(row(uint32_t(i)), res.Rgather);
   res.B = R;
-  for (size_t i = 0; i < u.n; ++i) res.B[i] += u.E[i];
+  for (size_t i = 0; i < u.n; ++i) res.B[i] += u.E[i] + u.rho[i] * res.ambient;
   res.Bvertex = faceToVertex(s, res.B);
   res.stats.add("iterations", res.iterations);
   res.stats.add("residual", res.residual);
@@ -391,7 +396,9 @@ void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std:
 // fixed); rows from `row`, held in memory when `transpose` (progressive
 // refinement may then read columns).
 RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
-                      int bounces, double tol, int maxIter, const Progress& progress) {
+                      const RadiosityOptions& opt, const Progress& progress) {
+  const int bounces = opt.bounces, maxIter = opt.maxIterations;
+  const double tol = opt.tolerance;
   RadiosityResult res;
   std::vector<glm::vec3> S(u.n);  // source: once-reflected direct light
   for (size_t i = 0; i < u.n; ++i) S[i] = u.rho[i] * u.Hd[i];
@@ -410,11 +417,23 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   }
   std::vector<glm::vec3> R = S;  // the reflected radiosity while solving
   std::vector<glm::vec3> prevR;  // fixed bounces: the iterate before the last sweep
+  SnapshotTaker snap(s, u.E, u.rho, u.A, opt, res);
+  if (!opt.snapshotSteps.empty()) {
+    stop.observe = [&](long step, const std::vector<glm::vec3>& Rk, const std::vector<glm::vec3>* dB) {
+      if (snap.wants(step)) snap.take(step, Rk, dB);
+    };
+    if (solver != RadiositySolver::Progressive) snap.take(0, R, nullptr);  // progressive: takes its own step 0
+  }
   switch (solver) {
     case RadiositySolver::Jacobi: jacobi(u, row, S, stop, progress, R, stop.fixed ? &prevR : nullptr, res); break;
     case RadiositySolver::GaussSeidel: gaussSeidel(u, row, S, stop, progress, R, res); break;
     default: progressiveRefinement(u, row, transpose, S, stop, progress, R, res); break;
   }
+  if (opt.ambientTerm && solver != RadiositySolver::Progressive)
+    res.stats.warn(std::string("ambient_term applies to progressive refinement only: ignored with the solver ") +
+                   kRadiositySolvers.logName(solver) + (stop.fixed ? " (a bounce count is set)" : ""));
+  if (!opt.ambientTerm || solver != RadiositySolver::Progressive) res.ambient = glm::vec3(0.f);
+  snap.finish(R, res.ambient);
   finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, res);
   if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");
   return res;
@@ -463,7 +482,12 @@ RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors&
   size_t entries = 0;
   for (const auto& r : rows) entries += r.j.size();
   RadiosityResult res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver,
-                              opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.8, 1.0));
+                              opt, progress.sub(0.8, 1.0));
+  if (!opt.exportSystem.empty()) {
+    std::vector<double> area(u.A);
+    for (double& a : area) a *= u.unit2;
+    res.exports = linearSystemFiles(rows, area, u.E, u.rho, u.Hd, res.B);
+  }
   res.stats.add("form_factor_seconds", ffSeconds);
   res.stats.add("form_factor_entries", double(entries));
   res.stats.add("form_factor_MB", double(entries) * 8.0 / 1048576.0);
@@ -479,7 +503,9 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
   if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
   thread_local FormFactorRow scratch;
   RadiosityResult res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; },
-                              false, solver, opt.bounces, opt.tolerance, opt.maxIterations, progress.sub(0.1, 1.0));
+                              false, solver, opt, progress.sub(0.1, 1.0));
+  if (!opt.exportSystem.empty())
+    res.stats.warn("export_system needs the form-factor matrix in memory (raise memory_budget_mb): nothing exported");
   res.stats.note("form factors on the fly: the matrix (estimated " + megabytes(mem.matrix) + " MB) and the rest (" +
                  megabytes(mem.rest) + " MB) exceed the memory budget");
   return res;
@@ -528,7 +554,7 @@ void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOption
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
   const std::vector<glm::vec3> Hi = gather ? gatherIndirect(s, caster, mat, opt, res) : faceToVertex(s, res.Hindirect);
   for (size_t v = 0; v < s.vertexCount(); ++v)
-    res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v]) : glm::vec3(0.f);
+    res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient) : glm::vec3(0.f);
   res.stats.add("vertex_output_seconds", vt.seconds());
   res.stats.note(gather ? "vertices: direct light and a final gather of the patch solution at each vertex"
                         : "vertices: direct light at each vertex, indirect interpolated from the patches");
@@ -614,12 +640,21 @@ int autoIterations(double r, double tolerance) {
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress) {
+  RadiosityOptions opt;
+  opt.solver = solver;
+  opt.bounces = bounces;
+  opt.tolerance = tolerance;
+  opt.maxIterations = maxIterations;
+  return solveWithRows(s, rows, Hd, opt, progress);
+}
+
+RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
+                              const RadiosityOptions& opt, const Progress& progress) {
   const Setup u = setup(s, Hd);
-  if (solver == RadiositySolver::Auto) solver = RadiositySolver::GaussSeidel;
+  const RadiositySolver solver = opt.solver == RadiositySolver::Auto ? RadiositySolver::GaussSeidel : opt.solver;
   if (solver == RadiositySolver::Hierarchical)
     throw std::invalid_argument("the hierarchical solver builds its own links: use solveHierarchical");
-  return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, bounces,
-               tolerance, maxIterations, progress);
+  return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, opt, progress);
 }
 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {

@@ -380,6 +380,29 @@ def case_cli(c):
         lines = [l for l in p.stderr.splitlines() if l.strip()]
         check(p.returncode != 0 and len(lines) == 1 and words in lines[0],
               "bad input %s: exit %d, one line: %s" % (args[-1], p.returncode, lines[-1] if lines else ""))
+    # The course's form-factor table: closed form beside the three methods, JSON, every method within its tolerance.
+    p = subprocess.run([c.gi, "formfactors-table", "--rays", "16384", "--segments", "16", "--rings", "1",
+                        "--parallel", "1,2,0.5", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "gi formfactors-table runs: %s" % p.stderr[-300:])
+    table = json.loads(p.stdout)
+    check(len(table) == 3 and all(len(r["methods"]) == 3 and all(m["within"] for m in r["methods"]) for r in table),
+          "formfactors-table: three configurations, three methods each, all within tolerance")
+    p = subprocess.run([c.gi, "formfactors-table", "--disks", "1,0,1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lines = [l for l in p.stderr.splitlines() if l.strip()]
+    check(p.returncode == 1 and len(lines) == 1 and "positive" in lines[0], "formfactors-table bad dimension: one line")
+    # Radiosity's course outputs from the CLI: snapshots as PLY properties, the residual CSV, the exported system.
+    csv, prefix = os.path.join(c.tmp, "residual.csv"), os.path.join(c.tmp, "system")
+    out = os.path.join(c.tmp, "course.ply")
+    p = subprocess.run([c.gi, "radiosity", os.path.join(c.meshes, "cornell_box.ply"), "-o", out, "-q", "--emitter_source", "1",
+                        "--rays_per_patch", "64", "--vertex_output", "Patch average", "--solver", "Progressive refinement",
+                        "--ambient_term", "true", "--snapshot_steps", "0,5", "--residual_csv", csv,
+                        "--export_system", prefix], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "radiosity with the course outputs runs: %s" % p.stderr[-300:])
+    header = open(out, "rb").read(4000).decode("latin-1")
+    check("Radiosity_step_0_x" in header and "Radiosity_step_5_z" in header, "snapshots as PLY vertex properties")
+    check(open(csv).readline().strip() == "step,residual", "residual CSV written")
+    check(all(os.path.exists(prefix + s) for s in ("_F.mtx", "_E.mtx", "_rho.mtx", "_Esys.mtx", "_B.mtx", "_area.mtx")),
+          "linear system exported as Matrix Market files")
 
 
 def scaled_box(path, k, n=3):

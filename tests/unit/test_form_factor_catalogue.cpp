@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "gi/form_factor_closed.h"
 #include "gi/form_factors.h"
 #include "gi/raycaster.h"
 #include "gi/scene.h"
@@ -19,63 +20,14 @@ using namespace gi;
 
 namespace {
 
-// Howell C-11: identical, parallel, directly opposed rectangles a x b at
-// distance c; X = a / c, Y = b / c.
-double parallelRectangles(double a, double b, double c) {
-  const double x = a / c, y = b / c;
-  return 2.0 / (M_PI * x * y) *
-         (std::log(std::sqrt((1 + x * x) * (1 + y * y) / (1 + x * x + y * y))) +
-          x * std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y)) +
-          y * std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) - x * std::atan(x) - y * std::atan(y));
-}
-
-// Howell C-14: two rectangles at 90 degrees with a common edge of length l;
-// F from A1 (the other side w) to A2 (the other side h), W = w / l, H = h / l:
-//   F = 1/(pi W) [W atan(1/W) + H atan(1/H) - sqrt(H^2 + W^2) atan(1/sqrt(H^2 + W^2))
-//       + 1/4 ln( (1+W^2)(1+H^2)/(1+W^2+H^2) [W^2 (1+W^2+H^2)/((1+W^2)(W^2+H^2))]^(W^2)
-//                 [H^2 (1+H^2+W^2)/((1+H^2)(H^2+W^2))]^(H^2) )].
-// Which side is which follows from the 1/W in front: F -> 0 as the source
-// grows away from the edge (W -> infinity) and reciprocity A1 F12 = A2 F21
-// holds with A1 = w l. The catalogue's "W 1, H 3, L 2" is w = 1, h = 3, l = 2:
-// F = 0.308140 (with w and h swapped it would be 0.102713).
-double perpendicularRectangles(double w, double h, double l) {
-  const double W = w / l, H = h / l, W2 = W * W, H2 = H * H, S = std::sqrt(H2 + W2);
-  const double a = W * std::atan(1 / W) + H * std::atan(1 / H) - S * std::atan(1 / S);
-  const double b = std::log((1 + W2) * (1 + H2) / (1 + W2 + H2)) +
-                   W2 * std::log(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2))) +
-                   H2 * std::log(H2 * (1 + H2 + W2) / ((1 + H2) * (H2 + W2)));
-  return (a + 0.25 * b) / (M_PI * W);
-}
-
-// A (faces 0, 1) at z = 0 facing +z, B (faces 2, 3) at z = c facing -z.
-Scene parallelScene(double a, double b, double c) {
-  const std::vector<glm::dvec3> p = {{0, 0, 0}, {a, 0, 0}, {a, b, 0}, {0, b, 0},
-                                     {0, 0, c}, {a, 0, c}, {a, b, c}, {0, b, c}};
-  return Scene::fromAbsolute(p, {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}});
-}
-
-// The common edge from (0,0,0) to (l,0,0); A (faces 0, 1) in z = 0 reaching
-// y = w, facing +z; B (faces 2, 3) in y = 0 reaching z = h, facing +y. The
-// two share no vertex (separate patches, as two files would be).
-Scene perpendicularScene(double w, double h, double l) {
-  const std::vector<glm::dvec3> p = {{0, 0, 0}, {l, 0, 0}, {l, w, 0}, {0, w, 0},
-                                     {0, 0, 0}, {l, 0, 0}, {l, 0, h}, {0, 0, h}};
-  return Scene::fromAbsolute(p, {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}});
-}
-
-struct Case {
-  std::string name;
-  Scene scene;
-  double F;
-};
+// The closed forms and the scenes are the engine's (gi/form_factor_closed.h),
+// shared with `gi formfactors-table`.
+using Case = ClosedFormScene;
 
 std::vector<Case> catalogue() {
-  return {{"parallel unit squares, distance 1", parallelScene(1, 1, 1), parallelRectangles(1, 1, 1)},
-          {"parallel 3 x 0.5 at 0.2", parallelScene(3, 0.5, 0.2), parallelRectangles(3, 0.5, 0.2)},
-          {"parallel 0.1 x 0.1 at 1", parallelScene(0.1, 0.1, 1), parallelRectangles(0.1, 0.1, 1)},
-          {"perpendicular w 1, h 3, l 2", perpendicularScene(1, 3, 2), perpendicularRectangles(1, 3, 2)},
-          {"perpendicular w 0.2, h 5, l 1", perpendicularScene(0.2, 5, 1), perpendicularRectangles(0.2, 5, 1)},
-          {"perpendicular w 4, h 0.5, l 0.3", perpendicularScene(4, 0.5, 0.3), perpendicularRectangles(4, 0.5, 0.3)}};
+  return {parallelRectanglesScene(1, 1, 1),         parallelRectanglesScene(3, 0.5, 0.2),
+          parallelRectanglesScene(0.1, 0.1, 1),     perpendicularRectanglesScene(1, 3, 2),
+          perpendicularRectanglesScene(0.2, 5, 1),  perpendicularRectanglesScene(4, 0.5, 0.3)};
 }
 
 // F(A -> B) through formFactorsOfFace, as the CLI computes one face's row.
@@ -97,16 +49,16 @@ double areaWeightedF(const Scene& s, const FormFactors::Settings& set) {
 
 // The closed forms themselves, against the catalogue's printed values.
 TEST(FormFactorCatalogue, ClosedForms) {
-  EXPECT_NEAR(parallelRectangles(1, 1, 1), 0.199825, 1e-6);
-  EXPECT_NEAR(parallelRectangles(3, 0.5, 0.2), 0.643409, 1e-6);
-  EXPECT_NEAR(parallelRectangles(0.1, 0.1, 1), 0.003162, 1e-6);
-  EXPECT_NEAR(perpendicularRectangles(1, 3, 2), 0.308140, 1e-6);
-  EXPECT_NEAR(perpendicularRectangles(0.2, 5, 1), 0.400286, 1e-6);
-  EXPECT_NEAR(perpendicularRectangles(4, 0.5, 0.3), 0.024245, 1e-6);
+  EXPECT_NEAR(parallelRectanglesF(1, 1, 1), 0.199825, 1e-6);
+  EXPECT_NEAR(parallelRectanglesF(3, 0.5, 0.2), 0.643409, 1e-6);
+  EXPECT_NEAR(parallelRectanglesF(0.1, 0.1, 1), 0.003162, 1e-6);
+  EXPECT_NEAR(perpendicularRectanglesF(1, 3, 2), 0.308140, 1e-6);
+  EXPECT_NEAR(perpendicularRectanglesF(0.2, 5, 1), 0.400286, 1e-6);
+  EXPECT_NEAR(perpendicularRectanglesF(4, 0.5, 0.3), 0.024245, 1e-6);
   // Reciprocity of C-14: A1 F12 = A2 F21 (w l F(w, h) = h l F(h, w)).
-  EXPECT_NEAR(1 * 2 * perpendicularRectangles(1, 3, 2), 3 * 2 * perpendicularRectangles(3, 1, 2), 1e-12);
+  EXPECT_NEAR(1 * 2 * perpendicularRectanglesF(1, 3, 2), 3 * 2 * perpendicularRectanglesF(3, 1, 2), 1e-12);
   // Unit squares at a common edge: 0.200044.
-  EXPECT_NEAR(perpendicularRectangles(1, 1, 1), 0.200044, 1e-6);
+  EXPECT_NEAR(perpendicularRectanglesF(1, 1, 1), 0.200044, 1e-6);
 }
 
 // Monte Carlo, 262,144 rays per triangle. Its independent-ray (binomial)
@@ -160,4 +112,32 @@ TEST(FormFactorCatalogue, Hemicube) {
     worstOne = std::max(worstOne, std::fabs(F1 / c.F - 1));
   }
   EXPECT_GT(worstOne, 0.5);  // the thin perpendicular case, one view: -89%
+}
+
+// The table of `gi formfactors-table` (compareWithClosedForm): parallel and
+// perpendicular rectangles and coaxial disks, each method within the
+// tolerance it states (gi/form_factor_closed.h; Monte Carlo at 65,536 rays
+// per triangle: four binomial standard errors). The disks are 32-gons of
+// one ring (a fan: coarse, so that 129 hemicube views per triangle stay
+// cheap): their meshing error 2 (1 - 0.9936) = 1.28% is added.
+TEST(FormFactorCatalogue, ClosedFormTableWithinStatedTolerances) {
+  ComparisonSettings set;
+  set.raysPerPatch = 65536;
+  for (const ClosedFormScene& c : {parallelRectanglesScene(1, 2, 0.5), perpendicularRectanglesScene(2, 1, 1.5),
+                                   coaxialDisksScene(1, 1, 1, 1, 32), coaxialDisksScene(0.5, 1, 0.8, 1, 32)}) {
+    const ClosedFormComparison t = compareWithClosedForm(c, set);
+    ASSERT_EQ(t.methods.size(), 3u);
+    for (const MethodEstimate& m : t.methods) {
+      std::printf("  %-40s closed %.6f  %-26s %.6f (%+.3f%%, tolerance %.2f%%)\n", t.name.c_str(), t.closed,
+                  kFormFactorMethods.logName(m.method), m.F, 100 * m.relError, 100 * m.tolerance);
+      EXPECT_TRUE(std::isfinite(m.tolerance));
+      EXPECT_TRUE(m.within()) << t.name << ", " << kFormFactorMethods.logName(m.method);
+    }
+  }
+  EXPECT_NEAR(coaxialDisksF(1, 1, 1), 0.381966, 1e-6);  // S = 3: (3 - sqrt 5) / 2
+  EXPECT_NEAR(coaxialDisksF(1, 0.5, 1), 0.117218, 1e-6);
+  // Reciprocity of C-41: A_i F_ij = A_j F_ji.
+  EXPECT_NEAR(1 * coaxialDisksF(1, 0.5, 0.7), 0.25 * coaxialDisksF(0.5, 1, 0.7), 1e-12);
+  EXPECT_THROW(parallelRectanglesScene(1, 0, 1), std::invalid_argument);
+  EXPECT_THROW(coaxialDisksScene(1, 1, std::nan("")), std::invalid_argument);
 }

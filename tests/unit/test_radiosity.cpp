@@ -10,6 +10,7 @@
 
 #include "gi/color.h"
 #include "gi/form_factor_analytic.h"
+#include "gi/form_factor_closed.h"
 #include "gi/radiosity.h"
 #include "gi/scenes.h"
 #include "test_helpers.h"
@@ -42,13 +43,7 @@ double plateToPlate(const Scene& s, const std::vector<FormFactorRow>& rows, size
 }
 
 // Closed form for coaxial parallel rectangles X x Y at distance L (docs/design.md, "Analytic references").
-double parallelPlates(double X, double Y, double L) {
-  const double x = X / L, y = Y / L;
-  return 2.0 / (M_PI * x * y) *
-         (std::log(std::sqrt((1 + x * x) * (1 + y * y) / (1 + x * x + y * y))) +
-          x * std::sqrt(1 + y * y) * std::atan(x / std::sqrt(1 + y * y)) +
-          y * std::sqrt(1 + x * x) * std::atan(y / std::sqrt(1 + x * x)) - x * std::atan(x) - y * std::atan(y));
-}
+double parallelPlates(double X, double Y, double L) { return parallelRectanglesF(X, Y, L); }
 
 std::vector<glm::vec3> direct(const Scene& s, int samples) {
   auto caster = makeEmbreeCaster(s);
@@ -364,38 +359,6 @@ TEST(FormFactors, FarPairsSkipped) {
   EXPECT_NEAR(F / Aa, Falone / Aa, 5e-3);
 }
 
-namespace {
-// Two coaxial disks of radius r at distance L facing each other, each a polar
-// grid of `rings` x `segments` patches (the first `faceCount / 2` faces are the
-// disk at z = 0, facing +z).
-Scene coaxialDisks(double r, double L, int rings, int segments) {
-  std::vector<glm::dvec3> pts;
-  std::vector<glm::uvec3> tris;
-  for (int side = 0; side < 2; ++side) {
-    const double z = side * L;
-    const uint32_t centre = uint32_t(pts.size());
-    pts.push_back({0, 0, z});
-    for (int k = 1; k <= rings; ++k)
-      for (int j = 0; j < segments; ++j) {
-        const double a = 2 * M_PI * j / segments, rr = r * k / rings;
-        pts.push_back({rr * std::cos(a), rr * std::sin(a), z});
-      }
-    auto id = [&](int k, int j) { return centre + 1 + uint32_t((k - 1) * segments + (j % segments)); };
-    auto tri = [&](uint32_t a, uint32_t b, uint32_t c) { side == 0 ? tris.push_back({a, b, c}) : tris.push_back({a, c, b}); };
-    for (int j = 0; j < segments; ++j) tri(centre, id(1, j), id(1, j + 1));
-    for (int k = 1; k < rings; ++k)
-      for (int j = 0; j < segments; ++j) {
-        tri(id(k, j), id(k + 1, j), id(k + 1, j + 1));
-        tri(id(k, j), id(k + 1, j + 1), id(k, j + 1));
-      }
-  }
-  Scene s = Scene::fromAbsolute(pts, tris);
-  s.rho.assign(s.faceCount(), glm::vec3(0.f));
-  s.emission.assign(s.faceCount(), glm::vec3(0.f));
-  return s;
-}
-}  // namespace
-
 // Coaxial disks (docs/design.md, "Analytic references"): r_i = r_j = L gives F = (S - sqrt(S^2 - 4)) / 2
 // with S = 1 + (1 + R^2) / R^2 = 3, F = 0.381966; for the 64-gon disks used
 // here the polygon's area is 0.9984 of the circle's (below 1e-3 in F). Each
@@ -405,11 +368,8 @@ Scene coaxialDisks(double r, double L, int rings, int segments) {
 // (128^2) within 0.005. Also r_j = 0.5: S = 1 + 1.25 / 1 = 2.25, F_ij =
 // (2.25 - sqrt(2.25^2 - 1)) / 2 = 0.1173.
 TEST(FormFactors, CoaxialDisksMatchClosedForm) {
-  auto closed = [](double ri, double rj, double L) {
-    const double Ri = ri / L, Rj = rj / L, S = 1 + (1 + Rj * Rj) / (Ri * Ri);
-    return (S - std::sqrt(S * S - 4 * (rj / ri) * (rj / ri))) / 2;
-  };
-  const Scene s = coaxialDisks(1.0, 1.0, 3, 64);
+  auto closed = coaxialDisksF;  // gi/form_factor_closed.h
+  const Scene s = coaxialDisksScene(1.0, 1.0, 1.0, 3, 64).scene;
   const size_t split = s.faceCount() / 2;
   for (auto [method, tol] : {std::pair{FormFactorMethod::MonteCarlo, 0.004}, std::pair{FormFactorMethod::Analytic, 0.003},
                              std::pair{FormFactorMethod::Hemicube, 0.005}}) {

@@ -67,6 +67,12 @@ struct FilterImage {
   std::string path;
 };
 
+// A text file a parameter asked for (radiosity's residual per step as CSV).
+struct FilterFile {
+  std::string path;
+  std::string text;
+};
+
 struct FilterResult {
   // Per vertex / face of the output scene (the input's, or `refined->scene`);
   // an empty array leaves that property of the mesh as it was.
@@ -78,6 +84,7 @@ struct FilterResult {
   std::vector<VertexAttribute> attributes;
   std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
   std::vector<FilterImage> images;
+  std::vector<FilterFile> files;
   // Per face, the linear RGB value the estimate leaves for the output step
   // to map to faceQuality and faceColor (radiosity's face output).
   std::vector<glm::vec3> faceRadiometry;
@@ -117,8 +124,8 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
 void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res);
 
 // Writes each image that has a path: the PNG there (sRGB at its exposure)
-// and the linear values beside it as PFM (same name, .pfm). Throws
-// std::runtime_error naming the file on failure.
-void writeImages(const FilterResult& r);
+// and the linear values beside it as PFM (same name, .pfm); and each text
+// file. Throws std::runtime_error naming the file on failure.
+void writeOutputFiles(const FilterResult& r);
 
 }  // namespace gi

@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -64,6 +66,14 @@ struct RadiosityOptions {
   RefineOptions refinement;       // its limits, thresholds and seed (RefineOptions::fromParams)
   VertexPart vertices;            // which vertices' final gather to compute (a split run; the patch
                                   // solution is computed whole); the others are left 0
+  // Course outputs (radiosity_course.cpp). The ambient term of progressive
+  // refinement (Cohen et al. 1988) for display: B_i + rho_i A, with A the
+  // unshot radiosity spread over all patches and reflected 1 / (1 - rho_avg)
+  // times; off, B is the physical value of the shots made so far.
+  bool ambientTerm = false;
+  std::vector<int> snapshotSteps;  // steps (sweeps; shots for progressive) after which B is kept per vertex
+  std::string residualCsv;         // where runFilter writes the residual per step (empty: not written)
+  std::string exportSystem;        // path prefix of the exported linear system (empty: none)
   static std::vector<ParamSpec> specs();
   static RadiosityOptions fromParams(const ParamValues& v);
 };
@@ -76,6 +86,19 @@ struct RadiosityResult {
   int iterations = 0;
   double residual = 0.0;            // relative, at the end
   std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
+  glm::vec3 ambient{0.f};           // the ambient term added to B (RadiosityOptions::ambientTerm), else 0
+  // B per vertex (patch average, with the ambient term when it is on) after
+  // each requested step; a step the solve did not reach holds the final state.
+  struct Snapshot {
+    int step = 0;          // as requested
+    int reached = 0;       // the step the values are from
+    double residual = 0;   // after that step (step 0: before any; progressive: the unshot fraction)
+    std::vector<glm::vec3> Bvertex;
+  };
+  std::vector<Snapshot> snapshots;
+  // The linear system as Matrix Market files (RadiosityOptions::exportSystem):
+  // (file name suffix, text), see linearSystemFiles.
+  std::vector<std::pair<std::string, std::string>> exports;
   RunStats stats;
 };
 
@@ -103,6 +126,33 @@ int autoIterations(double r, double tolerance);
 RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
                               RadiositySolver solver, int bounces, double tolerance, int maxIterations,
                               const Progress& progress);
+// The same with the solver, bounces, tolerance, maximum iterations, ambient
+// term and snapshot steps of `opt`.
+RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& rows, const std::vector<glm::vec3>& Hd,
+                              const RadiosityOptions& opt, const Progress& progress);
+
+// The residual per step as CSV ("step,residual"; progressive refinement: the
+// unshot power, else the change of a sweep, both relative to the emitted
+// power), and its log line: the residual after steps 1, 2, 4, 8, ... and the last.
+std::string residualCsv(const RadiosityResult& r);
+std::string residualLogNote(const RadiosityResult& r);
+// The system the filter solved, for a solver of one's own (Matrix Market,
+// 1-based): _F.mtx the form factors F (coordinate, n x n, F_ij in row i),
+// _E.mtx the emitted radiosity E, _rho.mtx the reflectance, _Esys.mtx the
+// source with the direct light exact, E + rho (H_direct - F E), _B.mtx the
+// filter's patch radiosity (each dense, n x 3, RGB in W/m^2), _area.mtx the
+// patch areas (n x 1, the mesh's units squared). B = Esys + rho F B has the
+// filter's B as its solution; B = E + rho F B is the classical system, with
+// the direct light from F as well.
+std::vector<std::pair<std::string, std::string>> linearSystemFiles(const std::vector<FormFactorRow>& rows,
+                                                                   const std::vector<double>& area,
+                                                                   const std::vector<glm::vec3>& E,
+                                                                   const std::vector<glm::vec3>& rho,
+                                                                   const std::vector<glm::vec3>& Hd,
+                                                                   const std::vector<glm::vec3>& B);
+// Parses snapshot_steps ("0, 10, 100"): at most 64 steps >= 0; throws
+// std::invalid_argument with one sentence otherwise.
+std::vector<int> parseSnapshotSteps(const std::string& text);
 
 // Adaptive mesh refinement (refine.h): solve, mark the faces where the
 // reflected radiosity jumps across an edge or a shadow boundary crosses,
