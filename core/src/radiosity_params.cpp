@@ -1,0 +1,113 @@
+// Parameter table of GI: Radiosity (MeshLab dialog, meshlabserver scripts and
+// CLI flags) and the options read from it once.
+#include "gi/form_factors.h"
+#include "gi/radiosity.h"
+#include "radiosity_course.h"
+
+namespace gi {
+
+std::vector<ParamSpec> RadiosityOptions::specs() {
+  std::vector<ParamSpec> s = formFactorSpecs();
+  const std::vector<ParamSpec> more = {
+      {.name = "light_samples", .label = "Shadow rays per patch",
+       .help = "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to "
+               "256 emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter "
+               "face, times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the "
+               "emitters sampled in proportion to power with a shadow ray each.",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      {.name = "solver", .label = "Solver",
+       .help = "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses "
+               "new values as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): "
+               "repeatedly shoots the unshot power of the brightest patch; useful images early. Auto: Gauss-Seidel, "
+               "or progressive refinement when the form factors do not fit the memory budget; hierarchical from 50,000 "
+               "patches on. Hierarchical with clustering (Hanrahan, Salzman and Aupperle 1991; Smits, Arvo and "
+               "Greenberg 1994): light travels on links between clusters of triangles where little power flows and "
+               "between triangles where much does, so time and memory grow about as n log n instead of n^2; the "
+               "form-factor method then applies to nothing (links have their own factors).",
+       .type = ParamType::Enum, .def = kRadiositySolvers.index(RadiositySolver::Auto),
+       .choices = kRadiositySolvers.choices()},
+      {.name = "bounces", .label = "Bounces",
+       .help = "-1: iterate until the tolerance is met (all bounces). 0: direct light only (B = E + rho H_direct); "
+               "k: light after k further diffuse inter-reflections (exactly k Jacobi sweeps, as in the course's "
+               "progressive images).",
+       .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
+      {.name = "tolerance", .label = "Tolerance",
+       .help = "Stop when the change of a sweep (Jacobi, Gauss-Seidel) or the unshot power (progressive), as power "
+               "relative to the emitted power, is below this.",
+       .type = ParamType::Float, .def = 1e-4, .min = 1e-12, .max = 1.0},
+      {.name = "max_iterations", .label = "Maximum iterations",
+       .help = "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
+               "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
+               "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
+               "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A "
+               "run stopped by this bound before the tolerance is met logs a warning with the possible error.",
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 1000000},
+      {.name = "memory_budget_mb", .label = "Memory budget (MB)",
+       .help = "Everything the solve holds counts: about 400 bytes per patch (scene, ray casting, solver), one "
+               "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch "
+               "of the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; "
+               "beyond that, progressive refinement computes each shooter's row on the fly (more rays, memory linear "
+               "in the patch count). A run that cannot fit even so is refused before it starts.",
+       .type = ParamType::Float, .def = 1024, .min = 1, .max = 1e7},
+      {.name = "hierarchy_epsilon", .label = "Hierarchical: link tolerance",
+       .help = "Hierarchical solver only. A link between two clusters (or patches) is split into links between "
+               "their children while the power it may carry, A_p F_max B_q (the BF criterion of Hanrahan et al. "
+               "1991), exceeds this fraction of the power leaving all surfaces (emitted and reflected), or while their "
+               "bounding spheres overlap. Smaller: "
+               "more links, closer to the flat solution (0: every patch pair, the flat solution at its cost).",
+       .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0},
+      {.name = "link_rays", .label = "Hierarchical: visibility rays per link",
+       .help = "Hierarchical solver only. Rays between paired points of a link's two nodes; the fraction that "
+               "passes scales the link's unoccluded form factor (cost: links x rays).",
+       .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
+      {.name = "vertex_output", .label = "Vertex values",
+       .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
+               "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
+               "gathered from the patch solution with rays from the vertex (no light leaking under objects that cut "
+               "through patches). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of "
+               "the incident patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity "
+               "(the classical look of the course's images).",
+       .type = ParamType::Enum, .def = kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather),
+       .choices = kRadiosityVertexOutputs.choices()},
+      {.name = "gather_rays", .label = "Final-gather rays per vertex",
+       .help = "Rays per vertex for the final gather of the indirect light (cosine-weighted).",
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      seedSpec("form-factor, shadow and final-gather rays"),
+      {.name = "refine", .label = "Adaptive mesh refinement",
+       .help = "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
+               "midpoints where its reflected radiosity jumps across an edge (staircase artefacts) or where a shadow "
+               "boundary crosses it (its vertices see the lights differently: shadow leaks); neighbours are bisected "
+               "or split too, so the mesh stays free of T-junctions (red-green refinement). The refined mesh "
+               "replaces the layer's geometry (faces keep colour, quality and selection). Off: the geometry is never "
+               "changed.",
+       .type = ParamType::Bool, .def = false},
+  };
+  s.insert(s.end(), more.begin(), more.end());
+  for (const ParamSpec& p : RefineOptions::specs()) s.push_back(p);
+  for (const ParamSpec& p : radiosityCourseSpecs()) s.push_back(p);
+  return s;
+}
+
+RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
+  RadiosityOptions o;
+  o.formFactors = formFactorSettings(v);
+  o.lightSamples = v.getInt("light_samples");
+  o.solver = kRadiositySolvers.get(v, "solver");
+  o.bounces = v.getInt("bounces");
+  o.tolerance = v.getFloat("tolerance");
+  o.maxIterations = v.getInt("max_iterations");
+  o.memoryBudgetMB = v.getFloat("memory_budget_mb");
+  o.hierarchyEpsilon = v.getFloat("hierarchy_epsilon");
+  o.linkRays = v.getInt("link_rays");
+  o.vertexOutput = kRadiosityVertexOutputs.get(v, "vertex_output");
+  o.gatherRays = v.getInt("gather_rays");
+  o.refine = v.getBool("refine");
+  o.refinement = RefineOptions::fromParams(v);
+  o.ambientTerm = v.getBool("ambient_term");
+  o.snapshotSteps = parseSnapshotSteps(v.getString("snapshot_steps"));
+  o.residualCsv = v.getString("residual_csv");
+  o.exportSystem = v.getString("export_system");
+  return o;
+}
+
+}  // namespace gi
