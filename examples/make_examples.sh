@@ -35,5 +35,9 @@ m="$root/test_meshes"
   --photons 1000000 --caustic_k 32 -o "$ex/photonmap_caustic.mlx"
 "$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
   --photons 250000 --progressive true --passes 16 -o "$ex/photonmap_caustic_progressive.mlx"
+# The light-path split (Heckbert 1990 notation): Radiosity_emitted (L E), Radiosity_direct (L D E),
+# Radiosity_caustic (L S+ D E) and Radiosity_indirect (the rest) as per-vertex attributes.
+"$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
+  --photons 1000000 --caustic_k 32 --light_path_split true -o "$ex/photonmap_caustic_paths.mlx"
 "$gi" script formfactors --face_index 0 --form_factor_method Hemicube -o "$ex/form_factors_face0.mlx"
 echo "examples written to $ex"

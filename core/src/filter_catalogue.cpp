@@ -103,6 +103,11 @@ const std::vector<FilterDesc>& allFilters() {
        "<sup>2</sup>)</i>), or a <b>final gather</b> that reads it where cosine rays from the vertex land. "
        "<b>Progressive</b> photon mapping (Hachisuka et al. 2008) shoots passes of photons and shrinks a per-vertex "
        "radius (alpha = 2/3) so the estimate converges.<br>"
+       "<b>Light paths</b> (Heckbert 1990 notation): with 'Split by light path' the radiosity is also written "
+       "as the attributes <i>Radiosity_emitted</i> (L E), <i>Radiosity_direct</i> (L D E: light sampling, or the "
+       "direct photons), <i>Radiosity_caustic</i> (L S+ D E: the caustic photons) and <i>Radiosity_indirect</i> "
+       "(diffuse interreflection: the global map or the final gather), which sum to Radiosity; progressive "
+       "photon mapping keeps its flux per vertex by the same kinds.<br>"
        "<b>Marking mirrors and glass</b>: load them as their own layers and name them (file name or Layer dialog "
        "rename) to match 'Mirror layers' / 'Glass layers' (default: any name containing 'mirror' / 'glass'); set "
        "'Scene extent' to all visible layers. Glass objects must be closed meshes with outward normals. Vertices "
@@ -122,7 +127,11 @@ const std::vector<FilterDesc>& allFilters() {
        "Output: vertex <b>quality</b> = luminance of the radiosity B (W/m<sup>2</sup>), vertex <b>colour</b> = "
        "sRGB(exposure &times; B), and the per-vertex attributes <i>StdError</i> (standard error of the quality, an "
        "honest Monte Carlo error bar) and <i>Paths</i>. With a target relative error, each vertex traces paths "
-       "until its error bar is small enough.",
+       "until its error bar is small enough. With 'Split by light path' each path's light is also sorted by the "
+       "bounces it took before the vertex (Heckbert 1990 notation): an emitter, the sky or the sun reached from "
+       "the vertex itself is <i>Radiosity_direct</i> (L D E), through mirror, glass and glossy bounces only "
+       "<i>Radiosity_caustic</i> (L S+ D E), after another diffuse bounce <i>Radiosity_indirect</i>; with "
+       "<i>Radiosity_emitted</i> (L E) they sum to Radiosity.",
        WritesVertexQuality | WritesVertexColor},
       {FilterKind::FormFactorsOfFace, "GI: Form Factors of Selected Face", "formfactors", "filter_radiosity",
        "form factors from one face to every other face (teaching, debugging)",

@@ -169,6 +169,15 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
   res.stats.note(out.summary);
 }
 
+// The light-path split (light_paths.h) as four RGB attributes, when asked for.
+void addLightPathAttributes(const LightPathSplit& split, FilterResult& res) {
+  if (split.empty()) return;
+  res.attributes.push_back(vectorAttribute("Radiosity_emitted", split.emitted));
+  res.attributes.push_back(vectorAttribute("Radiosity_direct", split.direct));
+  res.attributes.push_back(vectorAttribute("Radiosity_caustic", split.caustic));
+  res.attributes.push_back(vectorAttribute("Radiosity_indirect", split.indirect));
+}
+
 void runReference(FilterInput& in, FilterResult& res, const Progress& progress) {
   const auto caster = makeEmbreeCaster(in.scene);
   PathTraceOptions opt = PathTraceOptions::fromParams(in.values, in.scene.origin);
@@ -180,6 +189,7 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
   res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
+  addLightPathAttributes(r.split, res);
 }
 
 void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) {
@@ -214,6 +224,7 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   // Its direct part, for a two-pass view (which then need not estimate it again).
   if (r.Bdirect.size() == r.B.size()) res.attributes.push_back(vectorAttribute("RadiosityDirect", r.Bdirect));
   if (r.stdError.size() == r.B.size()) res.attributes.push_back(scalarAttribute("StdError", r.stdError));
+  addLightPathAttributes(r.split, res);
 }
 
 void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {

@@ -176,10 +176,25 @@ void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& sm
   st.ray = spawn(sp.x, sp.n, ev.d);
 }
 
-glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c) const {
+glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c,
+                            glm::vec3* parts) const {
   // A continuation ray that can only find lights is worth casting only if it can find one.
   const bool lightRays = !emitters_.empty() || hasSky_ || sunDisk_;
   glm::vec3 L(0.f);
+  // A light found along the ray (emission, sky, sun): its kind from the
+  // event that spawned the ray; a light sample at a glossy vertex: caustic
+  // before the second diffuse vertex (see the header).
+  auto found = [&](const glm::vec3& term) {
+    L += term;
+    if (parts)
+      parts[st.diffuseVertices > 1                     ? kPathIndirect
+            : st.kind == PathState::Kind::Diffuse ? kPathDirect
+                                                   : kPathCaustic] += term;
+  };
+  auto sampled = [&](const glm::vec3& term) {
+    L += term;
+    if (parts) parts[st.diffuseVertices > 1 ? kPathIndirect : kPathCaustic] += term;
+  };
   for (;;) {
     SurfacePoint sp;
     if (first) {
@@ -195,7 +210,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       sp = surfaceAt(st.ray, caster_.intersect(st.ray));
     }
     if (!sp.valid()) {
-      L += st.beta * escaped(st.ray.d, st.delta, st.pdfPrev, st.nLPrev);
+      found(st.beta * escaped(st.ray.d, st.delta, st.pdfPrev, st.nLPrev));
       break;
     }
     const Material m = s_.faceMaterial(sp.face);
@@ -212,12 +227,13 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       const Bsdf b = bsdfAt(sp, -st.ray.d);
       if (m == Material::Glossy) {
         if (st.lightOnly) break;
-        L += st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1);
+        sampled(st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1));
       } else {
-        if (emits(sp.face)) L += st.beta * emitted(sp.face, sp.t, cosO, st.delta, st.pdfPrev, st.nLPrev);
+        if (emits(sp.face)) found(st.beta * emitted(sp.face, sp.t, cosO, st.delta, st.pdfPrev, st.nLPrev));
         if (st.lightOnly) break;
         if (stored_ && stored_->alone()) {
-          L += st.beta * stored_->reflected(sp, b.rho, smp, c);
+          ++st.diffuseVertices;  // the stored light lies beyond this diffuse vertex
+          sampled(st.beta * stored_->reflected(sp, b.rho, smp, c));
           break;
         }
         ++st.diffuseVertices;
@@ -225,7 +241,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
         glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL);
         // A first pass's indirect part is a difference of noisy estimates: keep the sum >= 0.
         if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, b.rho, smp, c), glm::vec3(0.f));
-        L += st.beta * Ld;
+        sampled(st.beta * Ld);  // after ++diffuseVertices: indirect when x0 started the path
         wanted = rules_.interreflection &&
                  (rules_.maxDiffuseBounces < 0 || st.diffuseVertices <= rules_.maxDiffuseBounces);
         if (!b.reflects()) break;
@@ -259,11 +275,13 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
   return L;
 }
 
-glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c) const {
+glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c,
+                                       glm::vec3* parts) const {
   Bsdf b(n);
   b.rho = glm::vec3(1.f);
   const int nL = rules_.firstLightSamples;
   glm::vec3 L = nextEvent(x, n, b, smp, c, nL, 0.f);
+  if (parts) parts[kPathDirect] += L;  // light sampled at x0 itself: L D
   const bool lightRays = !emitters_.empty() || hasSky_ || sunDisk_;
   const bool wanted = rules_.interreflection && rules_.maxDiffuseBounces != 0;
   const bool goOn = wanted && rules_.maxDepth > 0;
@@ -279,7 +297,7 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
   st.depth = goOn ? 1 : 0;
   st.lightOnly = !goOn;
   st.kind = PathState::Kind::Diffuse;
-  return L + trace(st, nullptr, smp, c);
+  return L + trace(st, nullptr, smp, c, parts);
 }
 
 }  // namespace gi::paths

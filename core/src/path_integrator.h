@@ -29,6 +29,7 @@
 
 #include "gi/emitters.h"
 #include "gi/glossy.h"
+#include "gi/light_paths.h"
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
 #include "gi/scene.h"
@@ -145,12 +146,24 @@ class Integrator {
 
   // Radiance arriving along st.ray; `first` (optional) is its first surface
   // point, already found (a batch of primary rays, or a vertex).
-  glm::vec3 trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c) const;
+  // parts (kPathKinds entries of gi/light_paths.h, or null; the renderer
+  // passes null and pays one branch per term): the same terms added by the
+  // light path's kind as seen from the path's start vertex x0 (a path
+  // started by traceFromSurface, st.diffuseVertices = 1). In Heckbert's
+  // notation (Heckbert 1990), glossy vertices count as S, as the photon
+  // tracer tags them: a light found by x0's own light sample or BSDF ray is
+  // direct (L D), one found through mirror, glass and glossy events only
+  // (including a glossy vertex's light sample) caustic (L S+ D), and every
+  // light found at or after another diffuse vertex indirect.
+  glm::vec3 trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c,
+                  glm::vec3* parts = nullptr) const;
   // Radiance a white Lambertian surface at x (unit normal n) reflects, i.e.
   // its incident irradiance / pi, by next-event estimation at x and a path
   // continued from there. x must already lie off the surface (a vertex's ray
   // origin): rays leave from x itself.
-  glm::vec3 traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c) const;
+  // parts: as for trace (x is the start vertex x0).
+  glm::vec3 traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c,
+                             glm::vec3* parts = nullptr) const;
 
   SurfacePoint surfaceAt(const Ray& r, const Hit& h) const;
   bool emits(uint32_t face) const;

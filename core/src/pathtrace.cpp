@@ -60,6 +60,7 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
        .type = ParamType::Float, .def = 0.27, .min = 0.0, .max = 45},
   };
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
+  out.push_back(lightPathSplitSpec());
   out.push_back(seedSpec("paths"));
   return out;
 }
@@ -77,6 +78,7 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
   o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
   o.point = pointLightFromParams(v, origin);
+  o.lightPathSplit = v.getBool("light_path_split");
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }
@@ -121,6 +123,7 @@ void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, do
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
   glm::dvec3 sumH{0.0};
+  glm::dvec3 sumPart[kPathKinds] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};  // light_path_split
 };
 
 }  // namespace
@@ -158,7 +161,10 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     for (int k = 0; k < count; ++k) {
       // Independent numbers keyed by (vertex, path, seed): honest error bars, any thread count.
       paths::Sampler smp(hash3(uint32_t(i), opt.seed, 0x9a7eu), uint32_t(a.n), false);
-      const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(origins[i], mat.n[i], smp, counts[i]);
+      glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
+      const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(origins[i], mat.n[i], smp, counts[i],
+                                                                opt.lightPathSplit ? parts : nullptr);
+      for (int p = 0; p < kPathKinds; ++p) a.sumPart[p] += glm::dvec3(float(M_PI) * parts[p]);
       const double l = luminance(mat.rho[i] * H);
       a.n += 1;
       a.sumL += l;
@@ -220,6 +226,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.stdError.assign(nv, 0.f);
   res.stdErrorH.assign(nv, 0.f);
   res.samples.assign(nv, 0);
+  if (opt.lightPathSplit) res.split.assign(nv);
   double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
   size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
@@ -228,6 +235,13 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     if (!mat.valid[i] || acc[i].n == 0) continue;
     res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
     res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
+    if (opt.lightPathSplit) {
+      // rho H_k per kind, from the same paths: they sum to B - E within float rounding.
+      res.split.emitted[i] = mat.E[i];
+      res.split.direct[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathDirect] / acc[i].n);
+      res.split.caustic[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathCaustic] / acc[i].n);
+      res.split.indirect[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathIndirect] / acc[i].n);
+    }
     res.stdError[i] = float(stdErr(acc[i]));
     Accum h;
     h.n = acc[i].n;

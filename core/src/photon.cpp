@@ -83,6 +83,7 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        .type = ParamType::Int, .def = 32, .min = 1, .max = 1000},
   };
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
+  out.push_back(lightPathSplitSpec());
   out.push_back(seedSpec("photon paths"));
   return out;
 }
@@ -102,6 +103,7 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
   o.progressive = v.getBool("progressive");
   o.passes = v.getInt("passes");
   o.point = pointLightFromParams(v, origin);
+  o.lightPathSplit = v.getBool("light_path_split");
   o.seed = uint32_t(v.getInt("seed"));
   return o;
 }
@@ -152,6 +154,7 @@ struct PhotonEstimate {
   std::vector<double> noise;  // Poisson standard error (luminance)
   size_t verticesWithoutPhotons = 0;
   PhotonGatherCheck check;
+  std::vector<glm::vec3> byPath[kPathKinds];  // H's terms by the photons' path kind (light_path_split, k nearest)
 };
 
 // Direct light by light sampling at every vertex (area emitters and the
@@ -176,7 +179,9 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
   st.add("trace_seconds", pr.traceSeconds);
   st.add("photon_memory_mb", pr.peakBytes / 1048576.0);
   if (r.opt.finalGather) st.note("final gather not used: progressive photon mapping estimates all photon light");
-  return {std::move(pr.H), std::move(pr.noise), pr.verticesWithoutPhotons, pr.check};
+  PhotonEstimate e{std::move(pr.H), std::move(pr.noise), pr.verticesWithoutPhotons, pr.check};
+  for (int k = 0; k < kPathKinds; ++k) e.byPath[k] = std::move(pr.byPath[k]);
+  return e;
 }
 
 // The kd-trees of a k-nearest run over the traced photons (which must
@@ -226,6 +231,9 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
   PhotonEstimate e;
   e.H.assign(nv, glm::vec3(0.f));
   e.noise.assign(nv, 0.0);
+  const bool split = opt.lightPathSplit;
+  if (split)
+    for (auto& h : e.byPath) h.assign(nv, glm::vec3(0.f));
   std::atomic<size_t> some{0}, few{0};
   auto count = [&](int used) {
     if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
@@ -247,12 +255,20 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
       if (!r.mat.valid[i]) continue;
       double e1 = 0, e2 = 0;
       int used = 0;
+      // The terms by path kind: a final gather's photons lie one diffuse
+      // bounce beyond the vertex (all indirect); a map's by their tag.
+      glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
+      glm::vec3* byPath = split ? parts : nullptr;
       glm::vec3 H = m.all ? gathered[i]
                           : m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max,
-                                                 PhotonKernel::Uniform, &e1, &used);
+                                                 PhotonKernel::Uniform, &e1, &used, byPath);
+      if (m.all) parts[kPathIndirect] = gathered[i];
       if (!m.all) count(used);
       if (m.caustics)
-        H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2);
+        H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2,
+                                    nullptr, byPath);
+      if (split)
+        for (int k = 0; k < kPathKinds; ++k) e.byPath[k][i] = parts[k];
       e.H[i] = H;
       e.noise[i] = std::sqrt(e1 * e1 + e2 * e2);
     }
@@ -347,6 +363,14 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
     out.H[i] = Hd[i] + e.H[i];
     out.B[i] = mat.E[i] + mat.rho[i] * out.H[i];
     if (directApart) out.Bdirect[i] = mat.E[i] + mat.rho[i] * Hd[i];
+    if (!out.split.empty()) {
+      // rho H_k per kind; they sum to B - E within float rounding.
+      auto part = [&](int k) { return e.byPath[k].empty() ? glm::vec3(0.f) : e.byPath[k][i]; };
+      out.split.emitted[i] = mat.E[i];
+      out.split.direct[i] = mat.rho[i] * (Hd[i] + part(kPathDirect));
+      out.split.caustic[i] = mat.rho[i] * part(kPathCaustic);
+      out.split.indirect[i] = mat.rho[i] * part(kPathIndirect);
+    }
     out.stdError[i] = float(luminance(mat.rho[i]) * e.noise[i]);
     lum += luminance(out.B[i]);
     err2 += double(out.stdError[i]) * out.stdError[i];
@@ -400,6 +424,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   } else {
     photons = kNearestEstimate(run, progress, ts, st);
   }
+  if (opt.lightPathSplit) out.split.assign(nv);
   const Totals totals = combine(mat, Hd, photons, opt.directLight, out);
   if (needPhotons) photonStats(run, ts, photons, st);
   st.add("direct_light_seconds", directSeconds);

@@ -38,8 +38,12 @@ class PhotonGrid {
   size_t memoryBytes() const {
     return photons_.capacity() * sizeof(Photon) + keys_.capacity() * sizeof(uint64_t) + starts_.capacity() * sizeof(uint32_t);
   }
-  // Flux and count of the photons within sqrt(r2) of x that arrived on n's side.
-  void gather(const glm::vec3& x, const glm::vec3& n, float r2, glm::dvec3& flux, size_t& count) const {
+  // Flux and count of the photons within sqrt(r2) of x that arrived on n's
+  // side; byPath (3 entries, or null) gets the flux by the photons' path kind.
+  void gather(const glm::vec3& x, const glm::vec3& n, float r2, glm::dvec3& flux, size_t& count,
+              glm::dvec3* byPath = nullptr) const {
+    if (byPath)
+      for (int k = 0; k < 3; ++k) byPath[k] = glm::dvec3(0.0);
     flux = glm::dvec3(0.0);
     count = 0;
     const float r = std::sqrt(r2);
@@ -56,6 +60,7 @@ class PhotonGrid {
             const glm::vec3 d = p.p - x;
             if (glm::dot(d, d) > r2 || glm::dot(p.normal(), n) < kSameSide) continue;
             flux += glm::dvec3(p.power);
+            if (byPath) byPath[p.path] += glm::dvec3(p.power);
             ++count;
           }
         }

@@ -52,6 +52,7 @@ struct ProgressiveResult {
   double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;
   double peakBytes = 0;
   PhotonGatherCheck check;  // surface, photons over all passes, vertices with few photons
+  std::vector<glm::vec3> byPath[3];  // H's terms by the photons' path kind (opt.lightPathSplit)
 };
 ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                        const VertexMaterial& mat, unsigned pathMask, bool projection,

@@ -43,9 +43,11 @@ class PhotonMap {
   // Irradiance at x (unit normal n) from the k nearest photons on the same
   // side within sqrt(r2max), over the area of the counted surface within
   // their radius (photon_surface.h; pi r^2 on a plane all around x). *noise
-  // gets the Poisson standard error, *photons the number of photons used.
+  // gets the Poisson standard error, *photons the number of photons used;
+  // byPath (3 entries, or null) gets the same estimate's terms added by the
+  // photons' path kind (they sum to the result within float rounding).
   glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max, PhotonKernel kernel,
-                       double* noise = nullptr, int* photons = nullptr) const {
+                       double* noise = nullptr, int* photons = nullptr, glm::vec3* byPath = nullptr) const {
     if (photons) *photons = 0;
     if (size() == 0 || k < 1) return glm::vec3(0.f);
     Query q;
@@ -62,10 +64,12 @@ class PhotonMap {
     r2 = std::max(r2, 1e-30f);
     const float r = std::sqrt(r2);
     glm::dvec3 sum(0.0);
+    glm::dvec3 sumPath[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
     double sumL2 = 0.0;
     for (int m = 0; m < q.used; ++m) {
       const float w = kernel == PhotonKernel::Cone ? std::max(0.f, 1.f - std::sqrt(q.d2[m]) / (kCone * r)) : 1.f;
       sum += double(w) * glm::dvec3(q.ph[m]->power);
+      if (byPath) sumPath[q.ph[m]->path] += double(w) * glm::dvec3(q.ph[m]->power);
       const double l = double(w) * luminance(q.ph[m]->power);
       sumL2 += l * l;
     }
@@ -73,6 +77,8 @@ class PhotonMap {
     // The gather point's own faces hold it; no area only for a point off every counted face.
     if (!(area > 0.0)) area = M_PI * double(r2) * (kernel == PhotonKernel::Cone ? 1.0 - 2.0 / (3.0 * kCone) : 1.0);
     if (noise) *noise = std::sqrt(sumL2) / area;
+    if (byPath)
+      for (int p = 0; p < 3; ++p) byPath[p] += glm::vec3(sumPath[p] / area);
     return glm::vec3(sum / area);
   }
 

@@ -28,7 +28,12 @@ struct PpmVertices {
   std::vector<glm::dvec3> tau;
   std::vector<double> A;
   std::vector<size_t> seen;
-  explicit PpmVertices(size_t nv) : R2(nv, 0.f), N(nv, 0.0), tau(nv, glm::dvec3(0.0)), A(nv, 0.0), seen(nv, 0) {}
+  std::vector<glm::dvec3> tauPath[3];  // tau by the photons' path kind (light_path_split), scaled alike
+  PpmVertices(size_t nv, bool split)
+      : R2(nv, 0.f), N(nv, 0.0), tau(nv, glm::dvec3(0.0)), A(nv, 0.0), seen(nv, 0) {
+    if (split)
+      for (auto& t : tauPath) t.assign(nv, glm::dvec3(0.0));
+  }
 };
 
 // The photons of one pass; with projection, its caustic photons are the
@@ -84,9 +89,10 @@ void updateVertices(const Scene& s, const VertexMaterial& mat, const PhotonGrid&
   parallelBlocks(s.vertexCount(), progress, what, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
-      glm::dvec3 flux;
+      glm::dvec3 flux, fluxPath[3];
       size_t M = 0;
-      grid.gather(s.positions[i], mat.n[i], v.R2[i], flux, M);
+      const bool split = !v.tauPath[0].empty();
+      grid.gather(s.positions[i], mat.n[i], v.R2[i], flux, M, split ? fluxPath : nullptr);
       if (M == 0) continue;
       v.seen[i] += M;
       const double ratio = (v.N[i] + alpha * double(M)) / (v.N[i] + double(M));
@@ -95,7 +101,10 @@ void updateVertices(const Scene& s, const VertexMaterial& mat, const PhotonGrid&
       // The flux scales with the area the radius keeps: ratio on a plane,
       // not near a crease or border the shrinking disk moves off.
       const double A1 = surface.area(s.positions[i], mat.n[i], std::sqrt(v.R2[i]));
-      v.tau[i] = (v.tau[i] + flux) * (v.A[i] > 0.0 && A1 > 0.0 ? A1 / v.A[i] : ratio);
+      const double scale = v.A[i] > 0.0 && A1 > 0.0 ? A1 / v.A[i] : ratio;
+      v.tau[i] = (v.tau[i] + flux) * scale;
+      if (split)
+        for (int k = 0; k < 3; ++k) v.tauPath[k][i] = (v.tauPath[k][i] + fluxPath[k]) * scale;
       v.A[i] = A1;
     }
   });
@@ -107,6 +116,9 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, Prog
   const size_t nv = v.R2.size();
   r.H.assign(nv, glm::vec3(0.f));
   r.noise.assign(nv, 0.0);
+  const bool split = !v.tauPath[0].empty();
+  if (split)
+    for (auto& h : r.byPath) h.assign(nv, glm::vec3(0.f));
   double sumR = 0, sumN = 0;
   size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
@@ -122,6 +134,8 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, Prog
     const double area = v.A[i] > 0.0 ? v.A[i] : M_PI * double(v.R2[i]);
     const glm::dvec3 H = v.tau[i] / (area * passes);
     r.H[i] = glm::vec3(H);
+    if (split)
+      for (int k = 0; k < 3; ++k) r.byPath[k][i] = glm::vec3(v.tauPath[k][i] / (area * passes));
     // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
     r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(v.N[i]);
   }
@@ -135,7 +149,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
                                        const VertexMaterial& mat, unsigned pathMask, bool projection,
                                        const Progress& progress, PhotonTraceStats& stats) {
   ProgressiveResult r;
-  PpmVertices v(s.vertexCount());
+  PpmVertices v(s.vertexCount(), opt.lightPathSplit);
   const GatherSurface surface(s);
   const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
   // Vertices where the first pass finds fewer than k photons within the cap

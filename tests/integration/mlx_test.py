@@ -403,6 +403,15 @@ def case_cli(c):
     check(open(csv).readline().strip() == "step,residual", "residual CSV written")
     check(all(os.path.exists(prefix + s) for s in ("_F.mtx", "_E.mtx", "_rho.mtx", "_Esys.mtx", "_B.mtx", "_area.mtx")),
           "linear system exported as Matrix Market files")
+    # The light-path split of the reference: four RGB attributes in the PLY.
+    out = os.path.join(c.tmp, "paths.ply")
+    p = subprocess.run([c.gi, "reference", os.path.join(c.meshes, "cornell_box.ply"), "-o", out, "-q", "--emitter_source", "1",
+                        "--samples_per_vertex", "8", "--light_path_split", "true"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0, "reference with the light-path split runs: %s" % p.stderr[-300:])
+    header = open(out, "rb").read(4000).decode("latin-1")
+    check(all("Radiosity_%s_z" % k in header for k in ("emitted", "direct", "caustic", "indirect")),
+          "light-path split as PLY vertex properties")
 
 
 def scaled_box(path, k, n=3):

@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/light_paths.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
@@ -28,6 +29,7 @@ struct VertexRadiometry {
   std::vector<glm::vec3> Bdirect;  // its direct part E + rho H_direct, where computed apart (else empty)
   std::vector<glm::vec3> H;        // incident irradiance per vertex
   std::vector<float> stdError;     // standard error of luminance(B)
+  LightPathSplit split;            // B per light-path kind, when asked for (photon mapping)
   RunStats stats;
 };
 

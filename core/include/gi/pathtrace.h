@@ -26,6 +26,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/emitters.h"
+#include "gi/light_paths.h"
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
@@ -48,6 +49,7 @@ struct PathTraceOptions {
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
   VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
+  bool lightPathSplit = false;     // also B per light-path kind (light_paths.h)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
@@ -58,6 +60,7 @@ struct PathTraceResult {
   std::vector<float> stdError;    // standard error of luminance(B)
   std::vector<float> stdErrorH;   // standard error of luminance(H)
   std::vector<int> samples;       // per vertex
+  LightPathSplit split;           // B per light-path kind, when asked for
   RunStats stats;
 };
 

@@ -54,12 +54,16 @@ struct PhotonOptions {
   int passes = 16;
   double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
   PointLight point;           // optional point or spot light (relative to the scene origin, world units)
+  bool lightPathSplit = false;  // also B per light-path kind (light_paths.h)
   uint32_t seed = 0;
   static std::vector<ParamSpec> specs();
   static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
 
 enum PhotonPath : uint8_t { kDirectPhoton = 0, kCausticPhoton = 1, kIndirectPhoton = 2 };
+// A photon's path kind is the light-path kind of the light it brings (light_paths.h).
+static_assert(int(kDirectPhoton) == kPathDirect && int(kCausticPhoton) == kPathCaustic &&
+              int(kIndirectPhoton) == kPathIndirect);
 
 struct Photon {
   glm::vec3 p;      // position (local scene coordinates)
