@@ -6,7 +6,9 @@
 #include <glm/glm.hpp>
 
 #include "gi/color.h"
+#include "gi/glossy.h"
 #include "gi/render.h"
+#include "gi/sampling.h"
 #include "gi/scene.h"
 
 namespace gi::test {
@@ -78,6 +80,50 @@ inline double meanLuminance(const Image& img) {
   double s = 0;
   for (const auto& p : img.px) s += luminance(p);
   return s / double(img.px.size());
+}
+
+// A closed box [lo, hi], 8 x 8 cells per face, faces inward: walls of
+// reflectance wallRho emitting E, the floor (y = lo.y) a black GGX lobe
+// (normal reflectance F0, roughness alpha). The scene of the glossy tests.
+inline Scene glossyFloorBox(glm::dvec3 lo, glm::dvec3 hi, glm::vec3 wallRho, glm::vec3 E, glm::vec3 F0, float alpha) {
+  SceneBuilder b;
+  b.box(lo, hi, wallRho, E, Material::Diffuse, true, 8);
+  Scene s = b.build();
+  const std::vector<glm::vec3> n = unitFaceNormals(s);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (n[f].y > 0.99f) {
+      s.material[f] = Material::Glossy;
+      s.rho[f] = F0;
+      s.emission[f] = glm::vec3(0.f);
+      s.roughness[f] = alpha;
+    }
+  return s;
+}
+
+// The lobe's directional albedo A(mu) at mu = (i + 0.5) / bins, each by
+// `samples` microfacet normals drawn from D(h) cos(theta_h) (Walter et al.
+// 2007, "Microfacet models for refraction through rough surfaces", eq.
+// 35-36) with Sobol dimensions dim0 + i: independent of the visible-normal
+// sampling the estimators use.
+inline std::vector<glm::dvec3> ggxAlbedoTable(float alpha, glm::vec3 F0, int bins, int samples, uint32_t dim0) {
+  const GgxLobe lobe(alpha, F0);
+  std::vector<glm::dvec3> A(size_t(bins), glm::dvec3(0.0));
+  for (int i = 0; i < bins; ++i) {
+    const double mu = (i + 0.5) / bins;
+    const glm::vec3 wo(float(std::sqrt(1.0 - mu * mu)), 0.f, float(mu));
+    for (int k = 0; k < samples; ++k) {
+      const glm::vec2 u = sobolOwen2D(uint32_t(k), dim0 + uint32_t(i));
+      const double t2 = double(alpha) * alpha * u.x / (1.0 - u.x), c = 1.0 / std::sqrt(1.0 + t2);
+      const double sn = std::sqrt(1.0 - c * c), phi = 2 * M_PI * u.y;
+      const glm::vec3 h(float(sn * std::cos(phi)), float(sn * std::sin(phi)), float(c));
+      const float woh = glm::dot(wo, h);
+      if (woh <= 0.f) continue;
+      const glm::vec3 wi = 2.f * woh * h - wo;
+      if (wi.z <= 0.f) continue;
+      A[size_t(i)] += glm::dvec3(lobe.eval(wo, wi)) * double(wi.z) * (4.0 * woh / (lobe.D(h) * h.z)) / double(samples);
+    }
+  }
+  return A;
 }
 
 }  // namespace gi::test

@@ -37,44 +37,13 @@ constexpr double kHalf = 2.0, kHeight = 1.0;  // the box: [-2, 2] x [0, 1] x [-2
 
 // The box, 8 x 8 cells per face, faces inward; the floor (y = 0) glossy.
 Scene glossyBox() {
-  SceneBuilder b;
-  b.box({-kHalf, 0, -kHalf}, {kHalf, kHeight, kHalf}, glm::vec3(0.f), glm::vec3(kE), Material::Diffuse, true, 8);
-  Scene s = b.build();
-  const std::vector<glm::vec3> n = unitFaceNormals(s);
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (n[f].y > 0.99f) {
-      s.material[f] = Material::Glossy;
-      s.rho[f] = kF0;
-      s.emission[f] = glm::vec3(0.f);
-      s.roughness[f] = kAlpha;
-    }
-  return s;
+  return gi::test::glossyFloorBox({-kHalf, 0, -kHalf}, {kHalf, kHeight, kHalf}, glm::vec3(0.f), glm::vec3(kE), kF0, kAlpha);
 }
 
 // A(mu) at mu = (i + 0.5) / kMu, by 2^16 microfacet normals from D cos each
 // (standard error about 1e-3).
 constexpr int kMu = 128;
-std::vector<glm::dvec3> albedoTable() {
-  const GgxLobe lobe(kAlpha, kF0);
-  std::vector<glm::dvec3> A(kMu, glm::dvec3(0.0));
-  const int M = 1 << 16;
-  for (int i = 0; i < kMu; ++i) {
-    const double mu = (i + 0.5) / kMu;
-    const glm::vec3 wo(float(std::sqrt(1.0 - mu * mu)), 0.f, float(mu));
-    for (int k = 0; k < M; ++k) {
-      const glm::vec2 u = sobolOwen2D(uint32_t(k), uint32_t(1000 + i));
-      const double t2 = double(kAlpha) * kAlpha * u.x / (1.0 - u.x), c = 1.0 / std::sqrt(1.0 + t2);
-      const double sn = std::sqrt(1.0 - c * c), phi = 2 * M_PI * u.y;
-      const glm::vec3 h(float(sn * std::cos(phi)), float(sn * std::sin(phi)), float(c));
-      const float woh = glm::dot(wo, h);
-      if (woh <= 0.f) continue;
-      const glm::vec3 wi = 2.f * woh * h - wo;
-      if (wi.z <= 0.f) continue;
-      A[size_t(i)] += glm::dvec3(lobe.eval(wo, wi)) * double(wi.z) * (4.0 * woh / (lobe.D(h) * h.z)) / double(M);
-    }
-  }
-  return A;
-}
+std::vector<glm::dvec3> albedoTable() { return gi::test::ggxAlbedoTable(kAlpha, kF0, kMu, 1 << 16, 1000); }
 
 glm::dvec3 albedoAt(const std::vector<glm::dvec3>& A, double mu) {
   const double t = std::clamp(mu * kMu - 0.5, 0.0, double(kMu - 1));

@@ -250,46 +250,14 @@ const glm::vec3 kGlossyF0(0.9f, 0.6f, 0.3f);
 constexpr float kWallRho = 0.05f;
 
 Scene glossyFloorBox() {
-  gi::test::SceneBuilder b;
-  b.box({-2, 0, -2}, {2, 1, 2}, glm::vec3(kWallRho), glm::vec3(1.f), Material::Diffuse, true, 8);
-  Scene s = b.build();
-  const std::vector<glm::vec3> n = unitFaceNormals(s);
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (n[f].y > 0.99f) {
-      s.material[f] = Material::Glossy;
-      s.rho[f] = kGlossyF0;
-      s.emission[f] = glm::vec3(0.f);
-      s.roughness[f] = kGlossyAlpha;
-    }
-  return s;
+  return gi::test::glossyFloorBox({-2, 0, -2}, {2, 1, 2}, glm::vec3(kWallRho), glm::vec3(1.f), kGlossyF0, kGlossyAlpha);
 }
 
 // The lobe's directional albedo A(mu) at mu = (i + 0.5) / 64, by 2^15
-// microfacet normals drawn from D(h) cos(theta_h) (Walter et al. 2007,
-// "Microfacet models for refraction through rough surfaces", eq. 35-36),
+// microfacet normals drawn from D(h) cos(theta_h) (render_test_helpers.h),
 // not the visible-normal sampling the estimators use (standard error ~1.5e-3).
 constexpr int kMuBins = 64;
-std::vector<glm::dvec3> glossyAlbedo() {
-  const GgxLobe lobe(kGlossyAlpha, kGlossyF0);
-  std::vector<glm::dvec3> A(kMuBins, glm::dvec3(0.0));
-  const int M = 1 << 15;
-  for (int i = 0; i < kMuBins; ++i) {
-    const double mu = (i + 0.5) / kMuBins;
-    const glm::vec3 wo(float(std::sqrt(1.0 - mu * mu)), 0.f, float(mu));
-    for (int k = 0; k < M; ++k) {
-      const glm::vec2 u = sobolOwen2D(uint32_t(k), uint32_t(2000 + i));
-      const double t2 = double(kGlossyAlpha) * kGlossyAlpha * u.x / (1.0 - u.x), c = 1.0 / std::sqrt(1.0 + t2);
-      const double sn = std::sqrt(1.0 - c * c), phi = 2 * M_PI * u.y;
-      const glm::vec3 h(float(sn * std::cos(phi)), float(sn * std::sin(phi)), float(c));
-      const float woh = glm::dot(wo, h);
-      if (woh <= 0.f) continue;
-      const glm::vec3 wi = 2.f * woh * h - wo;
-      if (wi.z <= 0.f) continue;
-      A[size_t(i)] += glm::dvec3(lobe.eval(wo, wi)) * double(wi.z) * (4.0 * woh / (lobe.D(h) * h.z)) / double(M);
-    }
-  }
-  return A;
-}
+std::vector<glm::dvec3> glossyAlbedo() { return gi::test::ggxAlbedoTable(kGlossyAlpha, kGlossyF0, kMuBins, 1 << 15, 2000); }
 
 }  // namespace
 
