@@ -438,6 +438,7 @@ def main():
             text, _ = run([os.path.join(a.build, "bench", "ao_throughput"), mesh, "64" if large else "256",
                            "1" if a.quick else "3"])
             throughput[scene] = json.loads(text)
+            throughput[scene]["mesh"] = os.path.relpath(mesh, ROOT)  # results name no machine's folders
         if scene in ("bunny", "floor_wall") and not a.quick and not a.no_cross_check:
             checks.append(b.cross_check(scene, mesh, ref, 1024))
     if a.peers_only or a.refs_only:
