@@ -15,6 +15,19 @@
 namespace gi {
 namespace {
 
+// Lanes 0..m-1 of an 8-wide packet from rays[0..m-1]; the others repeat ray 0
+// and are masked off in `valid`.
+void toPacket8(const Ray* rays, size_t m, RTCRay8& p, int* valid) {
+  for (size_t i = 0; i < 8; ++i) {
+    const Ray& r = rays[i < m ? i : 0];
+    valid[i] = i < m ? -1 : 0;
+    p.org_x[i] = r.o.x; p.org_y[i] = r.o.y; p.org_z[i] = r.o.z; p.tnear[i] = r.tnear;
+    p.dir_x[i] = r.d.x; p.dir_y[i] = r.d.y; p.dir_z[i] = r.d.z; p.time[i] = 0.f;
+    p.tfar[i] = r.tfar; p.mask[i] = 0xffffffffu; p.id[i] = 0; p.flags[i] = 0;
+  }
+}
+
+
 struct ErrorSink {
   std::mutex m;
   std::string first;
@@ -191,12 +204,8 @@ class EmbreeCaster final : public RayCaster {
     alignas(32) int valid[8];
     for (size_t b = 0; b < n; b += 8) {
       const size_t m = std::min<size_t>(8, n - b);
+      toPacket8(rays + b, m, p.ray, valid);
       for (size_t i = 0; i < 8; ++i) {
-        const Ray& r = rays[b + (i < m ? i : 0)];
-        valid[i] = i < m ? -1 : 0;
-        p.ray.org_x[i] = r.o.x; p.ray.org_y[i] = r.o.y; p.ray.org_z[i] = r.o.z; p.ray.tnear[i] = r.tnear;
-        p.ray.dir_x[i] = r.d.x; p.ray.dir_y[i] = r.d.y; p.ray.dir_z[i] = r.d.z; p.ray.time[i] = 0.f;
-        p.ray.tfar[i] = r.tfar; p.ray.mask[i] = 0xffffffffu; p.ray.id[i] = 0; p.ray.flags[i] = 0;
         p.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
         p.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
       }
@@ -228,13 +237,7 @@ class EmbreeCaster final : public RayCaster {
     alignas(32) int valid[8];
     for (size_t b = 0; b < n; b += 8) {
       const size_t m = std::min<size_t>(8, n - b);
-      for (size_t i = 0; i < 8; ++i) {
-        const Ray& r = rays[b + (i < m ? i : 0)];
-        valid[i] = i < m ? -1 : 0;
-        p.org_x[i] = r.o.x; p.org_y[i] = r.o.y; p.org_z[i] = r.o.z; p.tnear[i] = r.tnear;
-        p.dir_x[i] = r.d.x; p.dir_y[i] = r.d.y; p.dir_z[i] = r.d.z; p.time[i] = 0.f;
-        p.tfar[i] = r.tfar; p.mask[i] = 0xffffffffu; p.id[i] = 0; p.flags[i] = 0;
-      }
+      toPacket8(rays + b, m, p, valid);
       rtcOccluded8(valid, scene_.get(), &ctx, &p);
       for (size_t i = 0; i < m; ++i) occ[b + i] = p.tfar[i] < 0.f ? 1 : 0;
     }
