@@ -342,6 +342,38 @@ SceneFile closedBox(double size, int n, bool inward) {
   return b.finish();
 }
 
+SceneFile shadowLeak() {
+  Builder b;
+  const double X = 2.0, Y = 1.2, Z = 1.0;
+  // Room, inward: 5 patches along x (edges at 0.4, 0.8, 1.2 ...), 3 along y and z.
+  b.quad({0, 0, 0}, {X, 0, 0}, {X, Y, 0}, {0, Y, 0}, 5, 3, {0, 0, 1}, kGrey);   // floor
+  b.quad({0, 0, Z}, {X, 0, Z}, {X, Y, Z}, {0, Y, Z}, 5, 3, {0, 0, -1}, kGrey);  // ceiling
+  b.quad({0, 0, 0}, {X, 0, 0}, {X, 0, Z}, {0, 0, Z}, 5, 3, {0, 1, 0}, kGrey);   // side y = 0
+  b.quad({0, Y, 0}, {X, Y, 0}, {X, Y, Z}, {0, Y, Z}, 5, 3, {0, -1, 0}, kGrey);  // side y = Y
+  b.quad({0, 0, 0}, {0, Y, 0}, {0, Y, Z}, {0, 0, Z}, 3, 3, {1, 0, 0}, kGrey);   // end x = 0
+  b.quad({X, 0, 0}, {X, Y, 0}, {X, Y, Z}, {X, 0, Z}, 3, 3, {-1, 0, 0}, kGrey);  // end x = X
+  // The partition's two faces, 1 cm beyond the room on every side, so no ray slips past an edge.
+  const double e = 0.01;
+  for (double x : {1.09, 1.11})
+    b.quad({x, -e, -e}, {x, Y + e, -e}, {x, Y + e, Z + e}, {x, -e, Z + e}, 3, 3, {x < 1.1 ? -1.0 : 1.0, 0, 0}, kGrey);
+  b.quad({0.3, 0.4, Z - 0.02}, {0.7, 0.4, Z - 0.02}, {0.7, 0.8, Z - 0.02}, {0.3, 0.8, Z - 0.02}, 1, 1, {0, 0, -1},
+         glm::vec3(0.f), glm::vec3(1.f));
+  return b.finish();
+}
+
+SceneFile staircase() {
+  Builder b;
+  b.quad({-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, 8, 8, {0, 0, 1}, kGrey);
+  const double l = kStaircaseLight / 2;
+  b.quad({-l, -l, 2}, {l, -l, 2}, {l, l, 2}, {-l, l, 2}, 1, 1, {0, 0, -1}, glm::vec3(0.f), glm::vec3(1.f));
+  // Occluder: its edge through (0.2, 0, 1) along (sin 30, cos 30), reaching 0.8 towards +x.
+  const double c = std::cos(kPi / 6), sn = std::sin(kPi / 6);
+  const dvec3 o(0.2, 0, 1), along(sn, c, 0), across(c, -sn, 0);
+  b.quad(o - 1.6 * along, o + 1.6 * along, o + 1.6 * along + 0.8 * across, o - 1.6 * along + 0.8 * across, 1, 1,
+         {0, 0, -1}, glm::vec3(0.f));
+  return b.finish();
+}
+
 SceneFile openPlane(double size, int n) {
   Builder b;
   const double s = size / 2;
@@ -412,7 +444,7 @@ SceneFile cylindricalHole(double a, double h, int n) {
 std::vector<std::string> names() {
   return {"cornell_box", "cornell_box_fine", "parallel_plates", "perpendicular_plates", "furnace_sphere",
           "closed_box",  "open_plane",       "floor_wall",      "bowl",                 "cylinder_hole",
-          "caustic_cornell", "caustic_cornell_glossy"};
+          "caustic_cornell", "caustic_cornell_glossy", "shadow_leak", "staircase"};
 }
 
 std::vector<NamedLayer> layersByName(const std::string& name) {
@@ -435,6 +467,8 @@ SceneFile byName(const std::string& name) {
     return sf;
   }
   if (name == "closed_box") return closedBox(1.0, 8, true);
+  if (name == "shadow_leak") return shadowLeak();
+  if (name == "staircase") return staircase();
   if (name == "open_plane") return openPlane(1.0, 16);
   if (name == "floor_wall") return floorWithWall(4.0, 1.0, 20);
   if (name == "bowl") return hemisphericalBowl(1.0, 16);

@@ -163,6 +163,24 @@ const std::vector<FilterDesc>& allFilters() {
        "(sRGB at the exposure) and the linear radiance as PFM. Optionally each vertex's radiance towards the "
        "camera as vertex colour (what a mirror vertex shows from this viewpoint).",
        WritesVertexQuality | WritesVertexColor | WritesImage},
+      {FilterKind::HemicubeOfFace, "GI: Hemicube of Selected Face", "hemicube", "filter_radiosity",
+       "the hemicube of one face as pictures: cells by patch, delta form factors, Nusselt's disk",
+       "The <b>hemicube</b> (Cohen and Greenberg 1985) of the selected face, made visible: at the face's centre "
+       "the scene is rasterised with a depth buffer onto the five faces of a unit hemicube, and each cell adds "
+       "its <b>delta form factor</b> to the patch it shows, <i>F<sub>ij</sub> = &sum;<sub>cells showing j</sub> "
+       "&Delta;F</i>, with <i>&Delta;F = h<sup>2</sup> / (&pi; (x<sup>2</sup> + y<sup>2</sup> + 1)<sup>2</sup>)"
+       "</i> on the top face and <i>y h<sup>2</sup> / (&pi; (x<sup>2</sup> + y<sup>2</sup> + 1)<sup>2</sup>)</i> "
+       "on a side (cells of side h at (x, y)). Three pictures, as new <b>raster layers</b> (and PNGs at the image "
+       "path): the hemicube unfolded into a cross (the top face in the middle, the sides folded out, the face's "
+       "plane at the outer edges) with every cell in the colour of the patch it sees (black: nothing; grey: a "
+       "patch's back); the same cells by their delta form factor (a ramp, brightest at the top's centre); and "
+       "<b>Nusselt's analogue</b> (Nusselt 1928): each patch projected onto the unit hemisphere around the point "
+       "and down onto its base disk, seen from above, where the area it covers divided by &pi; is its form "
+       "factor (drawn with one ray per pixel, independently of the hemicube).<br>"
+       "The mesh's faces take the colours of the pictures (the selected face white) and the hemicube's "
+       "F<sub>ij</sub> as face <b>quality</b>, exactly the factors of 'GI: Form Factors of Selected Face' with "
+       "the hemicube method and one view. The log compares the two methods patch by patch.",
+       WritesFaceQuality | WritesFaceColor | WritesImage},
   };
   return f;
 }

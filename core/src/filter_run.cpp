@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <vector>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 #include "gi/ambient.h"
 #include "gi/direct.h"
 #include "gi/form_factors.h"
+#include "gi/hemicube_view.h"
 #include "gi/output.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
@@ -167,6 +169,64 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
   res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
   res.stats.add("seconds", rep.seconds);
   res.stats.note(out.summary);
+}
+
+// The hemicube of the chosen face as pictures; the faces take the pictures'
+// colours and the hemicube's F_ij (gi/hemicube_view.h).
+void runHemicube(FilterInput& in, FilterResult& res) {
+  const Scene& s = in.scene;
+  const ParamValues& v = in.values;
+  const uint32_t face = chosenFace(v.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(face) + " is degenerate");
+  const Timer timer;
+  const auto caster = makeEmbreeCaster(s);
+  HemicubeView hv = hemicubeView(s, *caster, face, v.getInt("hemicube_resolution"), v.getInt("nusselt_resolution"));
+  const HemicubeCells& c = hv.cells;
+  res.faceQuality.assign(s.faceCount(), 0.f);
+  res.faceColor.resize(s.faceCount());
+  double rowSum = 0, nusseltSum = 0, maxDiff = 0;
+  size_t seen = 0;
+  for (size_t j = 0; j < s.faceCount(); ++j) {
+    res.faceQuality[j] = float(c.F[j]);  // as the form-factor row stores it
+    res.faceColor[j] = j == face ? Rgb8{255, 255, 255} : patchColor(uint32_t(j));
+    rowSum += c.F[j];
+    nusseltSum += hv.nusseltF[j];
+    maxDiff = std::max(maxDiff, std::fabs(hv.nusseltF[j] - c.F[j]));
+    seen += c.F[j] > 0;
+  }
+  const std::string path = v.getString("image_path");
+  const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+  const std::string stem =
+      dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(0, dot) : path;
+  auto add = [&](const char* name, Image&& img, const std::string& p, double fovDeg) {
+    FilterImage fi;
+    fi.name = name;
+    fi.image = std::move(img);
+    fi.exposure = 1.f;  // the colours are the pictures' own
+    fi.camera = Camera::lookAt(glm::dvec3(c.eye), glm::dvec3(c.eye + c.n), glm::dvec3(c.b), fovDeg, fi.image.width,
+                               fi.image.height);
+    fi.path = path.empty() ? "" : p;
+    res.images.push_back(std::move(fi));
+  };
+  const double crossFov = 2.0 * std::atan(2.0) * 180.0 / M_PI;  // the cross spans +-2 in the top face's plane
+  add("Hemicube cells by patch", std::move(hv.byPatch), path, crossFov);
+  add("Hemicube delta form factors", std::move(hv.deltaF), stem + "_dff.png", crossFov);
+  add("Nusselt disk", std::move(hv.nusselt), stem + "_nusselt.png", 90.0);
+  res.stats.add("face", double(face));
+  res.stats.add("row_sum", rowSum);
+  res.stats.add("lost", c.lost);
+  res.stats.add("cells_dF_sum", c.total);
+  res.stats.add("nusselt_sum", nusseltSum);
+  res.stats.add("nusselt_lost", hv.nusseltLost);
+  res.stats.add("max_hemicube_nusselt_difference", maxDiff);
+  res.stats.add("seconds", timer.seconds());
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "GI: Hemicube of Selected Face: face %u, %d cells across, %zu patches seen; hemicube row sum %.6f "
+                "(cells' dF sum %.6f before normalising), Nusselt disk %d pixels across: covered area / pi %.6f, "
+                "largest |F_hemicube - F_Nusselt| %.4g",
+                face, c.resolution, seen, rowSum, c.total, hv.nusseltResolution, nusseltSum, maxDiff);
+  res.stats.note(b);
 }
 
 // The light-path split (light_paths.h) as four RGB attributes, when asked for.
@@ -382,6 +442,7 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
     case FilterKind::Radiosity: runRadiosity(in, res, progress); break;
     case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
     case FilterKind::RayTracedView: runRender(in, res, progress); break;
+    case FilterKind::HemicubeOfFace: runHemicube(in, res); break;
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include "gi/ambient.h"
 #include "gi/form_factors.h"
+#include "gi/hemicube_view.h"
 #include "gi/direct.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
@@ -61,6 +62,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
                    .type = ParamType::Int, .def = -1, .min = -1, .max = 2147483647});
       add(formFactorSpecs());
       s.push_back(seedSpec("form-factor rays"));
+      break;
+    case FilterKind::HemicubeOfFace:
+      s.push_back(geometrySceneSpecs().front());  // scene extent
+      add(hemicubeViewSpecs());
       break;
     case FilterKind::RayTracedView:
       add(lightingSceneSpecs());

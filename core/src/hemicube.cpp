@@ -11,6 +11,8 @@
 #include <cmath>
 #include <limits>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "gi/form_factors.h"
@@ -62,15 +64,15 @@ class HemicubeFace {
   }
   // Adds each cell's delta form factor to its patch; returns their sum
   // (1 - O(1/res^2)), by which the caller normalises so closed rooms close.
-  double accumulate(std::vector<double>& F, double& lost) const {
+  // With `keep`, the cells (patch, back side, dF) are copied there for display.
+  double accumulate(std::vector<double>& F, double& lost, HemicubeCells::Face* keep) const {
     double total = 0;
-    const float cell = 2.f / float(w_);
+    if (keep) *keep = HemicubeCells::Face{w_, h_, id_, back_, std::vector<double>(size_t(w_) * h_)};
     for (int j = 0; j < h_; ++j)
       for (int i = 0; i < w_; ++i) {
-        const double x = -1.0 + (i + 0.5) * cell, y = (top_ ? -1.0 : 0.0) + (j + 0.5) * cell;
-        const double r = x * x + y * y + 1.0;
-        const double dF = (top_ ? 1.0 : y) * cell * cell / (M_PI * r * r);
+        const double dF = hemicubeDeltaFormFactor(w_, top_, i, j);
         const size_t k = size_t(j) * size_t(w_) + size_t(i);
+        if (keep) keep->dF[k] = dF;
         total += dF;
         if (id_[k] == kNoHit || back_[k]) lost += dF;
         else F[id_[k]] += dF;
@@ -93,6 +95,13 @@ class HemicubeFace {
 
 }  // namespace
 
+double hemicubeDeltaFormFactor(int resolution, bool top, int i, int j) {
+  const float cell = 2.f / float(resolution);
+  const double x = -1.0 + (i + 0.5) * cell, y = (top ? -1.0 : 0.0) + (j + 0.5) * cell;
+  const double r = x * x + y * y + 1.0;
+  return (top ? 1.0 : y) * cell * cell / (M_PI * r * r);
+}
+
 double hemicubeBufferBytes(int resolution) {
   const double res = std::max(4, resolution & ~1);
   return res * res * double(sizeof(float) + sizeof(uint32_t) + sizeof(uint8_t));
@@ -113,13 +122,26 @@ std::optional<std::string> hemicubeCostWarning(size_t patches, int resolution) {
 // One hemicube at point c (lifted off patch i) with its side axes turned by
 // phi about the normal: the delta form factors of the cells, normalised,
 // per patch shown (dense, indexed by face) and the fraction lost.
-double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F) const {
+double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F,
+                               HemicubeCells* keep) const {
   const int res = std::max(4, set_.hemicubeResolution & ~1);
   const Frame f0(normal_[i]);
   const float cp = std::cos(phi), sp = std::sin(phi);
   const glm::vec3 tt = f0.t * cp + f0.b * sp, bb = f0.b * cp - f0.t * sp, nn = f0.n;
-  // Five views: forward axis, right axis, up axis (local frame of patch i).
-  const glm::vec3 views[5][3] = {{nn, tt, bb}, {tt, bb, nn}, {-tt, -bb, nn}, {bb, -tt, nn}, {-bb, tt, nn}};
+  // Five views: forward axis, right axis, up axis (kHemicubeViews, in the local frame of patch i).
+  glm::vec3 views[5][3];
+  for (int v = 0; v < 5; ++v)
+    for (int a = 0; a < 3; ++a) {
+      const glm::vec3& l = kHemicubeViews[v][a];
+      views[v][a] = tt * l.x + bb * l.y + nn * l.z;
+    }
+  if (keep) {
+    keep->resolution = res;
+    keep->eye = c;
+    keep->t = tt;
+    keep->b = bb;
+    keep->n = nn;
+  }
   const float nearD = eps_;
   double lost = 0, total = 0;
   F.assign(s_.faceCount(), 0.0);
@@ -149,10 +171,27 @@ double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::v
       for (int k = 0; k < m; ++k) q[k] = {poly[k].x / poly[k].z, poly[k].y / poly[k].z, 1.f / poly[k].z};
       for (int k = 1; k + 1 < m; ++k) face.drawTriangle(q[0], q[k], q[k + 1], j, back);
     }
-    total += face.accumulate(F, lost);
+    total += face.accumulate(F, lost, keep ? &keep->faces[size_t(v)] : nullptr);
   }
   for (double& x : F) x /= total;
+  if (keep) {
+    keep->total = total;
+    keep->F = F;
+    keep->lost = lost / total;
+  }
   return lost / total;
+}
+
+HemicubeCells FormFactors::hemicubeCells(uint32_t i) const {
+  if (i >= s_.faceCount() || !ok_[i]) throw std::invalid_argument("face " + std::to_string(i) + " is degenerate");
+  // The single central view of hemicubeRow (hemicube_points = 1): same
+  // point, same axes (no turn), so the per-patch sums are that row.
+  const auto& t = s_.triangles[i];
+  const glm::vec3 c = (s_.positions[t.x] + s_.positions[t.y] + s_.positions[t.z]) / 3.f + normal_[i] * eps_;
+  HemicubeCells cells;
+  std::vector<double> F;
+  hemicubeAt(i, c, 0.f, F, &cells);
+  return cells;
 }
 
 FormFactorRow FormFactors::hemicubeRow(uint32_t i) const {

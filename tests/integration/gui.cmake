@@ -60,12 +60,12 @@ else()
       ENVIRONMENT "GUI_APPLY_FILTER=GI: ${name};GUI_APPLY_DOWNS=${downs};GUI_SCREEN_HEIGHT=${screen};GUI_APPLY_LOG=GI: ${name}: ")
   endforeach()
 
-  # GI: Ray Traced View from Filters -> Raster Layer (its 4th entry), then
+  # GI: Ray Traced View from Filters -> Raster Layer (its 5th entry, after GI: Hemicube of Selected Face), then
   # View -> Show Current Raster Mode: the picture on screen must be the
   # rendered Cornell box (red wall left of the green one, seen through the
   # raster's camera). The control shows the plain mesh view instead (the box
   # seen from behind, no red or green) and must fail the colour check.
-  set(_rt "GUI_APPLY_FILTER=GI: Ray Traced View;GUI_APPLY_MENU_DOWNS=12;GUI_APPLY_DOWNS=3;GUI_SCREEN_HEIGHT=2400;GUI_APPLY_LOG=GI: Ray Traced View: ;GUI_SHOW_RASTER=1")
+  set(_rt "GUI_APPLY_FILTER=GI: Ray Traced View;GUI_APPLY_MENU_DOWNS=12;GUI_APPLY_DOWNS=4;GUI_SCREEN_HEIGHT=2400;GUI_APPLY_LOG=GI: Ray Traced View: ;GUI_SHOW_RASTER=1")
   add_test(NAME gui_apply_ray_traced_view
     COMMAND bash ${CMAKE_CURRENT_LIST_DIR}/gui_screenshot.sh
             ${GI_STAGE_DIR}/bin ${PROJECT_SOURCE_DIR}/test_meshes/cornell_box.ply ${CMAKE_BINARY_DIR}/gui_apply_ray_traced_view.png)

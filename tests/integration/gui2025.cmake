@@ -101,10 +101,10 @@ set_tests_properties(gui2025_written_mesh_control PROPERTIES LABELS gui2025
   FIXTURES_REQUIRED "gui2025_written_photonmap;gui2025_expect_photonmap_53.407"
   PASS_REGULAR_EXPRESSION "vertex values differ beyond the tolerance")
 
-# GI: Ray Traced View from Filters -> Raster Layer (its only entry here), then View ->
+# GI: Ray Traced View from Filters -> Raster Layer (its 2nd entry here, after GI: Hemicube of Selected Face), then View ->
 # Show Current Raster Mode: the picture must be the rendered Cornell box (red wall left
 # of the green one). The control shows the plain mesh view and must fail the check.
-set(_rt "GUI_MESHLAB=2025.07;GUI_APPLY_FILTER=GI: Ray Traced View;GUI_APPLY_MENU_DOWNS=12;GUI_APPLY_DOWNS=0;GUI_SCREEN_HEIGHT=2400;GUI_APPLY_LOG=GI: Ray Traced View: ;GUI_SHOW_RASTER=1")
+set(_rt "GUI_MESHLAB=2025.07;GUI_APPLY_FILTER=GI: Ray Traced View;GUI_APPLY_MENU_DOWNS=12;GUI_APPLY_DOWNS=1;GUI_SCREEN_HEIGHT=2400;GUI_APPLY_LOG=GI: Ray Traced View: ;GUI_SHOW_RASTER=1")
 add_test(NAME gui2025_apply_ray_traced_view
   COMMAND bash ${_gui} ${GI_STAGE_DIR}/bin ${_meshes}/cornell_box.ply ${_out}/apply_ray_traced_view.png)
 set_tests_properties(gui2025_apply_ray_traced_view PROPERTIES TIMEOUT 180 LABELS gui2025 SKIP_RETURN_CODE 77

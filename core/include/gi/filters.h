@@ -22,6 +22,7 @@ enum class FilterKind {
   PathTracedReference,
   FormFactorsOfFace,
   RayTracedView,
+  HemicubeOfFace,
 };
 
 // What a filter may change in the mesh (MeshLab's postCondition, the PLY the CLI writes).

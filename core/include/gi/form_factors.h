@@ -14,6 +14,7 @@
 //    the five faces of a hemicube with a depth buffer; each cell adds its
 //    exact delta form factor to the patch it shows.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -34,6 +35,39 @@ inline constexpr auto kFormFactorMethods = makeEnumTable<FormFactorMethod>({
     {FormFactorMethod::Hemicube, "Hemicube", "hemicube"},
     {FormFactorMethod::Auto, "Auto", "auto"},
 });
+
+// The five views of a hemicube as (forward, right, up) axes in the local
+// frame (t, b, n) of the patch: the top face looks along n, the four sides
+// along +-t and +-b with n up. A side face's projected y runs from 0 (the
+// patch's plane) to 1 (the top face's edge).
+inline const glm::vec3 kHemicubeViews[5][3] = {
+    {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},   {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{-1, 0, 0}, {0, -1, 0}, {0, 0, 1}},
+    {{0, 1, 0}, {-1, 0, 0}, {0, 0, 1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}}};
+
+// The delta form factor of cell (i, j) (column, row from the bottom) of a
+// hemicube with `resolution` cells across, at the cell's centre (x, y):
+//   top face:  dF = h^2 / (pi (x^2 + y^2 + 1)^2)
+//   side face: dF = y h^2 / (pi (x^2 + y^2 + 1)^2),   h = 2 / resolution.
+double hemicubeDeltaFormFactor(int resolution, bool top, int i, int j);
+
+// One hemicube view kept whole for study ("GI: Hemicube of Selected Face"):
+// per face (0 the top, res x res cells; 1-4 the sides, res x res/2, in the
+// order of kHemicubeViews) the patch each cell shows (kNoHit: nothing),
+// whether it shows that patch's back, and the cell's delta form factor.
+struct HemicubeCells {
+  struct Face {
+    int width = 0, height = 0;  // cells across, rows (row 0 at the patch's plane for a side)
+    std::vector<uint32_t> patch;
+    std::vector<uint8_t> back;
+    std::vector<double> dF;  // row-major, not normalised
+  };
+  int resolution = 0;
+  glm::vec3 eye{0.f}, t{0.f}, b{0.f}, n{0.f};  // the view point and the local frame (world)
+  std::array<Face, 5> faces;
+  double total = 0;       // sum of every cell's dF (1 up to the cells' quadrature)
+  std::vector<double> F;  // per face of the scene: the sum of its cells' dF / total
+  double lost = 0;        // the cells showing nothing or a back, / total
+};
 
 // Sparse form-factor row of patch i: F_ij for the patches j its rays reached.
 struct FormFactorRow {
@@ -62,6 +96,9 @@ class FormFactors {
   uint64_t raysCast() const;
   uint64_t farPairsSkipped() const;  // analytic: pairs with F provably below kNegligibleF
   static constexpr double kNegligibleF = 1e-7;
+  // The hemicube of patch i seen from its centre, as the hemicube method's
+  // one-view row computes it (the same F, bit for bit), with its cells.
+  HemicubeCells hemicubeCells(uint32_t i) const;
   FormFactorMethod method() const { return set_.method; }  // never Auto
   bool unoccluded() const { return unoccluded_; }            // visibility rays skipped
   // Upper bound of the bytes a full sparse matrix of these rows needs.
@@ -74,7 +111,7 @@ class FormFactors {
   FormFactorRow monteCarloRow(uint32_t i) const;
   FormFactorRow analyticRow(uint32_t i) const;
   FormFactorRow hemicubeRow(uint32_t i) const;
-  double hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F) const;
+  double hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::vector<double>& F, HemicubeCells* keep = nullptr) const;
   const Scene& s_;
   const RayCaster& caster_;
   Settings set_;

@@ -77,6 +77,25 @@ std::vector<NamedLayer> causticCornellGlossyLayers(double patchSize, double floo
 Scene causticCornellGlossy(double patchSize, double floorPatch, int sphereSubdiv, float ior, float roughness,
                            const glm::vec3& F0);
 
+// Meshing artefacts (the course's "shadow leak" and "staircase"), z up:
+//
+// Shadow leak: a closed room x in [0, 2], y in [0, 1.2], z in [0, 1] seen
+// from inside, coarse patches (0.4 along x), rho 0.5, split by a partition
+// (two faces, x = 1.09 facing -x and x = 1.11 facing +x, reaching 1 cm into
+// floor, ceiling and walls) that cuts through the floor, ceiling and side
+// wall patches spanning x in [0.8, 1.2] (their triangles' centroids lie on
+// the lit side); a light 0.4 x 0.4 (black, emitting) 2 cm below the ceiling
+// over the lit half. No light reaches the dark half: B = 0 for x > 1.11.
+SceneFile shadowLeak();
+// Staircase: floor [-1, 1]^2 at z = 0 (rho 0.5, 8 x 8 quads), a light
+// kStaircaseLight wide (black, emitting) at z = 2 facing down, centred over
+// the origin, and a black occluder at z = 1 whose edge, turned 30 degrees
+// from the y axis, passes over (0.2, 0, 1): a nearly hard shadow edge through
+// (0.4, 0, 0) running diagonally across the patches. The floor sees only black
+// surfaces, so B_floor = rho H_direct exactly.
+inline constexpr double kStaircaseLight = 0.05;
+SceneFile staircase();
+
 // Sets uniform reflectance and emission on every face (and the attributes).
 void setUniform(SceneFile& sf, const glm::vec3& rho, const glm::vec3& E);
 
