@@ -40,15 +40,18 @@ m="$root/test_meshes"
 "$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
   --photons 1000000 --caustic_k 32 --light_path_split true -o "$ex/photonmap_caustic_paths.mlx"
 "$gi" script formfactors --face_index 0 --form_factor_method Hemicube -o "$ex/form_factors_face0.mlx"
-# The hemicube of a Cornell box floor patch (face 748, in front of the short block) as three raster layers.
-"$gi" script hemicube --face_index 748 --hemicube_resolution 64 -o "$ex/hemicube_cornell_floor.mlx"
+# The hemicube of a Cornell box floor patch (face 49, in front of the tall block) as three raster layers.
+"$gi" script hemicube --face_index 49 --hemicube_resolution 64 -o "$ex/hemicube_cornell_floor.mlx"
 # The artefact pack: each scene with patch averages (the artefact), final gather and adaptive refinement.
-for s in shadow_leak staircase; do
+# Refinement: 2 levels end the shadow leak's patches at the partition, 4 follow the staircase's edge.
+for s in shadow_leak:2 staircase:4; do
+  depth=${s#*:}
+  s=${s%:*}
   "$gi" script radiosity --mesh "$m/$s.ply" --emitter_source 1 --vertex_output "Patch average" \
     -o "$ex/${s}_patch_average.mlx"
   "$gi" script radiosity --mesh "$m/$s.ply" --emitter_source 1 --vertex_output "Final gather" \
     -o "$ex/${s}_final_gather.mlx"
   "$gi" script radiosity --mesh "$m/$s.ply" --emitter_source 1 --vertex_output "Patch average" --refine true \
-    --refine_max_depth 4 -o "$ex/${s}_refined.mlx"
+    --refine_max_depth "$depth" -o "$ex/${s}_refined.mlx"
 done
 echo "examples written to $ex"

@@ -56,7 +56,7 @@ VARIANTS = {
     "photonmap": [["--photons", "20000", "--light_samples", "16"]],
     "reference": [["--samples_per_vertex", "8", "--max_depth", "8"]],
     "formfactors": [["--face_index", "5", "--rays_per_patch", "4096"]],
-    "hemicube": [["--face_index", "748", "--hemicube_resolution", "32", "--nusselt_resolution", "64"]],
+    "hemicube": [["--face_index", "49", "--hemicube_resolution", "32", "--nusselt_resolution", "64"]],
     "render": [["--width", "48", "--height", "32", "--samples_per_pixel", "2", "--vertex_radiance", "true"],
                ["--width", "40", "--height", "40", "--samples_per_pixel", "4", "--mode", "Path traced",
                 "--max_depth", "4", "--vertex_radiance", "true"]],

@@ -13,6 +13,7 @@
 #include "gi/filter_run.h"
 #include "gi/form_factor_analytic.h"
 #include "gi/radiosity.h"
+#include "gi/scene_setup.h"
 #include "gi/scenes.h"
 
 using namespace gi;
@@ -21,15 +22,18 @@ namespace {
 
 enum class Fix { PatchAverage, FinalGather, Refined };
 
-FilterResult solve(const scenes::SceneFile& sf, Fix fix, Scene* prepared = nullptr) {
+// The settings of the example scripts: emitters by face quality, the vertex
+// output, refinement to `depth` levels.
+FilterResult solve(const scenes::SceneFile& sf, Fix fix, int depth, Scene* prepared = nullptr) {
   FilterInput in;
   in.scene = sf.scene;
   in.attrs = sf.attrs;
   in.values = defaultValues(filterSpecs(FilterKind::Radiosity), analyzeScene(in.scene).diagonal);
+  in.values.set("emitter_source", int(kEmitterSources.index(EmitterSource::QualityAbove)));
   const RadiosityVertexOutput out = fix == Fix::FinalGather ? RadiosityVertexOutput::FinalGather : RadiosityVertexOutput::PatchAverage;
   in.values.set("vertex_output", int(kRadiosityVertexOutputs.index(out)));
   in.values.set("refine", fix == Fix::Refined);
-  if (fix == Fix::Refined) in.values.set("refine_max_depth", 4);
+  if (fix == Fix::Refined) in.values.set("refine_max_depth", depth);
   FilterResult r = runFilter(FilterKind::Radiosity, in);
   if (prepared) *prepared = in.scene;
   return r;
@@ -71,9 +75,9 @@ double leak(const FilterResult& r, const scenes::SceneFile& sf) {
 // differently) until the lit parts end at the partition (measured 0.006 < 0.015).
 TEST(ArtefactScenes, ShadowLeakIsRealAndTheFixesRemoveIt) {
   const scenes::SceneFile sf = scenes::shadowLeak();
-  const double patch = leak(solve(sf, Fix::PatchAverage), sf);
-  const double gather = leak(solve(sf, Fix::FinalGather), sf);
-  const double refined = leak(solve(sf, Fix::Refined), sf);
+  const double patch = leak(solve(sf, Fix::PatchAverage, 0), sf);
+  const double gather = leak(solve(sf, Fix::FinalGather, 0), sf);
+  const double refined = leak(solve(sf, Fix::Refined, 2), sf);
   std::printf("shadow leak (dark / lit mean B; truth 0): patch average %.4f, final gather %.4f, refined %.4f\n", patch,
               gather, refined);
   EXPECT_GT(patch, 0.02);
@@ -152,10 +156,10 @@ double staircaseError(const FilterResult& r, const scenes::SceneFile& sf, const 
 TEST(ArtefactScenes, StaircaseIsRealAndRefinementRemovesIt) {
   const scenes::SceneFile sf = scenes::staircase();
   Scene prepared;
-  const FilterResult pa = solve(sf, Fix::PatchAverage, &prepared);
+  const FilterResult pa = solve(sf, Fix::PatchAverage, 0, &prepared);
   const double patch = staircaseError(pa, sf, prepared);
-  const double gather = staircaseError(solve(sf, Fix::FinalGather), sf, prepared);
-  const double refined = staircaseError(solve(sf, Fix::Refined), sf, prepared);
+  const double gather = staircaseError(solve(sf, Fix::FinalGather, 0), sf, prepared);
+  const double refined = staircaseError(solve(sf, Fix::Refined, 4), sf, prepared);
   std::printf("staircase (RMS error / mean B on the floor): patch average %.4f, final gather %.4f, refined %.4f\n",
               patch, gather, refined);
   EXPECT_GT(patch, 0.15);
