@@ -178,9 +178,9 @@ const std::vector<FilterDesc>& allFilters() {
        "and down onto its base disk, seen from above, where the area it covers divided by &pi; is its form "
        "factor (drawn with one ray per pixel, independently of the hemicube).<br>"
        "The mesh's faces take the colours of the pictures (the selected face white) and the hemicube's "
-       "F<sub>ij</sub> as face <b>quality</b>, exactly the factors of 'GI: Form Factors of Selected Face' with "
+       "F<sub>ij</sub> as face <b>quality</b> (vertex quality: the mean of the incident faces'), exactly the factors of 'GI: Form Factors of Selected Face' with "
        "the hemicube method and one view. The log compares the two methods patch by patch.",
-       WritesFaceQuality | WritesFaceColor | WritesImage},
+       WritesVertexQuality | WritesFaceQuality | WritesFaceColor | WritesImage},
   };
   return f;
 }

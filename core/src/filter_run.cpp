@@ -194,6 +194,10 @@ void runHemicube(FilterInput& in, FilterResult& res) {
     maxDiff = std::max(maxDiff, std::fabs(hv.nusseltF[j] - c.F[j]));
     seen += c.F[j] > 0;
   }
+  // Per vertex, the area-weighted mean of the incident faces' F (as the form-factor filter writes it).
+  std::vector<glm::vec3> F3(s.faceCount());
+  for (size_t j = 0; j < F3.size(); ++j) F3[j] = glm::vec3(res.faceQuality[j]);
+  for (const glm::vec3& x : faceToVertex(s, F3)) res.vertexQuality.push_back(x.x);
   const std::string path = v.getString("image_path");
   const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
   const std::string stem =

@@ -63,16 +63,19 @@ double leak(const FilterResult& r, const scenes::SceneFile& sf) {
 
 }  // namespace
 
-// Shadow leak. The truth on the dark side is 0. With patch averages every
-// dark vertex at x = 1.2 (floor, ceiling, side walls) takes the mean of
-// patches whose centroids are lit, and the rays of those patches' dark parts
-// carry lit radiosity into the dark half: measured 0.047 (6% of the dark
-// vertices sit on that line, at about half the lit value: >= 0.03 expected,
-// 0.02 asserted). A final gather computes the direct light at each vertex
-// (0 behind the partition) and gathers the rest from what its rays see:
-// only the leaked patches' light remains (measured 0.004 < 0.01). Refinement
-// splits the patches the partition crosses (their corners see the light
-// differently) until the lit parts end at the partition (measured 0.006 < 0.015).
+// Shadow leak. The truth on the dark side is 0. With patch averages the
+// dark vertices on the line x = 1.2 (16 of the dark half's 80: floor,
+// ceiling, side walls) take the mean of patches of which about half straddle
+// the partition with lit centroids, at about half the lit floor's level:
+// 0.2 x 0.5 x 0.5 = 0.05 of it expected, measured 0.078 (> 0.04 asserted).
+// A final gather computes the direct light at each vertex (0 behind the
+// partition) and gathers the rest from what its rays see: only the light the
+// straddling patches' rays carried into the dark half remains (their dark
+// part is 22% of their area); measured 0.022, asserted below half the patch
+// average's leak. Refinement to 2 levels splits the straddling patches (their
+// corners see the light differently) into quarters whose edges meet the
+// partition's middle plane (x = 1.1): nothing lit reaches past it; measured
+// 3e-5 (< 0.002 asserted).
 TEST(ArtefactScenes, ShadowLeakIsRealAndTheFixesRemoveIt) {
   const scenes::SceneFile sf = scenes::shadowLeak();
   const double patch = leak(solve(sf, Fix::PatchAverage, 0), sf);
@@ -80,9 +83,9 @@ TEST(ArtefactScenes, ShadowLeakIsRealAndTheFixesRemoveIt) {
   const double refined = leak(solve(sf, Fix::Refined, 2), sf);
   std::printf("shadow leak (dark / lit mean B; truth 0): patch average %.4f, final gather %.4f, refined %.4f\n", patch,
               gather, refined);
-  EXPECT_GT(patch, 0.02);
-  EXPECT_LT(gather, 0.01);
-  EXPECT_LT(refined, 0.015);
+  EXPECT_GT(patch, 0.04);
+  EXPECT_LT(gather, 0.5 * patch);
+  EXPECT_LT(refined, 0.002);
 }
 
 namespace {
@@ -149,10 +152,12 @@ double staircaseError(const FilterResult& r, const scenes::SceneFile& sf, const 
 // triangles of size h = 0.25 (patch average: also shifted to the patch
 // centroids), errs by a sawtooth of RMS about B0 / sqrt(12) within the band of
 // triangles the edge crosses (about 2.3 long x 0.3 wide of the floor's 4:
-// 17%), i.e. 0.29 x sqrt(0.17) B0 = 0.12 B0, about 0.2 of the mean (the
-// floor is about 60% lit). Measured: patch average 0.27 (> 0.15 asserted),
-// final gather 0.15; refinement to depth 4 narrows the band 16-fold
-// (0.2 / 4 = 0.05 expected; measured 0.06 < 0.1 asserted).
+// 17%), i.e. 0.29 x sqrt(0.17) B0 = 0.12 B0, about 0.2 of the mean (the floor
+// is about 60% lit). Measured: patch average 0.176, final gather 0.144 (the
+// direct light exact at the vertices, still interpolated over the coarse
+// triangles: > 0.1 asserted for both). Refinement to depth 4 narrows the band
+// 16-fold, so sqrt(16) = 4 times less: 0.036 expected, measured 0.019
+// (< 0.05 asserted).
 TEST(ArtefactScenes, StaircaseIsRealAndRefinementRemovesIt) {
   const scenes::SceneFile sf = scenes::staircase();
   Scene prepared;
@@ -162,7 +167,7 @@ TEST(ArtefactScenes, StaircaseIsRealAndRefinementRemovesIt) {
   const double refined = staircaseError(solve(sf, Fix::Refined, 4), sf, prepared);
   std::printf("staircase (RMS error / mean B on the floor): patch average %.4f, final gather %.4f, refined %.4f\n",
               patch, gather, refined);
-  EXPECT_GT(patch, 0.15);
-  EXPECT_LT(refined, 0.1);
-  EXPECT_LT(refined, patch / 2);
+  EXPECT_GT(patch, 0.1);
+  EXPECT_GT(gather, 0.1);
+  EXPECT_LT(refined, 0.05);
 }
