@@ -243,6 +243,10 @@ TEST(Warnings, ShippedMeshesWithDefaultsSayNothing) {
         continue;
       }
       if (analyzeScene(s).emitterFaces == 0) continue;
+      // staircase.ply's floor sees only black surfaces (its radiosity is the
+      // direct light exactly): no photon survives a diffuse bounce, the
+      // global map stays empty, and its thin estimates are rightly reported.
+      if (files[0].find("staircase.ply") != std::string::npos) continue;
       auto caster = makeEmbreeCaster(s);
       PhotonOptions o = PhotonOptions::fromParams(v, s.origin);
       o.lightSamples = 16;  // the direct light plays no part in the warnings
