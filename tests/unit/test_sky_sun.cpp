@@ -47,6 +47,22 @@ SkySun sunOnly(float E, float zenithDeg, float radiusDeg) {
   return o;
 }
 
+// The floor 2 m deep beside a wall 1 m high (both 20 m long), 0.25 m patches, rho 0.5.
+Scene floorBesideWall() {
+  auto sf = scenes::floorWithWall(2.0, 1.0, 8);
+  sf.scene.rho.assign(sf.scene.faceCount(), glm::vec3(kRho));
+  sf.scene.emission.assign(sf.scene.faceCount(), glm::vec3(0.f));
+  return sf.scene;
+}
+
+// A sky of 1 W/m^2 and a sun of 3 W/m^2 behind the wall (x < 0), 30.2 degrees from the zenith.
+SkySun skyAndSunBehindWall() {
+  SkySun o = skyOnly(1.f);
+  o.sunIrradiance = glm::vec3(3.f);
+  o.sunDirection = glm::normalize(glm::vec3(-0.5f, 0.3f, 1.f));
+  return o;
+}
+
 RadiosityResult radiosity(const Scene& s, const SkySun& out, RadiositySolver solver) {
   auto caster = makeEmbreeCaster(s);
   RadiosityOptions o;
@@ -172,13 +188,8 @@ TEST(SkySun, OpenPlanePhotonMapPhotonsOnly) {
 // where the indirect light is a third of B): 3% of the band mean.
 // Tolerance: 4 combined standard errors.
 TEST(SkySun, FloorBesideWallMatchesReference) {
-  auto sf = scenes::floorWithWall(2.0, 1.0, 8);
-  Scene& s = sf.scene;
-  s.rho.assign(s.faceCount(), glm::vec3(kRho));
-  s.emission.assign(s.faceCount(), glm::vec3(0.f));
-  SkySun o = skyOnly(1.f);
-  o.sunIrradiance = glm::vec3(3.f);
-  o.sunDirection = glm::normalize(glm::vec3(-0.5f, 0.3f, 1.f));
+  const Scene s = floorBesideWall();
+  const SkySun o = skyAndSunBehindWall();
   auto caster = makeEmbreeCaster(s);
   PathTraceOptions po;
   po.samplesPerVertex = 512;
@@ -243,13 +254,7 @@ TEST(SkySun, FloorBesideWallMatchesReference) {
 // and the sun bring in is emitted power, and emitted = absorbed + escaped
 // holds to the solver's tolerance (1e-4 of the emitted power; 1e-3 allowed).
 TEST(SkySun, EnergyBalanceWithSky) {
-  auto sf = scenes::floorWithWall(2.0, 1.0, 8);
-  Scene& s = sf.scene;
-  s.rho.assign(s.faceCount(), glm::vec3(kRho));
-  s.emission.assign(s.faceCount(), glm::vec3(0.f));
-  SkySun o = skyOnly(1.f);
-  o.sunIrradiance = glm::vec3(3.f);
-  const auto r = radiosity(s, o, RadiositySolver::GaussSeidel);
+  const auto r = radiosity(floorBesideWall(), skyAndSunBehindWall(), RadiositySolver::GaussSeidel);
   EXPECT_GT(r.stats.get("sky_sun_power_W"), 0.0);
   EXPECT_NEAR(r.stats.get("sky_sun_power_W"), r.stats.get("emitted_power_W"), 1e-9);
   EXPECT_LT(r.stats.get("energy_balance_error", 1.0), 1e-3);
