@@ -151,14 +151,16 @@ def reference_at_sample(gi, mesh, tmp, count, paths, seed):
 
 
 def error_at(values, idx, ref, ref_err):
-    """Relative RMS and mean difference of `values` at the reference's vertices, and the reference's own
-    relative RMS standard error there (the floor below which a difference cannot be resolved)."""
-    num = sum((values[i] - r) ** 2 for i, r in zip(idx, ref))
-    bias = sum(values[i] - r for i, r in zip(idx, ref))
-    den = sum(r * r for r in ref)
-    noise = sum(e * e for e in ref_err)
-    return {"rms_relative_error": math.sqrt(num / den), "mean_relative_error": bias / sum(ref),
-            "reference_rms_relative_std_error": math.sqrt(noise / den), "vertices": len(idx)}
+    """At the reference's vertices (B > 0): the RMS and the mean of the relative differences (x - r) / r of
+    `values`, and the RMS of the reference's own relative standard errors there (the floor below which a
+    difference cannot be resolved). Relative per vertex, so that the light's bright vertices do not weigh
+    more than the room's."""
+    pts = [(values[i], r, e) for i, r, e in zip(idx, ref, ref_err) if r > 0]
+    rel = [(x - r) / r for x, r, _ in pts]
+    return {"rms_relative_error": math.sqrt(sum(d * d for d in rel) / len(rel)),
+            "mean_relative_error": sum(rel) / len(rel),
+            "reference_rms_relative_std_error": math.sqrt(sum((e / r) ** 2 for _, r, e in pts) / len(pts)),
+            "vertices": len(pts)}
 
 
 def slope(xs, ys):
