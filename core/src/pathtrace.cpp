@@ -270,6 +270,13 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
+  if (part.subset)
+    st.note("traced a random sample of " + std::to_string(opt.tracedVertices) + " of the " + std::to_string(nv) +
+            " vertices (traced_vertex_seed " + std::to_string(opt.tracedVertexSeed) +
+            "); the others are 0, with ReferenceTraced 0");
+  else if (opt.tracedVertices >= nv && opt.tracedVertices > 0)
+    st.note("traced_vertices " + std::to_string(opt.tracedVertices) + " is not below the " + std::to_string(nv) +
+            " vertices: all traced");
   if (valid < part.count(nv))
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) got 0");

@@ -2,8 +2,8 @@
 // whole sphere (an unoccluded surface gets E_sky = pi L_sky) and a sun disk
 // of angular radius alpha whose radiance L_sun = E_sun / Omega_sun, with
 // Omega_sun = 2 pi (1 - cos alpha), gives a surface facing it E_sun. At a
-// point x with normal n (Cohen and Wallace 1993, ch. 2, the irradiance
-// integral):
+// point x with normal n, the irradiance integral (Cohen and Wallace 1993,
+// "Radiosity and Realistic Image Synthesis", ch. 2):
 //   H_out(x) = L_sky ∫_{n.w > 0} V(x, w) (n.w) dw + L_sun ∫_{sun} V(x, w) max(0, n.w) dw
 //            = E_sky <V>_{w ~ cos/pi} + E_sun <V max(0, n.w)>_{w uniform in the sun's cone}
 // estimated with cosine-weighted rays for the sky and rays uniform in the
