@@ -1,8 +1,7 @@
 // Hierarchical radiosity with clustering (gi/hierarchical.h) against the flat
 // solver: the Cornell box (1.5k and 10k patches) within the flat solver's own
 // error, the furnace B = E / (1 - rho) with energy balance, and epsilon -> 0
-// giving back the
-// flat solution.
+// giving back the flat solution.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
