@@ -16,8 +16,16 @@ Each run is `gi radiosity ROOM.ply --solver ... --vertex_output 'Patch
 average' --json` in a child process; its peak resident memory comes from
 wait4. The flat solver runs only up to --flat_max triangles (quadratic).
 
+With --reference_vertices N, `gi reference` traces N vertices drawn at random
+(--traced_vertices N, --traced_vertex_seed; the others stay 0 and its
+ReferenceTraced attribute is 0 there) and the hierarchical solution's
+relative RMS error and mean error is measured at those vertices only; the
+radiosity runs then use --vertex_output (default 'Final gather', the values
+the reference is comparable with; 'Patch average' otherwise).
+
 usage: python3 bench/hr_bench.py [--gi build/tools/gi] [--sizes 10000,40000,160000] [--flat_max 40000]
-                                 [--out hr_bench.json]
+                                 [--out hr_bench.json] [--reference_vertices N [--reference_paths 1024]
+                                 [--reference_seed 0] [--vertex_output 'Final gather']]
 """
 import argparse
 import json
@@ -85,8 +93,8 @@ def k_for(triangles):
     return max(2, int(round(math.sqrt(triangles / (2 * (5 + 10 / 16))))))
 
 
-def run(gi, mesh, out, solver, extra):
-    cmd = [gi, "radiosity", mesh, "-o", out, "--solver", solver, "--vertex_output", "Patch average",
+def run(gi, mesh, out, solver, extra, vertex_output="Patch average"):
+    cmd = [gi, "radiosity", mesh, "-o", out, "--solver", solver, "--vertex_output", vertex_output,
            "--json"] + extra
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -124,6 +132,37 @@ def vertex_values(path):
         return out
 
 
+def reference_at_sample(gi, mesh, tmp, count, paths, seed):
+    """`gi reference` on `count` random vertices: (traced vertex indices, their B luminance, standard errors, seconds)."""
+    saved = os.path.join(tmp, "ref.json")
+    cmd = [gi, "reference", mesh, "--traced_vertices", str(count), "--traced_vertex_seed", str(seed),
+           "--samples_per_vertex", str(paths), "--save-result", saved, "--json"]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        raise RuntimeError("%s failed: %s" % (" ".join(cmd), p.stderr[-500:]))
+    wall = time.perf_counter() - t0
+    with open(saved) as f:
+        r = json.load(f)
+    traced = r["attributes"]["ReferenceTraced"]["values"]
+    err = r["attributes"]["StdError"]["values"]
+    idx = [i for i, x in enumerate(traced) if x > 0.5]
+    return idx, [r["vertex_quality"][i] for i in idx], [err[i] for i in idx], wall
+
+
+def error_at(values, idx, ref, ref_err):
+    """At the reference's vertices (B > 0): the RMS and the mean of the relative differences (x - r) / r of
+    `values`, and the RMS of the reference's own relative standard errors there (the floor below which a
+    difference cannot be resolved). Relative per vertex, so that the light's bright vertices do not weigh
+    more than the room's."""
+    pts = [(values[i], r, e) for i, r, e in zip(idx, ref, ref_err) if r > 0]
+    rel = [(x - r) / r for x, r, _ in pts]
+    return {"rms_relative_error": math.sqrt(sum(d * d for d in rel) / len(rel)),
+            "mean_relative_error": sum(rel) / len(rel),
+            "reference_rms_relative_std_error": math.sqrt(sum((e / r) ** 2 for _, r, e in pts) / len(pts)),
+            "vertices": len(pts)}
+
+
 def slope(xs, ys):
     lx, ly = [math.log(x) for x in xs], [math.log(y) for y in ys]
     mx, my = sum(lx) / len(lx), sum(ly) / len(ly)
@@ -136,7 +175,15 @@ def main():
     ap.add_argument("--sizes", default="10000,40000,160000")
     ap.add_argument("--flat_max", type=int, default=40000)
     ap.add_argument("--out", default="hr_bench.json")
+    ap.add_argument("--reference_vertices", type=int, default=0,
+                    help="measure the error against `gi reference` at this many random vertices (0: not)")
+    ap.add_argument("--reference_paths", type=int, default=1024)
+    ap.add_argument("--reference_seed", type=int, default=0)
+    ap.add_argument("--vertex_output", default=None,
+                    help="the radiosity runs' vertex values (default: 'Final gather' with a reference, else "
+                         "'Patch average')")
     a = ap.parse_args()
+    vertex_output = a.vertex_output or ("Final gather" if a.reference_vertices > 0 else "Patch average")
     results = []
     with tempfile.TemporaryDirectory() as tmp:
         for target in [int(x) for x in a.sizes.split(",")]:
@@ -147,12 +194,22 @@ def main():
             vals = {}
             for solver in solvers:
                 out = os.path.join(tmp, "out.ply")
-                j, wall, rss = run(a.gi, mesh, out, solver, [])
+                j, wall, rss = run(a.gi, mesh, out, solver, [], vertex_output)
                 st = j.get("stats", j)
                 key = "hierarchical" if solver == "Hierarchical" else "flat"
                 row[key] = {"seconds": wall, "peak_MB": rss, "stats": st}
                 vals[key] = vertex_values(out)
                 print("%8d triangles %-12s %7.2f s %7.0f MB" % (n, key, wall, rss), file=sys.stderr, flush=True)
+            if a.reference_vertices > 0:
+                idx, ref, ref_err, ref_wall = reference_at_sample(a.gi, mesh, tmp, a.reference_vertices,
+                                                                  a.reference_paths, a.reference_seed)
+                row["reference"] = {"seconds": ref_wall, "vertices": len(idx), "paths": a.reference_paths}
+                for key in vals:
+                    row[key]["error_at_reference"] = error_at(vals[key], idx, ref, ref_err)
+                    print("%8d triangles %-12s error %.4f at %d reference vertices (reference noise %.4f)"
+                          % (n, key, row[key]["error_at_reference"]["rms_relative_error"], len(idx),
+                             row[key]["error_at_reference"]["reference_rms_relative_std_error"]),
+                          file=sys.stderr, flush=True)
             if "flat" in vals:
                 h, fl = vals["hierarchical"], vals["flat"]
                 num = sum((x - y) ** 2 for x, y in zip(h, fl) if y > 0)

@@ -253,6 +253,8 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
   res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
+  if (opt.tracedVertices > 0)
+    res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
   addLightPathAttributes(r.split, res);
 }
 

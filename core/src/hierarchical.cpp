@@ -370,6 +370,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     if (g.A[f] > 0) rhoMax = std::max({rhoMax, double(rho.r), double(rho.g), double(rho.b)});
     S[f] = g.A[f] > 0 ? rho * Hd[f] : glm::vec3(0.f);
   }
+  P += set.enteringPower;
   HierarchicalSolution sol;
   const Tree t = buildTree(g);
   const size_t nn = t.nodes.size();

@@ -11,6 +11,7 @@
 #include "gi/emitters.h"
 #include "gi/sampling.h"
 #include "gi/scene_setup.h"
+#include "gi/sky.h"
 #include "gi/specular.h"
 #include "path_integrator.h"
 
@@ -40,46 +41,42 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
                "reflectance rho, a share rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: "
                "a warning says so when it may exceed them.",
        .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
-      {.name = "sky_color", .label = "Sky colour",
-       .help = "Colour of a uniform sky around the scene (sRGB).",
-       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
-      {.name = "sky_irradiance", .label = "Sky irradiance (W/m^2)",
-       .help = "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.",
-       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
-      {.name = "sun_direction", .label = "Sun direction",
-       .help = "Direction towards the sun.",
-       .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)},
-      {.name = "sun_color", .label = "Sun colour",
-       .help = "Colour of the sun (sRGB).",
-       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
-      {.name = "sun_irradiance", .label = "Sun irradiance (W/m^2)",
-       .help = "Irradiance of the sun on a surface facing it; 0 = no sun.",
-       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
-      {.name = "sun_angular_radius", .label = "Sun angular radius (deg)",
-       .help = "0 gives a sharp directional light.",
-       .type = ParamType::Float, .def = 0.27, .min = 0.0, .max = 45},
   };
+  for (const ParamSpec& p : SkySun::specs()) out.push_back(p);
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
   out.push_back(lightPathSplitSpec());
   out.push_back(seedSpec("paths"));
+  out.push_back({.name = "traced_vertices", .label = "Traced vertices (0 = all)",
+                 .help = "A reference that scales: trace only this many vertices, drawn at random without "
+                         "replacement (uniformly over the mesh's vertices, from 'Sample seed'); cost is proportional "
+                         "to the count (a 1% sample of a million vertices costs a hundredth of the whole). The other "
+                         "vertices get 0 and the per-vertex attribute ReferenceTraced tells them apart (1 traced, 0 "
+                         "not): compare other methods only where it is 1. 0 traces every vertex.",
+                 .type = ParamType::Int, .def = 0, .min = 0, .max = 2000000000});
+  out.push_back({.name = "traced_vertex_seed", .label = "Sample seed",
+                 .help = "Which vertices 'Traced vertices' draws (the same seed, mesh and count: the same vertices, "
+                         "for any thread count and split); independent of the paths' seed.",
+                 .type = ParamType::Int, .def = 0, .min = 0, .max = 2147483647});
   return out;
 }
 
 PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::dvec3& origin) {
   PathTraceOptions o;
-  auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
   o.samplesPerVertex = v.getInt("samples_per_vertex");
   o.targetRelativeError = v.getFloat("target_relative_error");
   o.minSamples = v.getInt("min_samples");
   o.maxSamples = v.getInt("max_samples");
   o.maxDepth = v.getInt("max_depth");
-  o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
-  o.sunDirection = v.getDirection("sun_direction");
-  o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
-  o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
+  const SkySun out = SkySun::fromParams(v);
+  o.skyRadiance = out.skyRadiance;
+  o.sunDirection = out.sunDirection;
+  o.sunIrradiance = out.sunIrradiance;
+  o.sunAngularRadiusDeg = out.sunAngularRadiusDeg;
   o.point = pointLightFromParams(v, origin);
   o.lightPathSplit = v.getBool("light_path_split");
   o.seed = uint32_t(v.getInt("seed"));
+  o.tracedVertices = size_t(v.getInt("traced_vertices"));
+  o.tracedVertexSeed = uint32_t(v.getInt("traced_vertex_seed"));
   return o;
 }
 
@@ -181,7 +178,10 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     return std::sqrt(std::max(0.0, (a.sumL2 - a.n * m * m) / (a.n - 1)) / a.n);
   };
   const bool adaptive = opt.targetRelativeError > 0;
-  const VertexPart& part = opt.vertices;  // a split run traces its part of the vertices
+  // A split run traces its part of the vertices; a sample narrows it.
+  VertexPart part = opt.vertices;
+  if (opt.tracedVertices > 0 && opt.tracedVertices < nv)
+    part.subset = randomVertexSubset(nv, opt.tracedVertices, opt.tracedVertexSeed);
   if (adaptive && !part.all() && !part.sumOverParts)
     throw std::logic_error("an adaptive reference split over parts needs their sum (VertexPart::sumOverParts)");
   Timer traceTimer;
@@ -205,7 +205,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     double meanB = 0;
     size_t valid = 0;
     for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i]) { meanB += pilot[i]; ++valid; }
+      if (mat.valid[i] && part.inSubset(i)) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
     const double floorB = 0.1 * meanB;
     parallelBlocks(nv, progress.sub(0.2, 1.0), "tracing paths (adaptive)", [&](size_t b, size_t e) {
@@ -226,6 +226,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.stdError.assign(nv, 0.f);
   res.stdErrorH.assign(nv, 0.f);
   res.samples.assign(nv, 0);
+  res.traced.assign(nv, 0);
   if (opt.lightPathSplit) res.split.assign(nv);
   double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
   size_t valid = 0;
@@ -249,6 +250,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     h.sumL2 = acc[i].sumHL2;
     res.stdErrorH[i] = float(stdErr(h));
     res.samples[i] = int(acc[i].n);
+    res.traced[i] = 1;
     samples += acc[i].n;
     const double b = luminance(res.B[i]);
     lum += b;
@@ -258,6 +260,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   }
   auto& st = res.stats;
   st.add("vertices", double(nv));
+  st.add("traced_vertices", double(valid));
   st.add("paths", samples);
   st.add("rays", totalRays);
   st.add("seconds", timer.seconds());
@@ -267,6 +270,13 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
+  if (part.subset)
+    st.note("traced a random sample of " + std::to_string(opt.tracedVertices) + " of the " + std::to_string(nv) +
+            " vertices (traced_vertex_seed " + std::to_string(opt.tracedVertexSeed) +
+            "); the others are 0, with ReferenceTraced 0");
+  else if (opt.tracedVertices >= nv && opt.tracedVertices > 0)
+    st.note("traced_vertices " + std::to_string(opt.tracedVertices) + " is not below the " + std::to_string(nv) +
+            " vertices: all traced");
   if (valid < part.count(nv))
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) got 0");

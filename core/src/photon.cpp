@@ -63,7 +63,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
       {.name = "final_gather", .label = "Final gather",
        .help = "For the indirect diffuse light, cast cosine-weighted rays from each vertex (through mirrors and "
                "glass) and read the global photon map where they land (Jensen's final gather): much smoother, at the "
-               "cost of the rays. Caustics still come from the caustic map.",
+               "cost of the rays. Caustics still come from the caustic map. Rays that leave the scene add nothing: "
+               "the sky and the sun seen from the vertex are direct light (computed apart), seen through mirrors "
+               "and glass they are caustics (carried by photons).",
        .type = ParamType::Bool, .def = false},
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
        .help = "Rays per vertex for the final gather.",
@@ -82,6 +84,7 @@ std::vector<ParamSpec> PhotonOptions::specs() {
                "power still carried by cut paths is logged).",
        .type = ParamType::Int, .def = 32, .min = 1, .max = 1000},
   };
+  for (const ParamSpec& p : SkySun::specs()) out.push_back(p);
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);
   out.push_back(lightPathSplitSpec());
   out.push_back(seedSpec("photon paths"));
@@ -102,6 +105,7 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
   o.gatherRays = v.getInt("gather_rays");
   o.progressive = v.getBool("progressive");
   o.passes = v.getInt("passes");
+  o.outside = SkySun::fromParams(v);
   o.point = pointLightFromParams(v, origin);
   o.lightPathSplit = v.getBool("light_path_split");
   o.seed = uint32_t(v.getInt("seed"));
@@ -157,14 +161,15 @@ struct PhotonEstimate {
   std::vector<glm::vec3> byPath[kPathKinds];  // H's terms by the photons' path kind (light_path_split, k nearest)
 };
 
-// Direct light by light sampling at every vertex (area emitters and the
-// point or spot light), or none when the photons carry it.
+// Direct light by light sampling at every vertex (area emitters, the point
+// or spot light, the sky and the sun), or none when the photons carry it.
 std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress) {
   std::vector<glm::vec3> Hd(r.s.vertexCount(), glm::vec3(0.f));
   if (!r.opt.directLight) return Hd;
   Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress);
   const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
-  for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i];
+  const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed);
+  for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i] + Ho[i];
   return Hd;
 }
 
@@ -400,7 +405,10 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   // diffuse interreflection (rho > 0); with the direct light apart and
   // neither, there is nothing for them to do.
   const bool needPhotons = !opt.directLight || specular || anyDiffuseReflection(s);
-  const bool projection = opt.directLight && specular && opt.causticProjection;  // caustic photons aimed at mirrors and glass
+  // Caustic photons aimed at mirrors and glass. Not with a sky or a sun: the
+  // global photons then carry every caustic (the projection aims from points
+  // on the lights, which the sky and the sun have not).
+  const bool projection = opt.directLight && specular && opt.causticProjection && !opt.outside.any();
   // Which photons the vertex estimate reads: all, or all but the direct ones.
   const unsigned vertexPaths = opt.directLight ? (1u << kCausticPhoton) | (1u << kIndirectPhoton) : 7u;
   const float r2max = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
@@ -415,8 +423,8 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.note("no photons traced: the direct light is computed apart and nothing reflects it (rho = 0 everywhere, no "
             "mirror or glass)");
     // Still fail clearly without any light.
-    if (EmitterSampler(s).empty() && !opt.point.on())
-      throw std::invalid_argument("the scene has no light: no emitter faces and no point or spot light");
+    if (EmitterSampler(s).empty() && !opt.point.on() && !opt.outside.any())
+      throw std::invalid_argument("the scene has no light: no emitter faces, no point or spot light, no sky and no sun");
     photons.H.assign(nv, glm::vec3(0.f));
     photons.noise.assign(nv, 0.0);
   } else if (opt.progressive) {
@@ -433,6 +441,9 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   st.add("photon_noise_estimate", totals.rmsNoise);
   st.note(opt.directLight ? "direct light by explicit light sampling at the vertices; photons give caustics and indirect light"
                           : "all light from the photon map");
+  if (opt.outside.any() && specular && opt.causticProjection && opt.directLight)
+    st.note("caustic_projection not used: with a sky or a sun the global photons carry every caustic");
+  if (opt.outside.any()) st.note("sky and sun photons enter from a disk covering the scene's bounding sphere");
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
   if (specular && specOnly)
     st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only (or unusable) have no diffuse "

@@ -60,21 +60,37 @@ bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::v
   return true;
 }
 
-// The lights photons leave from: the area emitters and an optional point or
-// spot light, chosen in proportion to their (luminance) power.
+// The lights photons leave from: the area emitters, an optional point or
+// spot light, the sky and the sun, chosen in proportion to their (luminance)
+// power; the sky's and the sun's is what crosses the disk of the bounding
+// sphere's radius facing them (photon.h).
 class PhotonLights {
  public:
   PhotonLights(const Scene& s, const PhotonOptions& o) : area_(s), o_(o) {
+    if (o.outside.any()) {
+      glm::vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
+      for (const glm::vec3& p : s.positions)
+        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+      if (lo.x <= hi.x) {
+        centre_ = 0.5f * (lo + hi);
+        radius_ = 0.5f * glm::length(hi - lo) * 1.01f + float(sceneScale(s).rayEpsilon);
+      }
+      const double disk = M_PI * double(radius_) * radius_;
+      skyPower_ = o.outside.sky() ? 4.0 * M_PI * double(luminance(o.outside.skyRadiance)) * disk : 0.0;
+      sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk : 0.0;
+    }
     cosSpot_ = o.point.cosSpot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
     pointPower_ = double(luminance(o.point.intensity)) * 2.0 * M_PI * (1.0 - cosSpot_);
     if (!(pointPower_ > 0.0)) pointPower_ = 0.0;
-    total_ = area_.totalPower() + pointPower_;
+    inner_ = area_.totalPower() + pointPower_;
+    total_ = inner_ + skyPower_ + sunPower_;
     spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
   }
   bool empty() const { return !(total_ > 0.0); }
   double totalPower() const { return total_; }
-  // A point on a light: the origin of a photon, before its direction is drawn.
+  // A point on an area emitter or the point light (the caustic projection
+  // aims from it): the origin of a photon, before its direction is drawn.
   struct LightPoint {
     glm::vec3 o, n;   // n: the emitting face's normal (0 for the point light)
     glm::vec3 L;      // radiance E / pi of an area emitter, or the intensity I of the point light
@@ -82,7 +98,7 @@ class PhotonLights {
     bool point;
   };
   LightPoint samplePoint(glm::vec2 u0) const {
-    const double pPoint = pointPower_ / total_;
+    const double pPoint = pointPower_ / inner_;
     if (u0.x < pPoint) return {o_.point.position, glm::vec3(0.f), o_.point.intensity, float(pPoint), true};
     const float ux = float(std::min(0.99999994, (u0.x - pPoint) / (1.0 - pPoint)));
     const auto L = area_.sample({ux, u0.y});
@@ -97,7 +113,11 @@ class PhotonLights {
   // The global photons: cosine-distributed from area emitters, uniform in the
   // spot's cone; photon power for `count` photons in total.
   Emission sample(glm::vec2 u0, glm::vec2 u1, double count) const {
-    const LightPoint lp = samplePoint(u0);
+    const double pOut = (skyPower_ + sunPower_) / total_;
+    if (u0.x < pOut) return sampleOutside(float(u0.x / pOut), u0.y, u1, pOut, count);
+    u0.x = float(std::min(0.99999994, (u0.x - pOut) / (1.0 - pOut)));
+    LightPoint lp = samplePoint(u0);
+    lp.pdf *= float(1.0 - pOut);
     Emission e{lp.o, {}, {}, lp.n};
     if (lp.point) {
       // Flux per photon: I * solid angle / (p_choice * count).
@@ -112,8 +132,35 @@ class PhotonLights {
   }
 
  private:
+  // From the sky (a < pSky of the outside power) or the sun: w towards the
+  // light (uniform over the sphere, pdf 1 / (4 pi); uniform in the sun's
+  // cone, pdf 1 / Omega), a point uniform on the disk of radius R facing w
+  // at the centre + R w; the photon carries L / (pdf_w pdf_disk p count).
+  Emission sampleOutside(float a, float b, glm::vec2 u1, double pOut, double count) const {
+    const double pSky = skyPower_ / (skyPower_ + sunPower_);
+    const bool sky = a < pSky;
+    const double disk = M_PI * double(radius_) * radius_;
+    glm::vec3 w;
+    glm::vec3 power;
+    if (sky) {
+      w = uniformSphere(u1);
+      power = o_.outside.skyRadiance * float(4.0 * M_PI * disk / (pOut * pSky * count));
+    } else {
+      w = Frame(o_.outside.sunDirection).toWorld(uniformCone(u1, o_.outside.sunCos()));
+      // L_sun Omega = E_sun.
+      power = o_.outside.sunIrradiance * float(disk / (pOut * (1.0 - pSky) * count));
+    }
+    const float ad = sky ? a / float(pSky) : (a - float(pSky)) / float(1.0 - pSky);
+    const float r = radius_ * std::sqrt(std::clamp(ad, 0.f, 1.f)), phi = 2.f * float(M_PI) * b;
+    const glm::vec3 o = centre_ + radius_ * w + Frame(w).toWorld({r * std::cos(phi), r * std::sin(phi), 0.f});
+    return {o, -w, power, glm::vec3(0.f)};
+  }
+
   EmitterSampler area_;
   const PhotonOptions& o_;
+  glm::vec3 centre_{0.f};
+  float radius_ = 0.f;
+  double skyPower_ = 0.0, sunPower_ = 0.0, inner_ = 0.0;
   double pointPower_ = 0.0, total_ = 0.0, cosSpot_ = -1.0;
   glm::vec3 spotFrame_;
 };
@@ -124,8 +171,8 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
                                  size_t count, const Progress& progress, PhotonTraceStats& stats) {
   const PhotonLights lights(s, opt);
   if (lights.empty())
-    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality) "
-                                "and no point or spot light");
+    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality), "
+                                "no point or spot light, no sky and no sun");
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   // Fixed-size blocks, concatenated in order: the result is independent of threads.

@@ -29,11 +29,15 @@ struct Setup {
   size_t n;
   std::vector<double> A;
   std::vector<glm::vec3> E, rho, Hd;  // emission, reflectance, direct irradiance
-  double P = 0;  // emitted power (luminance), local units
+  double P = 0;  // emitted power and the power entering from the sky and the sun (luminance), local units
+  double Pout = 0;  // the latter alone
   double unit2 = 1;  // world area of one local unit of area (Scene::unit^2)
 };
 
-Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd) {
+// Hd: the direct irradiance from the emitters; Hout: from the sky and the sun
+// (gi/sky.h; empty: none). Both are direct light: the solve starts from
+// rho (Hd + Hout), and the power entering from outside counts as emitted.
+Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd, const std::vector<glm::vec3>& Hout = {}) {
   Setup u;
   u.n = s.faceCount();
   u.unit2 = s.unit * s.unit;
@@ -51,11 +55,18 @@ Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd) {
                                     " has " + std::to_string(u.rho[i][k]) + "): rho >= 1 creates energy");
     u.P += u.A[i] * luminance(u.E[i]);
   }
-  if (!(u.P > 0))
-    throw std::invalid_argument("the scene has no emitters: select the light's faces (or mark them by face quality) "
-                                "and choose the matching 'Emitters' option");
   u.Hd = Hd;
-  if (u.Hd.size() != u.n) throw std::logic_error("direct irradiance has the wrong size");
+  if (u.Hd.size() != u.n || (!Hout.empty() && Hout.size() != u.n))
+    throw std::logic_error("direct irradiance has the wrong size");
+  if (!Hout.empty()) {
+    for (size_t i = 0; i < u.n; ++i) u.Hd[i] += Hout[i];
+    u.Pout = enteringPower(s, Hout);
+    u.P += u.Pout;
+  }
+  if (!(u.P > 0))
+    throw std::invalid_argument("the scene has no emitters and no sky or sun reaching a surface: select the light's "
+                                "faces (or mark them by face quality) and choose the matching 'Emitters' option, or "
+                                "set sky_irradiance or sun_irradiance");
   return u;
 }
 
@@ -77,6 +88,7 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
     escaped += u.A[i] * (luminance(R[i]) * r.escaped - luminance(u.Hd[i]));
   }
   st.add("emitted_power_W", u.P * u.unit2);
+  if (u.Pout > 0) st.add("sky_sun_power_W", u.Pout * u.unit2);
   st.add("absorbed_power_W", absorbed * u.unit2);
   st.add("escaped_power_W", escaped * u.unit2);
   st.add("energy_balance_error", std::fabs(u.P - absorbed - escaped) / u.P);
@@ -421,6 +433,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   const uint32_t seed = opt.formFactors.seed;
   const bool refineNear = opt.bounces < 0;
   const DirectLightAt directAt(s, caster, 4);
+  const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<float> nearT(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
@@ -431,7 +444,8 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     uint32_t bits[3];
     std::memcpy(bits, &y, sizeof bits);
     const uint32_t key = hash3(bits[0] ^ seed, bits[1], bits[2] ^ f);
-    return s.faceRho(f) * (directAt(y, faceN[f], key) + res.Hindirect[f]);
+    const glm::vec3 Hout = skySunIrradianceAt(opt.outside, caster, y + faceN[f] * eps, faceN[f], 4, key);
+    return s.faceRho(f) * (directAt(y, faceN[f], key) + Hout + res.Hindirect[f]);
   };
   std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices);
   res.stats.add("gather_rays", double(opt.vertices.count(s.vertexCount())) * opt.gatherRays);
@@ -446,7 +460,10 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
 void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res) {
   Timer vt;
   const VertexMaterial mat = vertexMaterial(s);
-  const std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, Progress(nullptr), opt.vertices);
+  std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, Progress(nullptr), opt.vertices);
+  const std::vector<glm::vec3> Hout =
+      vertexSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed, opt.vertices);
+  for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
   const std::vector<glm::vec3> Hi = gather ? gatherIndirect(s, caster, mat, opt, res) : faceToVertex(s, res.Hindirect);
   for (size_t v = 0; v < s.vertexCount(); ++v)
@@ -474,12 +491,15 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
     throw std::invalid_argument(b);
   }
   Timer directTimer;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.2)));
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1)),
+                        patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed,
+                                              progress.sub(0.1, 0.2)));
   const double directSeconds = directTimer.seconds();
   HierarchySettings hs;
   hs.epsilon = opt.hierarchyEpsilon;
   hs.linkRays = opt.linkRays;
   hs.memoryBytes = budget - double(n) * kSolverBytesPerPatch;
+  hs.enteringPower = u.Pout;
   HierarchicalSolution h = solveHierarchical(s, caster, u.Hd, hs, opt.bounces, opt.tolerance, opt.maxIterations,
                                              progress.sub(0.2, 0.9));
   RadiosityResult res;
@@ -504,7 +524,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
   res.stats.add("direct_light_seconds", directSeconds);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
   res.stats.add("patches", double(u.n));
   res.stats.add("seconds", timer.seconds());
   return res;
@@ -563,7 +583,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.1)));
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05)),
+                        patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, ffs.seed, progress.sub(0.05, 0.1)));
   const double directSeconds = directTimer.seconds();
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = mem.fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
@@ -573,7 +594,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
                                  : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
   res.stats.add("direct_light_seconds", directSeconds);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));

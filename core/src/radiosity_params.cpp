@@ -13,8 +13,16 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        .help = "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to "
                "256 emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter "
                "face, times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the "
-               "emitters sampled in proportion to power with a shadow ray each.",
+               "emitters sampled in proportion to power with a shadow ray each. With a sky or a sun, this many rays "
+               "again for each (cosine-weighted to the sky, uniform in the sun's disk: soft shadows).",
        .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+  };
+  s.insert(s.end(), more.begin(), more.end());
+  // The sky and the sun light each patch from outside the scene: rho times
+  // their irradiance (light_samples rays each per patch and per vertex)
+  // enters as emission before the solve.
+  for (const ParamSpec& p : SkySun::specs()) s.push_back(p);
+  const std::vector<ParamSpec> solverSpecs = {
       {.name = "solver", .label = "Solver",
        .help = "Jacobi: B <- E + rho F B for all patches at once (one sweep = one more bounce). Gauss-Seidel: uses "
                "new values as soon as they exist (fewer sweeps). Progressive refinement (Cohen et al. 1988): "
@@ -82,7 +90,7 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "changed.",
        .type = ParamType::Bool, .def = false},
   };
-  s.insert(s.end(), more.begin(), more.end());
+  s.insert(s.end(), solverSpecs.begin(), solverSpecs.end());
   for (const ParamSpec& p : RefineOptions::specs()) s.push_back(p);
   for (const ParamSpec& p : radiosityCourseSpecs()) s.push_back(p);
   return s;
@@ -92,6 +100,7 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   RadiosityOptions o;
   o.formFactors = formFactorSettings(v);
   o.lightSamples = v.getInt("light_samples");
+  o.outside = SkySun::fromParams(v);
   o.solver = kRadiositySolvers.get(v, "solver");
   o.bounces = v.getInt("bounces");
   o.tolerance = v.getFloat("tolerance");

@@ -9,6 +9,7 @@
 #include "gi/pathtrace.h"
 #include "gi/render.h"
 #include "gi/scene_setup.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -148,7 +149,6 @@ std::vector<ParamSpec> RenderOptions::specs() {
 
 RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene, const ShotData* layerCamera) {
   RenderOptions o;
-  auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
   o.mode = kRenderModes.get(v, "mode");
   o.samplesPerPixel = v.getInt("samples_per_pixel");
   o.maxDepth = v.getInt("max_depth");
@@ -162,10 +162,11 @@ RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene
   o.causticMaxRadius = v.getFloat("caustic_max_radius");
   o.gatherRays = v.getInt("gather_rays");
   o.vertexRadiance = v.getBool("vertex_radiance");
-  o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
-  o.sunDirection = v.getDirection("sun_direction");
-  o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
-  o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
+  const SkySun out = SkySun::fromParams(v);
+  o.skyRadiance = out.skyRadiance;
+  o.sunDirection = out.sunDirection;
+  o.sunIrradiance = out.sunIrradiance;
+  o.sunAngularRadiusDeg = out.sunAngularRadiusDeg;
   o.point = pointLightFromParams(v, scene.origin);
   o.seed = uint32_t(v.getInt("seed"));
   const int w = v.getInt("width"), h = v.getInt("height");

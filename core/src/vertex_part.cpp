@@ -5,13 +5,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "gi/sampling.h"
+
 namespace gi {
 
 namespace {
 
 // Counts of work a part did: the whole run did their sum.
 bool isTotal(const std::string& key) {
-  static const char* const totals[] = {"rays", "paths", "gather_rays", "gather_near_hits_relit", "paths_cut_at_max_depth",
+  static const char* const totals[] = {"rays", "paths", "traced_vertices", "gather_rays", "gather_near_hits_relit", "paths_cut_at_max_depth",
                                        "shadow_rays", "skipped_open", "skipped_duplicates", "skipped_invalid"};
   for (const char* t : totals)
     if (key == t) return true;
@@ -50,6 +52,7 @@ std::vector<std::string> mergeTexts(const std::vector<RunStats>& parts, std::vec
 }  // namespace
 
 bool VertexPart::contains(size_t v, size_t n) const {
+  if (!inSubset(v)) return false;
   if (parts <= 1) return true;
   const uint64_t k = v / chunk;
   if (interleaved) return k % parts == part;
@@ -60,6 +63,11 @@ bool VertexPart::contains(size_t v, size_t n) const {
 std::vector<uint32_t> VertexPart::vertices(size_t n) const {
   std::vector<uint32_t> v;
   v.reserve(parts ? n / parts + chunk : n);
+  if (subset) {
+    for (size_t i = 0; i < n; ++i)
+      if (contains(i, n)) v.push_back(uint32_t(i));
+    return v;
+  }
   for (size_t i = 0; i < n; i += chunk)
     if (contains(i, n))
       for (size_t j = i; j < std::min(n, i + chunk); ++j) v.push_back(uint32_t(j));
@@ -68,6 +76,10 @@ std::vector<uint32_t> VertexPart::vertices(size_t n) const {
 
 size_t VertexPart::count(size_t n) const {
   size_t c = 0;
+  if (subset) {
+    for (size_t i = 0; i < n; ++i) c += contains(i, n) ? 1 : 0;
+    return c;
+  }
   for (size_t i = 0; i < n; i += chunk)
     if (contains(i, n)) c += std::min(n, i + chunk) - i;
   return c;
@@ -85,6 +97,17 @@ void VertexPart::check() const {
     throw std::invalid_argument("vertex part " + std::to_string(part) + " does not exist (parts 0 to " +
                                 std::to_string(parts - 1) + ")");
   if (chunk < 1) throw std::invalid_argument("the vertex chunk must hold at least one vertex");
+}
+
+std::shared_ptr<const std::vector<uint8_t>> randomVertexSubset(size_t n, size_t count, uint32_t seed) {
+  auto mask = std::make_shared<std::vector<uint8_t>>(n, uint8_t(count >= n ? 1 : 0));
+  if (count >= n) return mask;
+  // Keys (hash, index): distinct, so the chosen set is unique for any sort.
+  std::vector<std::pair<uint32_t, uint32_t>> key(n);
+  for (size_t v = 0; v < n; ++v) key[v] = {hash3(uint32_t(v), seed, 0x5e1ecu), uint32_t(v)};
+  std::nth_element(key.begin(), key.begin() + std::ptrdiff_t(count), key.end());
+  for (size_t k = 0; k < count; ++k) (*mask)[key[k].second] = 1;
+  return mask;
 }
 
 RunStats mergePartStats(const std::vector<RunStats>& parts) {

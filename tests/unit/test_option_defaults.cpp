@@ -97,6 +97,13 @@ TEST(OptionDefaults, AmbientEveryMode) {
   EXPECT_EQ(kAOColorMappings.get(defaults(FilterKind::AmbientOcclusion), "color_mapping"), AOColorMapping::Grey);
 }
 
+void expectSame(const SkySun& got, const SkySun& want) {
+  SAME(skyRadiance);
+  SAME(sunDirection);
+  SAME(sunIrradiance);
+  SAME(sunAngularRadiusDeg);
+}
+
 TEST(OptionDefaults, Thickness) {
   const ThicknessOptions got = ThicknessOptions::fromParams(defaults(FilterKind::Thickness)), want;
   SAME(raysPerVertex);
@@ -127,6 +134,7 @@ TEST(OptionDefaults, Radiosity) {
   SAME(vertexOutput);
   SAME(gatherRays);
   SAME(refine);
+  expectSame(got.outside, want.outside);
   expectSame(got.refinement, want.refinement);
   expectSame(RefineOptions::fromParams(v), RefineOptions{});
 }
@@ -150,6 +158,7 @@ TEST(OptionDefaults, PhotonMapping) {
   SAME(progressive);
   SAME(passes);
   SAME(alpha);
+  expectSame(got.outside, want.outside);
   expectSame(got.point, want.point);
   SAME(seed);
 }
@@ -169,6 +178,8 @@ TEST(OptionDefaults, PathTracedReference) {
   SAME(sunIrradiance);
   SAME(sunAngularRadiusDeg);
   expectSame(got.point, want.point);
+  SAME(tracedVertices);
+  SAME(tracedVertexSeed);
 }
 
 TEST(OptionDefaults, RayTracedView) {

@@ -34,6 +34,8 @@ struct HierarchySettings {
   double epsilon = 1e-4;      // BF refinement threshold, fraction of the power leaving all surfaces
   int linkRays = 4;           // visibility rays per link
   double memoryBytes = 1e18;  // the links stop being refined beyond this (with a warning)
+  double enteringPower = 0;   // luminance power the sky and the sun bring onto the surfaces (gi/sky.h), local
+                              // units; counts with the emitted power (Hd then holds their irradiance too)
 };
 
 struct HierarchicalSolution {

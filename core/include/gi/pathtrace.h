@@ -19,6 +19,11 @@
 // Monte Carlo error bar and the result does not depend on threads. Vertices
 // with no diffuse face (only on mirror, glass or glossy faces) have no
 // diffuse radiosity: they get 0, and the log says how many.
+// On a large mesh the reference may trace a random sample of its vertices
+// (tracedVertices, drawn by randomVertexSubset from its own seed): the
+// others get 0 and traced = 0 (the filter's per-vertex attribute
+// ReferenceTraced), never a value borrowed from a neighbour, so that an
+// error measured against the reference is measured where it was traced.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -49,6 +54,8 @@ struct PathTraceOptions {
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
   VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
+  size_t tracedVertices = 0;       // > 0: only a random sample of this many vertices (the others 0)
+  uint32_t tracedVertexSeed = 0;   // which sample
   bool lightPathSplit = false;     // also B per light-path kind (light_paths.h)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
@@ -60,6 +67,7 @@ struct PathTraceResult {
   std::vector<float> stdError;    // standard error of luminance(B)
   std::vector<float> stdErrorH;   // standard error of luminance(H)
   std::vector<int> samples;       // per vertex
+  std::vector<uint8_t> traced;    // per vertex: 1 if it was traced (in the part and the sample, on a diffuse face)
   LightPathSplit split;           // B per light-path kind, when asked for
   RunStats stats;
 };

@@ -1,6 +1,12 @@
 // Photon mapping (Jensen 1996) for the light paths radiosity cannot carry.
 // Photons leave the lights in proportion to power (area emitters; an optional
-// point or spot light), low-discrepancy in position and direction, and are
+// point or spot light; a uniform sky and a sun disk, gi/sky.h: a direction w
+// towards the light drawn (uniform over the sphere, or in the sun's cone),
+// the photon starts on the disk of the bounding sphere's radius R facing w,
+// outside the scene, and travels along -w with the power L x (solid angle)
+// x pi R^2 / count: 4 E_sky pi R^2 / count, or E_sun pi R^2 / count, so that
+// a surface facing the light receives E_sky or E_sun per unit area), low-
+// discrepancy in position and direction, and are
 // traced with Russian roulette through diffuse (Lambertian), mirror and glass
 // faces (gi/specular.h) and glossy ones (the GGX lobe, gi/glossy.h,
 // importance-sampled). Every diffuse hit is stored (glossy hits are not);
@@ -36,6 +42,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -54,6 +61,7 @@ struct PhotonOptions {
   int passes = 16;
   double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
   PointLight point;           // optional point or spot light (relative to the scene origin, world units)
+  SkySun outside;             // sky and sun: photons enter from a disk covering the scene's bounding sphere
   bool lightPathSplit = false;  // also B per light-path kind (light_paths.h)
   uint32_t seed = 0;
   static std::vector<ParamSpec> specs();

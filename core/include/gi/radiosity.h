@@ -25,6 +25,7 @@
 #include "gi/refine.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/sky.h"
 #include "gi/vertex_part.h"
 
 namespace gi {
@@ -51,7 +52,9 @@ struct RadiosityOptions {
   // filter's one seed: it keys the form-factor rays and also the shadow rays
   // and the final gather.
   FormFactors::Settings formFactors;
-  int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light
+  int lightSamples = 256;         // shadow rays per patch (and per vertex) for the direct light; as many
+                                  // again for the sky and for the sun, each
+  SkySun outside;                 // sky and sun: emitters outside the scene (gi/sky.h)
   RadiositySolver solver = RadiositySolver::Auto;
   int bounces = -1;               // -1: iterate to the tolerance; k >= 0: exactly k sweeps (0 = direct light only)
   double tolerance = 1e-4;        // on the relative residual / unshot power

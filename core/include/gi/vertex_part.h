@@ -6,11 +6,14 @@
 //   contiguous:   floor(k P / K) == p      (one run of chunks per part)
 // Each vertex's random numbers are keyed by its index and the seed, never by
 // who computes it, so the union of the parts' values is bit-identical to
-// computing all vertices in one process.
+// computing all vertices in one process. A subset (randomVertexSubset: the
+// path-traced reference on a sample of a large mesh's vertices) narrows any
+// part further to the vertices it marks.
 #pragma once
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "gi/run.h"
@@ -26,8 +29,13 @@ struct VertexPart {
   // run), so that a quantity coupling all vertices (the adaptive reference's
   // mean B) is the same in every part. Unset: one part, nothing to do.
   std::function<void(std::vector<double>&)> sumOverParts;
+  // Unset: every vertex of the part; else only those marked 1 (the same
+  // subset in every part).
+  std::shared_ptr<const std::vector<uint8_t>> subset;
 
-  bool all() const { return parts <= 1; }
+  bool all() const { return parts <= 1; }  // one part (a subset may still narrow it)
+  // Whether vertex v is in the subset (true without one), whichever part holds it.
+  bool inSubset(size_t v) const { return !subset || (v < subset->size() && (*subset)[v]); }
   // Whether vertex v of n belongs to this part.
   bool contains(size_t v, size_t n) const;
   // This part's vertices of n, ascending.
@@ -47,6 +55,11 @@ struct VertexPart {
 // vertices) cannot be combined exactly from the parts: they are left out and
 // a note names them. Notes and warnings are kept once; those of only some
 // parts say which part.
+// `count` of the n vertices drawn without replacement, uniformly and
+// deterministically from the seed (the smallest keys hash(v, seed)),
+// independent of threads and parts; count >= n marks all.
+std::shared_ptr<const std::vector<uint8_t>> randomVertexSubset(size_t n, size_t count, uint32_t seed);
+
 RunStats mergePartStats(const std::vector<RunStats>& parts);
 
 }  // namespace gi

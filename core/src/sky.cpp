@@ -1,0 +1,136 @@
+#include "gi/sky.h"
+
+#include <cmath>
+#include <limits>
+
+#include "gi/color.h"
+#include "gi/direct.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+bool SkySun::sky() const { return luminance(skyRadiance) > 0.f; }
+bool SkySun::sun() const { return luminance(sunIrradiance) > 0.f; }
+float SkySun::sunCos() const { return std::cos(glm::radians(sunAngularRadiusDeg)); }
+
+std::vector<ParamSpec> SkySun::specs() {
+  return {
+      {.name = "sky_color", .label = "Sky colour",
+       .help = "Colour of a uniform sky around the scene (sRGB).",
+       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
+      {.name = "sky_irradiance", .label = "Sky irradiance (W/m^2)",
+       .help = "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
+      {.name = "sun_direction", .label = "Sun direction",
+       .help = "Direction towards the sun.",
+       .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)},
+      {.name = "sun_color", .label = "Sun colour",
+       .help = "Colour of the sun (sRGB).",
+       .type = ParamType::Color, .defVec = glm::vec3(1.f)},
+      {.name = "sun_irradiance", .label = "Sun irradiance (W/m^2)",
+       .help = "Irradiance of the sun on a surface facing it; 0 = no sun.",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
+      {.name = "sun_angular_radius", .label = "Sun angular radius (deg)",
+       .help = "0 gives a sharp directional light.",
+       .type = ParamType::Float, .def = 0.27, .min = 0.0, .max = 45},
+  };
+}
+
+SkySun SkySun::fromParams(const ParamValues& v) {
+  auto lin = [](glm::vec3 c) { return glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b)); };
+  SkySun o;
+  o.skyRadiance = lin(v.getVec("sky_color")) * float(v.getFloat("sky_irradiance") / M_PI);
+  o.sunDirection = v.getDirection("sun_direction");
+  o.sunIrradiance = lin(v.getVec("sun_color")) * float(v.getFloat("sun_irradiance"));
+  o.sunAngularRadiusDeg = float(v.getFloat("sun_angular_radius"));
+  return o;
+}
+
+namespace {
+
+// Sample k of a padded sequence: dimension `skyDim` for the sky's cosine
+// direction, skyDim + 1 for the direction in the sun's cone.
+glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const Frame& frame,
+                       const glm::vec3& n, const Frame& sunFrame, float sunCos, const PaddedSobol& smp, uint32_t k,
+                       uint32_t skyDim) {
+  glm::vec3 H(0.f);
+  Ray ray;
+  ray.o = x;
+  if (o.sky()) {
+    ray.d = frame.toWorld(cosineHemisphere(smp(k, skyDim)));
+    ray.tfar = std::numeric_limits<float>::infinity();
+    if (!caster.occluded(ray)) H += o.skyRadiance * float(M_PI);
+  }
+  if (o.sun()) {
+    ray.d = sunFrame.toWorld(uniformCone(smp(k, skyDim + 1), sunCos));
+    const float c = glm::dot(ray.d, n);
+    ray.tfar = std::numeric_limits<float>::infinity();
+    if (c > 0.f && !caster.occluded(ray)) H += o.sunIrradiance * c;
+  }
+  return H;
+}
+
+}  // namespace
+
+glm::vec3 skySunIrradianceAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
+                             int rays, uint32_t key) {
+  if (!o.any() || rays < 1) return glm::vec3(0.f);
+  const PaddedSobol smp(hash3(key, 0x5c1u, 0x5e2u));
+  const Frame frame(n), sunFrame(o.sunDirection);
+  const float sunCos = o.sunCos();
+  glm::dvec3 sum(0.0);
+  for (int k = 0; k < rays; ++k) sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 0));
+  return glm::vec3(sum / double(rays));
+}
+
+std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
+                                             uint32_t seed, const Progress& progress) {
+  std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
+  if (!o.any() || rays < 1) return H;
+  const auto ok = usableFaceMask(s);
+  const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos();
+  const Frame sunFrame(o.sunDirection);
+  parallelBlocks(s.faceCount(), progress, "sky and sun", [&](size_t b, size_t e) {
+    for (size_t f = b; f < e; ++f) {
+      if (!ok[f]) continue;
+      const auto& t = s.triangles[f];
+      const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
+      const Frame frame(n);
+      // Point k on the patch (dimension 0), its sky and sun directions (1, 2).
+      const PaddedSobol smp(hash3(uint32_t(f), seed, 0x5c3u));
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < rays; ++k) {
+        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
+        const glm::vec3 x =
+            w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
+        sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 1));
+      }
+      H[f] = glm::vec3(sum / double(rays));
+    }
+  });
+  return H;
+}
+
+std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
+                                              uint32_t seed, const VertexPart& part) {
+  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  if (!o.any() || rays < 1) return H;
+  const VertexMaterial mat = vertexMaterial(s);
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
+  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t v = b; v < e; ++v)
+      if (mat.valid[v] && part.contains(v, s.vertexCount()))
+        H[v] = skySunIrradianceAt(o, caster, origins[v], mat.n[v], rays, hash3(uint32_t(v), seed, 0x5c4u));
+  });
+  return H;
+}
+
+double enteringPower(const Scene& s, const std::vector<glm::vec3>& Hout) {
+  const auto ok = usableFaceMask(s);
+  double P = 0;
+  for (size_t f = 0; f < Hout.size() && f < s.faceCount(); ++f)
+    if (ok[f]) P += faceArea(s, f) * luminance(Hout[f]);
+  return P;
+}
+
+}  // namespace gi
