@@ -123,6 +123,43 @@ std::vector<uint8_t> lightFreeMask(const Scene& s, const RayCaster& c, const Cam
   return keep;
 }
 
+// What each pixel's centre ray sees first, for the error map
+// (bench/render_error_map.py): channel 0 the surface, 0..5 a diffuse face by
+// its normal (floor +y, ceiling -y, left wall +x, right wall -x, back wall z,
+// other), 6 an emitter, 7 glossy, 8 mirror, 9 glass, 10 nothing; channel 1
+// the distance from the hit to the second-nearest plane of the scene's
+// bounding box (small: near an edge or corner of the room).
+Image surfaceClasses(const Scene& s, const RayCaster& c, const Camera& cam) {
+  const Bounds b = bounds(s);
+  const glm::dvec3 lo = b.lo - s.origin, hi = b.hi - s.origin;
+  const std::vector<glm::vec3> n = unitFaceNormals(s);
+  Image out(cam.width(), cam.height());
+  for (int y = 0; y < cam.height(); ++y)
+    for (int x = 0; x < cam.width(); ++x) {
+      const Ray ray = cam.ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, s.origin);
+      const Hit h = c.intersect(ray);
+      glm::vec3& px = out.at(x, y);
+      if (!h.valid()) { px = {10.f, 0.f, 0.f}; continue; }
+      const glm::dvec3 p = glm::dvec3(ray.o + ray.d * h.t);
+      double d[6] = {p.x - lo.x, hi.x - p.x, p.y - lo.y, hi.y - p.y, p.z - lo.z, hi.z - p.z};
+      std::sort(d, d + 6);
+      px.y = float(d[1]);
+      const Material m = s.faceMaterial(h.face);
+      const glm::vec3 fn = n[h.face];
+      if (m == Material::Glossy) px.x = 7.f;
+      else if (m == Material::Mirror) px.x = 8.f;
+      else if (m == Material::Glass) px.x = 9.f;
+      else if (luminance(s.faceEmission(h.face)) > 0.f) px.x = 6.f;
+      else if (fn.y > 0.9f) px.x = 0.f;
+      else if (fn.y < -0.9f) px.x = 1.f;
+      else if (fn.x > 0.9f) px.x = 2.f;
+      else if (fn.x < -0.9f) px.x = 3.f;
+      else if (std::abs(fn.z) > 0.9f) px.x = 4.f;
+      else px.x = 5.f;
+    }
+  return out;
+}
+
 struct ImageError {
   double rel = 0, relCorrected = 0, refMean = 0;
   size_t pixels = 0;
@@ -166,7 +203,7 @@ int reference(int w, int h, int spp, uint32_t seed, const std::string& stem) {
   return 0;
 }
 
-int run(int w, int h, const std::string& stem, const std::string& mode, int a, int b, uint32_t seed) {
+int run(int w, int h, const std::string& stem, const std::string& mode, int a, int b, uint32_t seed, int causticK) {
   const Scene s = benchScene();
   const auto caster = makeEmbreeCaster(s);
   const Image ref = readPfm(stem + ".pfm"), refSe = readPfm(stem + "_se.pfm");
@@ -191,7 +228,7 @@ int run(int w, int h, const std::string& stem, const std::string& mode, int a, i
     o.twoPass = mode == "gather" ? TwoPassDiffuse::FinalGather : TwoPassDiffuse::Caustics;
     o.samplesPerPixel = b;
     o.causticPhotons = a;
-    o.causticK = po.causticK;
+    o.causticK = causticK > 0 ? causticK : po.causticK;
     o.causticMaxRadius = radius;
     o.firstPassB = first.B;
     o.firstPassBdirect = first.Bdirect;  // as the filter passes it on (RadiosityDirect)
@@ -205,6 +242,7 @@ int run(int w, int h, const std::string& stem, const std::string& mode, int a, i
     for (size_t p = 0; p < m.px.size(); ++p) m.px[p] = glm::vec3(float(keep[p]));
     writePfm(maskPath, m);
   }
+  if (const char* classPath = std::getenv("RENDER_BENCH_CLASSES")) writePfm(classPath, surfaceClasses(s, *caster, o.camera));
   const ImageError e = imageError(r.image, ref, refSe, keep);
   std::printf("{\"mode\": \"%s\", \"a\": %d, \"b\": %d, \"seed\": %u, \"seconds\": %.4f, \"first_pass_seconds\": %.4f, "
               "\"rays\": %.0f, \"relative_rms_error\": %.6g, \"relative_rms_error_corrected\": %.6g, "
@@ -401,9 +439,9 @@ int main(int argc, char** argv) {
     const std::string cmd = argc > 1 ? argv[1] : "";
     if (cmd == "reference" && argc == 7)
       return reference(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), uint32_t(std::atoi(argv[5])), argv[6]);
-    if (cmd == "run" && argc == 9)
+    if (cmd == "run" && (argc == 9 || argc == 10))
       return run(std::atoi(argv[2]), std::atoi(argv[3]), argv[4], argv[5], std::atoi(argv[6]), std::atoi(argv[7]),
-                 uint32_t(std::atoi(argv[8])));
+                 uint32_t(std::atoi(argv[8])), argc == 10 ? std::atoi(argv[9]) : 0);
     if (cmd == "throughput" && argc == 6)
       return throughput(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), std::atoi(argv[5]));
   } catch (const std::exception& e) {
@@ -411,6 +449,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::fprintf(stderr,
-               "usage: render_bench reference W H SPP SEED STEM | run W H STEM MODE A B SEED | throughput W H SPP REPEATS\n");
+               "usage: render_bench reference W H SPP SEED STEM | run W H STEM MODE A B SEED [CAUSTIC_K] | throughput W H SPP "
+               "REPEATS\n");
   return 2;
 }

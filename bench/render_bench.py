@@ -11,7 +11,9 @@ antialiasing), relative to the reference's mean; reported raw and with the
 reference's own variance (its per-pixel standard errors) taken out: an
 unbiased estimate of the error against the exact image. Times: the
 engine's own (first pass included for two-pass), medians of repeats with
-different seeds; errors are medians too.
+different seeds, run round robin (seed k of every setting in pass k, so
+that a machine's changing load weighs on every mode alike); errors are
+medians too.
 
 Time to reach 2% (the goal) and 2.5% (corrected error): log-log
 interpolation between the two settings that bracket it; the ratio of path
@@ -62,7 +64,7 @@ def settings(quick):
     return ([("pt", n, 0) for n in (16, 64, 256, 1024)]
             + [("twopass", p, n) for p, n in ((50000, 4), (100000, 8), (200000, 16), (500000, 32), (1000000, 64))]
             + [("gather", p, n) for p, n in ((50000, 4), (100000, 8), (200000, 16), (500000, 32), (1000000, 64),
-                                            (2000000, 64))]
+                                            (1000000, 128), (1000000, 256))]
             + [("distributed", n, 0) for n in (4, 16, 64)] + [("whitted", 4, 0)])
 
 
@@ -109,13 +111,26 @@ def main():
         with open(stem + ".json", "w") as f:
             json.dump(ref, f)
     rows = []
-    for mode, x, y in settings(a.quick):
-        runs = [run_json([exe, "run", str(w), str(h), stem, mode, str(x), str(y), str(seed)]) for seed in range(1, repeats + 1)]
+    # Round robin: every setting's seed k runs in pass k, so that a load that
+    # changes during the run (other jobs on the machine) weighs on every mode alike.
+    todo = settings(a.quick)
+    runs_of = {st: [] for st in todo}
+    for seed in range(1, repeats + 1):
+        for mode, x, y in todo:
+            r = run_json([exe, "run", str(w), str(h), stem, mode, str(x), str(y), str(seed)])
+            r["load_average"] = os.getloadavg()[0]
+            runs_of[(mode, x, y)].append(r)
+            print("  pass %d: %-12s %8d %4d  %8.2f s  error %.4f (corrected %.4f), load %.1f"
+                  % (seed, mode, x, y, r["seconds"], r["relative_rms_error"], r["relative_rms_error_corrected"],
+                     r["load_average"]), flush=True)
+    for mode, x, y in todo:
+        runs = runs_of[(mode, x, y)]
         row = {"mode": mode, "a": x, "b": y, "seconds": median([r["seconds"] for r in runs]),
                "first_pass_seconds": median([r["first_pass_seconds"] for r in runs]),
                "rays": runs[0]["rays"], "error": median([r["relative_rms_error"] for r in runs]),
                "error_corrected": median([r["relative_rms_error_corrected"] for r in runs]),
-               "pixels": runs[0]["pixels_measured"], "repeats": repeats}
+               "pixels": runs[0]["pixels_measured"], "repeats": repeats,
+               "load_average": sum(r["load_average"] for r in runs) / len(runs)}
         rows.append(row)
         print("%-12s %8d %4d  %8.2f s  error %.4f (corrected %.4f)" % (mode, x, y, row["seconds"], row["error"],
                                                                      row["error_corrected"]), flush=True)
@@ -169,13 +184,14 @@ def report(result, outdir):
     L = ["# Ray-traced view: error versus time (caustic Cornell box with the glossy block)", "",
          "%d x %d pixels; reference: path traced, %d paths per pixel, %.0f s, its own relative RMS error %.2f%%."
          % (result["width"], result["height"], ref["spp"], ref["seconds"], 100 * ref["relative_rms_std_error"]), "",
-         "| mode | setting | time (s) | of which first pass | relative RMS error | without the reference's noise |",
-         "|---|---|---|---|---|---|"]
+         "| mode | setting | time (s) | of which first pass | relative RMS error | without the reference's noise | load average |",
+         "|---|---|---|---|---|---|---|"]
     for r in result["rows"]:
         setting = ("%d photons, %d spp" % (r["a"], r["b"])) if r["mode"] in ("twopass", "gather") else "%d spp" % r["a"]
-        L.append("| %s | %s | %.2f | %.2f | %.2f%% | %.2f%% |" % (LABELS[r["mode"]], setting, r["seconds"],
-                                                             r["first_pass_seconds"], 100 * r["error"],
-                                                             100 * r["error_corrected"]))
+        L.append("| %s | %s | %.2f | %.2f | %.2f%% | %.2f%% | %s |" % (LABELS[r["mode"]], setting, r["seconds"],
+                                                                  r["first_pass_seconds"], 100 * r["error"],
+                                                                  100 * r["error_corrected"],
+                                                                  "%.1f" % r["load_average"] if "load_average" in r else ""))
     for key, res in s.items():
         target = float(key)
         L += ["", "Time to %g%% (corrected error):" % (100 * target), "", "| mode | time to %g%% (s) | best error |" % (100 * target),
