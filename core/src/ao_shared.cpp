@@ -253,6 +253,9 @@ void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint
   r.n += count;
 }
 
+// How many slices parallelBlocks cuts `work` into: one per `perSlice`, 1 to 64.
+size_t slices(size_t work, size_t perSlice) { return std::clamp<size_t>(work / perSlice, 1, 64); }
+
 // Every vertex's rings (searchRings), kept across rounds. They depend on the
 // geometry and on which vertices have rays, which the first round settles
 // (counts only grow after it), so later rounds pool by walking a list
@@ -377,11 +380,17 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   for (int round = 0;; ++round) {
     const Progress bar = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
     Timer cast;
+    // Slices of about a second of work each (progress and cancelling happen
+    // between slices): each slice ends in a wait for the slowest thread,
+    // which on a machine shared with other jobs costs a time slice of the
+    // scheduler, and the later adaptive rounds cast few rays.
+    size_t work = 0;
+    for (size_t i = 0; i < nv; ++i) work += want[i] - std::min(want[i], rays[i].n);
     parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (want[i] > rays[i].n)
           castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
-    });
+    }, slices(work, size_t(1) << 20));
     if (split) {
       // Every part gets every vertex's rays (each vertex's from the part it
       // belongs to; a representative another part's duplicates need is cast
@@ -426,13 +435,15 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
           for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
       repool.swap(grown);
     }
+    size_t pools = 0;
+    for (size_t i = 0; i < nv; ++i) pools += repool[i] && mine[i];
     parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
       PoolScratch& sc = scratch.local();
       for (size_t i = b; i < e; ++i)
         if (repool[i] && mine[i])
           pooled[i] = listed ? poolListed(uint32_t(i), ringLists[i], points, normals, rays, o.bentNormals, po)
                              : poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
-    });
+    }, slices(pools, size_t(1) << 16));
     ++st.rounds;
     st.poolSeconds += pool.seconds();
     if (!adaptive) break;
