@@ -342,7 +342,7 @@ def plot(rows, scene_names, summary, path, speedup_path):
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for (views, tex), style in (((512, 512), "o-"), ((1024, 512), "s--"), ((512, 2048), "^-"), ((1024, 2048), "v--")):
-        for ours, colour in (("ours, shared", "C0"), ("ours, per vertex", "C1")):
+        for ours, colour in (("ours, shared", "C0"), ("ours, per vertex", "C1"), ("ours, shared, adaptive", "C2")):
             pts = sorted((s["vertices"], s["speedup"]) for s in summary
                          if s["views"] == views and s["tex"] == tex and s["ours"] == ours and s["speedup"])
             if pts:

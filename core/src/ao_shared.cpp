@@ -3,11 +3,14 @@
 #include "gi/ao_shared.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include "ambient_internal.h"
 #include "gi/sampling.h"
@@ -87,26 +90,23 @@ Fit fit(const PoolSums& s) {
   return f;
 }
 
-}  // namespace
 
-Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
-                  const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
-                  const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& sc) {
-  if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
-  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
-  const uint32_t now = sc.now;
-  const glm::vec3 ni = normals[i], pi = positions[i];
-  const Frame frame(ni);
-  sc.stamp[i] = now;
-  sc.frontier.assign(1, i);
+// Lepski's choice of scale for one vertex with own rays `own`. ring(h, grown,
+// db) adds ring h's vertices (those pooled at scale h and not before) to
+// grown and their unoccluded directions to db, and returns how many there
+// were (0: no ring h). Both ways of listing the rings (a search each time,
+// or lists kept across rounds) go through here in the same order, so they
+// give the same bits.
+template <class Ring>
+Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   constexpr int kMaxScales = 65;
   double A[kMaxScales], VarV[kMaxScales], V[kMaxScales];  // estimate, its variance / v, and v, per accepted scale
   PoolSums sums;
-  sums.add(rays[i].n, rays[i].sum, 0.0, 0.0);
+  sums.add(own.n, own.sum, 0.0, 0.0);
   Pooled p;
   p.vertices = 1;
-  p.bent = rays[i].bent;
-  if (rays[i].n == 0) return p;
+  p.bent = own.bent;
+  if (own.n == 0) return p;
   auto vOf = [](const PoolSums& s) {
     const double pt = (s.Y + 1.0) / (s.W + 2.0);  // Laplace: never 0 after rays that all agreed
     return pt * (1.0 - pt);
@@ -117,21 +117,10 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
   int chosen = 0;
   const int R = std::min(o.maxRings, kMaxScales - 1);
   for (int h = 1; h <= R; ++h) {
-    sc.next.clear();
     PoolSums grown = sums;
     glm::vec3 db(0.f);
-    for (uint32_t v : sc.frontier)
-      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
-        const uint32_t u = g.nbr[k];
-        if (sc.stamp[u] == now) continue;
-        sc.stamp[u] = now;
-        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
-        sc.next.push_back(u);
-        const glm::vec3 d = positions[u] - pi;
-        grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
-        db += rays[u].bent;
-      }
-    if (sc.next.empty()) break;
+    const uint32_t added = ring(h, grown, db);
+    if (added == 0) break;
     const Fit f = fit(grown);
     const double v = vOf(grown);
     // Lepski: the new estimate within gamma standard errors of every smaller
@@ -148,15 +137,79 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
     VarV[h] = f.varOverV;
     V[h] = v;
     sums = grown;
-    p.vertices += uint32_t(sc.next.size());
+    p.vertices += added;
     p.bent += db;
-    sc.frontier.swap(sc.next);
   }
   p.value = float(std::clamp(A[chosen], 0.0, 1.0));
   p.stdError = float(std::sqrt(V[chosen] * VarV[chosen]));
   p.rays = uint32_t(sums.W);
   p.rings = chosen;
   return p;
+}
+
+// Breadth-first rings around i through vertices that may be pooled with it
+// (poolable, with rays, normal within the tolerance); calls visit(h, u) for
+// every such u of ring h = 1, ..., maxRings in the order poolVertex pools
+// them, and returns the number of rings found (the search stops at an empty
+// ring, as poolVertex does).
+template <class Visit>
+int searchRings(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
+                const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
+                int maxRings, PoolScratch& sc, Visit&& visit) {
+  if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
+  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
+  const uint32_t now = sc.now;
+  const glm::vec3 ni = normals[i];
+  sc.stamp[i] = now;
+  sc.frontier.assign(1, i);
+  int h = 1;
+  for (; h <= maxRings; ++h) {
+    sc.next.clear();
+    for (uint32_t v : sc.frontier)
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+        const uint32_t u = g.nbr[k];
+        if (sc.stamp[u] == now) continue;
+        sc.stamp[u] = now;
+        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
+        sc.next.push_back(u);
+      }
+    if (sc.next.empty()) break;
+    for (uint32_t u : sc.next) visit(h, u);
+    sc.frontier.swap(sc.next);
+  }
+  return h - 1;
+}
+
+}  // namespace
+
+Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
+                  const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
+                  const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& sc) {
+  const glm::vec3 pi = positions[i];
+  const Frame frame(normals[i]);
+  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
+    if (h == 1) {
+      if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
+      if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
+      sc.stamp[i] = sc.now;
+      sc.frontier.assign(1, i);
+    }
+    const uint32_t now = sc.now;
+    sc.next.clear();
+    for (uint32_t v : sc.frontier)
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+        const uint32_t u = g.nbr[k];
+        if (sc.stamp[u] == now) continue;
+        sc.stamp[u] = now;
+        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], normals[i]) < o.normalCos) continue;
+        sc.next.push_back(u);
+        const glm::vec3 d = positions[u] - pi;
+        grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+        db += rays[u].bent;
+      }
+    sc.frontier.swap(sc.next);
+    return uint32_t(sc.frontier.size());
+  });
 }
 
 namespace {
@@ -200,6 +253,95 @@ void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint
   r.n += count;
 }
 
+// How many slices parallelBlocks cuts `work` into: one per `perSlice`, 1 to 64.
+size_t slices(size_t work, size_t perSlice) { return std::clamp<size_t>(work / perSlice, 1, 64); }
+
+// Every vertex's rings (searchRings), kept across rounds. They depend on the
+// geometry and on which vertices have rays, which the first round settles
+// (counts only grow after it), so later rounds pool by walking a list
+// instead of searching the mesh again: one read per pooled vertex instead of
+// a visit to every edge around it. Per vertex: [rings, count of ring 1, ...,
+// count of the last ring, the vertices of ring 1, of ring 2, ...].
+class RingLists {
+ public:
+  // The lists of the vertices with mine[i] = 1; false (none kept) if they
+  // would take more than maxBytes.
+  bool build(const VertexGraph& g, const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
+             const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine, const PoolOptions& o,
+             size_t maxBytes) {
+    const size_t nv = normals.size(), maxEntries = maxBytes / sizeof(uint32_t);
+    const int R = std::min(o.maxRings, 64);
+    std::vector<std::pair<std::vector<uint32_t>*, size_t>> at(nv, {nullptr, 0});
+    std::atomic<size_t> entries{0};
+    tbb::enumerable_thread_specific<PoolScratch> scratch;
+    tbb::enumerable_thread_specific<std::vector<uint32_t>> members;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      if (entries.load(std::memory_order_relaxed) > maxEntries) return;
+      std::vector<uint32_t>& list = lists_.local();
+      std::vector<uint32_t>& ring = members.local();
+      PoolScratch& sc = scratch.local();
+      uint32_t counts[65];
+      const size_t before = list.size();
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        if (!mine[i]) continue;
+        ring.clear();
+        std::fill(counts, counts + R + 1, 0u);
+        const int rings = searchRings(uint32_t(i), g, normals, rays, poolable, o, R, sc, [&](int h, uint32_t u) {
+          ++counts[h];
+          ring.push_back(u);
+        });
+        at[i] = {&list, list.size()};
+        list.push_back(uint32_t(rings));
+        list.insert(list.end(), counts + 1, counts + 1 + rings);
+        list.insert(list.end(), ring.begin(), ring.end());
+      }
+      entries += list.size() - before;
+    });
+    if (entries.load() > maxEntries) {
+      lists_.clear();
+      return false;
+    }
+    head_.assign(nv, nullptr);
+    for (size_t i = 0; i < nv; ++i)
+      if (at[i].first) head_[i] = at[i].first->data() + at[i].second;
+    return true;
+  }
+  const uint32_t* operator[](size_t i) const { return head_[i]; }
+
+ private:
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> lists_;
+  std::vector<const uint32_t*> head_;
+};
+
+// What pooling reads of a neighbour, in one place (one cache line or two).
+struct PoolPoint {
+  glm::vec3 p;
+  uint32_t n = 0;
+  double sum = 0.0;
+};
+
+// poolVertex over vertex i's listed rings: the same sums in the same order.
+Pooled poolListed(uint32_t i, const uint32_t* list, const std::vector<PoolPoint>& pts,
+                  const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays, bool bent,
+                  const PoolOptions& o) {
+  const glm::vec3 pi = pts[i].p;
+  const Frame frame(normals[i]);
+  const uint32_t rings = list[0];
+  const uint32_t* member = list + 1 + rings;
+  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
+    if (uint32_t(h) > rings) return 0;
+    const uint32_t count = list[h];
+    for (uint32_t k = 0; k < count; ++k) {
+      const PoolPoint& q = pts[member[k]];
+      const glm::vec3 d = q.p - pi;
+      grown.add(q.n, q.sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+      if (bent) db += rays[member[k]].bent;  // zero unless bent normals are asked for
+    }
+    member += count;
+    return count;
+  });
+}
+
 }  // namespace
 
 SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
@@ -229,17 +371,26 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   std::vector<Pooled> pooled(nv);
   std::vector<double> exchange;
   tbb::enumerable_thread_specific<PoolScratch> scratch;
+  RingLists ringLists;
+  bool listed = false;
+  std::vector<PoolPoint> points;
   // Progress: rounds double the ray count, so the last rounds dominate; the
   // bar follows the rounds' share of the largest possible count.
   const double total = std::log2(double(adaptive ? std::max(o.maxRays, 1) : 1) / double(std::max(first, 1u))) + 1.0;
   for (int round = 0;; ++round) {
     const Progress bar = progress.sub(std::min(0.95, round / total), std::min(0.95, (round + 1) / total));
     Timer cast;
+    // Slices of about a second of work each (progress and cancelling happen
+    // between slices): each slice ends in a wait for the slowest thread,
+    // which on a machine shared with other jobs costs a time slice of the
+    // scheduler, and the later adaptive rounds cast few rays.
+    size_t work = 0;
+    for (size_t i = 0; i < nv; ++i) work += want[i] - std::min(want[i], rays[i].n);
     parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (want[i] > rays[i].n)
           castRays(caster, o, tfar, uint32_t(i), origins[i], normals[i], rays[i].n, want[i] - rays[i].n, rays[i]);
-    });
+    }, slices(work, size_t(1) << 20));
     if (split) {
       // Every part gets every vertex's rays (each vertex's from the part it
       // belongs to; a representative another part's duplicates need is cast
@@ -261,6 +412,18 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     }
     st.castSeconds += cast.seconds();
     Timer pool;
+    if (round == 0) {
+      // Lists of rings need every poolable vertex to have rays from now on.
+      bool settled = true;
+      for (size_t i = 0; i < nv; ++i) settled = settled && !(poolable[i] && rays[i].n == 0);
+      listed = settled && ringLists.build(g, normals, rays, poolable, mine, po, o.shareRingBytes);
+      if (listed) {
+        points.resize(nv);
+        for (size_t i = 0; i < nv; ++i) points[i].p = scene.positions[i];
+      }
+    }
+    if (listed)
+      for (size_t i = 0; i < nv; ++i) { points[i].n = rays[i].n; points[i].sum = rays[i].sum; }
     // Pooled (again): every vertex within reach of one whose rays changed.
     std::fill(repool.begin(), repool.end(), 0);
     for (size_t i = 0; i < nv; ++i)
@@ -272,11 +435,15 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
           for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
       repool.swap(grown);
     }
+    size_t pools = 0;
+    for (size_t i = 0; i < nv; ++i) pools += repool[i] && mine[i];
     parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
       PoolScratch& sc = scratch.local();
       for (size_t i = b; i < e; ++i)
-        if (repool[i] && mine[i]) pooled[i] = poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
-    });
+        if (repool[i] && mine[i])
+          pooled[i] = listed ? poolListed(uint32_t(i), ringLists[i], points, normals, rays, o.bentNormals, po)
+                             : poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
+    }, slices(pools, size_t(1) << 16));
     ++st.rounds;
     st.poolSeconds += pool.seconds();
     if (!adaptive) break;

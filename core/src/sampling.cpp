@@ -1,5 +1,6 @@
 #include "gi/sampling.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -29,7 +30,22 @@ glm::vec3 cosineHemisphere(glm::vec2 u) {
   return {x, y, z};
 }
 
-void cosineHemisphereBlock(int n, const float* u0, const float* u1, float* x, float* y, float* z) {
+// Both block functions are built twice, for AVX2 and for any x86-64, and
+// the loader picks one (GCC function multiversioning). AVX2 has the 32-bit
+// multiplies and byte shuffles the scrambling needs in 8 lanes; neither
+// version uses fused multiply-adds (that would be the "fma" target), so they
+// give the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define GI_BLOCK_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define GI_BLOCK_CLONES
+#endif
+
+GI_BLOCK_CLONES void scrambleBlock(int n, const uint32_t* r, uint32_t seed, float* u) {
+  for (int j = 0; j < n; ++j) u[j] = toUnitFloat(reverseBits(laineKarrasPermutation(r[j], seed)));
+}
+
+GI_BLOCK_CLONES void cosineHemisphereBlock(int n, const float* u0, const float* u1, float* x, float* y, float* z) {
   // Same concentric map as cosineHemisphere, with selects instead of branches.
   for (int j = 0; j < n; ++j) {
     const float a = 2.f * u0[j] - 1.f, b = 2.f * u1[j] - 1.f;
@@ -41,7 +57,7 @@ void cosineHemisphereBlock(int n, const float* u0, const float* u1, float* x, fl
     fastSinCos(0.785398163f * t, sn, c);
     x[j] = r * (first ? c : sn);
     y[j] = r * (first ? sn : c);
-    z[j] = std::sqrt(std::fmax(0.f, 1.f - r * r));
+    z[j] = std::sqrt(std::max(0.f, 1.f - r * r));  // max, not fmax (a call): the loop vectorises; no NaN here
   }
 }
 

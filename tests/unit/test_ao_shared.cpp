@@ -256,6 +256,28 @@ TEST(AOShared, DeterministicForAnyThreadCount) {
   }
 }
 
+// The rings kept across rounds (AmbientOptions::shareRingBytes) give the
+// bits of searching the mesh again every round, adaptive with bent normals
+// and fixed with 5 rings (the same vertices pooled in the same order).
+TEST(AOShared, KeptRingsGiveTheSearchedBits) {
+  const TestScene& t = scene();
+  AmbientOptions adaptive = shared(0.03);
+  adaptive.bentNormals = true;
+  AmbientOptions fixed = shared(0.0, 10.f, 5);
+  fixed.raysPerVertex = 16;
+  for (AmbientOptions o : {adaptive, fixed}) {
+    const AmbientResult kept = run(t.s, o);
+    o.shareRingBytes = 0;  // no room: searched each round
+    const AmbientResult searched = run(t.s, o);
+    for (size_t i = 0; i < t.end; ++i) {
+      ASSERT_EQ(kept.value[i], searched.value[i]) << i;
+      ASSERT_EQ(kept.stdError[i], searched.stdError[i]) << i;
+      ASSERT_EQ(kept.rays[i], searched.rays[i]) << i;
+      if (o.bentNormals) ASSERT_EQ(kept.bentNormal[i], searched.bentNormal[i]) << i;
+    }
+  }
+}
+
 // With a normal tolerance of 0 no vertex of a curved mesh pools anything:
 // the shared estimator gives the per-vertex estimator's values (its own rays
 // are the per-vertex estimator's first rays).

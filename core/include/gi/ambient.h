@@ -67,6 +67,10 @@ struct AmbientOptions {
   bool mergeDuplicates = true;   // same position and normal computed once
   int shareRings = 3;            // Shared: largest neighbourhood in mesh rings
   float shareNormalAngleDeg = 10.f;  // Shared: neighbours' normals within this angle
+  // Shared: memory for each vertex's rings kept across adaptive rounds (about
+  // 150 bytes per vertex at 3 rings); above it they are searched again each
+  // round (same results, slower).
+  size_t shareRingBytes = size_t(1) << 30;
   VertexPart vertices;           // which vertices to compute (a split run); the others are left 0
 
   static std::vector<ParamSpec> specs(AmbientMode mode);

@@ -133,6 +133,11 @@ struct SobolRevDir1 {
 };
 inline constexpr SobolRevDir1 kSobolRevDir1{};
 
+// u[j] = toUnitFloat(reverseBits(laineKarrasPermutation(r[j], seed))) for
+// j < n: the scrambling of a block of points (sampling.cpp: built for AVX2
+// too, picked at run time; integer operations, so the same bits either way).
+void scrambleBlock(int n, const uint32_t* r, uint32_t seed, float* u);
+
 class SobolOwenStream {
  public:
   explicit SobolOwenStream(uint32_t key) : s0_(hashCombine(key, 0x68bc21ebu)), s1_(hashCombine(key, 0x02e5be93u)) {}
@@ -145,10 +150,8 @@ class SobolOwenStream {
       r0_ ^= 1u << c;
       r1_ ^= kSobolRevDir1.v[c];
     }
-    for (int j = 0; j < n; ++j) {
-      u0[j] = toUnitFloat(reverseBits(laineKarrasPermutation(a[j], s0_)));
-      u1[j] = toUnitFloat(reverseBits(laineKarrasPermutation(b[j], s1_)));
-    }
+    scrambleBlock(n, a, s0_, u0);
+    scrambleBlock(n, b, s1_, u1);
   }
   // Jumps to point i: the Gray code of i in dimension 1 (bit-reversed
   // domain), the XOR of the direction numbers of its set bits in dimension 2.
