@@ -53,7 +53,13 @@ VARIANTS = {
                    "--refine_max_depth", "1"],
                   ["--solver", "Hierarchical", "--hierarchy_epsilon", "0.001", "--link_rays", "2", "--light_samples",
                    "16", "--gather_rays", "16", "--face_output", "true"]],
-    "photonmap": [["--photons", "20000", "--light_samples", "16"]],
+    "photonmap": [["--photons", "20000", "--light_samples", "16"],
+                  # The photons as a new layer: MeshLab adds it beside the mesh, the CLI writes cli.Photons.ply.
+                  ["--photons", "20000", "--light_samples", "16", "--photon_layer", "true", "--photon_layer_max", "5000"]],
+    # On the input errormap_input makes: its quality against another seed's reference file, as z-scores.
+    "errormap": [["--reference_source", "PLY file", "--reference_attribute", "quality", "--reference_error", "StdError",
+                  "--error_measure", "2"],
+                 ["--reference_source", "PLY file", "--reference_attribute", "quality", "--error_measure", "1"]],
     "reference": [["--samples_per_vertex", "8", "--max_depth", "8"]],
     "formfactors": [["--face_index", "5", "--rays_per_patch", "4096"]],
     "render": [["--width", "48", "--height", "32", "--samples_per_pixel", "2", "--vertex_radiance", "true"],
@@ -91,6 +97,21 @@ def quality_function(script, attribute, path):
     return path
 
 
+def errormap_input(gi, mesh, tmp):
+    """The error map compares what a mesh carries with a reference: the input is
+    a short path-traced reference run's PLY (its quality), the reference file
+    another seed's; returns the input and the parameter naming the file."""
+    files = []
+    for seed in ("1", "2"):
+        files.append(os.path.join(tmp, "errormap_ref%s.ply" % seed))
+        run([gi, "reference", mesh, "-o", files[-1], "-q", "--samples_per_vertex", "8", "--max_depth", "4",
+             "--seed", seed])
+    return files[0], ["--reference_file", files[1]]
+
+
+INPUTS = {"errormap": errormap_input}
+
+
 def same(label, a, b, what):
     if len(a) != len(b):
         fail("%s: %s: %d values from meshlabserver, %d from the CLI" % (label, what, len(a), len(b)))
@@ -119,6 +140,10 @@ def main():
             continue
         for k, params in enumerate(VARIANTS.get(name, [[]])):
             label = "%s #%d" % (name, k + 1)
+            mesh = os.path.join(a.meshes, "cornell_box.ply")
+            if name in INPUTS:
+                mesh, more = INPUTS[name](gi, mesh, tmp)
+                params = params + more
             script = os.path.join(tmp, "%s%d.mlx" % (name, k))
             images = "image" in filt["writes"]
             ml_img, cli_img = os.path.join(tmp, "ml.png"), os.path.join(tmp, "cli.png")

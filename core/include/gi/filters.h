@@ -22,6 +22,7 @@ enum class FilterKind {
   PathTracedReference,
   FormFactorsOfFace,
   RayTracedView,
+  ErrorMap,
 };
 
 // What a filter may change in the mesh (MeshLab's postCondition, the PLY the CLI writes).
