@@ -25,6 +25,9 @@ what each writes must be bit-identical:
   compared through quality and colour (computed from the same arrays) and,
   for bent normals, through the vertex normals.
 
+- a new layer a filter adds (photon mapping's photons): MeshLab's layer 1
+  against the PLY the CLI writes beside its output.
+
 A filter the table below does not name runs with its defaults, so a new
 filter is covered the day it enters the catalogue.
 
@@ -150,8 +153,17 @@ def main():
             run([gi, "script", name, "--mesh", mesh, "-o", script] + params + (["--image_path", ml_img] if images else []))
             ml_out, cli_out = os.path.join(tmp, "ml.ply"), os.path.join(tmp, "cli.ply")
             mask = ["vc", "vq", "vn", "fc", "fq"]
-            run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + ["-s", script])
+            # A new layer (the photons): layer 1 in MeshLab, OUT.Photons.ply beside the CLI's output.
+            new_layer = "--photon_layer" in params
+            ml_layer = os.path.join(tmp, "ml_layer.ply")
+            more = ["-l", "0", "-o", ml_layer, "-l", "1", "-m", "vc", "vq", "vn"] if new_layer else []
+            run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + more + ["-s", script])
             run([gi, name, mesh, "-o", cli_out, "-q"] + params + (["--image_path", cli_img] if images else []))
+            if new_layer:
+                lm, lc = read_ply(ml_layer)["vertex"], read_ply(cli_out[:-4] + ".Photons.ply")["vertex"]
+                for props, what in ((("x", "y", "z"), "layer positions"), (("red", "green", "blue"), "layer colours"),
+                                    (("quality",), "layer quality"), (("nx", "ny", "nz"), "layer normals")):
+                    same(label, [tuple(r[p] for p in props) for r in lm], [tuple(r[p] for p in props) for r in lc], what)
             if images:
                 for ext in (".png", ".pfm"):
                     with open(ml_img[:-4] + ext, "rb") as f1, open(cli_img[:-4] + ext, "rb") as f2:
