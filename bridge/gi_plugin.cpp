@@ -70,6 +70,7 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
     writeOutputFiles(r);
     writeResult(b, r);
     addRasters(md, r);
+    addLayers(md, r);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);
   });
   return why;

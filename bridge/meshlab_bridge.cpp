@@ -11,7 +11,11 @@
 #include <cstring>
 #include <type_traits>
 
+#include <vcg/complex/algorithms/update/bounding.h>
 #include <vcg/complex/algorithms/update/color.h>
+#include <vcg/complex/algorithms/update/normal.h>
+
+#include "vertex_file.h"
 
 namespace gi::ml {
 
@@ -272,6 +276,17 @@ std::vector<VertexAttribute> readAttributes(const BridgeScene& b) {
   };
   collect(Scalarm(), 1);
   collect(Point3m(), 3);
+  // The vertex quality, where every layer has one, under the name the PLY
+  // files give it: the error map compares it (gi::kQualityAttribute).
+  bool quality = true;
+  for (const LayerPart& p : b.parts) quality &= p.mm->hasDataMask(MeshModel::MM_VERTQUALITY);
+  if (quality) {
+    VertexAttribute q{kQualityAttribute, 1, std::vector<float>(nv, 0.f)};
+    for (const LayerPart& p : b.parts)
+      for (size_t i = 0; i < p.mm->cm.vert.size(); ++i)
+        if (p.sceneVertex[i] >= 0) q.values[size_t(p.sceneVertex[i])] = float(p.mm->cm.vert[i].cQ());
+    out.push_back(std::move(q));
+  }
   return out;
 }
 
@@ -329,6 +344,35 @@ void addRasters(MeshDocument& md, const FilterResult& r) {
   }
 }
 
+void addLayers(MeshDocument& md, const FilterResult& r) {
+  for (const FilterLayer& L : r.layers) {
+    MeshModel* mm = compat::addMeshLayer(md, QString::fromStdString(L.name));
+    CMeshO& m = mm->cm;
+    const size_t nv = L.mesh.vertexCount();
+    int mask = 0;
+    if (!L.quality.empty()) mask |= MeshModel::MM_VERTQUALITY;
+    if (!L.color.empty()) mask |= MeshModel::MM_VERTCOLOR;
+    mm->updateDataMask(mask);
+    vcg::tri::Allocator<CMeshO>::AddVertices(m, nv);
+    for (size_t i = 0; i < nv; ++i) {
+      CVertexO& v = m.vert[i];
+      const glm::dvec3 p = L.mesh.toWorld(L.mesh.positions[i]);
+      v.P() = Point3m(Scalarm(p.x), Scalarm(p.y), Scalarm(p.z));
+      if (!L.normals.empty()) v.N() = Point3m(L.normals[i].x, L.normals[i].y, L.normals[i].z);
+      if (!L.quality.empty()) v.Q() = L.quality[i];
+      if (!L.color.empty()) v.C() = vcg::Color4b(L.color[i].r, L.color[i].g, L.color[i].b, 255);
+    }
+    if (!L.mesh.triangles.empty()) {
+      vcg::tri::Allocator<CMeshO>::AddFaces(m, L.mesh.triangles.size());
+      for (size_t f = 0; f < L.mesh.triangles.size(); ++f)
+        for (int k = 0; k < 3; ++k) m.face[f].V(k) = &m.vert[L.mesh.triangles[f][k]];
+      vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(m);
+      if (L.normals.empty()) vcg::tri::UpdateNormal<CMeshO>::PerVertexAngleWeighted(m);
+    }
+    vcg::tri::UpdateBounding<CMeshO>::Box(m);
+  }
+}
+
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b) {
   FilterInput in;
   in.values = readParams(par, filterSpecs(kind));
@@ -339,6 +383,7 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
   in.attrs = b.attrs;
   for (const LayerPart& p : b.parts) in.layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
   in.attributes = readAttributes(b);
+  in.readVertexFile = io::readVertexFile;  // a reference file a parameter names
   if (md.mm() && md.mm()->cm.shot.IsValid()) in.layerCamera = toShotData(md.mm()->cm.shot);
   return in;
 }

@@ -82,5 +82,8 @@ namespace gi::ml {
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b);
 // Each image of the result as a new raster layer with the camera it was seen from.
 void addRasters(MeshDocument& md, const FilterResult& r);
+// Each new layer of the result (points or triangles, colour, quality,
+// normals) as a new mesh layer; the current layer stays current.
+void addLayers(MeshDocument& md, const FilterResult& r);
 
 }  // namespace gi::ml

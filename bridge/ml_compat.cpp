@@ -13,6 +13,11 @@ std::vector<MeshModel*> meshes(MeshDocument& md) {
   return out;
 }
 
+MeshModel* addMeshLayer(MeshDocument& md, const QString& label) {
+  // 2025.07 also has addNewMesh(const CMeshO&, ...): the file path as a QString picks the same overload in both.
+  return md.addNewMesh(QString(), label, false);
+}
+
 void addDistance(RichParameterList& out, const QString& name, float def, float max, const QString& label,
                  const QString& help) {
 #ifdef GI_MESHLAB_2025

@@ -53,6 +53,8 @@ using ImagePlane = Plane;
 
 // The document's layers, in layer-dialog order.
 std::vector<MeshModel*> meshes(MeshDocument& md);
+// A new, empty mesh layer named `label` (not made current).
+MeshModel* addMeshLayer(MeshDocument& md, const QString& label);
 
 // Dialog parameters whose class changed: a distance with its percentage of the
 // diagonal, and a point or a direction.

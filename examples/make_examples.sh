@@ -54,4 +54,16 @@ for s in shadow_leak:2 staircase:4; do
   "$gi" script radiosity --mesh "$m/$s.ply" --emitter_source 1 --vertex_output "Patch average" --refine true \
     --refine_max_depth "$depth" -o "$ex/${s}_refined.mlx"
 done
+# The photons of the caustic box as a point-cloud layer (global map orange, caustic map blue).
+"$gi" script photonmap --mesh "$m/caustic_cornell_box.ply" --scene_extent "All visible layers" --emitter_source 1 \
+  --photons 200000 --photon_layer true -o "$ex/photonmap_caustic_photons.mlx"
+# The error map, three filters in one script: the path-traced reference (it leaves Reference and
+# ReferenceStdError), radiosity on the same layer (it overwrites quality), then the z-score of the radiosity
+# against the reference. gi script writes one filter: the three are joined without their inner
+# <FilterScript> lines.
+{
+  "$gi" script reference --mesh "$m/cornell_box.ply" --emitter_source 1 --samples_per_vertex 64 | sed '$d'
+  "$gi" script radiosity --mesh "$m/cornell_box.ply" --emitter_source 1 | sed '1,2d;$d'
+  "$gi" script errormap --mesh "$m/cornell_box.ply" --error_measure 2 | sed '1,2d'
+} > "$ex/errormap_radiosity_cornell.mlx"
 echo "examples written to $ex"

@@ -14,6 +14,7 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
 #include "mesh_parts.h"
+#include "vertex_file.h"
 
 namespace gi::io {
 
@@ -140,41 +141,6 @@ struct ByteWriter {
 
 namespace {
 
-// The kept vertex properties as named attributes, as writePly writes them:
-// NAME_x, NAME_y, NAME_z (all three present, no scalar NAME) make the vector
-// NAME; every other one is the scalar of its name.
-std::vector<VertexAttribute> vertexAttributes(const Polygons& p) {
-  const std::vector<std::string>& names = p.vertexFloatNames;
-  auto find = [&](const std::string& n) {
-    return size_t(std::find(names.begin(), names.end(), n) - names.begin());
-  };
-  std::vector<VertexAttribute> out;
-  std::vector<uint8_t> used(names.size(), 0);
-  const size_t nv = p.points.size();
-  for (size_t k = 0; k < names.size(); ++k) {
-    if (used[k]) continue;
-    const std::string& n = names[k];
-    if (n.size() > 2 && n.compare(n.size() - 2, 2, "_x") == 0) {
-      const std::string base = n.substr(0, n.size() - 2);
-      const size_t y = find(base + "_y"), z = find(base + "_z");
-      if (y < names.size() && z < names.size() && find(base) == names.size()) {
-        VertexAttribute a{base, 3, std::vector<float>(3 * nv)};
-        for (size_t i = 0; i < nv; ++i) {
-          a.values[3 * i] = p.vertexFloats[k][i];
-          a.values[3 * i + 1] = p.vertexFloats[y][i];
-          a.values[3 * i + 2] = p.vertexFloats[z][i];
-        }
-        used[k] = used[y] = used[z] = 1;
-        out.push_back(std::move(a));
-        continue;
-      }
-    }
-  }
-  for (size_t k = 0; k < names.size(); ++k)
-    if (!used[k]) out.push_back({names[k], 1, p.vertexFloats[k]});
-  return out;
-}
-
 LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
   if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
     failRead(name, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
@@ -202,7 +168,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
-  out.attributes = vertexAttributes(p);
+  out.attributes = detail::vertexAttributes(p);
   return out;
 }
 

@@ -19,6 +19,7 @@
 #include "gi_cluster.h"
 #include "gi_output.h"
 #include "mesh_io.h"
+#include "vertex_file.h"
 
 namespace gi::batch {
 
@@ -242,9 +243,12 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   in.layers.push_back({fs::path(job.input).filename().string(), 0, mesh.scene.faceCount()});
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
+  in.attributes = std::move(mesh.attributes);
+  in.readVertexFile = io::readVertexFile;
   FilterResult r = runFilter(d.kind, in);
   const fs::path tmp = ply.string() + ".part";
   writeResultPly(tmp.string(), in.scene, mesh.attrs, fileNormals, r);
+  const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
   fs::rename(tmp, ply);
   json s;
   s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
@@ -254,6 +258,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   s["warnings"] = r.stats.warnings;
   s["notes"] = r.stats.notes;
   s["log"] = r.logLines(d.meshlabName);
+  if (!layers.empty()) s["layers"] = layers;
   s["seconds"] = timer.seconds();
   return s;
 }

@@ -25,6 +25,7 @@
 #include "gi_output.h"
 #include "mesh_io.h"
 #include "result_file.h"
+#include "vertex_file.h"
 
 using namespace gi;
 using json = nlohmann::json;
@@ -154,6 +155,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
   in.attributes = std::move(mesh.attributes);  // what an earlier run left (PLY properties), e.g. a first pass
+  in.readVertexFile = io::readVertexFile;       // a reference file a parameter names
 
   const bool writer = cluster::rank() == 0;  // under mpirun only rank 0 writes and prints
   const Progress progress(stderrProgress(a.quiet || !writer));
@@ -175,14 +177,20 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   if (!reused) {
     cluster::compute(kind, in, r, progress, a.split);
     if (!writer) return 0;
-    if (!cached.empty() && !r.refined) {
+    if (!cached.empty() && !r.refined && r.layers.empty()) {  // a cached result holds no geometry
       io::writeResultFile(cached, key, r);
       r.stats.note("cached as " + cached);
     }
   }
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
-  if (!a.output.empty()) writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
+  std::vector<std::string> layerFiles;
+  if (!a.output.empty()) {
+    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
+    layerFiles = writeLayerPlys(a.output, r);
+  } else if (!r.layers.empty()) {
+    r.stats.note("the new layers are written only beside an output (-o)");
+  }
   writeOutputFiles(r);
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
@@ -192,6 +200,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     j["filter"] = desc.meshlabName;
     j["input"] = a.input;
     if (!a.output.empty()) j["output"] = a.output;
+    if (!layerFiles.empty()) j["layers"] = layerFiles;
     j["parameters"] = valuesJson(specs, in.values);
     j["scene"] = {{"vertices", rep.vertices}, {"faces", rep.faces}, {"usable_faces", rep.usableFaces()},
                   {"degenerate_faces", rep.degenerateFaces}, {"invalid_faces", rep.invalidFaces},
@@ -207,6 +216,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   } else if (!a.quiet) {
     for (const std::string& l : lines) std::cerr << l << "\n";
     if (!a.output.empty()) std::cerr << "wrote " << a.output << "\n";
+    for (const std::string& f : layerFiles) std::cerr << "wrote " << f << " (a new layer)\n";
     for (const FilterImage& img : r.images)
       if (!img.path.empty()) std::cerr << "wrote " << img.path << " (and .pfm)\n";
   }
@@ -300,7 +310,9 @@ int runCli(int argc, char** argv) {
   for (const FilterDesc& d : allFilters()) {
     CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
     sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required();
-    outputs.push_back({sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file)"),
+    outputs.push_back({sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file); a filter's new layers (e.g. "
+                                                  "photonmap --photon_layer) go beside it as OUT.NAME.ply (OUT.Photons.ply), "
+                                                  "listed under \"layers\" in --json"),
                        &a.output});
     sub->add_option("--layer", a.layers, "another mesh file in the same scene, like a visible layer in MeshLab "
                                          "(repeatable; its file name is its layer name)");

@@ -20,4 +20,15 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
   io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);
 }
 
+std::vector<std::string> writeLayerPlys(const std::string& outputPly, const FilterResult& r) {
+  std::vector<std::string> paths;
+  for (const FilterLayer& L : r.layers) {
+    io::PlyExtras extras;
+    extras.normals = L.normals;
+    paths.push_back(layerPath(outputPly, L.name));
+    io::writePly(paths.back(), L.mesh, MeshAttributes{}, L.quality, L.color, extras);
+  }
+  return paths;
+}
+
 }  // namespace gi

@@ -14,4 +14,9 @@ namespace gi {
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
                     const std::vector<glm::vec3>& fileNormals, const FilterResult& r);
 
+// Each new layer of the result (photon mapping's photons) as a PLY beside the
+// output, at gi::layerPath (out.ply -> out.Photons.ply): points, colour,
+// quality, normals. Returns the paths written.
+std::vector<std::string> writeLayerPlys(const std::string& outputPly, const FilterResult& r);
+
 }  // namespace gi

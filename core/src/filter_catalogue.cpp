@@ -131,7 +131,9 @@ const std::vector<FilterDesc>& allFilters() {
        "bounces it took before the vertex (Heckbert 1990 notation): an emitter, the sky or the sun reached from "
        "the vertex itself is <i>Radiosity_direct</i> (L D E), through mirror, glass and glossy bounces only "
        "<i>Radiosity_caustic</i> (L S+ D E), after another diffuse bounce <i>Radiosity_indirect</i>; with "
-       "<i>Radiosity_emitted</i> (L E) they sum to Radiosity.",
+       "<i>Radiosity_emitted</i> (L E) they sum to Radiosity. The quality and its error bar are also kept as "
+       "<i>Reference</i> and <i>ReferenceStdError</i>, which no other filter overwrites: run a method after it "
+       "on the same layer and 'GI: Error Map' compares the two.",
        WritesVertexQuality | WritesVertexColor},
       {FilterKind::FormFactorsOfFace, "GI: Form Factors of Selected Face", "formfactors", "filter_radiosity",
        "form factors from one face to every other face (teaching, debugging)",
@@ -181,6 +183,21 @@ const std::vector<FilterDesc>& allFilters() {
        "F<sub>ij</sub> as face <b>quality</b> (vertex quality: the mean of the incident faces'), exactly the factors of 'GI: Form Factors of Selected Face' with "
        "the hemicube method and one view. The log compares the two methods patch by patch.",
        WritesVertexQuality | WritesFaceQuality | WritesFaceColor | WritesImage},
+      {FilterKind::ErrorMap, "GI: Error Map", "errormap", "filter_reference",
+       "per-vertex error of a result against a reference (difference, relative, z-score)",
+       "Where is an algorithm wrong? The <b>error map</b> compares a per-vertex value v (the vertex quality a "
+       "filter wrote, or a named attribute) with a reference r: an attribute of the same mesh (run 'GI: Path "
+       "Traced Reference' first: it leaves <i>Reference</i> and <i>ReferenceStdError</i>; then run the method "
+       "under test, e.g. 'GI: Radiosity', on the same layer), or a PLY file of the same mesh. It writes to vertex "
+       "<b>quality</b> the difference <i>v - r</i>, the relative difference <i>(v - r) / |r|</i> or the "
+       "<b>z-score</b> <i>z = (v - r) / &radic;(s<sub>r</sub><sup>2</sup> + s<sub>v</sub><sup>2</sup>)</i> with "
+       "the standard errors s of the reference and, if noisy, of the value. Where v is right, z is about "
+       "N(0,1) and only 0.27% of the vertices have |z| &gt; 3 by chance: more show a real error (bias, a leak, a "
+       "missing caustic), not noise. Vertex <b>colour</b>: a diverging ramp (Moreland 2009), blue below the "
+       "reference, white on it, red above, over a symmetric range [-R, R] stated in the log. The log gives the "
+       "RMS error, the relative RMS error, the largest |v - r|, the mean difference (bias) and, for z-scores, "
+       "the fraction with |z| &gt; 3.",
+       WritesVertexQuality | WritesVertexColor},
   };
   return f;
 }

@@ -1,6 +1,7 @@
 #include "gi/filter_run.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -10,6 +11,7 @@
 
 #include "gi/ambient.h"
 #include "gi/direct.h"
+#include "gi/error_map.h"
 #include "gi/form_factors.h"
 #include "gi/hemicube_view.h"
 #include "gi/output.h"
@@ -255,6 +257,13 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
   if (opt.tracedVertices > 0)
     res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
+  // The same value and error bar under names no other filter writes: they
+  // stay on the mesh while a method under test overwrites quality, Radiosity
+  // and StdError, for 'GI: Error Map' to compare with.
+  std::vector<float> Y(r.B.size());
+  for (size_t i = 0; i < Y.size(); ++i) Y[i] = luminance(r.B[i]);
+  res.attributes.push_back(scalarAttribute("Reference", Y));
+  res.attributes.push_back(scalarAttribute("ReferenceStdError", r.stdError));
   addLightPathAttributes(r.split, res);
 }
 
@@ -281,10 +290,48 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   for (auto& [suffix, text] : r.exports) res.files.push_back({opt.exportSystem + suffix, std::move(text)});
 }
 
+// The photons of the maps as a point-cloud layer (photon_layer), in the
+// scene's frame: past `cap` points, every k-th photon of the two maps in turn
+// (indices floor(j total / cap), so each map keeps its share).
+FilterLayer photonLayer(const Scene& s, const PhotonMapContents& maps, size_t cap, RunStats& st) {
+  static const Rgb8 kGlobal{255, 140, 20}, kCaustic{40, 110, 255};
+  FilterLayer L;
+  L.name = "Photons";
+  L.mesh.origin = s.origin;
+  L.mesh.unit = s.unit;
+  const size_t total = maps.global.size() + maps.caustic.size(), n = std::min(total, cap);
+  const double powerUnit = s.unit * s.unit;  // flux in world units, as emitted_power_W
+  for (size_t j = 0; j < n; ++j) {
+    const size_t k = n == total ? j : size_t(double(j) * double(total) / double(n));
+    const bool caustic = k >= maps.global.size();
+    const Photon& p = caustic ? maps.caustic[k - maps.global.size()] : maps.global[k];
+    L.mesh.positions.push_back(p.p);
+    L.quality.push_back(float(luminance(p.power) * powerUnit));
+    L.color.push_back(caustic ? kCaustic : kGlobal);
+    L.normals.push_back(p.normal());
+  }
+  st.add("photon_layer_points", double(n));
+  if (n < total)
+    st.note("photon layer: " + std::to_string(n) + " of " + std::to_string(total) +
+            " stored photons (evenly subsampled: photon_layer_max)");
+  return L;
+}
+
 void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) {
   const auto caster = makeEmbreeCaster(in.scene);
-  VertexRadiometry r = computePhotonMap(in.scene, *caster, PhotonOptions::fromParams(in.values, in.scene.origin), progress);
+  const PhotonOptions opt = PhotonOptions::fromParams(in.values, in.scene.origin);
+  const bool layer = in.values.getBool("photon_layer");
+  PhotonMapContents maps;
+  VertexRadiometry r = computePhotonMap(in.scene, *caster, opt, progress, layer ? &maps : nullptr);
   res.stats = std::move(r.stats);
+  if (layer && opt.progressive)
+    res.stats.warn("photon_layer: progressive photon mapping keeps no photon map, so no layer was added");
+  else if (layer && maps.global.empty() && maps.caustic.empty())
+    res.stats.note("photon layer: no photons were stored, so no layer was added");
+  else if (layer)
+    res.layers.push_back(photonLayer(in.scene, maps, size_t(in.values.getInt("photon_layer_max")), res.stats));
+  else if (in.values.getInt("photon_layer_max") != 1000000)
+    res.stats.warn("photon_layer_max is not used: photon_layer is off");
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
   radiometric(res, in.scene, in.values.getFloat("exposure"), "Radiosity");
   // Its direct part, for a two-pass view (which then need not estimate it again).
@@ -352,6 +399,15 @@ void finish(FilterResult& res, const Scene& out) {
     sized(a.values.size(), nv * size_t(a.components), a.name.c_str());
     for (float& x : a.values) clean(x);
   }
+  for (FilterLayer& L : res.layers) {
+    const size_t n = L.mesh.vertexCount();
+    sized(L.quality.size(), n, "layer qualities");
+    sized(L.color.size(), n, "layer colours");
+    sized(L.normals.size(), n, "layer normals");
+    for (float& q : L.quality) clean(q);
+    for (glm::vec3& p : L.mesh.positions) clean(p.x), clean(p.y), clean(p.z);
+    for (glm::vec3& m : L.normals) clean(m.x), clean(m.y), clean(m.z);
+  }
   if (bad) res.stats.warn(std::to_string(bad) + " non-finite values were written as 0");
 }
 
@@ -377,6 +433,15 @@ void writeOutputFiles(const FilterResult& r) {
     const std::string stem = dot != std::string::npos && (slash == std::string::npos || dot > slash) ? img.path.substr(0, dot) : img.path;
     writePfm(stem + ".pfm", img.image);
   }
+}
+
+std::string layerPath(const std::string& outputPly, const std::string& layerName) {
+  const size_t slash = outputPly.find_last_of('/'), dot = outputPly.find_last_of('.');
+  const bool ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  std::string name = layerName;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  return (ext ? outputPly.substr(0, dot) : outputPly) + "." + name + ".ply";
 }
 
 const VertexAttribute* FilterResult::attribute(const std::string& name) const {
@@ -449,6 +514,7 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
     case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
     case FilterKind::RayTracedView: runRender(in, res, progress); break;
     case FilterKind::HemicubeOfFace: runHemicube(in, res); break;
+    case FilterKind::ErrorMap: computeErrorMap(in, res); break;
   }
 }
 

@@ -9,6 +9,7 @@
 #include "gi/form_factors.h"
 #include "gi/hemicube_view.h"
 #include "gi/direct.h"
+#include "gi/error_map.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/radiosity.h"
@@ -52,6 +53,19 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       add(materialSpecs());
       add(glossySpecs());
       add(PhotonOptions::specs());
+      s.push_back({.name = "photon_layer", .label = "Photons as a new layer",
+                   .help = "Also add the stored photons as a point-cloud layer (the command-line tool: a PLY beside "
+                           "the output, NAME.Photons.ply): each photon of the maps the estimates read is a point "
+                           "where it landed, coloured by its map (global map orange, caustic map blue), with "
+                           "quality = its power (luminance, W) and normal = the side it arrived on. Colour by power "
+                           "with MeshLab's Colorize by vertex quality. Not with progressive photon mapping, which "
+                           "keeps no map.",
+                   .type = ParamType::Bool, .def = false});
+      s.push_back({.name = "photon_layer_max", .label = "Most points in the photon layer",
+                   .help = "A cap on the photon layer's points (about 40 bytes each in MeshLab): with more stored "
+                           "photons, every k-th of each map is kept, evenly, and the log says how many were left "
+                           "out. The points keep their own power.",
+                   .type = ParamType::Int, .def = 1000000, .min = 1, .max = 100000000});
       add(displaySpecs());
       break;
     case FilterKind::FormFactorsOfFace:
@@ -80,6 +94,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       add(glossySpecs());
       add(PathTraceOptions::specs());
       add(displaySpecs());
+      break;
+    case FilterKind::ErrorMap:
+      s.push_back(geometrySceneSpecs().front());  // scene extent
+      add(ErrorMapOptions::specs());
       break;
   }
   return s;

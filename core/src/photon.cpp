@@ -287,7 +287,8 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
 
 // Photon mapping proper (Jensen 1996): trace, build the maps, estimate at
 // the vertices.
-PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, PhotonTraceStats& ts, RunStats& st) {
+PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, PhotonTraceStats& ts, RunStats& st,
+                                PhotonMapContents* contents) {
   const PhotonOptions& opt = r.opt;
   Timer traceTimer;
   std::vector<Photon> photons =
@@ -300,6 +301,17 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   const GatherSurface surface(r.s);
   const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts);
   const double buildSeconds = buildTimer.seconds();
+  if (contents) {
+    // The same membership as the trees': `all` (final gather) or the global
+    // paths, and the caustic map from the projection or the global trace.
+    const unsigned globalMask = maps.all ? 7u : maps.global ? maps.globalPaths : 0u;
+    for (const Photon& p : photons)
+      if ((globalMask >> p.path) & 1u) contents->global.push_back(p);
+    if (maps.caustics) {
+      for (const Photon& p : r.projection && !causticPhotons.empty() ? causticPhotons : photons)
+        if (p.path == kCausticPhoton) contents->caustic.push_back(p);
+    }
+  }
   Timer queryTimer;
   PhotonEstimate e = estimateAtVertices(r, maps, progress.sub(0.55, 1.0));
   st.add("trace_seconds", traceSeconds);
@@ -387,7 +399,7 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
 }  // namespace
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
-                                  const Progress& progress) {
+                                  const Progress& progress, PhotonMapContents* maps) {
   PhotonOptions opt = optWorld;  // distances and the point light in local units (Scene::unit)
   opt.maxRadius = optWorld.maxRadius / s.unit;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
@@ -430,7 +442,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   } else if (opt.progressive) {
     photons = progressiveEstimate(run, progress, ts, st);
   } else {
-    photons = kNearestEstimate(run, progress, ts, st);
+    photons = kNearestEstimate(run, progress, ts, st, maps);
   }
   if (opt.lightPathSplit) out.split.assign(nv);
   const Totals totals = combine(mat, Hd, photons, opt.directLight, out);

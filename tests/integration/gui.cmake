@@ -45,7 +45,7 @@ else()
   # light marked by face quality: the default 'Auto' emitters find it). Their
   # dialogs are taller than 1024 pixels: a taller screen keeps Apply visible.
   # The numbers are the filters' places in the alphabetical submenu.
-  foreach(f "Radiosity;19;2000;radiosity" "Photon Mapping;18;2200;photon_mapping")
+  foreach(f "Radiosity;20;2000;radiosity" "Photon Mapping;19;2200;photon_mapping")
     list(GET f 0 name)
     list(GET f 1 downs)
     list(GET f 2 screen)

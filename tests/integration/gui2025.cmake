@@ -54,11 +54,11 @@ set(_e53 "--emitter_intensity 53.4")
 set(_cases
   "Ambient Obscurance|obscurance|bunny.ply|test_meshes/bunny.ply|0|1024|5e-5"
   "Ambient Occlusion|ao|bunny.ply|test_meshes/bunny.ply|1|1024|0"
-  "Form Factors of Selected Face|formfactors|@ff|test_meshes/cornell_box.ply --face_index ${_ff_face}|2|1024|0"
-  "Path Traced Reference|reference|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|3|2200|0"
-  "Photon Mapping|photonmap|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|4|2200|5e-6"
-  "Radiosity|radiosity|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|5|2000|0"
-  "Sky Lighting|sky|bunny.ply|test_meshes/bunny.ply|6|1024|0")
+  "Form Factors of Selected Face|formfactors|@ff|test_meshes/cornell_box.ply --face_index ${_ff_face}|3|1024|0"
+  "Path Traced Reference|reference|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|4|2200|0"
+  "Photon Mapping|photonmap|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|5|2200|5e-6"
+  "Radiosity|radiosity|cornell_box.ply|test_meshes/cornell_box.ply ${_e53}|6|2000|0"
+  "Sky Lighting|sky|bunny.ply|test_meshes/bunny.ply|7|1024|0")
 foreach(c ${_cases})
   string(REPLACE "|" ";" c "${c}")
   list(GET c 0 name)

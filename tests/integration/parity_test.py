@@ -25,6 +25,9 @@ what each writes must be bit-identical:
   compared through quality and colour (computed from the same arrays) and,
   for bent normals, through the vertex normals.
 
+- a new layer a filter adds (photon mapping's photons): MeshLab's layer 1
+  against the PLY the CLI writes beside its output.
+
 A filter the table below does not name runs with its defaults, so a new
 filter is covered the day it enters the catalogue.
 
@@ -53,7 +56,13 @@ VARIANTS = {
                    "--refine_max_depth", "1"],
                   ["--solver", "Hierarchical", "--hierarchy_epsilon", "0.001", "--link_rays", "2", "--light_samples",
                    "16", "--gather_rays", "16", "--face_output", "true"]],
-    "photonmap": [["--photons", "20000", "--light_samples", "16"]],
+    "photonmap": [["--photons", "20000", "--light_samples", "16"],
+                  # The photons as a new layer: MeshLab adds it beside the mesh, the CLI writes cli.Photons.ply.
+                  ["--photons", "20000", "--light_samples", "16", "--photon_layer", "true", "--photon_layer_max", "5000"]],
+    # On the input errormap_input makes: its quality against another seed's reference file, as z-scores.
+    "errormap": [["--reference_source", "PLY file", "--reference_attribute", "quality", "--reference_error", "StdError",
+                  "--error_measure", "2"],
+                 ["--reference_source", "PLY file", "--reference_attribute", "quality", "--error_measure", "1"]],
     "reference": [["--samples_per_vertex", "8", "--max_depth", "8"]],
     "formfactors": [["--face_index", "5", "--rays_per_patch", "4096"]],
     "hemicube": [["--face_index", "49", "--hemicube_resolution", "32", "--nusselt_resolution", "64"]],
@@ -92,6 +101,21 @@ def quality_function(script, attribute, path):
     return path
 
 
+def errormap_input(gi, mesh, tmp):
+    """The error map compares what a mesh carries with a reference: the input is
+    a short path-traced reference run's PLY (its quality), the reference file
+    another seed's; returns the input and the parameter naming the file."""
+    files = []
+    for seed in ("1", "2"):
+        files.append(os.path.join(tmp, "errormap_ref%s.ply" % seed))
+        run([gi, "reference", mesh, "-o", files[-1], "-q", "--samples_per_vertex", "8", "--max_depth", "4",
+             "--seed", seed])
+    return files[0], ["--reference_file", files[1]]
+
+
+INPUTS = {"errormap": errormap_input}
+
+
 def same(label, a, b, what):
     if len(a) != len(b):
         fail("%s: %s: %d values from meshlabserver, %d from the CLI" % (label, what, len(a), len(b)))
@@ -120,14 +144,27 @@ def main():
             continue
         for k, params in enumerate(VARIANTS.get(name, [[]])):
             label = "%s #%d" % (name, k + 1)
+            mesh = os.path.join(a.meshes, "cornell_box.ply")
+            if name in INPUTS:
+                mesh, more = INPUTS[name](gi, mesh, tmp)
+                params = params + more
             script = os.path.join(tmp, "%s%d.mlx" % (name, k))
             images = "image" in filt["writes"]
             ml_img, cli_img = os.path.join(tmp, "ml.png"), os.path.join(tmp, "cli.png")
             run([gi, "script", name, "--mesh", mesh, "-o", script] + params + (["--image_path", ml_img] if images else []))
             ml_out, cli_out = os.path.join(tmp, "ml.ply"), os.path.join(tmp, "cli.ply")
             mask = ["vc", "vq", "vn", "fc", "fq"]
-            run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + ["-s", script])
+            # A new layer (the photons): layer 1 in MeshLab, OUT.Photons.ply beside the CLI's output.
+            new_layer = "--photon_layer" in params
+            ml_layer = os.path.join(tmp, "ml_layer.ply")
+            more = ["-l", "0", "-o", ml_layer, "-l", "1", "-m", "vc", "vq", "vn"] if new_layer else []
+            run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + more + ["-s", script])
             run([gi, name, mesh, "-o", cli_out, "-q"] + params + (["--image_path", cli_img] if images else []))
+            if new_layer:
+                lm, lc = read_ply(ml_layer)["vertex"], read_ply(cli_out[:-4] + ".Photons.ply")["vertex"]
+                for props, what in ((("x", "y", "z"), "layer positions"), (("red", "green", "blue"), "layer colours"),
+                                    (("quality",), "layer quality"), (("nx", "ny", "nz"), "layer normals")):
+                    same(label, [tuple(r[p] for p in props) for r in lm], [tuple(r[p] for p in props) for r in lc], what)
             if images:
                 for ext in (".png", ".pfm"):
                     with open(ml_img[:-4] + ext, "rb") as f1, open(cli_img[:-4] + ext, "rb") as f2:

@@ -712,6 +712,9 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
       {"camera", L{"Frame the scene", "Look at", "The layer's camera"}},
       {"two_pass_diffuse", L{"First pass alone", "Ray-traced direct + stored indirect",
                              "Direct + caustic map + stored indirect", "Direct + caustic map + final gather"}},
+      {"reference_source", L{"Attribute of this mesh", "PLY file"}},
+      {"error_measure", L{"Difference (value - reference)", "Relative difference ((value - reference) / |reference|)",
+                          "z-score ((value - reference) / standard error)"}},
   };
   std::set<std::string> seen;
   for (const gi::FilterDesc& d : gi::allFilters())

@@ -14,6 +14,7 @@
 //      physical scalar, colour = its display mapping) and check that nothing
 //      non-finite leaves the engine.
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,20 @@ struct VertexAttribute {
   std::vector<float> values;  // vertexCount x components
 };
 
+// The vertex quality the layers carry, as an input attribute of this name
+// (the PLY property's; MeshLab's per-vertex quality, where the layers have it).
+inline const char* const kQualityAttribute = "quality";
+
+// What a front end reads from a mesh file a parameter names (the error map's
+// reference): its vertex count and per-vertex values ("quality" and the other
+// float properties, as FilterInput::attributes). Throws std::runtime_error
+// with one sentence on a file it cannot read.
+struct VertexFile {
+  size_t vertexCount = 0;
+  std::vector<VertexAttribute> attributes;
+};
+using VertexFileReader = std::function<VertexFile(const std::string& path)>;
+
 struct FilterInput {
   Scene scene;                     // all layers as one scene (vertex normals are not used: see docs/design.md)
   MeshAttributes attrs;            // colours, face quality and selection, as the meshes carry them
@@ -53,6 +68,8 @@ struct FilterInput {
   // The per-vertex estimators compute only this part of the vertices (a run
   // split over processes, see estimateFilter); all of them by default.
   VertexPart vertices;
+  // Reads a mesh file a parameter names; unset: the front end reads none.
+  VertexFileReader readVertexFile;
   const VertexAttribute* attribute(const std::string& name) const;
 };
 
@@ -73,6 +90,23 @@ struct FilterFile {
   std::string text;
 };
 
+// A new layer a filter made (photon mapping's photons): a point cloud (no
+// triangles) or a triangle mesh, with per-vertex colour and quality and,
+// optionally, normals. MeshLab adds it to the document; the command-line
+// tool writes it as a PLY beside its output (layerPath).
+struct FilterLayer {
+  std::string name;        // the layer's name (MeshLab) and the file name's suffix (CLI)
+  Scene mesh;              // positions (absolute through mesh.toWorld), triangles (empty: points)
+  std::vector<float> quality;
+  std::vector<Rgb8> color;
+  std::vector<glm::vec3> normals;  // unit, per vertex, or empty
+};
+
+// Where the command-line tool writes `layer` beside its output PLY:
+// "out.ply" and the layer "Photons" -> "out.Photons.ply" (characters other
+// than letters, digits, '-' and '_' in the name become '_').
+std::string layerPath(const std::string& outputPly, const std::string& layerName);
+
 struct FilterResult {
   // Per vertex / face of the output scene (the input's, or `refined->scene`);
   // an empty array leaves that property of the mesh as it was.
@@ -85,6 +119,7 @@ struct FilterResult {
   std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
   std::vector<FilterImage> images;
   std::vector<FilterFile> files;
+  std::vector<FilterLayer> layers;  // new layers (the input's are not among them)
   // Per face, the linear RGB value the estimate leaves for the output step
   // to map to faceQuality and faceColor (radiosity's face output).
   std::vector<glm::vec3> faceRadiometry;

@@ -23,6 +23,7 @@ enum class FilterKind {
   FormFactorsOfFace,
   RayTracedView,
   HemicubeOfFace,
+  ErrorMap,
 };
 
 // What a filter may change in the mesh (MeshLab's postCondition, the PLY the CLI writes).

@@ -115,7 +115,16 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
 // they count, instead of pi r^2, which holds only on a plane all around x.
 double triangleBallArea(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& x, double r);
 
+// The photons the density estimates read, in local scene coordinates: the
+// global map's (with a final gather, every photon the gather rays read) and
+// the caustic map's. Progressive photon mapping keeps no map (each pass's
+// photons are dropped once counted): both stay empty.
+struct PhotonMapContents {
+  std::vector<Photon> global, caustic;
+};
+
+// `maps` (optional) receives the photons of the maps (the photon layer).
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                  const Progress& progress = Progress(nullptr));
+                                  const Progress& progress = Progress(nullptr), PhotonMapContents* maps = nullptr);
 
 }  // namespace gi

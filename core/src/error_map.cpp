@@ -1,0 +1,260 @@
+#include "gi/error_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace gi {
+
+std::vector<ParamSpec> ErrorMapOptions::specs() {
+  return {
+      {.name = "value", .label = "Value to check",
+       .help = "The per-vertex value compared with the reference: 'quality' (the vertex quality every GI filter "
+               "writes: W/m^2 for radiosity, photon mapping and the reference) or the name of a per-vertex "
+               "attribute a filter left (a vector one such as Radiosity by its luminance, 0.2126 R + 0.7152 G + "
+               "0.0722 B).",
+       .type = ParamType::String, .defText = kQualityAttribute},
+      {.name = "value_error", .label = "Standard error of the value",
+       .help = "For a noisy value (photon mapping, a second reference): the attribute holding its standard error "
+               "(e.g. StdError), counted in the z-score's denominator sqrt(s_ref^2 + s_value^2). Empty: the value "
+               "is taken as exact (radiosity).",
+       .type = ParamType::String, .defText = ""},
+      {.name = "reference_source", .label = "Reference from",
+       .help = "Where the reference comes from: an attribute of this mesh (run 'GI: Path Traced Reference' on the "
+               "layer first: it leaves Reference and ReferenceStdError, which the other filters do not overwrite), "
+               "or a PLY file of the same mesh (same vertices in the same order, e.g. written by `gi reference`).",
+       .type = ParamType::Enum, .def = kReferenceSources.index(ReferenceSource::Attribute),
+       .choices = kReferenceSources.choices()},
+      {.name = "reference_attribute", .label = "Reference value",
+       .help = "The reference's per-vertex value: an attribute name (in the mesh or the file), or 'quality' (in a "
+               "file, its vertex quality). Vector attributes are compared by luminance.",
+       .type = ParamType::String, .defText = "Reference"},
+      {.name = "reference_error", .label = "Reference's standard error",
+       .help = "The attribute with the reference's standard error per vertex (the path-traced reference writes "
+               "ReferenceStdError; in its own PLY also StdError). Needed for z-scores; empty: none.",
+       .type = ParamType::String, .defText = "ReferenceStdError"},
+      {.name = "reference_file", .label = "Reference PLY file",
+       .help = "With 'Reference from' = PLY file: the file (absolute path, or relative to the working folder). It "
+               "must have the mesh's vertex count.",
+       .type = ParamType::String, .defText = ""},
+      {.name = "error_measure", .label = "Error written",
+       .help = "What goes to vertex quality: the difference value - reference (units of the value), the relative "
+               "difference (value - reference) / |reference| (undefined, 0, where the reference is 0), or the "
+               "z-score (value - reference) / sqrt(s_ref^2 + s_value^2): about N(0,1) where the value is right, "
+               "so |z| > 3 (0.27% of vertices by chance) marks a real error.",
+       .type = ParamType::Enum, .def = kErrorMeasures.index(ErrorMeasure::Difference),
+       .choices = kErrorMeasures.choices()},
+      {.name = "color_range", .label = "Colour range",
+       .help = "R of the diverging colour ramp: -R blue, 0 white, +R red (symmetric, so white is always 'no "
+               "error'). 0 = automatic: the 99th percentile of |error| (z-scores: 3). The log states it.",
+       .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e30},
+  };
+}
+
+ErrorMapOptions ErrorMapOptions::fromParams(const ParamValues& v) {
+  ErrorMapOptions o;
+  o.value = v.getString("value");
+  o.valueError = v.getString("value_error");
+  o.source = kReferenceSources.get(v, "reference_source");
+  o.reference = v.getString("reference_attribute");
+  o.referenceError = v.getString("reference_error");
+  o.file = v.getString("reference_file");
+  o.measure = kErrorMeasures.get(v, "error_measure");
+  o.colorRange = v.getFloat("color_range");
+  return o;
+}
+
+Rgb8 divergingColor(double t) {
+  // Moreland's cool-warm end points and white in the middle, interpolated in
+  // linear RGB (he interpolates in his Msh space; this keeps the ends and the
+  // neutral middle, which is what the map is read by).
+  static const glm::vec3 cold = srgb8ToLinear(59, 76, 192), mid = srgb8ToLinear(242, 242, 242),
+                         warm = srgb8ToLinear(180, 4, 38);
+  const float u = float(std::clamp(std::isfinite(t) ? t : 0.0, -1.0, 1.0));
+  const glm::vec3 c = u < 0.f ? mid + (cold - mid) * -u : mid + (warm - mid) * u;
+  return displayMap(c, 1.f);
+}
+
+namespace {
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x);
+  return b;
+}
+
+}  // namespace
+
+ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float>& reference,
+                        const std::vector<float>& sigmaRef, const std::vector<float>& sigmaValue,
+                        ErrorMeasure measure, double colorRange) {
+  const size_t n = value.size();
+  if (reference.size() != n || (!sigmaRef.empty() && sigmaRef.size() != n) || (!sigmaValue.empty() && sigmaValue.size() != n))
+    throw std::logic_error("error map: arrays of different lengths");
+  if (measure == ErrorMeasure::ZScore && sigmaRef.empty() && sigmaValue.empty())
+    throw std::invalid_argument("a z-score needs a standard error: name the reference's (reference_error) or the "
+                                "value's (value_error)");
+  ErrorMapResult out;
+  out.error.assign(n, 0.f);
+  double sumD2 = 0, sumR2 = 0, sumD = 0, maxAbs = 0, sumZ2 = 0;
+  size_t used = 0, undefined = 0, beyond3 = 0, zCount = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double v = value[i], r = reference[i];
+    if (!std::isfinite(v) || !std::isfinite(r)) { ++undefined; continue; }
+    const double d = v - r;
+    sumD2 += d * d, sumR2 += r * r, sumD += d, maxAbs = std::max(maxAbs, std::abs(d));
+    ++used;
+    double e = d;
+    if (measure == ErrorMeasure::Relative) {
+      if (r == 0.0) {
+        if (d != 0.0) ++undefined;
+        continue;  // 0 written: no relative error where the reference is 0
+      }
+      e = d / std::abs(r);
+    } else if (measure == ErrorMeasure::ZScore) {
+      const double sr = sigmaRef.empty() ? 0.0 : sigmaRef[i], sv = sigmaValue.empty() ? 0.0 : sigmaValue[i];
+      const double s = std::sqrt(sr * sr + sv * sv);
+      if (!(s > 0.0) || !std::isfinite(s)) {
+        if (d != 0.0) ++undefined;  // a difference with no error bar: no z
+        continue;
+      }
+      e = d / s;
+      sumZ2 += e * e, ++zCount, beyond3 += std::abs(e) > 3.0;
+    }
+    out.error[i] = float(e);
+  }
+  // The colour range: given, or the 99th percentile of |error| (z: 3).
+  double R = colorRange;
+  if (!(R > 0.0)) {
+    if (measure == ErrorMeasure::ZScore) {
+      R = 3.0;
+    } else {
+      std::vector<float> a;
+      for (float e : out.error)
+        if (e != 0.f) a.push_back(std::abs(e));
+      if (!a.empty()) {
+        const size_t k = std::min(a.size() - 1, size_t(0.99 * double(a.size())));
+        std::nth_element(a.begin(), a.begin() + long(k), a.end());
+        R = a[k];
+      } else {
+        R = 0.0;
+      }
+    }
+  }
+  out.range = R;
+  out.color.resize(n);
+  for (size_t i = 0; i < n; ++i) out.color[i] = divergingColor(R > 0.0 ? out.error[i] / R : 0.0);
+
+  RunStats& st = out.stats;
+  st.add("vertices", double(used));
+  st.add("rms_error", used ? std::sqrt(sumD2 / double(used)) : 0.0);
+  st.add("relative_rms_error", sumR2 > 0 ? std::sqrt(sumD2 / sumR2) : 0.0);
+  st.add("max_abs_error", maxAbs);
+  st.add("mean_error", used ? sumD / double(used) : 0.0);
+  if (measure == ErrorMeasure::ZScore) {
+    st.add("rms_z", zCount ? std::sqrt(sumZ2 / double(zCount)) : 0.0);
+    st.add("fraction_abs_z_above_3", zCount ? double(beyond3) / double(zCount) : 0.0);
+    st.note("|z| > 3 at " + std::to_string(beyond3) + " of " + std::to_string(zCount) +
+            " vertices (0.27% expected from noise alone)");
+  }
+  st.add("color_range", R);
+  st.note(std::string("quality = ") + kErrorMeasures.logName(measure) +
+          (R > 0.0 ? "; colour ramp blue -" + fmt(R) + ", white 0, red +" + fmt(R) + (colorRange > 0 ? "" : " (automatic)")
+                   : "; every error is 0: all white"));
+  if (undefined)
+    st.note(std::to_string(undefined) + " vertices with no defined " + kErrorMeasures.logName(measure) +
+            " (reference 0, no error bar, or not finite): 0 written");
+  return out;
+}
+
+namespace {
+
+// A per-vertex scalar: a scalar attribute as it is, a vector one (RGB) by its luminance.
+std::vector<float> scalarValues(const VertexAttribute& a) {
+  if (a.components == 1) return a.values;
+  std::vector<float> out(a.values.size() / 3);
+  for (size_t i = 0; i < out.size(); ++i)
+    out[i] = luminance({a.values[3 * i], a.values[3 * i + 1], a.values[3 * i + 2]});
+  return out;
+}
+
+std::string names(const std::vector<VertexAttribute>& attrs) {
+  std::string s;
+  for (const VertexAttribute& a : attrs) s += (s.empty() ? "" : ", ") + a.name;
+  return s.empty() ? "none" : s;
+}
+
+const VertexAttribute* find(const std::vector<VertexAttribute>& attrs, const std::string& name) {
+  for (const VertexAttribute& a : attrs)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+// The attribute `name` of `attrs` as per-vertex scalars; `where` names the
+// mesh or file in the message when it is missing.
+std::vector<float> attributeValues(const std::vector<VertexAttribute>& attrs, const std::string& name,
+                                   const std::string& where, const std::string& hint, bool scalarOnly = false) {
+  const VertexAttribute* a = find(attrs, name);
+  if (!a)
+    throw std::invalid_argument(where + " has no per-vertex " +
+                                (name == kQualityAttribute ? std::string("quality") : "attribute '" + name + "'") + hint +
+                                " (it has: " + names(attrs) + ")");
+  if (scalarOnly && a->components != 1)
+    throw std::invalid_argument("'" + name + "' is a vector attribute: a standard error must be a scalar");
+  return scalarValues(*a);
+}
+
+}  // namespace
+
+void computeErrorMap(const FilterInput& in, FilterResult& res) {
+  const ErrorMapOptions o = ErrorMapOptions::fromParams(in.values);
+  const size_t nv = in.scene.vertexCount();
+  const std::string mesh = "the mesh";
+  const std::vector<float> v = attributeValues(in.attributes, o.value, mesh,
+                                               o.value == kQualityAttribute ? ": run a filter on it first" : "");
+  std::vector<float> sv;
+  if (!o.valueError.empty()) sv = attributeValues(in.attributes, o.valueError, mesh, "", true);
+
+  std::vector<float> r, sr;
+  std::string from;
+  if (o.source == ReferenceSource::Attribute) {
+    if (!o.file.empty()) res.stats.warn("reference_file is not read: the reference comes from an attribute of the mesh");
+    r = attributeValues(in.attributes, o.reference, mesh,
+                        o.reference == "Reference" ? ": run 'GI: Path Traced Reference' on this layer first" : "");
+    if (!o.referenceError.empty() && find(in.attributes, o.referenceError))
+      sr = attributeValues(in.attributes, o.referenceError, mesh, "", true);
+    from = "attribute " + o.reference;
+  } else {
+    if (o.file.empty()) throw std::invalid_argument("reference_file is empty: name the reference PLY");
+    if (!in.readVertexFile) throw std::invalid_argument("this front end cannot read a reference file");
+    VertexFile f;
+    try {
+      f = in.readVertexFile(o.file);
+    } catch (const std::runtime_error& e) {
+      throw std::invalid_argument(e.what());
+    }
+    if (f.vertexCount != nv)
+      throw std::invalid_argument("the reference " + o.file + " has " + std::to_string(f.vertexCount) +
+                                  " vertices and the mesh " + std::to_string(nv) + ": it must be the same mesh");
+    r = attributeValues(f.attributes, o.reference, o.file, "");
+    if (!o.referenceError.empty() && find(f.attributes, o.referenceError))
+      sr = attributeValues(f.attributes, o.referenceError, o.file, "", true);
+    from = o.file + " (" + o.reference + ")";
+  }
+  if (o.measure == ErrorMeasure::ZScore && sr.empty() && sv.empty())
+    throw std::invalid_argument("a z-score needs a standard error, and the reference has no attribute '" +
+                                o.referenceError + "' (and no value_error is named)");
+  if (o.measure != ErrorMeasure::ZScore && !o.valueError.empty())
+    res.stats.warn("value_error is used only by the z-score");
+  if (v.size() != nv || r.size() != nv) throw std::logic_error("error map: attribute of the wrong size");
+  ErrorMapResult e = errorMap(v, r, sr, sv, o.measure, o.colorRange);
+  res.vertexQuality = std::move(e.error);
+  res.vertexColor = std::move(e.color);
+  res.stats.numbers = std::move(e.stats.numbers);
+  res.stats.notes.insert(res.stats.notes.begin(), "value " + o.value + " against the reference " + from +
+                                                      (sr.empty() ? "" : ", its error bar " + o.referenceError));
+  for (std::string& n : e.stats.notes) res.stats.notes.push_back(std::move(n));
+}
+
+}  // namespace gi

@@ -1,0 +1,194 @@
+// GI: Error Map (gi/error_map.h): zero against itself, the known error of a
+// known perturbation (difference, relative, z-score, the summary), z-scores
+// of one path-traced reference against an independent one (another seed)
+// spread as N(0, 1), a reference from a PLY file, and a clear error for a
+// missing attribute or a file of another vertex count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "gi/error_map.h"
+#include "gi/filter_run.h"
+#include "gi/filters.h"
+#include "gi/scenes.h"
+#include "mesh_io.h"
+#include "vertex_file.h"
+
+using namespace gi;
+
+namespace {
+
+FilterInput inputOf(const scenes::SceneFile& sf, FilterKind kind, const std::map<std::string, std::string>& params) {
+  FilterInput in;
+  in.scene = sf.scene;
+  in.attrs = sf.attrs;
+  in.layers.push_back({"mesh", 0, sf.scene.faceCount()});
+  const auto specs = filterSpecs(kind);
+  const double diag = analyzeScene(in.scene).diagonal;
+  in.values = defaultValues(specs, diag);
+  for (const auto& [k, v] : params) in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+  return in;
+}
+
+// What the mesh carries after a filter ran on it: its attributes and its
+// quality (as MeshLab's bridge and the PLY files hand them to the next filter).
+std::vector<VertexAttribute> leftOnMesh(const FilterResult& r) {
+  std::vector<VertexAttribute> a = r.attributes;
+  a.push_back({kQualityAttribute, 1, r.vertexQuality});
+  return a;
+}
+
+FilterResult reference(const scenes::SceneFile& sf, int seed, int samples) {
+  FilterInput in = inputOf(sf, FilterKind::PathTracedReference,
+                           {{"samples_per_vertex", std::to_string(samples)}, {"seed", std::to_string(seed)}});
+  return runFilter(FilterKind::PathTracedReference, in);
+}
+
+FilterResult errorMapOf(const scenes::SceneFile& sf, std::vector<VertexAttribute> attrs,
+                        const std::map<std::string, std::string>& params) {
+  FilterInput in = inputOf(sf, FilterKind::ErrorMap, params);
+  in.attributes = std::move(attrs);
+  in.readVertexFile = io::readVertexFile;
+  return runFilter(FilterKind::ErrorMap, in);
+}
+
+std::string messageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+// The reference's quality against its own Reference attribute (the same
+// luminance of the same B): every error exactly 0, the colour the ramp's white.
+TEST(ErrorMap, ZeroAgainstItself) {
+  const auto sf = scenes::cornellBox(150.0);
+  const FilterResult ref = reference(sf, 1, 8);
+  for (const char* measure : {"0", "1", "2"}) {
+    const FilterResult e = errorMapOf(sf, leftOnMesh(ref), {{"error_measure", measure}});
+    ASSERT_EQ(e.vertexQuality.size(), sf.scene.vertexCount());
+    for (float q : e.vertexQuality) ASSERT_EQ(q, 0.f) << measure;
+    const Rgb8 white = divergingColor(0.0);
+    for (const Rgb8& c : e.vertexColor) ASSERT_TRUE(c.r == white.r && c.g == white.g && c.b == white.b);
+    EXPECT_EQ(e.stats.get("rms_error", -1), 0.0);
+    EXPECT_EQ(e.stats.get("max_abs_error", -1), 0.0);
+  }
+}
+
+// v = r (1 + 0.1 s_i) with s_i = +1 or -1 alternately: the difference is
+// 0.1 s_i r_i, the relative difference 0.1 s_i, and with an error bar of
+// 0.05 r_i the z-score 2 s_i; RMS = 0.1 sqrt(mean r^2), relative RMS 0.1,
+// no |z| > 3. Float rounding of v only: tolerances of a few ulps.
+TEST(ErrorMap, KnownPerturbationGivesKnownError) {
+  const auto sf = scenes::cornellBox(150.0);
+  const size_t n = sf.scene.vertexCount();
+  VertexAttribute r{"R", 1, {}}, v{"V", 1, {}}, sr{"SR", 1, {}};
+  double sumR2 = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float ri = 1.f + float(i % 7);
+    const float s = i % 2 ? -1.f : 1.f;
+    r.values.push_back(ri);
+    v.values.push_back(ri * (1.f + 0.1f * s));
+    sr.values.push_back(0.05f * ri);
+    sumR2 += double(ri) * ri;
+  }
+  const std::vector<VertexAttribute> attrs = {r, v, sr};
+  const std::map<std::string, std::string> base = {{"value", "V"}, {"reference_attribute", "R"}, {"reference_error", "SR"}};
+  auto with = [&](const char* measure) {
+    auto p = base;
+    p["error_measure"] = measure;
+    return errorMapOf(sf, attrs, p);
+  };
+  const FilterResult d = with("0"), rel = with("1"), z = with("2");
+  for (size_t i = 0; i < n; ++i) {
+    const double s = i % 2 ? -1.0 : 1.0, ri = r.values[i];
+    EXPECT_NEAR(d.vertexQuality[i], 0.1 * s * ri, 1e-5 * ri);
+    EXPECT_NEAR(rel.vertexQuality[i], 0.1 * s, 1e-5);
+    EXPECT_NEAR(z.vertexQuality[i], 2.0 * s, 1e-4);
+  }
+  EXPECT_NEAR(d.stats.get("rms_error"), 0.1 * std::sqrt(sumR2 / double(n)), 1e-5);
+  EXPECT_NEAR(d.stats.get("relative_rms_error"), 0.1, 1e-5);
+  EXPECT_NEAR(d.stats.get("max_abs_error"), 0.7, 1e-5);  // r = 7
+  EXPECT_NEAR(z.stats.get("rms_z"), 2.0, 1e-4);
+  EXPECT_EQ(z.stats.get("fraction_abs_z_above_3", -1), 0.0);
+  EXPECT_EQ(z.stats.get("color_range"), 3.0);  // automatic for z
+  // The ramp: blue below the reference, red above, white between.
+  EXPECT_GT(z.vertexColor[0].r, z.vertexColor[0].b);
+  EXPECT_GT(z.vertexColor[1].b, z.vertexColor[1].r);
+  // The log states the range.
+  EXPECT_NE(z.logLines("GI: Error Map")[1].find("colour ramp blue -3, white 0, red +3"), std::string::npos);
+}
+
+// Two path-traced references with different seeds are independent unbiased
+// estimates with honest error bars, so z = (a - b) / sqrt(s_a^2 + s_b^2) is
+// close to N(0, 1) at each vertex: E[z^2] = 1 and P(|z| > 3) = 0.0027. With
+// n vertices the mean of z^2 has a standard deviation sqrt(2 / n) (0.03 for
+// the ~2300 here); error bars estimated from 256 paths each make z a little
+// heavier-tailed than normal (Student's t with many degrees of freedom:
+// variance 1 + O(1/N)), hence rms_z within 0.1 of 1. The count with |z| > 3
+// is binomial with mean 0.0027 n (about 6): a bound of 1.5%, 5 times the
+// expected fraction plus 4 binomial standard deviations, holds unless the
+// error bars are too small (z's spread too wide). Leaving out the value's own
+// error bar (z against s_b only) gives rms_z = sqrt(2), which fails.
+TEST(ErrorMap, ZScoresOfIndependentReferencesAreStandardNormal) {
+  const auto sf = scenes::cornellBox(40.0);
+  const FilterResult a = reference(sf, 11, 256), b = reference(sf, 12, 256);
+  std::vector<VertexAttribute> attrs = leftOnMesh(b);  // b is the reference on the mesh
+  attrs.push_back({"ValueStdError", 1, a.attribute("StdError")->values});
+  attrs.push_back({"Value", 1, a.vertexQuality});
+  const FilterResult z = errorMapOf(sf, attrs, {{"value", "Value"}, {"value_error", "ValueStdError"}, {"error_measure", "2"}});
+  const double n = z.stats.get("vertices");
+  ASSERT_GT(n, 1000.0);
+  EXPECT_NEAR(z.stats.get("rms_z"), 1.0, 0.1);
+  EXPECT_LT(z.stats.get("fraction_abs_z_above_3"), 0.015);
+  // Without the value's error bar the spread is sqrt(2) times wider.
+  const FilterResult zRefOnly = errorMapOf(sf, attrs, {{"value", "Value"}, {"error_measure", "2"}});
+  EXPECT_GT(zRefOnly.stats.get("rms_z"), 1.25);
+}
+
+// A reference from a PLY file (as `gi reference -o` writes it); a file of
+// another mesh or a missing attribute is one clear sentence.
+TEST(ErrorMap, ReferenceFileAndClearErrors) {
+  const auto sf = scenes::cornellBox(150.0);
+  const FilterResult ref = reference(sf, 1, 8);
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string file = (dir / "gi_errormap_ref.ply").string(), other = (dir / "gi_errormap_other.ply").string();
+  io::PlyExtras extras;
+  extras.attributes = ref.attributes;
+  io::writePly(file, sf.scene, sf.attrs, ref.vertexQuality, ref.vertexColor, extras);
+  const auto coarse = scenes::cornellBox(300.0);
+  io::writePly(other, coarse.scene, coarse.attrs, std::vector<float>(coarse.scene.vertexCount(), 1.f), {});
+  // The file's quality against the mesh's quality: the same values, error 0.
+  const FilterResult same = errorMapOf(sf, leftOnMesh(ref), {{"reference_source", "1"}, {"reference_file", file},
+                                                             {"reference_attribute", "quality"}, {"error_measure", "2"}});
+  for (float q : same.vertexQuality) ASSERT_EQ(q, 0.f);
+  EXPECT_NE(same.stats.notes.front().find("gi_errormap_ref.ply"), std::string::npos);
+
+  const std::string mismatch = messageOf([&] {
+    errorMapOf(sf, leftOnMesh(ref), {{"reference_source", "1"}, {"reference_file", other}, {"reference_attribute", "quality"}});
+  });
+  EXPECT_NE(mismatch.find("vertices and the mesh"), std::string::npos) << mismatch;
+  EXPECT_EQ(mismatch.find('\n'), std::string::npos);
+  const std::string missing = messageOf([&] { errorMapOf(sf, {}, {}); });
+  EXPECT_NE(missing.find("no per-vertex quality"), std::string::npos) << missing;
+  const std::string noRef = messageOf([&] { errorMapOf(sf, {{kQualityAttribute, 1, ref.vertexQuality}}, {}); });
+  EXPECT_NE(noRef.find("'Reference'"), std::string::npos) << noRef;
+  EXPECT_NE(noRef.find("GI: Path Traced Reference"), std::string::npos) << noRef;
+  const std::string noSigma = messageOf([&] {
+    errorMapOf(sf, leftOnMesh(ref), {{"reference_error", "Nothing"}, {"error_measure", "2"}});
+  });
+  EXPECT_NE(noSigma.find("standard error"), std::string::npos) << noSigma;
+  const std::string noFile = messageOf([&] {
+    errorMapOf(sf, leftOnMesh(ref), {{"reference_source", "1"}, {"reference_file", (dir / "gi_no_such.ply").string()}});
+  });
+  EXPECT_NE(noFile.find("no such file"), std::string::npos) << noFile;
+  std::filesystem::remove(file);
+  std::filesystem::remove(other);
+}
