@@ -273,7 +273,9 @@ TEST(AOShared, KeptRingsGiveTheSearchedBits) {
       ASSERT_EQ(kept.value[i], searched.value[i]) << i;
       ASSERT_EQ(kept.stdError[i], searched.stdError[i]) << i;
       ASSERT_EQ(kept.rays[i], searched.rays[i]) << i;
-      if (o.bentNormals) ASSERT_EQ(kept.bentNormal[i], searched.bentNormal[i]) << i;
+      if (o.bentNormals) {
+        ASSERT_EQ(kept.bentNormal[i], searched.bentNormal[i]) << i;
+      }
     }
   }
 }
