@@ -148,34 +148,45 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
 }
 
 // Breadth-first rings around i through vertices that may be pooled with it
-// (poolable, with rays, normal within the tolerance); calls visit(h, u) for
-// every such u of ring h = 1, ..., maxRings in the order poolVertex pools
-// them, and returns the number of rings found (the search stops at an empty
-// ring, as poolVertex does).
+// (poolable, with rays, normal within the tolerance). startRings begins the
+// search; each nextRing leaves the next ring in sc.frontier (empty: no more).
+void startRings(uint32_t i, size_t vertexCount, PoolScratch& sc) {
+  if (sc.stamp.size() != vertexCount) { sc.stamp.assign(vertexCount, 0); sc.now = 0; }
+  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
+  sc.stamp[i] = sc.now;
+  sc.frontier.assign(1, i);
+}
+
+void nextRing(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
+              const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
+              PoolScratch& sc) {
+  const uint32_t now = sc.now;
+  const glm::vec3 ni = normals[i];
+  sc.next.clear();
+  for (uint32_t v : sc.frontier)
+    for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
+      const uint32_t u = g.nbr[k];
+      if (sc.stamp[u] == now) continue;
+      sc.stamp[u] = now;
+      if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
+      sc.next.push_back(u);
+    }
+  sc.frontier.swap(sc.next);
+}
+
+// Calls visit(h, u) for every vertex u of ring h = 1, ..., maxRings in the
+// order poolVertex pools them, and returns the number of rings found (the
+// search stops at an empty ring, as poolVertex does).
 template <class Visit>
 int searchRings(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
                 const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
                 int maxRings, PoolScratch& sc, Visit&& visit) {
-  if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
-  if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
-  const uint32_t now = sc.now;
-  const glm::vec3 ni = normals[i];
-  sc.stamp[i] = now;
-  sc.frontier.assign(1, i);
+  startRings(i, normals.size(), sc);
   int h = 1;
   for (; h <= maxRings; ++h) {
-    sc.next.clear();
-    for (uint32_t v : sc.frontier)
-      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
-        const uint32_t u = g.nbr[k];
-        if (sc.stamp[u] == now) continue;
-        sc.stamp[u] = now;
-        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
-        sc.next.push_back(u);
-      }
-    if (sc.next.empty()) break;
-    for (uint32_t u : sc.next) visit(h, u);
-    sc.frontier.swap(sc.next);
+    nextRing(i, g, normals, rays, poolable, o, sc);
+    if (sc.frontier.empty()) break;
+    for (uint32_t u : sc.frontier) visit(h, u);
   }
   return h - 1;
 }
@@ -188,26 +199,13 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
   const glm::vec3 pi = positions[i];
   const Frame frame(normals[i]);
   return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
-    if (h == 1) {
-      if (sc.stamp.size() != normals.size()) { sc.stamp.assign(normals.size(), 0); sc.now = 0; }
-      if (++sc.now == 0) { std::fill(sc.stamp.begin(), sc.stamp.end(), 0); sc.now = 1; }
-      sc.stamp[i] = sc.now;
-      sc.frontier.assign(1, i);
+    if (h == 1) startRings(i, normals.size(), sc);
+    nextRing(i, g, normals, rays, poolable, o, sc);
+    for (uint32_t u : sc.frontier) {
+      const glm::vec3 d = positions[u] - pi;
+      grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+      db += rays[u].bent;
     }
-    const uint32_t now = sc.now;
-    sc.next.clear();
-    for (uint32_t v : sc.frontier)
-      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
-        const uint32_t u = g.nbr[k];
-        if (sc.stamp[u] == now) continue;
-        sc.stamp[u] = now;
-        if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], normals[i]) < o.normalCos) continue;
-        sc.next.push_back(u);
-        const glm::vec3 d = positions[u] - pi;
-        grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
-        db += rays[u].bent;
-      }
-    sc.frontier.swap(sc.next);
     return uint32_t(sc.frontier.size());
   });
 }
