@@ -45,6 +45,15 @@ row() {  # out in...
   echo "wrote $out ($(stat -c %s "$out") bytes)"
 }
 
+# The per-vertex B a mesh carries (its attribute Radiosity), as the two-pass
+# view's "First pass alone" shows it: size x size pixels, 4 samples each.
+first_pass() {  # ply png size exposure [more gi render options...]
+  local ply=$1 png=$2 size=$3 exposure=$4
+  shift 4
+  "$gi" render "$ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" "$@" \
+    --width "$size" --height "$size" --samples_per_pixel 4 --exposure "$exposure" --image_path "$png" -q
+}
+
 # Face 49 of cornell_box.ply: a floor patch at (435, 0, 136), in front of the
 # tall block; its hemicube sees the ceiling, the walls, both blocks and (black)
 # the open front. 64 cells across the top face show the cells themselves.
@@ -67,9 +76,7 @@ artefact() {  # name refinement-depth exposure camera-args...
   for fix in "--vertex_output 'Patch average'" "--vertex_output 'Final gather'" \
              "--vertex_output 'Patch average' --refine true --refine_max_depth $depth"; do
     eval "\"$gi\" radiosity \"$mesh\" --emitter_source 1 $fix -o \"$tmp/$name$k.ply\" -q"
-    "$gi" render "$tmp/$name$k.ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" \
-      --camera "Look at" "$@" --width 240 --height 240 --samples_per_pixel 4 --exposure "$exposure" \
-      --image_path "$tmp/$name$k.png" -q
+    first_pass "$tmp/$name$k.ply" "$tmp/$name$k.png" 240 "$exposure" --camera "Look at" "$@"
     pics+=("$tmp/$name$k.png")
     k=$((k + 1))
   done
@@ -91,9 +98,8 @@ progressive() {
   local -a pics=()
   for step in 1 10 100; do
     # The snapshot as the first pass: rename its attribute to Radiosity.
-    python3 "$root/scripts/rename_ply_attribute.py" "$tmp/prog.ply" "$tmp/prog$step.ply" "Radiosity_step_$step" Radiosity
-    "$gi" render "$tmp/prog$step.ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" \
-      --width 200 --height 200 --samples_per_pixel 4 --exposure 2.5 --image_path "$tmp/prog$step.png" -q
+    "$py" "$root/scripts/rename_ply_attribute.py" "$tmp/prog.ply" "$tmp/prog$step.ply" "Radiosity_step_$step" Radiosity
+    first_pass "$tmp/prog$step.ply" "$tmp/prog$step.png" 200 2.5
     pics+=("$tmp/prog$step.png")
   done
   row "$img/progressive_cornell.png" "${pics[@]}"
@@ -223,8 +229,7 @@ twopass() {
 photons() {
   "$gi" photonmap "$m/caustic_cornell_box.ply" "${caustic_layers[@]}" --emitter_source 1 --photons 200000 \
     --photon_layer true --photon_layer_max 60000 -o "$tmp/pm.ply" -q
-  "$gi" render "$tmp/pm.ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" \
-    --width 240 --height 240 --samples_per_pixel 4 --exposure 0.7 --image_path "$tmp/pm.png" -q
+  first_pass "$tmp/pm.ply" "$tmp/pm.png" 240 0.7
   "$py" "$root/scripts/turn_ply.py" "$tmp/pm.Photons.ply" "$tmp/photons_view.ply"
   shot "$tmp/photons_view.ply" "$tmp/photons.png" 240
   row "$img/photonmap_caustic.png" "$tmp/pm.png" "$tmp/photons.png"
@@ -239,8 +244,7 @@ lightpaths() {
   local -a pics=()
   for part in emitted direct indirect caustic; do
     "$py" "$root/scripts/rename_ply_attribute.py" "$tmp/lp.ply" "$tmp/lp_$part.ply" "Radiosity_$part" Radiosity
-    "$gi" render "$tmp/lp_$part.ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" \
-      --width 180 --height 180 --samples_per_pixel 4 --exposure 1 --image_path "$tmp/lp_$part.png" -q
+    first_pass "$tmp/lp_$part.ply" "$tmp/lp_$part.png" 180 1
     pics+=("$tmp/lp_$part.png")
   done
   row "$img/light_paths_caustic.png" "${pics[@]}"
@@ -254,8 +258,7 @@ reference() {
   local -a pics=()
   for n in 16 256; do
     "$gi" reference "$m/cornell_box.ply" --emitter_source 1 --samples_per_vertex "$n" -o "$tmp/ref$n.ply" -q
-    "$gi" render "$tmp/ref$n.ply" --emitter_source 1 --mode Two-pass --two_pass_diffuse "First pass alone" \
-      --width 200 --height 200 --samples_per_pixel 4 --exposure 2.5 --image_path "$tmp/ref$n.png" -q
+    first_pass "$tmp/ref$n.ply" "$tmp/ref$n.png" 200 2.5
     pics+=("$tmp/ref$n.png")
   done
   row "$img/reference_cornell.png" "${pics[@]}"
