@@ -329,7 +329,7 @@ if [[ -n "$apply_name" ]]; then
   note "$apply_name applied from the GUI menus; showing its raster layer"
 fi
 if [[ "${GUI_NO_CHECK:-0}" == 1 ]]; then
-  # Documentation screenshots (scripts/readme_images.sh): no colour check.
+  # Documentation screenshots (scripts/make_figures.sh): no colour check.
   sleep "${GUI_SETTLE:-4}"
   dismiss_dialogs
   fill_screen
