@@ -82,6 +82,27 @@ inline double meanLuminance(const Image& img) {
   return s / double(img.px.size());
 }
 
+// Two renders of one view over the block of side T at (bx, by): the sums of
+// their pixels' luminance and of their pixels' variance (stdError^2), for
+// comparing block means within combined standard errors.
+struct BlockSums {
+  double a = 0, b = 0, varA = 0, varB = 0;
+};
+
+inline BlockSums blockSums(const RenderResult& ra, const RenderResult& rb, int bx, int by, int T) {
+  const int W = ra.image.width;
+  BlockSums s;
+  for (int y = by; y < by + T; ++y)
+    for (int x = bx; x < bx + T; ++x) {
+      const size_t p = size_t(y) * size_t(W) + size_t(x);
+      s.a += luminance(ra.image.px[p]);
+      s.b += luminance(rb.image.px[p]);
+      s.varA += double(ra.stdError[p]) * ra.stdError[p];
+      s.varB += double(rb.stdError[p]) * rb.stdError[p];
+    }
+  return s;
+}
+
 // A closed box [lo, hi], 8 x 8 cells per face, faces inward: walls of
 // reflectance wallRho emitting E, the floor (y = lo.y) a black GGX lobe
 // (normal reflectance F0, roughness alpha). The scene of the glossy tests.

@@ -104,7 +104,9 @@ TEST(HierarchicalRadiosity, FurnaceAndEnergyBalance) {
     RadiosityOptions o = patchOptions(RadiositySolver::Hierarchical);
     o.tolerance = 1e-9;
     const RadiosityResult r = solveRadiosity(sf.scene, *caster, o);
-    if (rho == 0.5f) EXPECT_GT(r.stats.get("links"), r.stats.get("links_patch_to_patch")) << "clusters linked";
+    if (rho == 0.5f) {
+      EXPECT_GT(r.stats.get("links"), r.stats.get("links_patch_to_patch")) << "clusters linked";
+    }
     double B = 0, H = 0, R = 0, A = 0;
     for (size_t f = 0; f < r.B.size(); ++f) {
       const double a = faceArea(sf.scene, f);
@@ -120,7 +122,9 @@ TEST(HierarchicalRadiosity, FurnaceAndEnergyBalance) {
     EXPECT_NEAR(B / A * (1.0 - p), predicted, direct) << "rho " << rho;
     EXPECT_NEAR(r.stats.get("absorbed_power_W") / r.stats.get("emitted_power_W"), 1.0,
                 p * std::fabs(delta) / (1.0 - p) + direct) << "rho " << rho;
-    if (rho == 0.99f) EXPECT_NEAR(B / A * (1.0 - p), 1.0, 0.01);
+    if (rho == 0.99f) {
+      EXPECT_NEAR(B / A * (1.0 - p), 1.0, 0.01);
+    }
   }
 }
 

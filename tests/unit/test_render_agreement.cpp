@@ -26,6 +26,8 @@
 #include "render_test_helpers.h"
 
 using namespace gi;
+using gi::test::BlockSums;
+using gi::test::blockSums;
 
 namespace {
 
@@ -51,15 +53,8 @@ Agreement compareTiles(const RenderResult& tp, const RenderResult& pt, double sh
   double va = 0, vb = 0;
   for (int by = 0; by + T <= H; by += T)
     for (int bx = 0; bx + T <= W; bx += T) {
-      double a = 0, b = 0, sa = 0, sb = 0;
-      for (int y = by; y < by + T; ++y)
-        for (int x = bx; x < bx + T; ++x) {
-          const size_t p = size_t(y) * size_t(W) + size_t(x);
-          a += luminance(tp.image.px[p]);
-          b += luminance(pt.image.px[p]);
-          sa += double(tp.stdError[p]) * tp.stdError[p];
-          sb += double(pt.stdError[p]) * pt.stdError[p];
-        }
+      const BlockSums s = blockSums(tp, pt, bx, by, T);
+      const double a = s.a, b = s.b, sa = s.varA, sb = s.varB;
       const double n = double(T) * T;
       const double sigma = std::sqrt(sa + sb) / n;
       const double excess = std::abs(a - b) / n / (4 * sigma + share * b / n + 1e-9);

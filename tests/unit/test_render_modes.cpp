@@ -19,6 +19,8 @@
 #include "render_test_helpers.h"
 
 using namespace gi;
+using gi::test::BlockSums;
+using gi::test::blockSums;
 using gi::test::SceneBuilder;
 
 namespace {
@@ -63,15 +65,8 @@ void expectBlocksAgree(const RenderResult& a, const RenderResult& b, int block, 
   double sa = 0, sb = 0, vsa = 0, vsb = 0;
   for (int by = 0; by + block <= H; by += block)
     for (int bx = 0; bx + block <= W; bx += block) {
-      double ma = 0, mb = 0, va = 0, vb = 0;
-      for (int y = by; y < by + block; ++y)
-        for (int x = bx; x < bx + block; ++x) {
-          const size_t p = size_t(y) * size_t(W) + size_t(x);
-          ma += luminance(a.image.px[p]);
-          mb += luminance(b.image.px[p]);
-          va += double(a.stdError[p]) * a.stdError[p];
-          vb += double(b.stdError[p]) * b.stdError[p];
-        }
+      const BlockSums s = blockSums(a, b, bx, by, block);
+      const double ma = s.a, mb = s.b, va = s.varA, vb = s.varB;
       const double n = double(block) * block;
       EXPECT_NEAR(ma / n, mb / n, 4 * std::sqrt(va + vb) / n + 1e-6) << what << " block " << bx << "," << by;
       sa += ma;
