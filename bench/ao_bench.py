@@ -108,6 +108,36 @@ def run(cmd, timeout=7200):
     return out, wall
 
 
+def run_logged(cmd, log, timeout=7200):
+    """run(), with the output also written to `log` as it comes, each chunk stamped with the seconds since the
+    start: MeshLab's progress per view can be read there while it runs (or after it was stopped)."""
+    import select
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    chunks = []
+    with open(log, "a") as f:
+        f.write("\n=== %s: %s\n" % (time.strftime("%Y-%m-%d %H:%M:%S"), " ".join(cmd)))
+        while True:
+            if time.perf_counter() - t0 > timeout:
+                p.kill()
+                raise RuntimeError("command timed out: %s" % " ".join(cmd))
+            ready, _, _ = select.select([p.stdout], [], [], 5.0)
+            if not ready:
+                continue
+            data = os.read(p.stdout.fileno(), 65536)
+            if not data:
+                break
+            chunks.append(data)
+            f.write("[%9.2f s] %s\n" % (time.perf_counter() - t0, data.decode("utf-8", "replace").rstrip()))
+            f.flush()
+    p.wait()
+    wall = time.perf_counter() - t0
+    out = b"".join(chunks).decode("utf-8", "replace")
+    if p.returncode != 0:
+        raise RuntimeError("command failed (%d): %s\n%s" % (p.returncode, " ".join(cmd), out[-2000:]))
+    return out, wall
+
+
 def load_average():
     try:
         with open("/proc/loadavg") as f:
@@ -137,9 +167,21 @@ class Bench:
         self.ours_sig = signature(self.gi)
 
     def save_cache(self):
-        with open(self.cache_path + ".tmp", "w") as f:
-            json.dump(self.cache, f)
-        os.replace(self.cache_path + ".tmp", self.cache_path)
+        """Merges this run's entries into the file under a lock, so that runs on different meshes (one per
+        process, e.g. MeshLab on two large scans) can fill the same cache side by side."""
+        import fcntl
+        with open(self.cache_path + ".lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            disk = {}
+            if os.path.exists(self.cache_path):
+                with open(self.cache_path) as f:
+                    disk = json.load(f)
+            disk.update(self.cache)
+            self.cache = disk
+            tmp = "%s.%d.tmp" % (self.cache_path, os.getpid())
+            with open(tmp, "w") as f:
+                json.dump(self.cache, f)
+            os.replace(tmp, self.cache_path)
 
     def reference(self, scene, mesh, normals, rays):
         """Mean of two independent per-vertex runs (seeds 987654 and 987655) and its own RMS error."""
@@ -203,9 +245,10 @@ class Bench:
     def ours(self, scene, mesh, nv, ref, label, args, knob, value, repeats, server=False):
         key = "|".join(["ours", scene, signature(mesh), self.ours_sig, label, " ".join(args), str(server)])
         if key not in self.cache:
-            times, walls, stats = [], [], None
+            times, walls, stats, loads = [], [], None, []
             out = os.path.join(self.tmp, "ours.ply")
             for _ in range(repeats):
+                loads.append(load_average())
                 if server:
                     script = os.path.join(self.tmp, "ours.mlx")
                     run([self.gi, "script", "ao", "--mesh", mesh, "-o", script] + args)
@@ -223,12 +266,34 @@ class Bench:
             np.save(os.path.join(self.tmp, "q.npy"), q)
             self.cache[key] = {"seconds": statistics.median(times), "wall": statistics.median(walls),
                                "rays_per_vertex": stats["rays"] / nv, "rays_per_second": stats["rays_per_second"],
+                               "load_average": loads, "finished": time.strftime("%Y-%m-%d %H:%M:%S"),
                                "quality_file": self.keep(q, key)}
             self.save_cache()
         c = self.cache[key]
         q = np.load(c["quality_file"])
         self.add(scene, nv, label, knob, value, c["seconds"], c["wall"], q, ref,
-                 {"rays_per_vertex": c["rays_per_vertex"], "rays_per_second": c["rays_per_second"]})
+                 {"rays_per_vertex": c["rays_per_vertex"], "rays_per_second": c["rays_per_second"],
+                  "load_average": c.get("load_average")})
+
+    def cached_ours(self, scene, mesh):
+        """The settings of ours in the cache for this mesh and binary: ray counts per vertex, shared ray counts,
+        adaptive targets, and whether the meshlabserver run is there."""
+        prefix = "|".join(["ours", scene, signature(mesh), self.ours_sig]) + "|"
+        per_vertex, shared, targets, server = set(), set(), set(), False
+        for key in self.cache:
+            if not key.startswith(prefix):
+                continue
+            label, args, via_server = key[len(prefix):].split("|")
+            words = args.split()
+            if via_server == "True":
+                server = True
+            elif label == "ours, per vertex":
+                per_vertex.add(int(words[words.index("--rays_per_vertex") + 1]))
+            elif label == "ours, shared":
+                shared.add(int(words[words.index("--rays_per_vertex") + 1]))
+            elif label == "ours, shared, adaptive":
+                targets.add(float(words[words.index("--target_error") + 1]))
+        return sorted(per_vertex), sorted(shared), sorted(targets, reverse=True), server
 
     def keep(self, q, key):
         d = os.path.join(self.results, "ao_runs")
@@ -237,27 +302,39 @@ class Bench:
         np.save(path, q.astype(np.float32))
         return path
 
-    def meshlab(self, scene, mesh, nv, ref, views, tex, repeats):
+    def meshlab(self, scene, mesh, nv, ref, views, tex, repeats, cached_only=False):
+        """MeshLab's filter at one setting (cached by mesh); with `cached_only` a setting not in the cache is left
+        out (returns False) instead of run."""
         key = "|".join(["meshlab", scene, signature(mesh), str(views), str(tex)])
+        if key not in self.cache and cached_only:
+            print("%-14s MeshLab %d views, %d^2: not in the cache, left out" % (scene, views, tex), flush=True)
+            return False
         if key not in self.cache:
             script = os.path.join(self.tmp, "mlao.mlx")
             with open(script, "w") as f:
                 f.write(MESHLAB_AO_SCRIPT.format(views=views, tex=tex))
             times, walls = [], []
             out = os.path.join(self.tmp, "mlao.ply")
+            logs = os.path.join(self.results, "meshlab_logs")
+            os.makedirs(logs, exist_ok=True)
+            log = os.path.join(logs, "%s_%dx%d.log" % (scene, views, tex))
+            loads = []
             for _ in range(repeats):
-                load = load_average()
-                text, wall = run([self.mlx, "-i", mesh, "-o", out, "-m", "vq", "-s", script])
+                loads.append(load_average())
+                text, wall = run_logged([self.mlx, "-i", mesh, "-o", out, "-m", "vq", "-s", script], log)
                 m = re.search(r"Successfully calculated A\.O\. after ([0-9.]+) sec", text)
                 times.append(float(m.group(1)) if m else float("nan"))
                 walls.append(wall)
+                loads[-1] = {"before": loads[-1], "after": load_average()}
             q = 4.0 * vertex_property(out, "quality")  # MeshLab averages V max(0, n.d) over the sphere: open = 0.25
             self.cache[key] = {"seconds": statistics.median(times), "wall": statistics.median(walls),
-                               "runs": repeats, "load_average_before_last": load, "quality_file": self.keep(q, key)}
+                               "runs": repeats, "load_average": loads, "quality_file": self.keep(q, key)}
             self.save_cache()
         c = self.cache[key]
-        self.add(scene, nv, "MeshLab AO (CPU, depth %d)" % tex, "reqViews", views, c["seconds"], c["wall"],
-                 np.load(c["quality_file"]), ref)
+        if ref is not None:  # None: filling the cache only (--peers-only)
+            self.add(scene, nv, "MeshLab AO (CPU, depth %d)" % tex, "reqViews", views, c["seconds"], c["wall"],
+                     np.load(c["quality_file"]), ref, {"load_average": c.get("load_average")})
+        return True
 
 
 def time_to_reach(rows, target, key="filter_seconds"):
@@ -301,7 +378,8 @@ def subdivided(src, dst, levels):
         f.write(b"".join(struct.pack("<B3i", 3, *t) for t in faces))
 
 
-def scenes(build, out, sizes):
+def scenes(build, out, sizes, wanted=None):
+    """The benchmark's meshes of `sizes` (or only those named in `wanted`), generating the missing ones."""
     meshes = os.path.join(ROOT, "test_meshes")
     s = {}
     if sizes in ("small", "all"):
@@ -312,6 +390,8 @@ def scenes(build, out, sizes):
     if sizes in ("large", "all"):
         for level, name in ((3, "scan_118k"), (4, "scan_470k"), (5, "scan_1.9M")):
             path = os.path.join(out, name + ".ply")
+            if wanted and name not in wanted:
+                continue
             if not os.path.exists(path):
                 run([os.path.join(build, "tools", "gi-scenes"), "scan", os.path.join(meshes, "bunny.ply"), str(level), path])
             s[name] = path
@@ -319,6 +399,50 @@ def scenes(build, out, sizes):
         s.update({"cylinder_hole": os.path.join(meshes, "cylinder_hole.ply"),
                   "floor_wall": os.path.join(meshes, "floor_wall.ply")})
     return s
+
+
+OURS = ("ours, per vertex", "ours, shared", "ours, shared, adaptive")
+
+
+def load_range(loads):
+    """The range of the 1-minute load averages recorded around a method's runs ("8.1-10.3"), or "-"."""
+    one = []
+    for l in loads or []:
+        if isinstance(l, dict):
+            one += [x[0] for x in (l.get("before"), l.get("after")) if x]
+        elif l:
+            one.append(l[0])
+    if not one:
+        return "-"
+    return "%.1f" % one[0] if len(one) == 1 else "%.1f-%.1f" % (min(one), max(one))
+
+
+def speedup_table(summary):
+    """Markdown: per mesh and MeshLab setting, MeshLab's time and RMS error, and for each of ours the time and rays
+    per vertex to reach that error and the speed-up; the load averages around each side's runs."""
+    lines = ["| mesh (vertices) | MeshLab views, depth map | MeshLab time | MeshLab RMS (raw) | load, MeshLab | "
+             "ours per vertex | ours shared, fixed | ours shared, adaptive | load, ours |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    keys = []
+    for s in summary:
+        if (s["scene"], s["views"], s["tex"]) not in keys:
+            keys.append((s["scene"], s["views"], s["tex"]))
+    for scene, views, tex in keys:
+        by = {s["ours"]: s for s in summary if (s["scene"], s["views"], s["tex"]) == (scene, views, tex)}
+        s = next(iter(by.values()))
+        cells, loads = [], []
+        for ours in OURS:
+            o = by.get(ours)
+            if o is None or o["ours_seconds"] is None:
+                cells.append("not reached")
+            else:
+                cells.append("%.2f s, %.0f rays: %.1fx" % (o["ours_seconds"], o["ours_rays_per_vertex"], o["speedup"]))
+            if o is not None:
+                loads += o["ours_load_average"]
+        lines.append("| %s (%s) | %d, %d^2 | %.1f s | %.4f (%.4f) | %s | %s | %s |" % (
+            scene, "{:,}".format(s["vertices"]), views, tex, s["meshlab_seconds"], s["meshlab_rms"],
+            s["meshlab_rms_raw"], load_range(s["meshlab_load_average"]), " | ".join(cells), load_range(loads)))
+    return lines
 
 
 def plot(rows, scene_names, summary, path, speedup_path):
@@ -348,11 +472,16 @@ def plot(rows, scene_names, summary, path, speedup_path):
             if pts:
                 ax.semilogx([p[0] for p in pts], [p[1] for p in pts], style, color=colour, ms=4,
                             label="%s vs MeshLab %d views, %d^2" % (ours, views, tex))
-    ax.axhline(20, color="grey", lw=0.6, ls=":")
-    ax.axhline(30, color="grey", lw=0.6, ls=":")
+    ups = [s["speedup"] for s in summary if s["speedup"]] or [1.0]
+    ax.set_yscale("log")
+    ax.set_ylim(min(0.8, 0.8 * min(ups)), max(45.0, 1.3 * max(ups)))
+    ax.axhline(20, color="black", lw=0.8, ls=":")
+    ax.axhline(30, color="black", lw=0.8, ls="-.")
+    ax.text(ax.get_xlim()[0] * 1.1, 20 * 1.04, "goal 20x (all sizes)", fontsize=7)
+    ax.text(ax.get_xlim()[0] * 1.1, 30 * 1.04, "goal 30x (500k and above)", fontsize=7)
     ax.set_xlabel("vertices")
     ax.set_ylabel("speed-up at MeshLab's error (x)")
-    ax.set_yscale("log")
+    ax.set_title("time to MeshLab's RMS error: MeshLab's / ours", fontsize=9)
     ax.grid(True, which="both", lw=0.3)
     ax.legend(fontsize=6)
     fig.tight_layout()
@@ -369,9 +498,26 @@ def main():
     ap.add_argument("--scenes", default="", help="comma-separated scene names (default: all of --sizes)")
     ap.add_argument("--meshlab", default="512x512,1024x512,512x2048,1024x2048",
                     help="MeshLab settings VIEWSxDEPTHMAP to run on every scene (the first is the goal's)")
+    ap.add_argument("--meshlab-repeats", type=int, default=0,
+                    help="runs of MeshLab per setting (0: medians of 3 below 50k vertices, single runs above)")
+    ap.add_argument("--cached-ours-only", action="store_true",
+                    help="the settings of ours are those already in the cache for each mesh and this binary")
+    ap.add_argument("--cached-meshlab-only", action="store_true",
+                    help="MeshLab settings not already in the cache are left out instead of run (the tables say so)")
     ap.add_argument("--refs-only", action="store_true", help="only the references (no cache writes: can run beside)")
     ap.add_argument("--max-rays-total", type=float, default=3e8,
                     help="largest rays per run on the large meshes (ray counts n with n x vertices above it are left out)")
+    ap.add_argument("--max-ref-rays-total", type=float, default=0,
+                    help="halve a reference's rays per vertex while rays x vertices exceed this (0: no cap); its own "
+                         "error, larger then, is still measured and removed in quadrature")
+    ap.add_argument("--ref-rays", default="", help="reference rays per vertex (each of the two runs) by scene, "
+                    "e.g. scan_470k=128,scan_1.9M=32 (overrides the defaults and --max-ref-rays-total)")
+    ap.add_argument("--per-vertex-rays", default="", help="ray counts of ours per vertex (a,b,c; default by size)")
+    ap.add_argument("--shared-rays", default="", help="ray counts of ours shared (default by size)")
+    ap.add_argument("--targets", default="", help="adaptive targets of ours shared (default 0.04,0.02,0.01,0.005)")
+    ap.add_argument("--repeats", type=int, default=0, help="runs of ours per setting (0: 3 below 50k vertices, else 1)")
+    ap.add_argument("--no-server", action="store_true", help="leave out the run of ours through meshlabserver")
+    ap.add_argument("--no-throughput", action="store_true", help="skip the throughput runs (ao_throughput)")
     ap.add_argument("--no-cross-check", action="store_true", help="skip the reference's check by the path tracer")
     ap.add_argument("--no-sweep", action="store_true", help="no sweep of MeshLab's views on the small meshes")
     ap.add_argument("--peers-only", action="store_true",
@@ -380,7 +526,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     b = Bench(a.build, a.out, a.quick)
     conditions = {"cpus": os.cpu_count(), "load_average_start": load_average(), "started": time.ctime()}
-    sc = scenes(a.build, a.out, a.sizes)
+    sc = scenes(a.build, a.out, a.sizes, a.scenes.split(",") if a.scenes else None)
     if a.scenes:
         sc = {k: v for k, v in sc.items() if k in a.scenes.split(",")}
     main_configs = [tuple(int(x) for x in c.split("x")) for c in a.meshlab.split(",")]
@@ -389,9 +535,20 @@ def main():
         nv = len(vertex_property(mesh, "x"))
         large = nv > LARGE
         repeats = 1 if (a.quick or large) else 3
+        ml_repeats = a.meshlab_repeats or repeats
         ref_rays = 8192 if nv < 5000 else 4096 if nv < LARGE else 1024 if nv < 300000 else 512 if nv < 1000000 else 256
         if a.quick:
             ref_rays = min(ref_rays, 1024)
+        if a.max_ref_rays_total:  # a power of two with rays x vertices within the cap, at least 16
+            while ref_rays > 16 and ref_rays * nv > a.max_ref_rays_total:
+                ref_rays //= 2
+        ref_rays = dict((k, int(v)) for k, v in (x.split("=") for x in a.ref_rays.split(",") if x)).get(scene, ref_rays)
+        ml_configs = list(main_configs)
+        if not large and not a.quick and not a.no_sweep:
+            ml_configs += [(v, 512) for v in (16, 32, 64, 128, 256)]
+        if a.peers_only:  # MeshLab's runs first (the longest), then the references, filling the caches
+            for views, tex in ml_configs:
+                b.meshlab(scene, mesh, nv, None, views, tex, ml_repeats)
         ref = b.reference(scene, mesh, "angle", ref_rays)
         ref_ml = b.reference(scene, mesh, "area", ref_rays)
         if a.refs_only:
@@ -402,15 +559,19 @@ def main():
         per_vertex = [n for n in (8, 16, 32, 64, 128, 256, 512, 1024, 2048) if n * nv <= max(a.max_rays_total, 2048 * 5e4)]
         shared = [n for n in (4, 8, 16, 32, 64, 128, 256, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
         targets = [0.04, 0.02, 0.01, 0.005]
+        # explicit settings (a loaded machine: the few around MeshLab's error)
+        per_vertex = [int(x) for x in a.per_vertex_rays.split(",") if x] if a.per_vertex_rays else per_vertex
+        shared = [int(x) for x in a.shared_rays.split(",") if x] if a.shared_rays else shared
+        targets = [float(x) for x in a.targets.split(",") if x] if a.targets else targets
+        if a.repeats:
+            repeats = a.repeats
         if a.quick:
             per_vertex, shared, targets = [16, 64, 256], [8, 32, 128], [0.01]
-        ml_configs = list(main_configs)
-        if not large and not a.quick and not a.no_sweep:
-            ml_configs += [(v, 512) for v in (16, 32, 64, 128, 256)]
         if a.peers_only:
-            for views, tex in ml_configs:
-                b.meshlab(scene, mesh, nv, ref_ml, views, tex, repeats)
             continue
+        if a.cached_ours_only:  # every setting of ours already measured on this mesh with this binary
+            per_vertex, shared, targets, server = b.cached_ours(scene, mesh)
+            a.no_server = not server
         for n in per_vertex:
             b.ours(scene, mesh, nv, ref, "ours, per vertex", ["--rays_per_vertex", str(n), "--seed", "1"],
                    "rays_per_vertex", n, repeats)
@@ -420,21 +581,28 @@ def main():
         for t in targets:
             b.ours(scene, mesh, nv, ref, "ours, shared, adaptive",
                    ["--estimator", "1", "--target_error", str(t), "--min_rays", "8", "--seed", "1"], "target_error", t, repeats)
-        b.ours(scene, mesh, nv, ref, "ours, shared (meshlabserver)",
-               ["--estimator", "1", "--rays_per_vertex", "32", "--seed", "1"], "rays_per_vertex", 32, repeats, server=True)
-        for views, tex in ml_configs:
-            b.meshlab(scene, mesh, nv, ref_ml, views, tex, repeats)
+        if not a.no_server:
+            b.ours(scene, mesh, nv, ref, "ours, shared (meshlabserver)",
+                   ["--estimator", "1", "--rays_per_vertex", "32", "--seed", "1"], "rays_per_vertex", 32, repeats,
+                   server=True)
+        ran = {(views, tex): b.meshlab(scene, mesh, nv, ref_ml, views, tex, ml_repeats, a.cached_meshlab_only)
+               for views, tex in ml_configs}
         rows = [r for r in b.rows if r["scene"] == scene]
         for ours in ("ours, shared", "ours, per vertex", "ours, shared, adaptive"):
             mine = [r for r in rows if r["method"] == ours]
             for views, tex in main_configs:
+                if not ran[(views, tex)]:
+                    continue
                 ml = [r for r in rows if r["method"] == "MeshLab AO (CPU, depth %d)" % tex and r["value"] == views][0]
                 to = time_to_reach(mine, ml["rms_error"])
                 summary.append({"scene": scene, "vertices": nv, "ours": ours, "views": views, "tex": tex,
-                                "meshlab_rms": ml["rms_error"], "meshlab_seconds": ml["filter_seconds"],
+                                "meshlab_rms": ml["rms_error"], "meshlab_rms_raw": ml["rms_error_raw"],
+                                "reference_noise": ml["reference_noise"], "meshlab_seconds": ml["filter_seconds"],
+                                "meshlab_load_average": ml["load_average"],
+                                "ours_load_average": [l for r in mine for l in (r["load_average"] or [])],
                                 "ours_rays_per_vertex": time_to_reach(mine, ml["rms_error"], "rays_per_vertex"),
                                 "ours_seconds": to, "speedup": ml["filter_seconds"] / to if to else None})
-        if scene in ("bunny", "bunny_fine", "scan_118k"):
+        if scene in ("bunny", "bunny_fine", "scan_118k") and not a.no_throughput:
             text, _ = run([os.path.join(a.build, "bench", "ao_throughput"), mesh, "64" if large else "256",
                            "1" if a.quick else "3"])
             throughput[scene] = json.loads(text)
@@ -453,18 +621,7 @@ def main():
         w = csv.DictWriter(f, fieldnames=sorted({k for r in b.rows for k in r}))
         w.writeheader()
         w.writerows(b.rows)
-    lines = ["| scene (vertices) | MeshLab views, depth map | MeshLab RMS | MeshLab time | ours shared | speed-up | "
-             "ours per vertex | speed-up |", "|---|---|---|---|---|---|---|---|"]
-    for s in summary:
-        if s["ours"] != "ours, shared":
-            continue
-        pv = [x for x in summary if x["scene"] == s["scene"] and x["ours"] == "ours, per vertex" and
-              x["views"] == s["views"] and x["tex"] == s["tex"]][0]
-        fmt = lambda t: "not reached" if t is None else "%.3f s" % t
-        lines.append("| %s (%d) | %d, %d^2 | %.4f | %.2f s | %s | %s | %s | %s |" % (
-            s["scene"], s["vertices"], s["views"], s["tex"], s["meshlab_rms"], s["meshlab_seconds"],
-            fmt(s["ours_seconds"]), "%.0fx" % s["speedup"] if s["speedup"] else "-",
-            fmt(pv["ours_seconds"]), "%.0fx" % pv["speedup"] if pv["speedup"] else "-"))
+    lines = speedup_table(summary)
     lines += ["", "| scene | bare Embree rays/s | bare robust rays/s | ours rays/s | ours / bare | ours / bare robust |",
               "|---|---|---|---|---|---|"]
     for scene, t in throughput.items():
