@@ -464,7 +464,7 @@ def plot(rows, scene_names, summary, path, speedup_path):
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(9.6, 4.6))
     for (views, tex), style in (((512, 512), "o-"), ((1024, 512), "s--"), ((512, 2048), "^-"), ((1024, 2048), "v--")):
         for ours, colour in (("ours, shared", "C0"), ("ours, per vertex", "C1"), ("ours, shared, adaptive", "C2")):
             pts = sorted((s["vertices"], s["speedup"]) for s in summary
@@ -473,6 +473,7 @@ def plot(rows, scene_names, summary, path, speedup_path):
                 ax.semilogx([p[0] for p in pts], [p[1] for p in pts], style, color=colour, ms=4,
                             label="%s vs MeshLab %d views, %d^2" % (ours, views, tex))
     ups = [s["speedup"] for s in summary if s["speedup"]] or [1.0]
+    ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_ylim(min(0.8, 0.8 * min(ups)), max(45.0, 1.3 * max(ups)))
     ax.axhline(20, color="black", lw=0.8, ls=":")
@@ -483,7 +484,7 @@ def plot(rows, scene_names, summary, path, speedup_path):
     ax.set_ylabel("speed-up at MeshLab's error (x)")
     ax.set_title("time to MeshLab's RMS error: MeshLab's / ours", fontsize=9)
     ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=6)
+    ax.legend(fontsize=6, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     fig.savefig(speedup_path, dpi=110)
     plt.close(fig)
