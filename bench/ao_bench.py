@@ -32,11 +32,13 @@ usage: /usr/bin/python3 bench/ao_bench.py [--build build] [--quick] [--sizes sma
 """
 import argparse
 import csv
+import fcntl
 import hashlib
 import json
 import math
 import os
 import re
+import select
 import statistics
 import subprocess
 import sys
@@ -98,43 +100,36 @@ def vertex_property(path, name):
     return rec[name].astype(np.float64)
 
 
-def run(cmd, timeout=7200):
+def run(cmd, timeout=7200, log=None):
+    """Runs cmd, returns (output, wall seconds); raises on a non-zero exit. With `log`, the output is also written
+    there as it comes, each chunk stamped with the seconds since the start: MeshLab's progress per view can be read
+    there while it runs (or after it was stopped)."""
     t0 = time.perf_counter()
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
+    if log is None:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
+        returncode, out = p.returncode, p.stdout.decode("utf-8", "replace")
+    else:
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        chunks = []
+        with open(log, "a") as f:
+            f.write("\n=== %s: %s\n" % (time.strftime("%Y-%m-%d %H:%M:%S"), " ".join(cmd)))
+            while True:
+                if time.perf_counter() - t0 > timeout:
+                    p.kill()
+                    raise RuntimeError("command timed out: %s" % " ".join(cmd))
+                ready, _, _ = select.select([p.stdout], [], [], 5.0)
+                if not ready:
+                    continue
+                data = os.read(p.stdout.fileno(), 65536)
+                if not data:
+                    break
+                chunks.append(data)
+                f.write("[%9.2f s] %s\n" % (time.perf_counter() - t0, data.decode("utf-8", "replace").rstrip()))
+                f.flush()
+        returncode, out = p.wait(), b"".join(chunks).decode("utf-8", "replace")
     wall = time.perf_counter() - t0
-    out = p.stdout.decode("utf-8", "replace")
-    if p.returncode != 0:
-        raise RuntimeError("command failed (%d): %s\n%s" % (p.returncode, " ".join(cmd), out[-2000:]))
-    return out, wall
-
-
-def run_logged(cmd, log, timeout=7200):
-    """run(), with the output also written to `log` as it comes, each chunk stamped with the seconds since the
-    start: MeshLab's progress per view can be read there while it runs (or after it was stopped)."""
-    import select
-    t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    chunks = []
-    with open(log, "a") as f:
-        f.write("\n=== %s: %s\n" % (time.strftime("%Y-%m-%d %H:%M:%S"), " ".join(cmd)))
-        while True:
-            if time.perf_counter() - t0 > timeout:
-                p.kill()
-                raise RuntimeError("command timed out: %s" % " ".join(cmd))
-            ready, _, _ = select.select([p.stdout], [], [], 5.0)
-            if not ready:
-                continue
-            data = os.read(p.stdout.fileno(), 65536)
-            if not data:
-                break
-            chunks.append(data)
-            f.write("[%9.2f s] %s\n" % (time.perf_counter() - t0, data.decode("utf-8", "replace").rstrip()))
-            f.flush()
-    p.wait()
-    wall = time.perf_counter() - t0
-    out = b"".join(chunks).decode("utf-8", "replace")
-    if p.returncode != 0:
-        raise RuntimeError("command failed (%d): %s\n%s" % (p.returncode, " ".join(cmd), out[-2000:]))
+    if returncode != 0:
+        raise RuntimeError("command failed (%d): %s\n%s" % (returncode, " ".join(cmd), out[-2000:]))
     return out, wall
 
 
@@ -169,7 +164,6 @@ class Bench:
     def save_cache(self):
         """Merges this run's entries into the file under a lock, so that runs on different meshes (one per
         process, e.g. MeshLab on two large scans) can fill the same cache side by side."""
-        import fcntl
         with open(self.cache_path + ".lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)
             disk = {}
@@ -321,7 +315,7 @@ class Bench:
             loads = []
             for _ in range(repeats):
                 loads.append(load_average())
-                text, wall = run_logged([self.mlx, "-i", mesh, "-o", out, "-m", "vq", "-s", script], log)
+                text, wall = run([self.mlx, "-i", mesh, "-o", out, "-m", "vq", "-s", script], log=log)
                 m = re.search(r"Successfully calculated A\.O\. after ([0-9.]+) sec", text)
                 times.append(float(m.group(1)) if m else float("nan"))
                 walls.append(wall)
@@ -398,7 +392,7 @@ def scenes(build, out, sizes, wanted=None):
     if sizes in ("small", "all"):
         s.update({"cylinder_hole": os.path.join(meshes, "cylinder_hole.ply"),
                   "floor_wall": os.path.join(meshes, "floor_wall.ply")})
-    return s
+    return {k: v for k, v in s.items() if not wanted or k in wanted}
 
 
 OURS = ("ours, per vertex", "ours, shared", "ours, shared, adaptive")
@@ -528,8 +522,6 @@ def main():
     b = Bench(a.build, a.out, a.quick)
     conditions = {"cpus": os.cpu_count(), "load_average_start": load_average(), "started": time.ctime()}
     sc = scenes(a.build, a.out, a.sizes, a.scenes.split(",") if a.scenes else None)
-    if a.scenes:
-        sc = {k: v for k, v in sc.items() if k in a.scenes.split(",")}
     main_configs = [tuple(int(x) for x in c.split("x")) for c in a.meshlab.split(",")]
     summary, throughput, checks = [], {}, []
     for scene, mesh in sc.items():
