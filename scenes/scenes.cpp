@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "gi/color.h"
+#include "gi/scan.h"
 
 namespace gi::scenes {
 
@@ -438,6 +439,59 @@ SceneFile cylindricalHole(double a, double h, int n) {
     b.zip(prev, cur, [&](const dvec3&) { return up; }, kGrey);
     prev.swap(cur);
   }
+  return b.finish();
+}
+
+SceneFile scanRoom(const Scene& base, size_t triangles, const ScanOptions& o) {
+  const size_t nb = base.faceCount();
+  if (nb == 0) throw std::invalid_argument("the scan's base mesh has no triangles");
+  if (double(nb) > kScanRoomScanShare * double(triangles) || triangles > 200000000)
+    throw std::invalid_argument("scan room: " + std::to_string(triangles) + " triangles cannot hold the base's " +
+                                std::to_string(nb) + " and a room (at least " +
+                                std::to_string(size_t(std::ceil(nb / kScanRoomScanShare))) + ")");
+  ScanOptions so = o;
+  so.levels = 0;
+  while (so.levels < 8 && double(nb) * std::pow(4.0, so.levels + 1) <= kScanRoomScanShare * double(triangles))
+    ++so.levels;
+  const Scene scan = displacedScan(base, so);
+  dvec3 lo(1e300), hi(-1e300);
+  for (const auto& p : scan.positions) {
+    lo = glm::min(lo, scan.toWorld(p));
+    hi = glm::max(hi, scan.toWorld(p));
+  }
+  const double size = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  if (!(size > 0)) throw std::invalid_argument("the scan's base mesh is flat to a point");
+  const dvec3 shift(-0.5 * (lo.x + hi.x), -lo.y, -0.5 * (lo.z + hi.z));
+  Builder b;
+  for (const auto& p : scan.positions) b.vertex((scan.toWorld(p) + shift) / size + dvec3(0.0, 1e-3, 0.0));
+  for (const auto& t : scan.triangles) {
+    b.tris.push_back(t);
+    b.rho.push_back(glm::vec3(0.6f));
+    b.E.push_back(glm::vec3(0.f));
+  }
+  // The room: area 46.8 (window cut out), two triangles per h x h cell.
+  const double X = 1.5, Y = 2.5, roomArea = 8 * X * X + 8 * X * Y - 1.2;
+  const double left = double(triangles) - double(scan.faceCount());
+  const double h = std::sqrt(2.0 * roomArea / std::max(left - 200.0, 64.0));
+  const glm::vec3 wall(0.75f), floorRho(0.4f);
+  b.quadH({-X, 0, -X}, {X, 0, -X}, {X, 0, X}, {-X, 0, X}, h, {0, 1, 0}, floorRho);
+  b.quadH({-X, Y, -X}, {X, Y, -X}, {X, Y, X}, {-X, Y, X}, h, {0, -1, 0}, wall);
+  b.quadH({-X, 0, -X}, {X, 0, -X}, {X, Y, -X}, {-X, Y, -X}, h, {0, 0, 1}, wall);
+  b.quadH({-X, 0, X}, {X, 0, X}, {X, Y, X}, {-X, Y, X}, h, {0, 0, -1}, wall);
+  b.quadH({-X, 0, -X}, {-X, 0, X}, {-X, Y, X}, {-X, Y, -X}, h, {1, 0, 0}, wall);
+  // The window's wall x = X: four rectangles around the opening.
+  const double z0 = -0.6, z1 = 0.6, y0 = 0.8, y1 = 1.8;
+  auto windowWall = [&](double za, double zb, double ya, double yb) {
+    b.quadH({X, ya, za}, {X, ya, zb}, {X, yb, zb}, {X, yb, za}, h, {-1, 0, 0}, wall);
+  };
+  windowWall(-X, z0, 0, Y);
+  windowWall(z1, X, 0, Y);
+  windowWall(z0, z1, 0, y0);
+  windowWall(z0, z1, y1, Y);
+  const int kl = std::clamp(int(std::lround(0.8 / h)), 1, 10);
+  const double yl = Y - 1e-3;
+  b.quad({-0.4, yl, -0.9}, {0.4, yl, -0.9}, {0.4, yl, -0.1}, {-0.4, yl, -0.1}, kl, kl, {0, -1, 0}, glm::vec3(0.78f),
+         glm::vec3(1.f));
   return b.finish();
 }
 

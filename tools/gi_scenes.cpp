@@ -4,6 +4,9 @@
 // filters read); vertex colour shows rho, vertex quality is 0.
 // gi-scenes scan BASE LEVELS OUT.ply [AMPLITUDE FREQUENCY OCTAVES]: a
 // generated scan (gi/scan.h), BASE Loop-subdivided LEVELS times and displaced.
+// gi-scenes scanroom BASE TRIANGLES OUT.ply [SEED]: that scan standing in a
+// room with a ceiling light and a window (gi::scenes::scanRoom), about
+// TRIANGLES triangles in all, emitters marked like the canonical scenes'.
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -17,6 +20,29 @@
 #include "mesh_io.h"
 
 namespace {
+
+// Face colour = sRGB of rho, face quality = 1 on emitters, vertex colour = rho.
+void writeSceneFile(const std::string& path, const gi::scenes::SceneFile& sf) {
+  const auto vertexRho = gi::faceToVertex(sf.scene, sf.scene.rho);
+  std::vector<gi::Rgb8> colour;
+  colour.reserve(vertexRho.size());
+  for (const auto& r : vertexRho) colour.push_back(gi::displayMap(r, 1.f));
+  const std::vector<float> quality(sf.scene.vertexCount(), 0.f);
+  gi::io::writePly(path, sf.scene, sf.attrs, quality, colour);
+  std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), sf.scene.vertexCount(), sf.scene.faceCount());
+}
+
+int writeScanRoom(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: gi-scenes scanroom BASE TRIANGLES OUT.ply [SEED]\n");
+    return 2;
+  }
+  gi::scenes::ScanOptions o;
+  if (argc > 5) o.seed = uint32_t(std::stoul(argv[5]));
+  const gi::io::LoadedMesh base = gi::io::loadMesh(argv[2]);
+  writeSceneFile(argv[4], gi::scenes::scanRoom(base.scene, size_t(std::stoull(argv[3])), o));
+  return 0;
+}
 
 int writeScan(int argc, char** argv) {
   if (argc < 5) {
@@ -38,16 +64,17 @@ int writeScan(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "scan") {
+  if (argc > 1 && (std::string(argv[1]) == "scan" || std::string(argv[1]) == "scanroom")) {
     try {
-      return writeScan(argc, argv);
+      return std::string(argv[1]) == "scan" ? writeScan(argc, argv) : writeScanRoom(argc, argv);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "gi-scenes: %s\n", e.what());
       return 1;
     }
   }
   if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
-    std::printf("usage: gi-scenes OUTDIR [NAME...]\nscenes:");
+    std::printf("usage: gi-scenes OUTDIR [NAME...]\n       gi-scenes scan BASE LEVELS OUT.ply [AMPLITUDE FREQUENCY OCTAVES]\n"
+                "       gi-scenes scanroom BASE TRIANGLES OUT.ply [SEED]\nscenes:");
     for (const auto& n : gi::scenes::names()) std::printf(" %s", n.c_str());
     std::printf("\n");
     return argc < 2 ? 2 : 0;
@@ -58,17 +85,7 @@ int main(int argc, char** argv) {
   try {
     std::filesystem::create_directories(dir);
     for (const auto& name : names) {
-      for (const auto& layer : gi::scenes::layersByName(name)) {
-        const gi::scenes::SceneFile& sf = layer.file;
-        const auto vertexRho = gi::faceToVertex(sf.scene, sf.scene.rho);
-        std::vector<gi::Rgb8> colour;
-        colour.reserve(vertexRho.size());
-        for (const auto& r : vertexRho) colour.push_back(gi::displayMap(r, 1.f));
-        const std::vector<float> quality(sf.scene.vertexCount(), 0.f);
-        const std::string path = (dir / layer.name).string();
-        gi::io::writePly(path, sf.scene, sf.attrs, quality, colour);
-        std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), sf.scene.vertexCount(), sf.scene.faceCount());
-      }
+      for (const auto& layer : gi::scenes::layersByName(name)) writeSceneFile((dir / layer.name).string(), layer.file);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gi-scenes: %s\n", e.what());

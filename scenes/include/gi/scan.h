@@ -8,7 +8,10 @@
 // (Perlin 2002, "Improving Noise", hashed gradients), n the angle-weighted
 // vertex normal of the subdivided surface.
 #pragma once
+#include <cstddef>
+
 #include "gi/scene.h"
+#include "gi/scenes.h"
 
 namespace gi::scenes {
 
@@ -25,5 +28,21 @@ struct ScanOptions {
 Scene loopSubdivide(const Scene& base, int levels);
 // The subdivided and displaced mesh (in the base's coordinates).
 Scene displacedScan(const Scene& base, const ScanOptions& o);
+
+// A scan in a room, for radiosity at scale: the base displaced as above
+// (o.levels ignored: the largest count of Loop steps whose scan keeps at
+// most kScanRoomScanShare of `triangles`), scaled to a largest extent of 1,
+// standing 1e-3 above the floor at the centre of a closed room x, z in
+// [-1.5, 1.5], y (up) in [0, 2.5] whose walls, floor and ceiling take the
+// other triangles (roughly square patches of two). A 0.8 x 0.8 ceiling
+// light (at most 200 triangles, 1e-3 below the ceiling, facing down,
+// emission 1: face quality 1) sits above the scan towards z < 0; the wall
+// x = 1.5 has a window opening (z in [-0.6, 0.6], y in [0.8, 1.8]) for sky
+// light (the filters' sky parameters). Reflectances: scan 0.6, floor 0.4,
+// walls and ceiling 0.75. The scan's triangles come first, keeping its
+// winding; the room's face inwards. About `triangles` in all (the room's
+// patches are rounded per rectangle); deterministic for a base and seed.
+inline constexpr double kScanRoomScanShare = 0.9;
+SceneFile scanRoom(const Scene& base, size_t triangles, const ScanOptions& o);
 
 }  // namespace gi::scenes
