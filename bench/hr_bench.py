@@ -93,7 +93,9 @@ def k_for(triangles):
     return max(2, int(round(math.sqrt(triangles / (2 * (5 + 10 / 16))))))
 
 
-def run(gi, mesh, out, solver, extra, vertex_output="Patch average"):
+def run(gi, mesh, out, solver, extra, vertex_output="Patch average", usage=None):
+    """The run's JSON, wall seconds and peak resident MB; its CPU seconds (user + system) are appended to
+    `usage` if given."""
     cmd = [gi, "radiosity", mesh, "-o", out, "--solver", solver, "--vertex_output", vertex_output,
            "--json"] + extra
     t0 = time.perf_counter()
@@ -104,6 +106,8 @@ def run(gi, mesh, out, solver, extra, vertex_output="Patch average"):
     wall = time.perf_counter() - t0
     if status != 0:
         raise RuntimeError("%s failed: %s" % (" ".join(cmd), stderr.decode()[-500:]))
+    if usage is not None:
+        usage.append(ru.ru_utime + ru.ru_stime)
     return json.loads(stdout), wall, ru.ru_maxrss / 1024.0
 
 
@@ -132,11 +136,11 @@ def vertex_values(path):
         return out
 
 
-def reference_at_sample(gi, mesh, tmp, count, paths, seed):
+def reference_at_sample(gi, mesh, tmp, count, paths, seed, extra=()):
     """`gi reference` on `count` random vertices: (traced vertex indices, their B luminance, standard errors, seconds)."""
     saved = os.path.join(tmp, "ref.json")
     cmd = [gi, "reference", mesh, "--traced_vertices", str(count), "--traced_vertex_seed", str(seed),
-           "--samples_per_vertex", str(paths), "--save-result", saved, "--json"]
+           "--samples_per_vertex", str(paths), "--save-result", saved, "--json"] + list(extra)
     t0 = time.perf_counter()
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     if p.returncode != 0:

@@ -222,7 +222,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
                                    uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
-                                   const VertexPart& part) {
+                                   const VertexPart& part, const Progress& progress) {
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
     const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -230,7 +230,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
   }
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
-  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+  parallelBlocks(s.vertexCount(), progress, "final gather at vertices", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
       if (!mat.valid[v] || !part.contains(v, s.vertexCount())) continue;
       SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));

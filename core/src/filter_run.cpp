@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <vector>
 #include <stdexcept>
 #include <string>
@@ -244,10 +245,25 @@ void addLightPathAttributes(const LightPathSplit& split, FilterResult& res) {
   res.attributes.push_back(vectorAttribute("Radiosity_indirect", split.indirect));
 }
 
+// The vertex selection (traced_selected), 0/1 per vertex; an error sentence
+// when no vertex is selected.
+std::shared_ptr<const std::vector<uint8_t>> selectedVertices(const FilterInput& in) {
+  const std::vector<uint8_t>& sel = in.attrs.vertexSelected;
+  const size_t nv = in.scene.vertexCount();
+  if (sel.size() != nv || std::none_of(sel.begin(), sel.end(), [](uint8_t x) { return x != 0; }))
+    throw std::invalid_argument(
+        "traced_selected is on but no vertex is selected (MeshLab: select vertices first, e.g. Filters > Selection; "
+        "a PLY file: bit 0x20 of the vertex property 'flags'); turn traced_selected off to trace all vertices");
+  auto out = std::make_shared<std::vector<uint8_t>>(nv);
+  for (size_t v = 0; v < nv; ++v) (*out)[v] = sel[v] ? 1 : 0;
+  return out;
+}
+
 void runReference(FilterInput& in, FilterResult& res, const Progress& progress) {
   const auto caster = makeEmbreeCaster(in.scene);
   PathTraceOptions opt = PathTraceOptions::fromParams(in.values, in.scene.origin);
   opt.vertices = in.vertices;
+  if (opt.tracedSelected) opt.selectedVertices = selectedVertices(in);
   PathTraceResult r = pathTrace(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
@@ -255,7 +271,7 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
   res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
-  if (opt.tracedVertices > 0)
+  if (opt.tracedVertices > 0 || opt.tracedSelected)
     res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
   // The same value and error bar under names no other filter writes: they
   // stay on the mesh while a method under test overwrites quality, Radiosity
@@ -276,6 +292,7 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
     r = std::move(ar.result);
     res.refined = std::move(ar.mesh);
   } else {
+    checkRadiosityMemory(in.scene.faceCount(), opt);  // before the ray-casting structure is built
     const auto caster = makeEmbreeCaster(in.scene);
     r = solveRadiosity(in.scene, *caster, opt, progress);
   }

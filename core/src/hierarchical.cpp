@@ -207,6 +207,7 @@ struct Refiner {
   size_t maxLinks;
   std::vector<Link>& out;
   std::vector<uint8_t>& fresh;       // 1: F still to compute
+  size_t reserved = 0;               // links still to be carried over after this one (later rounds)
   uint64_t splits = 0;
   bool budgetHit = false;
 
@@ -253,7 +254,7 @@ struct Refiner {
       return;
     }
     if (culled(p, q)) return;
-    if (acceptable(p, q) || out.size() >= maxLinks) {
+    if (acceptable(p, q) || out.size() + reserved >= maxLinks) {
       budgetHit |= !acceptable(p, q);
       add(p, q, 0.f, true);
       return;
@@ -372,6 +373,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   }
   P += set.enteringPower;
   HierarchicalSolution sol;
+  progress.report(0.0, "cluster tree");  // serial stages: named, so a long one shows what runs
   const Tree t = buildTree(g);
   const size_t nn = t.nodes.size();
   sol.R = S;
@@ -415,12 +417,18 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     double leaving = P;
     for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
     Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, nextFresh};
+    pr.report(0.0, "refining links");
     if (first) {
       ref.refine(0, 0);
     } else {
+      // The links still to come keep their share of the budget: a link is
+      // split only into what they leave.
       for (size_t k = 0; k < links.size(); ++k) {
-        if (ref.acceptable(links[k].p, links[k].q) || next.size() >= maxLinks) ref.add(links[k].p, links[k].q, links[k].F, false);
-        else ref.refine(links[k].p, links[k].q);
+        ref.reserved = links.size() - k - 1;
+        if (ref.acceptable(links[k].p, links[k].q) || next.size() + ref.reserved >= maxLinks)
+          ref.add(links[k].p, links[k].q, links[k].F, false);
+        else
+          ref.refine(links[k].p, links[k].q);
       }
     }
     const uint64_t newSplits = ref.splits;

@@ -57,6 +57,13 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
                  .help = "Which vertices 'Traced vertices' draws (the same seed, mesh and count: the same vertices, "
                          "for any thread count and split); independent of the paths' seed.",
                  .type = ParamType::Int, .def = 0, .min = 0, .max = 2147483647});
+  out.push_back({.name = "traced_selected", .label = "Trace selected vertices only",
+                 .help = "Trace only the selected vertices (MeshLab: the vertex selection; the command-line tool: "
+                         "bit 0x20 of the PLY vertex property 'flags', as MeshLab saves a selection): a reference "
+                         "where it matters, at a cost proportional to their count. The others get 0 and "
+                         "ReferenceTraced 0. Not with 'Traced vertices' > 0; with no vertex selected the filter "
+                         "stops with an error.",
+                 .type = ParamType::Bool, .def = false});
   return out;
 }
 
@@ -77,6 +84,7 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
   o.seed = uint32_t(v.getInt("seed"));
   o.tracedVertices = size_t(v.getInt("traced_vertices"));
   o.tracedVertexSeed = uint32_t(v.getInt("traced_vertex_seed"));
+  o.tracedSelected = v.getBool("traced_selected");
   return o;
 }
 
@@ -180,8 +188,15 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   const bool adaptive = opt.targetRelativeError > 0;
   // A split run traces its part of the vertices; a sample narrows it.
   VertexPart part = opt.vertices;
-  if (opt.tracedVertices > 0 && opt.tracedVertices < nv)
+  if (opt.tracedSelected) {
+    if (opt.tracedVertices > 0)
+      throw std::invalid_argument("traced_selected and traced_vertices > 0 both choose the traced vertices: use one");
+    if (!opt.selectedVertices || opt.selectedVertices->size() != nv)
+      throw std::logic_error("traced_selected needs the selection of every vertex");
+    part.subset = opt.selectedVertices;
+  } else if (opt.tracedVertices > 0 && opt.tracedVertices < nv) {
     part.subset = randomVertexSubset(nv, opt.tracedVertices, opt.tracedVertexSeed);
+  }
   if (adaptive && !part.all() && !part.sumOverParts)
     throw std::logic_error("an adaptive reference split over parts needs their sum (VertexPart::sumOverParts)");
   Timer traceTimer;
@@ -270,7 +285,10 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
-  if (part.subset)
+  if (opt.tracedSelected)
+    st.note("traced the " + std::to_string(std::count(part.subset->begin(), part.subset->end(), uint8_t(1))) +
+            " selected of the " + std::to_string(nv) + " vertices; the others are 0, with ReferenceTraced 0");
+  else if (part.subset)
     st.note("traced a random sample of " + std::to_string(opt.tracedVertices) + " of the " + std::to_string(nv) +
             " vertices (traced_vertex_seed " + std::to_string(opt.tracedVertexSeed) +
             "); the others are 0, with ReferenceTraced 0");

@@ -429,7 +429,7 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
 // solution: with a fixed bounce count the patch values are what the count
 // asks for.
 std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
-                                      const RadiosityOptions& opt, RadiosityResult& res) {
+                                      const RadiosityOptions& opt, RadiosityResult& res, const Progress& progress) {
   const uint32_t seed = opt.formFactors.seed;
   const bool refineNear = opt.bounces < 0;
   const DirectLightAt directAt(s, caster, 4);
@@ -447,7 +447,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     const glm::vec3 Hout = skySunIrradianceAt(opt.outside, caster, y + faceN[f] * eps, faceN[f], 4, key);
     return s.faceRho(f) * (directAt(y, faceN[f], key) + Hout + res.Hindirect[f]);
   };
-  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices);
+  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices, progress);
   res.stats.add("gather_rays", double(opt.vertices.count(s.vertexCount())) * opt.gatherRays);
   if (refineNear) res.stats.add("gather_near_hits_relit", double(nearHits.load()));
   return Hi;
@@ -457,15 +457,20 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
 // light at each vertex and the indirect light gathered (final gather:
 // visibility at the vertex itself, no leaks under objects that cut through
 // patches) or interpolated from the incident patches.
-void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res) {
+void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res,
+                  const Progress& progress = Progress(nullptr)) {
   Timer vt;
   const VertexMaterial mat = vertexMaterial(s);
-  std::vector<glm::vec3> Hd = vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, Progress(nullptr), opt.vertices);
-  const std::vector<glm::vec3> Hout =
-      vertexSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed, opt.vertices);
-  for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
-  const std::vector<glm::vec3> Hi = gather ? gatherIndirect(s, caster, mat, opt, res) : faceToVertex(s, res.Hindirect);
+  // Progress: shadow rays, sky and sun, then the gather's many more rays.
+  const double d = gather ? 0.25 : 0.8, o = gather ? 0.35 : 1.0;
+  std::vector<glm::vec3> Hd =
+      vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, d), opt.vertices);
+  const std::vector<glm::vec3> Hout = vertexSkySunIrradiance(s, caster, opt.outside, opt.lightSamples,
+                                                             opt.formFactors.seed, opt.vertices, progress.sub(d, o));
+  for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
+  const std::vector<glm::vec3> Hi =
+      gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect);
   for (size_t v = 0; v < s.vertexCount(); ++v)
     res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient) : glm::vec3(0.f);
   res.stats.add("vertex_output_seconds", vt.seconds());
@@ -479,17 +484,9 @@ void vertexValues(const Scene& s, const RayCaster& caster, const RadiosityOption
 RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                            const Progress& progress) {
   Timer timer;
-  const double MB = 1048576.0, budget = opt.memoryBudgetMB * MB;
+  const double budget = opt.memoryBudgetMB * 1048576.0;
   const size_t n = s.faceCount();
-  const double base = double(n) * (kSolverBytesPerPatch + 2.0 * kHierarchyBytesPerNode);
-  if (base > budget) {
-    char b[300];
-    std::snprintf(b, sizeof b,
-                  "memory_budget_mb = %g is too small: %zu patches need about %.1f MB for the scene, the ray-casting "
-                  "structure and the cluster hierarchy before any link; raise memory_budget_mb",
-                  opt.memoryBudgetMB, n, base / MB);
-    throw std::invalid_argument(b);
-  }
+  checkRadiosityMemory(n, opt);
   Timer directTimer;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1)),
                         patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed,
@@ -500,8 +497,10 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   hs.linkRays = opt.linkRays;
   hs.memoryBytes = budget - double(n) * kSolverBytesPerPatch;
   hs.enteringPower = u.Pout;
+  // Progress: direct light 0-20%, the hierarchy to 70% (to 100% without per-vertex values), the vertices after.
+  const bool vertices = opt.vertexOutput != RadiosityVertexOutput::PatchAverage;
   HierarchicalSolution h = solveHierarchical(s, caster, u.Hd, hs, opt.bounces, opt.tolerance, opt.maxIterations,
-                                             progress.sub(0.2, 0.9));
+                                             progress.sub(0.2, vertices ? 0.7 : 1.0));
   RadiosityResult res;
   res.stats = std::move(h.stats);
   res.iterations = h.iterations;
@@ -522,10 +521,11 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (opt.hierarchyEpsilon == 0 && n > 20000)
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
-  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
+  if (vertices) vertexValues(s, caster, opt, res, progress.sub(0.7, 1.0));
   res.stats.add("direct_light_seconds", directSeconds);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
   res.stats.add("patches", double(u.n));
+  res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
   res.stats.add("seconds", timer.seconds());
   return res;
 }
@@ -544,6 +544,30 @@ double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
   if (ff.method == FormFactorMethod::Hemicube) row += hemicubeBufferBytes(ff.hemicubeResolution);
   if (ff.method == FormFactorMethod::MonteCarlo) row = 12.0 * ff.raysPerPatch;
   return n * kSolverBytesPerPatch + workerThreads() * row;
+}
+
+bool usesHierarchy(size_t patches, const RadiosityOptions& opt) {
+  return opt.solver == RadiositySolver::Hierarchical ||
+         (opt.solver == RadiositySolver::Auto && patches >= kHierarchicalAutoPatches);
+}
+
+void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt) {
+  const double MB = 1048576.0, n = double(patches);
+  const bool hierarchy = usesHierarchy(patches, opt);
+  const double need = hierarchy ? n * (kSolverBytesPerPatch + 2.0 * kHierarchyBytesPerNode) : solverBaseBytes(patches, opt);
+  if (need <= opt.memoryBudgetMB * MB) return;
+  char b[500];
+  std::snprintf(b, sizeof b,
+                "memory_budget_mb = %g is too small: %zu patches need about %.0f MB for %s before anything is "
+                "computed; raise memory_budget_mb to at least %.0f, or use fewer patches",
+                opt.memoryBudgetMB, patches, std::ceil(need / MB),
+                hierarchy ? "the scene, the ray-casting structure and the cluster hierarchy (hierarchical solver, "
+                            "about 880 bytes per patch; the links take what is left)"
+                          : "the scene, the ray-casting structure, the solver's vectors and a form-factor row per "
+                            "thread (flat solver; the form-factor matrix takes what is left, else it is computed on "
+                            "the fly)",
+                std::ceil(need / MB) + 1.0);
+  throw std::invalid_argument(b);
 }
 
 int autoIterations(double r, double tolerance) {
@@ -576,9 +600,8 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
   const FormFactors::Settings& ffs = opt.formFactors;
   if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
-  if (opt.solver == RadiositySolver::Hierarchical ||
-      (opt.solver == RadiositySolver::Auto && s.faceCount() >= kHierarchicalAutoPatches))
-    return solveHierarchicalRadiosity(s, caster, opt, progress);
+  if (usesHierarchy(s.faceCount(), opt)) return solveHierarchicalRadiosity(s, caster, opt, progress);
+  checkRadiosityMemory(s.faceCount(), opt);
   Timer timer;
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits

@@ -112,12 +112,12 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
 }
 
 std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
-                                              uint32_t seed, const VertexPart& part) {
+                                              uint32_t seed, const VertexPart& part, const Progress& progress) {
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   if (!o.any() || rays < 1) return H;
   const VertexMaterial mat = vertexMaterial(s);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
-  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+  parallelBlocks(s.vertexCount(), progress, "sky and sun at vertices", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v)
       if (mat.valid[v] && part.contains(v, s.vertexCount()))
         H[v] = skySunIrradianceAt(o, caster, origins[v], mat.n[v], rays, hash3(uint32_t(v), seed, 0x5c4u));

@@ -56,7 +56,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 // the hit point. Only the vertices of `part` (the others 0).
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
                                    uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
-                                   const VertexPart& part = VertexPart());
+                                   const VertexPart& part = VertexPart(), const Progress& progress = Progress(nullptr));
 
 namespace detail {
 class DirectLight;

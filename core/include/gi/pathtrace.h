@@ -24,8 +24,11 @@
 // others get 0 and traced = 0 (the filter's per-vertex attribute
 // ReferenceTraced), never a value borrowed from a neighbour, so that an
 // error measured against the reference is measured where it was traced.
+// Or it traces the vertices the user selected (tracedSelected: the mesh's
+// vertex selection, which the filter turns into selectedVertices).
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -56,6 +59,8 @@ struct PathTraceOptions {
   VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
   size_t tracedVertices = 0;       // > 0: only a random sample of this many vertices (the others 0)
   uint32_t tracedVertexSeed = 0;   // which sample
+  bool tracedSelected = false;     // only the vertices marked 1 in selectedVertices (the others 0)
+  std::shared_ptr<const std::vector<uint8_t>> selectedVertices;  // per vertex; set by the filter from the mesh
   bool lightPathSplit = false;     // also B per light-path kind (light_paths.h)
   static std::vector<ParamSpec> specs();
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);

@@ -116,6 +116,18 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
 // a hemicube's buffers, 144 MB at resolution 4096).
 inline constexpr double kSolverBytesPerPatch = 400;
 double solverBaseBytes(size_t patches, const RadiosityOptions& opt);
+// Whether solveRadiosity runs the hierarchical solver (asked for, or Auto
+// from kHierarchicalAutoPatches on).
+bool usesHierarchy(size_t patches, const RadiosityOptions& opt);
+// Refuses, before anything large is allocated (the front ends call it
+// before building the ray-casting structure), a run whose fixed memory
+// exceeds memory_budget_mb: per patch kSolverBytesPerPatch, and the cluster
+// tree (2 kHierarchyBytesPerNode) for the hierarchical solver or a
+// form-factor row per thread for the flat ones (solverBaseBytes). Throws
+// std::invalid_argument with one sentence: the megabytes needed, the budget
+// and what to change. What is left of the budget bounds the hierarchy's
+// links or the flat form-factor matrix (kept in memory only if it fits).
+void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt);
 int workerThreads();  // the threads parallel loops may use now
 
 // Sweeps enough for the residual to fall below `tolerance` when each sweep

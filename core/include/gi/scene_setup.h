@@ -22,6 +22,7 @@ struct MeshAttributes {
   std::vector<glm::u8vec3> vertexColor;  // sRGB bytes
   std::vector<float> faceQuality;
   std::vector<uint8_t> faceSelected;
+  std::vector<uint8_t> vertexSelected;   // 1: selected (MeshLab's vertex selection, PLY vertex flags bit 0x20)
 };
 
 enum class EmitterSource { SelectedFaces, QualityAbove, None, Auto };

@@ -55,7 +55,8 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
 // H_out at every vertex of `part` (the others, and vertices without a usable
 // face, 0), from the per-vertex ray origins (vertexRayOrigins).
 std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
-                                              uint32_t seed, const VertexPart& part = VertexPart());
+                                              uint32_t seed, const VertexPart& part = VertexPart(),
+                                              const Progress& progress = Progress(nullptr));
 
 // The power entering the scene from outside, as luminance: sum over faces
 // of A_f luminance(H_out,f) (local units of area).
