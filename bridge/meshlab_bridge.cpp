@@ -63,6 +63,7 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
         // Layers without vertex colours count as white-less grey: 188 = 0.5 linear.
         b.attrs.vertexColor.push_back(vc ? glm::u8vec3(v.cC()[0], v.cC()[1], v.cC()[2]) : glm::u8vec3(188));
       }
+      b.attrs.vertexSelected.push_back(v.IsS() ? 1 : 0);
     }
     for (size_t i = 0; i < m.face.size(); ++i) {
       const CFaceO& f = m.face[i];

@@ -168,6 +168,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
+  out.attrs.vertexSelected = p.vertexSelected;
   out.attributes = detail::vertexAttributes(p);
   return out;
 }
@@ -276,6 +277,7 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
   merge(into.attrs.vertexColor, other.attrs.vertexColor, nv0, nv1, glm::u8vec3(188));
   merge(into.attrs.faceQuality, other.attrs.faceQuality, nf0, nf1, 0.f);
   merge(into.attrs.faceSelected, other.attrs.faceSelected, nf0, nf1, uint8_t(0));
+  merge(into.attrs.vertexSelected, other.attrs.vertexSelected, nv0, nv1, uint8_t(0));
   const bool normals = !into.scene.vertexNormals.empty() || !other.scene.vertexNormals.empty();
   if (normals) {
     // Missing normals of one part: computed from its faces.

@@ -14,7 +14,7 @@ namespace gi::io {
 
 struct LoadedMesh {
   Scene scene;            // positions (re-centred), triangles (polygons fan-triangulated), normals if the file has them
-  MeshAttributes attrs;   // face/vertex colours (sRGB bytes), face quality, if present in the file
+  MeshAttributes attrs;   // face/vertex colours (sRGB bytes), face quality, vertex selection (PLY flags), if in the file
   std::vector<uint32_t> triangleToFace;  // source polygon of each triangle
   // Per-vertex values an earlier filter left (PLY only: the vertex element's
   // other float properties; NAME_x, NAME_y, NAME_z as the vector NAME).

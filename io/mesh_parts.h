@@ -16,6 +16,7 @@ struct Polygons {
   std::vector<glm::dvec3> points;
   std::vector<glm::vec3> normals;          // per vertex, or empty
   std::vector<glm::u8vec3> vertexColor;    // or empty
+  std::vector<uint8_t> vertexSelected;     // 1: selected (PLY vertex flags bit 0x20), or empty
   std::vector<uint32_t> faceStart{0};      // face f: index[faceStart[f] .. faceStart[f+1])
   std::vector<uint32_t> index;
   std::vector<glm::u8vec3> faceColor;      // or empty

@@ -4,10 +4,11 @@
 // numbers are whole tokens, in range for their declared type; binary data is
 // little or big endian. Read: vertex x y z, nx ny nz, red green blue (integer
 // 0..255 or float 0..1); face vertex_indices (or vertex_index), red green
-// blue, quality (any numeric type); the vertex element's other float and
-// double properties are kept by name (an earlier filter's per-vertex
-// results). Every other element and property is skipped by its size, so
-// MeshLab's extras (flags, texture coordinates) load.
+// blue, quality (any numeric type); vertex flags (an integer: bit 0x20 is
+// vcglib's SELECTED, as MeshLab saves a selection); the vertex element's
+// other float and double properties are kept by name (an earlier filter's
+// per-vertex results). Every other element and property is skipped by its
+// size, so MeshLab's extras (face flags, texture coordinates) load.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -54,7 +55,7 @@ std::pair<double, double> integerRange(Type t) {
   }
 }
 
-enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices, Keep };
+enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices, Flags, Keep };
 
 struct Property {
   std::string name;
@@ -170,6 +171,7 @@ void assignRoles(Header& h, const std::string& name) {
         else if (n == "nx") p.role = Role::NX;
         else if (n == "ny") p.role = Role::NY;
         else if (n == "nz") p.role = Role::NZ;
+        else if (n == "flags" && !p.list && isInteger(p.type)) p.role = Role::Flags;
       }
       if (vertex || face) {
         if (n == "red" || n == "diffuse_red") p.role = Role::R;
@@ -320,6 +322,7 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
       out.points.resize(size_t(e.count));
       if (normals) out.normals.resize(size_t(e.count));
       if (colours) out.vertexColor.resize(size_t(e.count));
+      if (has(e, Role::Flags)) out.vertexSelected.resize(size_t(e.count));
     }
     if (isFace) {
       out.faceStart.reserve(size_t(e.count) + 1);
@@ -386,6 +389,7 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
           case Role::G: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].g = colourByte(p.type, v); break;
           case Role::B: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].b = colourByte(p.type, v); break;
           case Role::Quality: out.faceQuality[k] = float(v); break;
+          case Role::Flags: out.vertexSelected[k] = (int64_t(v) & 0x20) ? 1 : 0; break;
           default: break;
         }
       }

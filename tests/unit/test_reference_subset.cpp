@@ -1,14 +1,19 @@
 // The path-traced reference on a random sample of the vertices
 // (traced_vertices): the sample is deterministic and uniform, the traced
 // vertices get exactly the values of a full run (random numbers keyed by the
-// vertex), the others 0 with traced = 0, and the count is reported.
+// vertex), the others 0 with traced = 0, and the count is reported. And on
+// the selected vertices (traced_selected), the selection read from a PLY's
+// vertex flags as MeshLab saves it.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
+#include "gi/filter_run.h"
 #include "gi/pathtrace.h"
 #include "gi/scenes.h"
 #include "gi/vertex_part.h"
+#include "mesh_io.h"
 
 using namespace gi;
 
@@ -67,4 +72,62 @@ TEST(ReferenceSubset, TracedVerticesMatchTheFullRun) {
   EXPECT_EQ(traced, 40u);
   EXPECT_EQ(part.stats.get("traced_vertices"), 40.0);
   EXPECT_EQ(full.stats.get("traced_vertices"), double(s.vertexCount()));
+}
+
+// 'GI: Path-Traced Reference' with traced_selected, as MeshLab and the CLI run
+// it: the selected vertices get exactly the full run's values (keyed by the
+// vertex), the others 0 and ReferenceTraced 0; no selection is an error.
+TEST(ReferenceSubset, TracedSelectedTracesOnlyTheSelection) {
+  const auto sf = scenes::cornellBox(150.0);
+  auto run = [&](bool selected, const std::vector<uint8_t>& sel) {
+    FilterInput in;
+    in.scene = sf.scene;
+    in.attrs = sf.attrs;
+    in.attrs.vertexSelected = sel;
+    in.layers.push_back({"mesh", 0, sf.scene.faceCount()});
+    const auto specs = filterSpecs(FilterKind::PathTracedReference);
+    in.values = defaultValues(specs, analyzeScene(in.scene).diagonal);
+    in.values.set("emitter_source", int(kEmitterSources.index(EmitterSource::QualityAbove)));
+    in.values.set("samples_per_vertex", 16);
+    in.values.set("traced_selected", selected);
+    return runFilter(FilterKind::PathTracedReference, in);
+  };
+  const size_t nv = sf.scene.vertexCount();
+  std::vector<uint8_t> sel(nv, 0);
+  for (size_t v = 3; v < nv; v += 17) sel[v] = 1;
+  const FilterResult full = run(false, {}), part = run(true, sel);
+  const VertexAttribute* traced = part.attribute("ReferenceTraced");
+  ASSERT_NE(traced, nullptr);
+  size_t count = 0;
+  for (size_t v = 0; v < nv; ++v) {
+    ASSERT_EQ(traced->values[v], float(sel[v])) << v;
+    count += sel[v];
+    if (sel[v]) EXPECT_EQ(part.vertexQuality[v], full.vertexQuality[v]) << v;
+    else EXPECT_EQ(part.attribute("Radiosity")->values[3 * v], 0.f) << v;
+  }
+  EXPECT_EQ(part.stats.get("traced_vertices"), double(count));
+  for (const std::vector<uint8_t>& none : {std::vector<uint8_t>{}, std::vector<uint8_t>(nv, 0)}) {
+    try {
+      run(true, none);
+      ADD_FAILURE() << "no selection was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("no vertex is selected"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The PLY reader takes the selection from the vertex flags (bit 0x20, as
+// MeshLab writes them), whatever the other bits.
+TEST(ReferenceSubset, PlyVertexFlagsGiveTheSelection) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property int flags\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 0\n1 0 0 32\n1 1 0 3\n0 1 0 -2147483616\n3 0 1 2\n3 0 2 3\n";
+  const io::LoadedMesh m = io::parseMesh(ply, "ply", "flags.ply");
+  EXPECT_EQ(m.attrs.vertexSelected, (std::vector<uint8_t>{0, 1, 0, 1}));
+  const io::LoadedMesh plain = io::parseMesh(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      "ply", "plain.ply");
+  EXPECT_TRUE(plain.attrs.vertexSelected.empty());
 }
