@@ -469,13 +469,22 @@ SceneFile scanRoom(const Scene& base, size_t triangles, const ScanOptions& o) {
     b.rho.push_back(glm::vec3(0.6f));
     b.E.push_back(glm::vec3(0.f));
   }
-  // The room: area 46.8 (window cut out), two triangles per h x h cell.
-  const double X = 1.5, Y = 2.5, roomArea = 8 * X * X + 8 * X * Y - 1.2;
+  // The room: area 46.2 (window and light cut out), two triangles per h x h cell.
+  const double X = 1.5, Y = 2.5, roomArea = 8 * X * X + 8 * X * Y - 1.2 - 0.64;
   const double left = double(triangles) - double(scan.faceCount());
   const double h = std::sqrt(2.0 * roomArea / std::max(left - 200.0, 64.0));
   const glm::vec3 wall(0.75f), floorRho(0.4f);
   b.quadH({-X, 0, -X}, {X, 0, -X}, {X, 0, X}, {-X, 0, X}, h, {0, 1, 0}, floorRho);
-  b.quadH({-X, Y, -X}, {X, Y, -X}, {X, Y, X}, {-X, Y, X}, h, {0, -1, 0}, wall);
+  // The ceiling around the light's rectangle x in [-0.4, 0.4], z in [-0.9, -0.1] (as in
+  // the Cornell box: no ceiling hidden behind the light, nowhere black).
+  const double lx = 0.4, lz0 = -0.9, lz1 = -0.1;
+  auto ceiling = [&](double xa, double xb, double za, double zb) {
+    b.quadH({xa, Y, za}, {xb, Y, za}, {xb, Y, zb}, {xa, Y, zb}, h, {0, -1, 0}, wall);
+  };
+  ceiling(-X, X, -X, lz0);
+  ceiling(-X, X, lz1, X);
+  ceiling(-X, -lx, lz0, lz1);
+  ceiling(lx, X, lz0, lz1);
   b.quadH({-X, 0, -X}, {X, 0, -X}, {X, Y, -X}, {-X, Y, -X}, h, {0, 0, 1}, wall);
   b.quadH({-X, 0, X}, {X, 0, X}, {X, Y, X}, {-X, Y, X}, h, {0, 0, -1}, wall);
   b.quadH({-X, 0, -X}, {-X, 0, X}, {-X, Y, X}, {-X, Y, -X}, h, {1, 0, 0}, wall);
@@ -490,7 +499,7 @@ SceneFile scanRoom(const Scene& base, size_t triangles, const ScanOptions& o) {
   windowWall(z0, z1, y1, Y);
   const int kl = std::clamp(int(std::lround(0.8 / h)), 1, 10);
   const double yl = Y - 1e-3;
-  b.quad({-0.4, yl, -0.9}, {0.4, yl, -0.9}, {0.4, yl, -0.1}, {-0.4, yl, -0.1}, kl, kl, {0, -1, 0}, glm::vec3(0.78f),
+  b.quad({-lx, yl, lz0}, {lx, yl, lz0}, {lx, yl, lz1}, {-lx, yl, lz1}, kl, kl, {0, -1, 0}, glm::vec3(0.78f),
          glm::vec3(1.f));
   return b.finish();
 }

@@ -35,8 +35,9 @@ Scene displacedScan(const Scene& base, const ScanOptions& o);
 // standing 1e-3 above the floor at the centre of a closed room x, z in
 // [-1.5, 1.5], y (up) in [0, 2.5] whose walls, floor and ceiling take the
 // other triangles (roughly square patches of two). A 0.8 x 0.8 ceiling
-// light (at most 200 triangles, 1e-3 below the ceiling, facing down,
-// emission 1: face quality 1) sits above the scan towards z < 0; the wall
+// light (at most 200 triangles, 1e-3 below a hole of its size in the
+// ceiling, facing down, emission 1: face quality 1) sits above the scan
+// towards z < 0; the wall
 // x = 1.5 has a window opening (z in [-0.6, 0.6], y in [0.8, 1.8]) for sky
 // light (the filters' sky parameters). Reflectances: scan 0.6, floor 0.4,
 // walls and ceiling 0.75. The scan's triangles come first, keeping its
