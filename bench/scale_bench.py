@@ -113,7 +113,7 @@ def main():
     ap.add_argument("--budget", type=float, default=2048.0, help="memory_budget_mb (the goal's 2 GB)")
     ap.add_argument("--sample", type=float, default=0.01, help="share of the vertices the reference traces")
     ap.add_argument("--min_sample", type=int, default=200)
-    ap.add_argument("--ref_paths", type=int, default=1024)
+    ap.add_argument("--ref_paths", type=int, default=4096)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="bench/scale_bench_results.json")
     ap.add_argument("--plot", default="docs/img/scale_bench.png")

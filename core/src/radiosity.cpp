@@ -546,30 +546,6 @@ double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
   return n * kSolverBytesPerPatch + workerThreads() * row;
 }
 
-bool usesHierarchy(size_t patches, const RadiosityOptions& opt) {
-  return opt.solver == RadiositySolver::Hierarchical ||
-         (opt.solver == RadiositySolver::Auto && patches >= kHierarchicalAutoPatches);
-}
-
-void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt) {
-  const double MB = 1048576.0, n = double(patches);
-  const bool hierarchy = usesHierarchy(patches, opt);
-  const double need = hierarchy ? n * (kSolverBytesPerPatch + 2.0 * kHierarchyBytesPerNode) : solverBaseBytes(patches, opt);
-  if (need <= opt.memoryBudgetMB * MB) return;
-  char b[500];
-  std::snprintf(b, sizeof b,
-                "memory_budget_mb = %g is too small: %zu patches need about %.0f MB for %s before anything is "
-                "computed; raise memory_budget_mb to at least %.0f, or use fewer patches",
-                opt.memoryBudgetMB, patches, std::ceil(need / MB),
-                hierarchy ? "the scene, the ray-casting structure and the cluster hierarchy (hierarchical solver, "
-                            "about 880 bytes per patch; the links take what is left)"
-                          : "the scene, the ray-casting structure, the solver's vectors and a form-factor row per "
-                            "thread (flat solver; the form-factor matrix takes what is left, else it is computed on "
-                            "the fly)",
-                std::ceil(need / MB) + 1.0);
-  throw std::invalid_argument(b);
-}
-
 int autoIterations(double r, double tolerance) {
   if (!(r > 0.0)) return 10;
   if (!(r < 1.0)) return 1000000;
