@@ -131,6 +131,8 @@ def main():
         for target in [int(s) for s in a.sizes.split(",")]:
             row = measure(a, tmp, target)
             row["date_utc"] = time.strftime("%Y-%m-%d %H:%M", time.gmtime())
+            row["source_commit"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                                                  text=True).stdout.strip()
             rows = sorted([r for r in rows if r["target"] != target] + [row], key=lambda r: r["target"])
             summary = {"goal": GOAL, "settings": {"sky_irradiance": a.sky, "memory_budget_mb": a.budget,
                                                   "sample": a.sample, "reference_paths": a.ref_paths,
