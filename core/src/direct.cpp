@@ -117,17 +117,38 @@ class DirectLight {
     unoccluded_ = pairwiseUnoccluded(s);
     if (exact_) {
       lumOfFace_.assign(s.faceCount(), kNoHit);
-      for (size_t L = 0; L < lums_.count(); ++L)
-        for (uint32_t f : lums_.list()[L].faces) lumOfFace_[f] = uint32_t(L);
+      for (size_t L = 0; L < lums_.count(); ++L) {
+        const Luminaire& l = lums_.list()[L];
+        for (uint32_t f : l.faces) lumOfFace_[f] = uint32_t(L);
+        double r = 0;
+        for (const glm::dvec3& c : l.corners) r = std::max(r, glm::length(c - l.origin));
+        lumRadius_.push_back(r);
+      }
     }
   }
   bool empty() const { return lights_.empty(); }
   bool exact() const { return exact_; }
   float eps() const { return eps_; }
-  // Points per patch for `lightSamples` shadow rays: with luminaires, one
-  // point per kPatchPointRays rays (each point's budget in penumbra).
+  // Points per patch for `lightSamples` shadow rays. Power sampling: one
+  // each. Luminaires: at most one per kPatchPointRays rays (each point's
+  // budget in penumbra), and only as many as the irradiance's variation over
+  // the patch asks for: kPointsPerRatio x r / d, r the patch's radius and d
+  // its distance from the nearest luminaire's bounding sphere (at least r);
+  // one for a patch small against its distance to every light.
   static constexpr int kPatchPointRays = 64;
-  int points(int lightSamples) const { return exact_ ? std::max(1, lightSamples / kPatchPointRays) : lightSamples; }
+  static constexpr double kPointsPerRatio = 40.0;
+  int maxPoints(int lightSamples) const { return exact_ ? std::max(1, lightSamples / kPatchPointRays) : lightSamples; }
+  int points(int lightSamples, size_t face) const {
+    const int most = maxPoints(lightSamples);
+    if (!exact_ || most == 1) return most;
+    const auto& t = s_.triangles[face];
+    const glm::dvec3 a(s_.positions[t.x]), b(s_.positions[t.y]), c(s_.positions[t.z]), m = (a + b + c) / 3.0;
+    const double r = std::max({glm::length(a - m), glm::length(b - m), glm::length(c - m)});
+    double ratio = 0;
+    for (size_t L = 0; L < lums_.count(); ++L)
+      ratio = std::max(ratio, r / std::max(r, glm::length(m - lums_.list()[L].origin) - lumRadius_[L]));
+    return std::clamp(int(std::ceil(kPointsPerRatio * ratio)), 1, most);
+  }
 
   // Sample k of the point's padded sequence: dimensions 1 (light point) and 2
   // (direction) for the MIS samples; dimension 0 is left to the caller (the
@@ -176,6 +197,7 @@ class DirectLight {
   Luminaires lums_;
   float eps_;
   std::vector<uint32_t> lumOfFace_;
+  std::vector<double> lumRadius_;
   bool exact_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
 
@@ -201,12 +223,14 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
   const DirectLight direct(s, caster);
   if (direct.empty()) return H;
   const auto ok = usableFaceMask(s);
-  const int points = direct.points(lightSamples), budget = lightSamples / points;
-  std::atomic<uint64_t> rays{0}, penumbra{0};
+  const int budget = lightSamples / direct.maxPoints(lightSamples);
+  std::atomic<uint64_t> rays{0}, penumbra{0}, allPoints{0};
   parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
-    uint64_t r = 0, pen = 0;
+    uint64_t r = 0, pen = 0, pts = 0;
     for (size_t i = b; i < e; ++i) {
       if (!ok[i]) continue;
+      const int points = direct.points(lightSamples, i);
+      pts += uint64_t(points);
       const auto& t = s.triangles[i];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
       // Point k on the patch (dimension 0) and its light sample (dimensions 1
@@ -227,8 +251,9 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
     }
     rays += r;
     penumbra += pen;
+    allPoints += pts;
   });
-  if (stats) direct.report(*stats, rays.load(), penumbra.load(), uint64_t(std::count(ok.begin(), ok.end(), 1)) * points);
+  if (stats) direct.report(*stats, rays.load(), penumbra.load(), allPoints.load());
   return H;
 }
 

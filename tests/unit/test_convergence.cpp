@@ -223,7 +223,9 @@ TEST(Convergence, FormFactorsMonteCarlo) {
 // Direct light on the receiving patches: their area-weighted mean irradiance
 // is E F(receiver -> emitter). Two branches: the exact point-to-polygon
 // factor to the parallel emitter (one luminaire) at N / 64 QMC points of
-// each patch (no shadow rays: nothing can occlude; F = 0.199825), and the
+// each patch, at most 40 here (the patch's radius over its distance from
+// the light's bounding sphere, x 40; no shadow rays: nothing can occlude;
+// F = 0.199825), and the
 // emitter standing on the receiver's edge split into 288 triangles and
 // slightly noisy (288 luminaires, more than 256: power-sampled light points
 // combined by MIS with cosine-weighted directions; Howell C-14, F =
