@@ -121,7 +121,7 @@ class DirectLight {
         const Luminaire& l = lums_.list()[L];
         for (uint32_t f : l.faces) lumOfFace_[f] = uint32_t(L);
         double r = 0;
-        for (const glm::dvec3& c : l.corners) r = std::max(r, glm::length(c - l.origin));
+        for (const glm::dvec3& p : l.corners) r = std::max(r, glm::length(p - l.origin));
         lumRadius_.push_back(r);
       }
     }
@@ -177,14 +177,16 @@ class DirectLight {
               "): power sampling with MIS");
       return;
     }
-    char b[200];
+    char b[300];
     std::snprintf(b, sizeof b, "%s: exact form factor x visibility%s", found.c_str(),
                   unoccluded_ ? " (no shadow rays: nothing can occlude)" : "");
     std::string line = std::string("direct light: ") + b;
     if (!unoccluded_) {
-      std::snprintf(b, sizeof b, " (%d shadow rays per luminaire, more in penumbra: %.1f%% of %llu points)",
-                    Luminaires::kFirstRays, points ? 100.0 * double(penumbra) / double(points) : 0.0,
-                    (unsigned long long)points);
+      std::snprintf(b, sizeof b,
+                    " (%d stratified shadow rays and one to each of up to %zu corners per luminaire, more in penumbra: "
+                    "%.1f%% of %llu points)",
+                    Luminaires::kFirstRays, Luminaires::kProbes,
+                    points ? 100.0 * double(penumbra) / double(points) : 0.0, (unsigned long long)points);
       line += b;
     }
     st.note(line);
