@@ -43,9 +43,10 @@ VertexMaterial vertexMaterial(const Scene& s);
 
 // Direct irradiance per face from the emitters: with up to
 // Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), the exact form
-// factor to each times its visibility, at max(1, lightSamples / 64) points
-// of the patch, each with up to lightSamples / points shadow rays per
-// luminaire in penumbra (16 elsewhere); with more, lightSamples
+// factor to each times its visibility, at up to P = max(1, lightSamples /
+// 64) points of the patch (fewer where the patch is small against its
+// distance to the luminaires), each with up to lightSamples / P shadow rays
+// per luminaire in penumbra (16 and the corners elsewhere); with more, lightSamples
 // power-proportional light samples with MIS. *stats (if given) gets the
 // luminaires found, the method and the shadow rays.
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
