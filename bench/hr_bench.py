@@ -7,8 +7,8 @@ two solutions' vertex values (patch averages) where both run.
 The room: floor, ceiling, back and side walls of a 1 x 1 x 1 box (open at the
 front, like the Cornell box; red left wall, green right wall, white rest),
 two boxes standing on the floor, and a square light of 0.2 x 0.2 below the
-ceiling (at most 200 triangles, so that the direct light takes its exact
-per-emitter path at every size) marked by face quality 1. Every quad of a k x k grid is two
+ceiling (at most 200 triangles, one planar luminaire for the direct light
+at every size) marked by face quality 1. Every quad of a k x k grid is two
 triangles; k grows to reach the requested triangle counts. Generated here,
 never shipped.
 
@@ -75,7 +75,7 @@ def room(path, k):
     kb = max(1, k // 4)
     box((0.2, 0.0, 0.5), (0.45, 0.5, 0.75), kb, white, verts, faces)
     box((0.55, 0.0, 0.25), (0.8, 0.25, 0.5), kb, white, verts, faces)
-    kl = max(1, min(k // 5, 10))  # at most 200 emitter triangles: the direct light's exact path
+    kl = max(1, min(k // 5, 10))  # at most 200 emitter triangles, one luminaire
     quad_grid((0.4, 0.999, 0.4), (0.2, 0, 0), (0, 0, 0.2), kl, (255, 255, 255), 1, verts, faces)  # light, facing -y
     with open(path, "wb") as f:
         f.write(("ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"

@@ -1,6 +1,9 @@
 #include "gi/direct.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -8,8 +11,8 @@
 
 #include "gi/color.h"
 #include "gi/emitters.h"
-#include "gi/form_factor_analytic.h"
 #include "gi/form_factors.h"
+#include "gi/luminaires.h"
 #include "gi/sampling.h"
 
 namespace gi {
@@ -99,56 +102,105 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
 
 namespace detail {
 
-// Direct irradiance from the emitters at points of the scene. With up to 256
-// emitter faces: the exact point-to-triangle factor to every emitter face
-// times the visibility of one shadow ray to a random point on it (Wallace et
-// al. 1989); with more: power-proportional point sampling.
+// Direct irradiance from the emitters at points of the scene. With up to
+// Luminaires::kMaxLuminaires luminaires (coplanar, edge-connected emitter
+// triangles of one emission; gi/luminaires.h): the exact point-to-polygon
+// factor of each times its visibility from stratified shadow rays (more in
+// penumbra); with more: power-proportional light samples combined with
+// cosine-weighted directions by MIS (one shadow ray each).
 class DirectLight {
  public:
-  // sampled: always power-proportional MIS light samples (one shadow ray each).
+  // sampled: always the MIS light samples.
   DirectLight(const Scene& s, const RayCaster& c, bool sampled = false)
-      : s_(s), caster_(c), lights_(s), eps_(float(sceneScale(s).rayEpsilon)) {
-    const auto ok = usableFaceMask(s);
-    for (size_t f = 0; f < s.faceCount(); ++f)
-      if (ok[f] && luminance(s.faceEmission(f)) > 0.f) emitters_.push_back(uint32_t(f));
-    analytic_ = !sampled && emitters_.size() <= 256;
+      : s_(s), caster_(c), lights_(s), lums_(s), eps_(float(sceneScale(s).rayEpsilon)) {
+    exact_ = !sampled && lums_.usable();
     unoccluded_ = pairwiseUnoccluded(s);
+    if (exact_) {
+      lumOfFace_.assign(s.faceCount(), kNoHit);
+      for (size_t L = 0; L < lums_.count(); ++L) {
+        const Luminaire& l = lums_.list()[L];
+        for (uint32_t f : l.faces) lumOfFace_[f] = uint32_t(L);
+        double r = 0;
+        for (const glm::dvec3& p : l.corners) r = std::max(r, glm::length(p - l.origin));
+        lumRadius_.push_back(r);
+      }
+    }
   }
-  bool unoccluded() const { return unoccluded_; }
   bool empty() const { return lights_.empty(); }
+  bool exact() const { return exact_; }
   float eps() const { return eps_; }
-  // Shadow rays per estimate() call.
-  int raysPerPoint() const { return analytic_ ? int(emitters_.size()) : 1; }
+  // Points per patch for `lightSamples` shadow rays. Power sampling: one
+  // each. Luminaires: at most one per kPatchPointRays rays (each point's
+  // budget in penumbra), and only as many as the irradiance's variation over
+  // the patch asks for: kPointsPerRatio x r / d, r the patch's radius and d
+  // its distance from the nearest luminaire's bounding sphere (at least r);
+  // one for a patch small against its distance to every light.
+  static constexpr int kPatchPointRays = 64;
+  static constexpr double kPointsPerRatio = 40.0;
+  int maxPoints(int lightSamples) const { return exact_ ? std::max(1, lightSamples / kPatchPointRays) : lightSamples; }
+  int points(int lightSamples, size_t face) const {
+    const int most = maxPoints(lightSamples);
+    if (!exact_ || most == 1) return most;
+    const auto& t = s_.triangles[face];
+    const glm::dvec3 a(s_.positions[t.x]), b(s_.positions[t.y]), c(s_.positions[t.z]), m = (a + b + c) / 3.0;
+    const double r = std::max({glm::length(a - m), glm::length(b - m), glm::length(c - m)});
+    double ratio = 0;
+    for (size_t L = 0; L < lums_.count(); ++L)
+      ratio = std::max(ratio, r / std::max(r, glm::length(m - lums_.list()[L].origin) - lumRadius_[L]));
+    return std::clamp(int(std::ceil(kPointsPerRatio * ratio)), 1, most);
+  }
 
   // Sample k of the point's padded sequence: dimensions 1 (light point) and 2
-  // (direction) here; dimension 0 is left to the caller (the point on a patch).
-  glm::vec3 estimate(const glm::vec3& x, const glm::vec3& n, const PaddedSobol& smp, uint32_t k, Rng& rng,
-                     uint32_t skip) const {
-    if (!analytic_) return sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, smp(k, 1), smp(k, 2), eps_);
-    glm::dvec3 sum(0.0);
-    for (uint32_t L : emitters_) {
-      if (L == skip) continue;
-      const auto& te = s_.triangles[L];
-      const glm::vec3 nL = faceNormalUnnormalized(s_, L);
-      if (glm::dot(nL, x - s_.positions[te.x]) <= 0.f) continue;  // behind the emitter: it emits one-sided
-      const double F = pointToTriangleFormFactor(glm::dvec3(x), glm::dvec3(n), glm::dvec3(s_.positions[te.x]),
-                                                 glm::dvec3(s_.positions[te.y]), glm::dvec3(s_.positions[te.z]));
-      if (F <= 0) continue;
-      if (!unoccluded_ &&
-          !visibleToRandomPoint(caster_, x, s_.positions[te.x], s_.positions[te.y], s_.positions[te.z], rng, eps_))
-        continue;
-      sum += F * glm::dvec3(s_.faceEmission(L));
+  // (direction) for the MIS samples; dimension 0 is left to the caller (the
+  // point on a patch). With luminaires: `budget` shadow rays at most per
+  // luminaire, keyed by `key`; light from the luminaire of face `skip` is left out.
+  LuminaireEstimate estimate(const glm::vec3& x, const glm::vec3& n, const PaddedSobol& smp, uint32_t k, int budget,
+                             uint32_t key, uint32_t skip) const {
+    if (!exact_) {
+      LuminaireEstimate e;
+      e.H = sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, smp(k, 1), smp(k, 2), eps_);
+      e.rays = 1;
+      return e;
     }
-    return glm::vec3(sum);
+    const uint32_t skipL = skip < lumOfFace_.size() ? lumOfFace_[skip] : kNoHit;
+    return luminaireIrradiance(lums_, caster_, x, n, budget, key, eps_, unoccluded_, skipL);
+  }
+
+  // The log: luminaires found and the method used, and the shadow rays cast.
+  void report(RunStats& st, uint64_t rays, uint64_t penumbra, uint64_t points) const {
+    st.add("luminaires", double(lums_.count()));
+    st.add("direct_shadow_rays", double(rays));
+    const std::string found = std::to_string(lums_.count()) + " luminaire" + (lums_.count() == 1 ? "" : "s") + " from " +
+                              std::to_string(lums_.emitterFaces()) + " emitter triangles";
+    if (!exact_) {
+      st.note("direct light: " + found + " (more than " + std::to_string(Luminaires::kMaxLuminaires) +
+              "): power sampling with MIS");
+      return;
+    }
+    char b[300];
+    std::snprintf(b, sizeof b, "%s: exact form factor x visibility%s", found.c_str(),
+                  unoccluded_ ? " (no shadow rays: nothing can occlude)" : "");
+    std::string line = std::string("direct light: ") + b;
+    if (!unoccluded_) {
+      std::snprintf(b, sizeof b,
+                    " (%d stratified shadow rays and one to each of up to %zu corners per luminaire, more in penumbra: "
+                    "%.1f%% of %llu points)",
+                    Luminaires::kFirstRays, Luminaires::kProbes,
+                    points ? 100.0 * double(penumbra) / double(points) : 0.0, (unsigned long long)points);
+      line += b;
+    }
+    st.note(line);
   }
 
  private:
   const Scene& s_;
   const RayCaster& caster_;
   EmitterSampler lights_;
+  Luminaires lums_;
   float eps_;
-  std::vector<uint32_t> emitters_;
-  bool analytic_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
+  std::vector<uint32_t> lumOfFace_;
+  std::vector<double> lumRadius_;
+  bool exact_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
 
 }  // namespace detail
@@ -161,39 +213,49 @@ DirectLightAt::~DirectLightAt() = default;
 glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const {
   if (impl_->empty()) return glm::vec3(0.f);
   const PaddedSobol smp(hash3(key, 0xd8u, 0x5au));
-  Rng rng(hash3(key, 0xd9u, 0x5bu));
   glm::vec3 sum(0.f);
-  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, smp, uint32_t(k), rng, kNoHit);
+  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, smp, uint32_t(k), 1, key, kNoHit).H;
   return sum / float(samples_);
 }
 
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                             const Progress& progress) {
+                                             const Progress& progress, RunStats* stats) {
   if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
   const DirectLight direct(s, caster);
   if (direct.empty()) return H;
   const auto ok = usableFaceMask(s);
-  const int points = std::max(1, lightSamples / direct.raysPerPoint());
+  const int budget = lightSamples / direct.maxPoints(lightSamples);
+  std::atomic<uint64_t> rays{0}, penumbra{0}, allPoints{0};
   parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
+    uint64_t r = 0, pen = 0, pts = 0;
     for (size_t i = b; i < e; ++i) {
       if (!ok[i]) continue;
+      const int points = direct.points(lightSamples, i);
+      pts += uint64_t(points);
       const auto& t = s.triangles[i];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
       // Point k on the patch (dimension 0) and its light sample (dimensions 1
       // and 2) from one padded sequence: independent of each other.
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd3u));
-      Rng rng(hash3(uint32_t(i), seed, 0xd5u));
       glm::dvec3 sum(0.0);
       for (int k = 0; k < points; ++k) {
         const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
         const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] +
                             n * direct.eps();
-        sum += glm::dvec3(direct.estimate(x, n, smp, uint32_t(k), rng, uint32_t(i)));
+        const LuminaireEstimate est =
+            direct.estimate(x, n, smp, uint32_t(k), budget, hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i));
+        sum += glm::dvec3(est.H);
+        r += est.rays;
+        pen += est.penumbra;
       }
       H[i] = glm::vec3(sum / double(points));
     }
+    rays += r;
+    penumbra += pen;
+    allPoints += pts;
   });
+  if (stats) direct.report(*stats, rays.load(), penumbra.load(), allPoints.load());
   return H;
 }
 
@@ -204,21 +266,22 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
   const DirectLight direct(s, caster);
   if (direct.empty()) return H;
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, direct.eps());
-  const int points = std::max(1, lightSamples / direct.raysPerPoint());
+  // A vertex is one point: with luminaires, all of light_samples in penumbra.
+  const int points = direct.exact() ? 1 : lightSamples, budget = lightSamples;
   parallelBlocks(s.vertexCount(), progress, "direct light at vertices", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i] || !part.contains(i, s.vertexCount())) continue;
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd6u));
-      Rng rng(hash3(uint32_t(i), seed, 0xd7u));
       glm::dvec3 sum(0.0);
       for (int k = 0; k < points; ++k)
-        sum += glm::dvec3(direct.estimate(origins[i], mat.n[i], smp, uint32_t(k), rng, kNoHit));
+        sum += glm::dvec3(
+            direct.estimate(origins[i], mat.n[i], smp, uint32_t(k), budget, hash3(uint32_t(i), seed ^ uint32_t(k), 0xd7u),
+                            kNoHit).H);
       H[i] = glm::vec3(sum / double(points));
     }
   });
   return H;
 }
-
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
                                    uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,

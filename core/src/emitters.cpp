@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "gi/color.h"
+#include "gi/luminaires.h"
 #include "gi/raycaster.h"
-#include "gi/sampling.h"
 #include "gi/sampling.h"
 
 namespace gi {
@@ -27,11 +27,9 @@ EmitterSampler::EmitterSampler(const Scene& s) : s_(s) {
 }
 
 EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
-  const double x = double(u.x) * total_;
-  size_t k = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), x) - cdf_.begin());
-  k = std::min(k, faces_.size() - 1);
-  const double lo = k ? cdf_[k - 1] : 0.0, w = cdf_[k] - lo;
-  const float ux = w > 0 ? float(std::clamp((x - lo) / w, 0.0, 0.99999994)) : 0.5f;
+  float ux;
+  const size_t k = invertCdf(cdf_, double(u.x), &ux);
+  const double w = cdf_[k] - (k ? cdf_[k - 1] : 0.0);
   const uint32_t f = faces_[k];
   const auto& t = s_.triangles[f];
   const glm::vec2 b = uniformTriangle({ux, u.y});

@@ -10,6 +10,14 @@
 
 namespace gi {
 
+double lambertEdgeTerm(const glm::dvec3& v0, const glm::dvec3& v1, const glm::dvec3& n) {
+  if (glm::dot(v0, v0) == 0 || glm::dot(v1, v1) == 0) return 0.0;  // x on the polygon's corner
+  const glm::dvec3 cr = glm::cross(v0, v1);
+  const double lc = glm::length(cr);
+  if (lc == 0) return 0.0;
+  return std::atan2(lc, glm::dot(v0, v1)) * glm::dot(n, cr) / lc;
+}
+
 double pointToTriangleFormFactor(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
                                  const glm::dvec3& c) {
   // Clip the triangle to n . (p - x) >= 0 (Sutherland-Hodgman, one plane).
@@ -25,16 +33,7 @@ double pointToTriangleFormFactor(const glm::dvec3& x, const glm::dvec3& n, const
   }
   if (m < 3) return 0.0;
   double sum = 0;
-  for (int k = 0; k < m; ++k) {
-    const glm::dvec3 v0 = poly[k], v1 = poly[(k + 1) % m];
-    const double l0 = glm::length(v0), l1 = glm::length(v1);
-    if (l0 == 0 || l1 == 0) continue;  // x on the polygon's corner: that edge adds nothing
-    const glm::dvec3 cr = glm::cross(v0, v1);
-    const double lc = glm::length(cr);
-    if (lc == 0) continue;
-    const double theta = std::atan2(lc, glm::dot(v0, v1));
-    sum += theta * glm::dot(n, cr) / lc;
-  }
+  for (int k = 0; k < m; ++k) sum += lambertEdgeTerm(poly[k], poly[(k + 1) % m], n);
   return std::fabs(sum) / (2.0 * M_PI);
 }
 

@@ -58,7 +58,10 @@ std::vector<ParamSpec> PhotonOptions::specs() {
                "Off: all light from the photon map (the classic noisy look).",
        .type = ParamType::Bool, .def = true},
       {.name = "light_samples", .label = "Shadow rays per vertex",
-       .help = "Shadow rays for the direct light at each vertex.",
+       .help = "Shadow rays for the direct light at each vertex. With up to 256 luminaires (coplanar, "
+               "edge-connected emitter faces of one emission), the exact form factor to each times its visible "
+               "fraction from 16 stratified rays (and its corners), up to this many in penumbra; with more, this "
+               "many light points sampled in proportion to power.",
        .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
       {.name = "final_gather", .label = "Final gather",
        .help = "For the indirect diffuse light, cast cosine-weighted rays from each vertex (through mirrors and "

@@ -25,6 +25,13 @@ namespace {
 
 using RowFn = std::function<const FormFactorRow&(uint32_t)>;
 
+// The direct light's numbers and notes (luminaires, method) after the solver's.
+void appendStats(RunStats& to, const RunStats& from) {
+  to.numbers.insert(to.numbers.end(), from.numbers.begin(), from.numbers.end());
+  to.notes.insert(to.notes.end(), from.notes.begin(), from.notes.end());
+  to.warnings.insert(to.warnings.end(), from.warnings.begin(), from.warnings.end());
+}
+
 struct Setup {
   size_t n;
   std::vector<double> A;
@@ -488,7 +495,9 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   const size_t n = s.faceCount();
   checkRadiosityMemory(n, opt);
   Timer directTimer;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1)),
+  RunStats directStats;
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1),
+                                                 &directStats),
                         patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed,
                                               progress.sub(0.1, 0.2)));
   const double directSeconds = directTimer.seconds();
@@ -523,6 +532,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
   if (vertices) vertexValues(s, caster, opt, res, progress.sub(0.7, 1.0));
   res.stats.add("direct_light_seconds", directSeconds);
+  appendStats(res.stats, directStats);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
   res.stats.add("patches", double(u.n));
   res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
@@ -582,7 +592,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05)),
+  RunStats directStats;
+  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05), &directStats),
                         patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, ffs.seed, progress.sub(0.05, 0.1)));
   const double directSeconds = directTimer.seconds();
   RadiositySolver solver = opt.solver;
@@ -593,6 +604,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
                                  : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) vertexValues(s, caster, opt, res);
   res.stats.add("direct_light_seconds", directSeconds);
+  appendStats(res.stats, directStats);
   res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +

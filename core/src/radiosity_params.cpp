@@ -16,11 +16,14 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
   std::vector<ParamSpec> s = formFactorSpecs();
   const std::vector<ParamSpec> more = {
       {.name = "light_samples", .label = "Shadow rays per patch",
-       .help = "Direct light is computed apart from the form factors, so small lights stay noise-free: with up to "
-               "256 emitter faces, the exact point-to-triangle form factor from points on the patch to every emitter "
-               "face, times the visibility of one shadow ray each (Wallace et al. 1989); with more, points on the "
-               "emitters sampled in proportion to power with a shadow ray each. With a sky or a sun, this many rays "
-               "again for each (cosine-weighted to the sky, uniform in the sun's disk: soft shadows).",
+       .help = "Direct light is computed apart from the form factors, so small lights stay noise-free. Coplanar, "
+               "edge-connected emitter faces of one emission are grouped into luminaires (polygons); with up to 256 "
+               "of them, the exact point-to-polygon form factor from points on the patch (one per 64 rays) and at "
+               "each vertex to every luminaire, times its visible fraction from 16 shadow rays stratified over it, "
+               "and where they disagree (penumbra) up to this many per patch and per vertex (Wallace et al. 1989); "
+               "with more luminaires, points on the emitters sampled in proportion to power with a shadow ray each. "
+               "With a sky or a sun, this many rays again for each (cosine-weighted to the sky, uniform in the sun's "
+               "disk: soft shadows).",
        .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
   };
   s.insert(s.end(), more.begin(), more.end());

@@ -91,13 +91,14 @@ TEST(HierarchicalRadiosity, AgreesWithFlatOnCornellBoxWithinFlatError) {
 // 1e-3 (the triangle-to-triangle factors' adaptive rule leaves about 6e-5,
 // the clusters' 16-point rule 6.5e-4 where many clusters link, measured at
 // rho 0.5); the mean B as that closure predicts, within 2e-4 / (1 - rho)
-// (the direct light, exact factors at 256 points per patch to the 192
-// emitting faces, is E to about 1e-4, amplified by 1 / (1 - rho)); the energy
+// (the direct light, exact factors to the 6 walls, each one luminaire of 32
+// emitting faces, at up to 4 points per patch, is E to about 1e-4,
+// amplified by 1 / (1 - rho)); the energy
 // balance (emitted = absorbed in a closed box) within rho |delta| / (1 - rho)
 // + 2e-4 / (1 - rho); and at rho = 0.99, where the links to bright sources
 // are refined to triangles, B within 1% of 1 / (1 - rho).
 TEST(HierarchicalRadiosity, FurnaceAndEnergyBalance) {
-  auto sf = scenes::closedBox(1.0, 4, true);  // 192 triangles, all emitting: exact direct light
+  auto sf = scenes::closedBox(1.0, 4, true);  // 192 triangles, all emitting: 6 luminaires, exact direct light
   for (float rho : {0.5f, 0.9f, 0.99f}) {
     scenes::setUniform(sf, glm::vec3(rho), glm::vec3(1.f));
     auto caster = makeEmbreeCaster(sf.scene);

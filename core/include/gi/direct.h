@@ -41,11 +41,20 @@ struct VertexMaterial {
 };
 VertexMaterial vertexMaterial(const Scene& s);
 
-// Direct irradiance per face from the emitters (shadow rays, power sampling).
+// Direct irradiance per face from the emitters: with up to
+// Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), the exact form
+// factor to each times its visibility, at up to P = max(1, lightSamples /
+// 64) points of the patch (fewer where the patch is small against its
+// distance to the luminaires), each with up to lightSamples / P shadow rays
+// per luminaire in penumbra (16 and the corners elsewhere); with more, lightSamples
+// power-proportional light samples with MIS. *stats (if given) gets the
+// luminaires found, the method and the shadow rays.
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                             const Progress& progress = Progress(nullptr));
+                                             const Progress& progress = Progress(nullptr), RunStats* stats = nullptr);
 
-// The same at every vertex (used for the per-vertex output), or at the vertices of one part (the others 0).
+// The same at every vertex (used for the per-vertex output), or at the
+// vertices of one part (the others 0); with luminaires, one point with up
+// to lightSamples shadow rays per luminaire in penumbra.
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                               const Progress& progress = Progress(nullptr),
                                               const VertexPart& part = VertexPart());

@@ -13,6 +13,10 @@
 
 namespace gi {
 
+// One edge's term of the contour integral, Theta n . (v0 x v1) / |v0 x v1|
+// with v0, v1 the edge's ends relative to x (0 for a degenerate edge).
+double lambertEdgeTerm(const glm::dvec3& v0, const glm::dvec3& v1, const glm::dvec3& n);
+
 // Triangle (a, b, c), seen from either side; 0 if it lies behind x's tangent plane.
 double pointToTriangleFormFactor(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
                                  const glm::dvec3& c);
