@@ -138,18 +138,20 @@ void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt) {
   const bool hierarchy = usesHierarchy(patches, opt);
   const double need = hierarchy ? n * (kSolverBytesPerPatch + 2.0 * kHierarchyBytesPerNode) : solverBaseBytes(patches, opt);
   if (need <= opt.memoryBudgetMB * MB) return;
-  char b[500];
+  const bool hemicube = !hierarchy && opt.formFactors.method == FormFactorMethod::Hemicube;
+  char b[600];
   std::snprintf(b, sizeof b,
-                "memory_budget_mb = %g is too small: %zu patches need about %.0f MB for %s (%.0f bytes per patch%s) "
-                "before anything is computed; raise memory_budget_mb to at least %.0f, or use fewer patches",
+                "memory_budget_mb = %g is too small: %zu patches need about %.0f MB for %s%s (%.0f bytes per patch%s) "
+                "before anything is computed; raise memory_budget_mb to at least %.0f, or use fewer patches%s",
                 opt.memoryBudgetMB, patches, std::ceil(need / MB),
                 hierarchy ? "the scene, the ray-casting structure and the cluster hierarchy (hierarchical solver"
                           : "the scene, the ray-casting structure, the solver's vectors and a form-factor row per "
-                            "thread (flat solver",
+                            "thread",
+                hemicube ? ", each with the buffers of a hemicube (flat solver" : (hierarchy ? "" : " (flat solver"),
                 need / std::max(n, 1.0),
                 hierarchy ? "; the links take what is left)"
                           : "; the form-factor matrix takes what is left, else it is computed on the fly)",
-                std::ceil(need / MB) + 1.0);
+                std::ceil(need / MB) + 1.0, hemicube ? " or a lower hemicube resolution" : "");
   throw std::invalid_argument(b);
 }
 
