@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -252,6 +253,68 @@ struct Refiner {
     fresh.push_back(isFresh ? 1 : 0);
   }
 
+  // The power a link may carry (what BF refinement bounds): the order in
+  // which a budget-limited refinement splits.
+  double power(uint32_t p, uint32_t q) const {
+    const Node &np = t.nodes[p], &nq = t.nodes[q];
+    const double d = glm::length(np.c - nq.c) - np.r - nq.r;
+    const double Fmax = d > 0 ? std::min(1.0, nq.A / (M_PI * d * d)) : 1.0;
+    return np.A * Fmax * Rmax[q];
+  }
+
+  // Which node of an unacceptable link is split: a wide receiver, else the larger.
+  bool splitsReceiver(const Node& np, const Node& nq) const {
+    return !np.leaf() && (wideReceiver(np) || nq.leaf() || np.r >= nq.r);
+  }
+
+  // Budget-limited refinement, best first: the link that may carry the most
+  // power is split first, so that where the budget stops the refinement the
+  // coarse links left are the weakest ones everywhere (depth-first order
+  // would leave whole parts of the scene on coarse links). `start`: the
+  // links to refine (kept ones carry their index into `old`, fresh ones
+  // kNoHit); the links made are added to out.
+  struct Candidate {
+    double power;
+    uint32_t p, q, old;
+    bool operator<(const Candidate& o) const {  // max-heap: most power first, then a fixed order
+      return power != o.power ? power < o.power : (p != o.p ? p > o.p : q > o.q);
+    }
+  };
+  void refineBestFirst(std::vector<Candidate> heap, const std::vector<Link>& old) {
+    std::make_heap(heap.begin(), heap.end());
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end());
+      const Candidate c = heap.back();
+      heap.pop_back();
+      const Node &np = t.nodes[c.p], &nq = t.nodes[c.q];
+      if (c.p == c.q) {  // a node with itself is always split (as refine does)
+        if (np.leaf()) continue;
+        for (uint32_t a : {np.left, np.right})
+          for (uint32_t b : {np.left, np.right}) push(heap, a, b);
+        continue;
+      }
+      if (acceptable(c.p, c.q) || out.size() + heap.size() + 1 >= maxLinks) {
+        budgetHit |= !acceptable(c.p, c.q);
+        if (c.old != kNoHit) add(old[c.old], false);
+        else add(Link{c.p, c.q, 0.f}, true);
+        continue;
+      }
+      ++splits;
+      if (splitsReceiver(np, nq)) {
+        push(heap, np.left, c.q);
+        push(heap, np.right, c.q);
+      } else {
+        push(heap, c.p, nq.left);
+        push(heap, c.p, nq.right);
+      }
+    }
+  }
+  void push(std::vector<Candidate>& heap, uint32_t p, uint32_t q) const {
+    if (p != q && culled(p, q)) return;
+    heap.push_back({p == q ? std::numeric_limits<double>::infinity() : power(p, q), p, q, kNoHit});
+    std::push_heap(heap.begin(), heap.end());
+  }
+
   // Links covering every triangle pair of (p, q), split where needed.
   void refine(uint32_t p, uint32_t q) {
     if (p == q) {  // a node with itself: a flat triangle sees nothing of itself
@@ -271,8 +334,7 @@ struct Refiner {
     }
     ++splits;
     const Node &np = t.nodes[p], &nq = t.nodes[q];
-    const bool splitP = !np.leaf() && (wideReceiver(np) || nq.leaf() || np.r >= nq.r);
-    if (splitP) {
+    if (splitsReceiver(np, nq)) {
       refine(np.left, q);
       refine(np.right, q);
     } else {
@@ -470,6 +532,23 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
         if (ref.acceptable(links[k].p, links[k].q) || next.size() + ref.reserved >= maxLinks) ref.add(links[k], false);
         else ref.refine(links[k].p, links[k].q);
       }
+    }
+    if (ref.budgetHit) {
+      // The budget stopped the depth-first refinement: again, best first.
+      next.clear();
+      nextFresh.clear();
+      ref.splits = 0;
+      ref.reserved = 0;
+      std::vector<Refiner::Candidate> start;
+      if (first) {
+        start.push_back({std::numeric_limits<double>::infinity(), 0, 0, kNoHit});
+      } else {
+        for (size_t k = 0; k < links.size(); ++k) {
+          if (ref.acceptable(links[k].p, links[k].q)) ref.add(links[k], false);
+          else start.push_back({ref.power(links[k].p, links[k].q), links[k].p, links[k].q, uint32_t(k)});
+        }
+      }
+      ref.refineBestFirst(std::move(start), links);
     }
     const uint64_t newSplits = ref.splits;
     splits += newSplits;

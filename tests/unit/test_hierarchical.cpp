@@ -10,6 +10,7 @@
 
 #include "gi/color.h"
 #include "gi/direct.h"
+#include "gi/hierarchical.h"
 #include "gi/pathtrace.h"
 #include "gi/radiosity.h"
 #include "gi/scenes.h"
@@ -279,4 +280,35 @@ TEST(HierarchicalRadiosity, ClusterSourcesGatherWhatTheirRaysSee) {
               100 * eS, areaMean, 100 * eA);
   EXPECT_LT(std::fabs(eS), 0.008);
   EXPECT_GT(std::fabs(eA), 2 * std::fabs(eS));
+}
+
+// A memory budget that stops the link refinement stops it where the links
+// carry the least power: once the budget is hit the refinement is redone
+// best first, so that the coarse links left are the weakest ones everywhere
+// (depth-first, the part of the tree visited last stayed coarse: 10% error
+// on a 30k-triangle scan room at half its links, 1.5% best first, the same
+// as without the budget). The Cornell box with a third of its links:
+// measured 0.21% RMS from the unbudgeted patch values and -0.54% absorbed
+// power (depth-first: 1.8% and -15%); asserted within 0.6% and 1.5%.
+TEST(HierarchicalRadiosity, BudgetStopsTheWeakestLinksFirst) {
+  auto sf = scenes::cornellBox(50.0);
+  const Scene& s = sf.scene;
+  auto caster = makeEmbreeCaster(s);
+  RadiosityOptions o = patchOptions(RadiositySolver::Hierarchical);
+  o.tolerance = 1e-6;
+  o.lightSamples = 64;
+  const RadiosityResult full = solveRadiosity(s, *caster, o);
+  const double links = full.stats.get("links");
+  const double fixedMB = double(s.faceCount()) * (kSolverBytesPerPatch + 2 * kHierarchyBytesPerNode) / 1048576.0;
+  o.memoryBudgetMB = fixedMB + links / 3 * kHierarchyBytesPerLink / 1048576.0;
+  const RadiosityResult cut = solveRadiosity(s, *caster, o);
+  bool warned = false;
+  for (const std::string& w : cut.stats.warnings) warned |= w.find("memory budget") != std::string::npos;
+  const double e = rmsAll(cut.B, full.B);
+  const double dP = cut.stats.get("absorbed_power_W") / full.stats.get("absorbed_power_W") - 1;
+  std::printf("links %g -> %g: patch values %.4f RMS, absorbed power %+.4f\n", links, cut.stats.get("links"), e, dP);
+  EXPECT_TRUE(warned);
+  EXPECT_LT(cut.stats.get("links"), 0.4 * links);
+  EXPECT_LT(e, 0.006);
+  EXPECT_LT(std::fabs(dP), 0.015);
 }
