@@ -534,9 +534,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
       }
     }
     if (ref.budgetHit) {
-      // The budget stopped the depth-first refinement: again, best first.
-      next.clear();
-      nextFresh.clear();
+      // The budget stopped the depth-first refinement: again, best first
+      // (its links freed first: the heap takes their place).
+      std::vector<Link>().swap(next);
+      std::vector<uint8_t>().swap(nextFresh);
       ref.splits = 0;
       ref.reserved = 0;
       std::vector<Refiner::Candidate> start;
@@ -637,9 +638,11 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     solveSweeps(maxSweeps, progress.sub(0.7, 1.0));
   } else {
     // Refine again with the solved R (a brighter source needs finer links)
-    // until no link is split; at most 4 rounds.
+    // until no link is split; at most 4 rounds, and none after a round the
+    // memory budget stopped (another would only trade links at the budget:
+    // at 300k triangles twice the time for the same error).
     solveSweeps(maxSweeps, part(0, 0.7, 1.0));
-    for (; rounds < 4; ++rounds) {
+    for (; rounds < 4 && !budgetHit; ++rounds) {
       pull(sol.R);
       if (refineLinks(false, sol.R, part(rounds, 0.0, 0.7)) == 0) break;
       solveSweeps(maxSweeps, part(rounds, 0.7, 1.0));

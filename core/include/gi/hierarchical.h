@@ -16,7 +16,10 @@
 // triangles and the flat solution comes back. A sweep gathers on every link,
 // pushes the gathered irradiance down to the triangles and pulls area means
 // up (push-pull); sweeps (Jacobi) repeat to the tolerance, and the links are
-// refined again with the solved R until no link needs splitting.
+// refined again with the solved R until no link needs splitting. Where a
+// memory budget stops the refinement, the round is redone best first (the
+// link that may carry the most power is split first), so the coarse links
+// left are the weakest ones everywhere.
 // Visibility: a link's F_pq is its unoccluded factor times the fraction of
 // its rays between paired points of p and q that pass. Where q is a cluster
 // the link remembers which rays passed, and the sweep gathers R at those
