@@ -1,0 +1,245 @@
+// The cluster tree of the hierarchical solver, its nodes' quadrature points
+// and the link form factors with visibility rays (see gi/hierarchical.h for
+// the equation and the citations, hierarchy_nodes.h for the types).
+#include "hierarchy_nodes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gi/form_factor_analytic.h"
+
+namespace gi::hierarchy {
+
+Tree buildTree(const Geometry& g) {
+  Tree t;
+  const size_t nf = g.s.faceCount();
+  for (uint32_t f = 0; f < nf; ++f)
+    if (g.A[f] > 0) t.order.push_back(f);
+  t.leafOf.assign(nf, kNoHit);
+  if (t.order.empty()) return t;
+  t.nodes.assign(2 * t.order.size() - 1, Node{});
+  struct Job { uint32_t node, first, count; int level; };
+  std::vector<Job> stack;
+  stack.push_back({0, 0, uint32_t(t.order.size()), 1});
+  while (!stack.empty()) {
+    const Job j = stack.back();
+    stack.pop_back();
+    t.depth = std::max(t.depth, j.level);
+    glm::dvec3 lo(1e300), hi(-1e300), clo(1e300), chi(-1e300);
+    double A = 0;
+    for (uint32_t k = j.first; k < j.first + j.count; ++k) {
+      const uint32_t f = t.order[k];
+      const glm::uvec3 tri = g.s.triangles[f];
+      for (int v = 0; v < 3; ++v) {
+        lo = glm::min(lo, glm::dvec3(g.s.positions[tri[v]]));
+        hi = glm::max(hi, glm::dvec3(g.s.positions[tri[v]]));
+      }
+      clo = glm::min(clo, g.centroid[f]);
+      chi = glm::max(chi, g.centroid[f]);
+      A += g.A[f];
+    }
+    Node& nd = t.nodes[j.node];
+    nd.c = 0.5 * (lo + hi);
+    nd.r = 0.5 * glm::length(hi - lo);
+    nd.A = A;
+    nd.lo = glm::vec3(lo);
+    nd.hi = glm::vec3(hi);
+    nd.first = j.first;
+    nd.count = j.count;
+    if (j.count == 1) {
+      t.leafOf[t.order[j.first]] = j.node;
+      continue;
+    }
+    // Median split of the centroids along the longest axis.
+    const glm::dvec3 ext = chi - clo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const uint32_t mid = j.first + j.count / 2;
+    std::nth_element(t.order.begin() + j.first, t.order.begin() + mid, t.order.begin() + j.first + j.count,
+                     [&](uint32_t a, uint32_t b) {
+                       return g.centroid[a][axis] < g.centroid[b][axis] ||
+                              (g.centroid[a][axis] == g.centroid[b][axis] && a < b);
+                     });
+    // Preorder: a subtree of c triangles holds the 2c - 1 nodes from its
+    // root on; the left subtree follows the parent, the right follows it.
+    const uint32_t nl = mid - j.first, nr = j.count - nl;
+    const uint32_t left = j.node + 1;
+    const uint32_t right = left + 2 * nl - 1;
+    Node& parent = t.nodes[j.node];
+    parent.left = left;
+    parent.right = right;
+    t.nodes[left].parent = t.nodes[right].parent = j.node;
+    stack.push_back({right, mid, nr, j.level + 1});
+    stack.push_back({left, j.first, nl, j.level + 1});
+  }
+  // Planar nodes, bottom-up: a whole wall's clusters exchange no light with
+  // each other, and are culled without descending to their triangles.
+  for (size_t k = t.nodes.size(); k-- > 0;) {
+    Node& nd = t.nodes[k];
+    if (nd.leaf()) {
+      const uint32_t f = t.order[nd.first];
+      nd.planar = true;
+      nd.x0 = g.centroid[f];
+      nd.n = nd.axis = g.n[f];
+      continue;
+    }
+    const Node &l = t.nodes[nd.left], &r = t.nodes[nd.right];
+    const glm::vec3 sum = float(l.A) * l.axis + float(r.A) * r.axis;
+    nd.axis = glm::length(sum) > 1e-12f ? glm::normalize(sum) : l.axis;
+    auto half = [&](const Node& c) {  // the child's cone seen from the new axis
+      return std::acos(std::clamp(glm::dot(nd.axis, c.axis), -1.f, 1.f)) + std::acos(std::clamp(c.coneCos, -1.f, 1.f));
+    };
+    nd.coneCos = std::cos(std::min(float(M_PI), std::max(half(l), half(r))));
+    nd.planar = l.planar && r.planar && glm::dot(l.n, r.n) > 1.f - 1e-6f &&
+                std::fabs(glm::dot(glm::dvec3(l.n), r.x0 - l.x0)) <= 1e-6 * (nd.r + glm::length(nd.c)) &&
+                std::fabs(glm::dot(glm::dvec3(r.n), l.x0 - r.x0)) <= 1e-6 * (nd.r + glm::length(nd.c));
+    nd.x0 = l.x0;
+    nd.n = l.n;
+  }
+  t.Acum.resize(t.order.size() + 1, 0.0);
+  for (size_t k = 0; k < t.order.size(); ++k) t.Acum[k + 1] = t.Acum[k] + g.A[t.order[k]];
+  return t;
+}
+
+// The centroid of sub-triangle k (0..15) of (a, b, c) split twice at its
+// edge midpoints; k's low base-4 digit picks the first split's quarter, so
+// any four consecutive k lie in four different quarters.
+static glm::dvec3 subCentroid(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, int k) {
+  for (int level = 0; level < 2; ++level, k /= 4) {
+    const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+    switch (k % 4) {
+      case 0: b = ab; c = ca; break;
+      case 1: a = ab; c = bc; break;
+      case 2: a = ca; b = bc; break;
+      default: a = ab; b = bc; c = ca; break;
+    }
+  }
+  return (a + b + c) / 3.0;
+}
+
+// The node's 16 quadrature points, stratified by area: point k lies at the
+// area fraction (k + 1/2) / 16 of the node's triangles in tree order, at the
+// centroid of the sub-triangle holding that fraction of its triangle (a
+// triangle: its 16 sub-triangle centroids), with its triangle's normal.
+void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[kPoints], glm::vec3 n[kPoints],
+                uint32_t faces[kPoints]) {
+  const double base = t.Acum[nd.first];
+  for (int k = 0; k < kPoints; ++k) {
+    const int stratum = (k % 4) * 4 + k / 4;  // consecutive k spread over the node
+    const double target = base + nd.A * (stratum + 0.5) / kPoints;
+    auto it = std::upper_bound(t.Acum.begin() + nd.first + 1, t.Acum.begin() + nd.first + nd.count + 1, target);
+    size_t pos = size_t(it - t.Acum.begin()) - 1;
+    pos = std::min<size_t>(pos, nd.first + nd.count - 1);
+    const uint32_t f = t.order[pos];
+    const double w = std::clamp((target - t.Acum[pos]) / g.A[f], 0.0, 0.999999);
+    const glm::uvec3 tri = g.s.triangles[f];
+    const int sub = int(w * kPoints);
+    x[k] = subCentroid(glm::dvec3(g.s.positions[tri.x]), glm::dvec3(g.s.positions[tri.y]),
+                       glm::dvec3(g.s.positions[tri.z]), (sub % 4) * 4 + sub / 4);
+    n[k] = g.n[f];
+    if (faces) faces[k] = f;
+  }
+}
+
+
+bool boxBehind(const Node& box, const glm::dvec3& x0, const glm::vec3& n) {
+  double best = -1e300;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z);
+    best = std::max(best, glm::dot(glm::dvec3(n), corner - x0));
+  }
+  return best <= 1e-6 * (box.r + glm::length(box.c)) + 1e-30;  // float positions: relative rounding
+}
+
+// F_pq for one link: the exact unoccluded triangle-to-triangle factor for
+// two triangles (gi/form_factor_analytic.h); between a cluster and a
+// triangle, the exact point-to-triangle factor from the cluster's 16 points
+// (by reciprocity when the cluster is the source); between two clusters the
+// mean of the point kernel cos cos / (pi r^2) A_q over the 16 x 16 point pairs
+// (the cluster's elements keep their own orientation: Smits et al. 1994); times
+// the fraction of linkRays visibility rays between paired points that pass.
+// A cluster source remembers which rays passed (Link::samples): the sweep
+// then gathers the radiosity at their source points, not the cluster's area
+// mean, because bright and visible go together (a triangle in a nook is both
+// darker and hidden), and the area mean times the visible fraction carries
+// too little (7-8% on the links from clusters in the Cornell-like room).
+void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, Link& link, int linkRays,
+                    bool unoccluded, float eps, uint64_t& rays) {
+  const uint32_t p = link.p, q = link.q;
+  const Node &np = t.nodes[p], &nq = t.nodes[q];
+  glm::dvec3 xp[kPoints], xq[kPoints];
+  glm::vec3 npn[kPoints], nqn[kPoints];
+  nodePoints(g, t, np, xp, npn);
+  nodePoints(g, t, nq, xq, nqn);
+  auto corners = [&](const Node& nd, glm::dvec3 v[3]) {
+    const glm::uvec3 tri = g.s.triangles[t.order[nd.first]];
+    for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(g.s.positions[tri[k]]);
+  };
+  // From points x (normals n) of a cluster to a triangle: the exact
+  // point-to-triangle factor, 0 where the triangle turns its back on x.
+  auto toTriangle = [&](const glm::dvec3 x[kPoints], const glm::vec3 n[kPoints], const Node& tri) {
+    glm::dvec3 v[3];
+    corners(tri, v);
+    const glm::dvec3 tn(g.n[t.order[tri.first]]);
+    double sum = 0;
+    for (int k = 0; k < kPoints; ++k)
+      if (glm::dot(tn, x[k] - v[0]) > 0) sum += pointToTriangleFormFactor(x[k], glm::dvec3(n[k]), v[0], v[1], v[2]);
+    return sum / kPoints;
+  };
+  double F = 0;
+  if (np.leaf() && nq.leaf()) {
+    glm::dvec3 a[3], b[3];
+    corners(np, a);
+    corners(nq, b);
+    F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
+  } else if (nq.leaf()) {
+    F = toTriangle(xp, npn, nq);  // exact over the source triangle, 16 points of the receiving cluster
+  } else if (np.leaf()) {
+    F = nq.A / np.A * toTriangle(xq, nqn, np);  // reciprocity: A_p F_pq = A_q F_qp
+  } else {
+    for (int i = 0; i < kPoints; ++i)
+      for (int j = 0; j < kPoints; ++j) {
+        const glm::dvec3 d = xq[j] - xp[i];
+        const double r2 = glm::dot(d, d);
+        if (!(r2 > 0)) continue;
+        const double ci = glm::dot(glm::dvec3(npn[i]), d), cj = -glm::dot(glm::dvec3(nqn[j]), d);
+        if (ci <= 0 || cj <= 0) continue;
+        F += ci * cj / (M_PI * r2 * r2);
+      }
+    F *= nq.A / double(kPoints * kPoints);
+  }
+  F = std::min(F, 1.0);
+  link.F = 0.f;
+  link.samples = Link::kAreaMean;
+  if (!(F > 0)) return;
+  link.F = float(F);
+  if (unoccluded) return;
+  int pass = 0, cast = 0;
+  uint32_t mask = 0;
+  for (int k = 0; k < linkRays; ++k) {
+    const int i = rayReceiverPoint(k), j = raySourcePoint(k);
+    const glm::vec3 o = glm::vec3(xp[i]) + npn[i] * eps;
+    const glm::vec3 e = glm::vec3(xq[j]) + nqn[j] * eps;
+    const glm::vec3 d = e - o;
+    const float len = glm::length(d);
+    if (!(len > 0)) continue;
+    if (glm::dot(npn[i], d) <= 0 || glm::dot(nqn[j], d) >= 0) continue;  // this pair exchanges nothing
+    Ray r;
+    r.o = o;
+    r.d = d / len;
+    r.tfar = len * (1.f - 1e-4f) - eps;
+    ++cast;
+    if (caster.occluded(r)) continue;
+    ++pass;
+    if (k < kMaxSampledRays) mask |= 1u << k;
+  }
+  rays += uint64_t(cast);
+  if (!cast) return;
+  if (!nq.leaf() && linkRays <= kMaxSampledRays) {
+    link.F = float(F / double(cast));
+    link.samples = mask;
+  } else {
+    link.F = float(F * double(pass) / double(cast));
+  }
+}
+
+}  // namespace gi::hierarchy

@@ -1,0 +1,81 @@
+// Internal to the hierarchical solver (hierarchical.cpp): the cluster tree
+// over the triangles, its nodes' quadrature points and the link form
+// factors with their visibility rays (hierarchy_nodes.cpp).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi/raycaster.h"
+#include "gi/scene.h"
+
+namespace gi::hierarchy {
+
+// A node of the cluster tree: a triangle (leaf) or the triangles of
+// order[first, first + count). Nodes are stored in preorder, so a parent's
+// index is below its children's (push: forward loop; pull: backward loop).
+struct Node {
+  glm::dvec3 c{0.0};   // bounding-sphere centre (bbox centre)
+  double r = 0;        // bounding-sphere radius (half the bbox diagonal)
+  double A = 0;        // area
+  uint32_t first = 0, count = 0;
+  uint32_t left = 0, right = 0;  // children (leaves: 0)
+  uint32_t parent = 0;
+  glm::vec3 lo{0.f}, hi{0.f};    // bbox (plane culling)
+  bool planar = false;           // all its triangles in one plane (x0, n), facing n
+  glm::dvec3 x0{0.0};
+  glm::vec3 n{0.f};
+  glm::vec3 axis{0.f};           // normal cone: unit axis and the cosine of its half-angle
+  float coneCos = 1.f;
+  bool leaf() const { return count == 1; }
+};
+
+struct Link {
+  uint32_t p, q;  // receiver, source
+  float F;        // area-mean form factor F_pq; with samples: F_pq per passing sample
+  uint32_t samples = kAreaMean;  // bit k: visibility ray k passed (its source point's R is gathered)
+  static constexpr uint32_t kAreaMean = 0x80000000u;  // no samples: gather the source's area mean
+};
+
+struct Tree {
+  std::vector<Node> nodes;
+  std::vector<uint32_t> order;      // triangle of each leaf position
+  std::vector<double> Acum;         // prefix sums of the leaves' areas in `order`
+  std::vector<uint32_t> leafOf;     // node of each face (kNoHit: unusable)
+  int depth = 0;
+};
+
+struct Geometry {
+  const Scene& s;
+  std::vector<double> A;
+  std::vector<glm::vec3> n;  // unit face normals
+  std::vector<glm::dvec3> centroid;
+};
+
+// The cluster tree over the triangles: a median split of the centroids
+// along the longest axis, nodes in preorder, planar nodes and normal cones.
+Tree buildTree(const Geometry& g);
+
+// The node's 16 quadrature points, stratified by area (faces: the triangle
+// under each point, when asked for).
+constexpr int kPoints = 16;
+void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[kPoints], glm::vec3 n[kPoints],
+                uint32_t faces[kPoints] = nullptr);
+
+// Visibility ray k of a link pairs point i of the receiver with point j of
+// the source; both point sets are walked in different orders.
+inline int rayReceiverPoint(int k) { return k % kPoints; }
+inline int raySourcePoint(int k) { return (5 * k + 3 + k / kPoints) % kPoints; }
+constexpr int kMaxSampledRays = 31;  // rays a link can remember (bits of Link::samples)
+
+// True when no point of the box lies strictly in front of the plane (x0, n):
+// nothing in the box can exchange light with the front of that plane.
+bool boxBehind(const Node& box, const glm::dvec3& x0, const glm::vec3& n);
+
+// F_pq of a link (and which of its rays passed, for a cluster source): see
+// hierarchy_nodes.cpp.
+void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, Link& link, int linkRays,
+                    bool unoccluded, float eps, uint64_t& rays);
+
+}  // namespace gi::hierarchy
