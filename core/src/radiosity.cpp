@@ -493,7 +493,6 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   Timer timer;
   const double budget = opt.memoryBudgetMB * 1048576.0;
   const size_t n = s.faceCount();
-  checkRadiosityMemory(n, opt);
   Timer directTimer;
   RunStats directStats;
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1),
@@ -586,8 +585,8 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
   const FormFactors::Settings& ffs = opt.formFactors;
   if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
+  checkRadiosityMemory(s.faceCount(), opt);  // either solver: before any work
   if (usesHierarchy(s.faceCount(), opt)) return solveHierarchicalRadiosity(s, caster, opt, progress);
-  checkRadiosityMemory(s.faceCount(), opt);
   Timer timer;
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
