@@ -235,7 +235,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   io::LoadedMesh mesh = io::loadMesh(job.input);
   const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);
   mesh.scene.vertexNormals.clear();
-  const double diag = analyzeScene(mesh.scene).diagonal;
+  const double diag = sceneDiagonal(mesh.scene);
   FilterInput in;
   in.values = defaultValues(specs, diag);
   for (const auto& [k, v] : params) in.values.set(k, parseValue(*findSpec(specs, k), v, diag));

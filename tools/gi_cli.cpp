@@ -151,7 +151,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   }
   const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);  // written back unchanged
   mesh.scene.vertexNormals.clear();
-  in.values = resolve(specs, a, analyzeScene(mesh.scene).diagonal);
+  in.values = resolve(specs, a, sceneDiagonal(mesh.scene));
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
   in.attributes = std::move(mesh.attributes);  // what an earlier run left (PLY properties), e.g. a first pass
@@ -250,7 +250,7 @@ int listFilters(bool asJson) {
 int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   double diag = 1.0;
   if (!a.mesh.empty()) {
-    diag = analyzeScene(io::loadMesh(a.mesh).scene).diagonal;
+    diag = sceneDiagonal(io::loadMesh(a.mesh).scene);
   } else {
     for (FilterKind k : kinds)
       for (const auto& p : filterSpecs(k))

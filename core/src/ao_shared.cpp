@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "ambient_internal.h"
 #include "gi/sampling.h"
@@ -273,9 +274,17 @@ class RingLists {
     std::atomic<size_t> entries{0};
     tbb::enumerable_thread_specific<PoolScratch> scratch;
     tbb::enumerable_thread_specific<std::vector<uint32_t>> members;
+    // A list's expected length: the count, the ring sizes and about 3h(h + 1)
+    // vertices within h rings of a regular mesh (6 per ring and ring).
+    size_t mineCount = 0;
+    for (size_t i = 0; i < nv; ++i) mineCount += mine[i];
+    const size_t perVertex = 1 + size_t(R) + 3 * size_t(R) * size_t(R + 1);
+    const size_t perThread =
+        std::min(maxEntries, mineCount / size_t(std::max(1, tbb::this_task_arena::max_concurrency())) * perVertex * 9 / 8);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
       if (entries.load(std::memory_order_relaxed) > maxEntries) return;
       std::vector<uint32_t>& list = lists_.local();
+      if (list.capacity() == 0) list.reserve(perThread);  // grown by copies otherwise (4% of a run)
       std::vector<uint32_t>& ring = members.local();
       PoolScratch& sc = scratch.local();
       uint32_t counts[65];
@@ -365,7 +374,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   std::vector<uint32_t> want(nv, 0), pooledWith(nv, 0);  // pooledWith: ray counts at the last pooling
   for (size_t i = 0; i < nv; ++i)
     if (mine[i]) want[i] = first;
-  std::vector<uint8_t> repool(nv, 0);
+  std::vector<uint32_t> repool, marked(nv, 0);  // the vertices to pool again; the round that marked each
   std::vector<Pooled> pooled(nv);
   std::vector<double> exchange;
   tbb::enumerable_thread_specific<PoolScratch> scratch;
@@ -422,26 +431,38 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     }
     if (listed)
       for (size_t i = 0; i < nv; ++i) { points[i].n = rays[i].n; points[i].sum = rays[i].sum; }
-    // Pooled (again): every vertex within reach of one whose rays changed.
-    std::fill(repool.begin(), repool.end(), 0);
+    // Pooled (again): every vertex within reach of one whose rays changed,
+    // found from those vertices outwards (late rounds change few).
+    const uint32_t stamp = uint32_t(round) + 1;
+    repool.clear();
     for (size_t i = 0; i < nv; ++i)
-      if (rays[i].n != pooledWith[i]) { repool[i] = 1; pooledWith[i] = rays[i].n; }
+      if (rays[i].n != pooledWith[i]) {
+        pooledWith[i] = rays[i].n;
+        marked[i] = stamp;
+        repool.push_back(uint32_t(i));
+      }
+    size_t begin = 0;
     for (int ring = 0; ring < po.maxRings; ++ring) {
-      std::vector<uint8_t> grown = repool;
-      for (size_t v = 0; v < nv; ++v)
-        if (repool[v])
-          for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) grown[g.nbr[k]] = 1;
-      repool.swap(grown);
+      const size_t end = repool.size();
+      for (size_t k = begin; k < end; ++k) {
+        const uint32_t v = repool[k];
+        for (uint32_t e = g.offset[v]; e < g.offset[v + 1]; ++e) {
+          const uint32_t u = g.nbr[e];
+          if (marked[u] != stamp) { marked[u] = stamp; repool.push_back(u); }
+        }
+      }
+      begin = end;
     }
-    size_t pools = 0;
-    for (size_t i = 0; i < nv; ++i) pools += repool[i] && mine[i];
-    parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
+    repool.erase(std::remove_if(repool.begin(), repool.end(), [&](uint32_t i) { return !mine[i]; }), repool.end());
+    std::sort(repool.begin(), repool.end());  // in memory order
+    parallelBlocks(repool.size(), bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
       PoolScratch& sc = scratch.local();
-      for (size_t i = b; i < e; ++i)
-        if (repool[i] && mine[i])
-          pooled[i] = listed ? poolListed(uint32_t(i), ringLists[i], points, normals, rays, o.bentNormals, po)
-                             : poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
-    }, slices(pools, size_t(1) << 16));
+      for (size_t k = b; k < e; ++k) {
+        const uint32_t i = repool[k];
+        pooled[i] = listed ? poolListed(i, ringLists[i], points, normals, rays, o.bentNormals, po)
+                           : poolVertex(i, g, scene.positions, normals, rays, poolable, po, sc);
+      }
+    }, slices(repool.size(), size_t(1) << 16));
     ++st.rounds;
     st.poolSeconds += pool.seconds();
     if (!adaptive) break;

@@ -50,7 +50,7 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   for (const ParamSpec& p : specs)
     if ((p.type == ParamType::Float || p.type == ParamType::Distance) && in.values.has(p.name))
       in.values.set(p.name, double(float(in.values.getFloat(p.name))));
-  const double diagonal = analyzeScene(in.scene).diagonal;
+  const double diagonal = sceneDiagonal(in.scene);
   if (auto err = validate(specs, in.values, diagonal)) throw std::invalid_argument(*err);
   const ParamValues& v = in.values;
   if (v.has("reflectance_source"))

@@ -201,6 +201,29 @@ TEST(Scene, AppendKeepsPerFaceArraysAligned) {
   EXPECT_EQ(p.triangles[1], glm::uvec3(3, 4, 5));
 }
 
+// Duplicated faces are the same three corner positions in any order, whether
+// the copy reuses the vertices or has its own (a triangle soup); sharing two
+// corners, or a corner that differs in the last bit, is not a duplicate.
+TEST(Scene, DuplicateFacesByPositionNotIndex) {
+  const float nudged = std::nextafter(1.f, 2.f);
+  const gi::Scene s = gi::Scene::fromAbsolute(
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},        // 0-3: two triangles of a square
+       {0, 1, 0}, {0, 0, 0}, {1, 0, 0},                   // 4-6: own copies of 2, 0, 1
+       {0, 0, 0}, {1, 0, 0}, {0, double(nudged), 0},      // 7-9: 0, 1 and a corner one ulp off 2
+       {-0.0, 0, 0}, {1, 0, 0}, {0, 1, 0}},               // 10-12: a third copy, its own vertices
+      {{0, 1, 2}, {1, 3, 2},
+       {2, 1, 0},     // same vertices, other order: duplicate
+       {4, 5, 6},     // own vertices, rotated: duplicate
+       {7, 8, 9},     // one corner differs: not
+       {0, 1, 3},     // shares two corners: not
+       {10, 11, 12}}  // duplicate
+  );
+  const gi::SceneReport r = gi::analyzeScene(s);
+  EXPECT_EQ(r.duplicateFaces, 3u);
+  EXPECT_EQ(r.usableFaces(), 7u);
+  EXPECT_NEAR(gi::sceneDiagonal(s), r.diagonal, 1e-12);
+}
+
 TEST(Scene, VertexNormalsOfClosedCubePointOutwards) {
   // Near and far (1e6 offset) cubes; one extra isolated vertex gets zero.
   for (double off : {0.0, 1e6}) {

@@ -97,6 +97,8 @@ struct SceneScale {
   double rayEpsilon = 0.0;  // offset for ray origins (local units)
 };
 SceneScale sceneScale(const Scene& s);
+// The bbox diagonal in world units (analyzeScene(s).diagonal without the rest of the analysis).
+inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
 
