@@ -7,9 +7,11 @@
 // gi-scenes scanroom BASE TRIANGLES OUT.ply [SEED]: that scan standing in a
 // room with a ceiling light and a window (gi::scenes::scanRoom), about
 // TRIANGLES triangles in all, emitters marked like the canonical scenes'.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -32,15 +34,29 @@ void writeSceneFile(const std::string& path, const gi::scenes::SceneFile& sf) {
   std::printf("%s: %zu vertices, %zu triangles\n", path.c_str(), sf.scene.vertexCount(), sf.scene.faceCount());
 }
 
+// A whole non-negative decimal number (std::stoull takes "-5" as 2^64 - 5
+// and "12abc" as 12).
+unsigned long long parseCount(const std::string& text, const char* what) {
+  const bool digits = !text.empty() && text.size() <= 19 &&
+                      std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (!digits) throw std::invalid_argument(std::string(what) + " must be a whole number >= 0, not '" + text + "'");
+  return std::stoull(text);
+}
+
 int writeScanRoom(int argc, char** argv) {
   if (argc < 5) {
     std::fprintf(stderr, "usage: gi-scenes scanroom BASE TRIANGLES OUT.ply [SEED]\n");
     return 2;
   }
   gi::scenes::ScanOptions o;
-  if (argc > 5) o.seed = uint32_t(std::stoul(argv[5]));
+  if (argc > 5) {
+    const unsigned long long seed = parseCount(argv[5], "SEED");
+    if (seed > 0xffffffffull) throw std::invalid_argument("SEED must be below 2^32");
+    o.seed = uint32_t(seed);
+  }
+  const size_t triangles = size_t(parseCount(argv[3], "TRIANGLES"));
   const gi::io::LoadedMesh base = gi::io::loadMesh(argv[2]);
-  writeSceneFile(argv[4], gi::scenes::scanRoom(base.scene, size_t(std::stoull(argv[3])), o));
+  writeSceneFile(argv[4], gi::scenes::scanRoom(base.scene, triangles, o));
   return 0;
 }
 
