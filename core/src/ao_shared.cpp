@@ -11,7 +11,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "ambient_internal.h"
 #include "gi/sampling.h"
@@ -274,17 +273,9 @@ class RingLists {
     std::atomic<size_t> entries{0};
     tbb::enumerable_thread_specific<PoolScratch> scratch;
     tbb::enumerable_thread_specific<std::vector<uint32_t>> members;
-    // A list's expected length: the count, the ring sizes and about 3h(h + 1)
-    // vertices within h rings of a regular mesh (6 per ring and ring).
-    size_t mineCount = 0;
-    for (size_t i = 0; i < nv; ++i) mineCount += mine[i];
-    const size_t perVertex = 1 + size_t(R) + 3 * size_t(R) * size_t(R + 1);
-    const size_t perThread =
-        std::min(maxEntries, mineCount / size_t(std::max(1, tbb::this_task_arena::max_concurrency())) * perVertex * 9 / 8);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
       if (entries.load(std::memory_order_relaxed) > maxEntries) return;
       std::vector<uint32_t>& list = lists_.local();
-      if (list.capacity() == 0) list.reserve(perThread);  // grown by copies otherwise (4% of a run)
       std::vector<uint32_t>& ring = members.local();
       PoolScratch& sc = scratch.local();
       uint32_t counts[65];
