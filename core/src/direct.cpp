@@ -284,7 +284,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 }
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
+                                   uint32_t key, const std::function<glm::vec3(const GatherHit&)>& value,
                                    const VertexPart& part, const Progress& progress) {
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
@@ -306,7 +306,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
         ray.tfar = std::numeric_limits<float>::infinity();
         const Hit h = caster.intersect(ray);
         if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f)
-          sum += glm::dvec3(value(h.face, ray.o + ray.d * h.t, h.t));
+          sum += glm::dvec3(value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k)}));
       }
       H[v] = glm::vec3(sum / double(rays));
     }

@@ -284,7 +284,7 @@ TEST(Convergence, FinalGather) {
   const VertexMaterial mat = vertexMaterial(s);
   const Study st = study(64, [&](int N, uint32_t seed) {
     const auto H = finalGather(s, *caster, mat, N, seed,
-                               [](uint32_t f, const glm::vec3&, float) { return glm::vec3(f >= 2 ? 1.f : 0.f); });
+                               [](const GatherHit& h) { return glm::vec3(h.face >= 2 ? 1.f : 0.f); });
     return 0.25 * double(H[0].g + H[1].g + H[2].g + H[3].g);
   });
   expectConverges("final gather", st, kFcorner, -2.0, kQMC2D + kSlopeMargin);

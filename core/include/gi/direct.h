@@ -59,12 +59,22 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
                                               const Progress& progress = Progress(nullptr),
                                               const VertexPart& part = VertexPart());
 
+// One gather ray's hit: the face, the point and its distance, and which
+// vertex cast it as its how-manyth ray (for a sample of its own that is
+// stratified with the vertex's other rays: gatherSample).
+struct GatherHit {
+  uint32_t face;
+  glm::vec3 point;
+  float t;
+  uint32_t vertex, ray;
+};
+
 // Final gather at every vertex: the mean over `rays` cosine-weighted rays of
-// value(face hit, point hit, distance), for hits on a face's front (0
-// otherwise) — an irradiance estimate when value is the radiosity leaving
-// the hit point. Only the vertices of `part` (the others 0).
+// value(hit), for hits on a face's front (0 otherwise) — an irradiance
+// estimate when value is the radiosity leaving the hit point. Only the
+// vertices of `part` (the others 0).
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
-                                   uint32_t key, const std::function<glm::vec3(uint32_t, const glm::vec3&, float)>& value,
+                                   uint32_t key, const std::function<glm::vec3(const GatherHit&)>& value,
                                    const VertexPart& part = VertexPart(), const Progress& progress = Progress(nullptr));
 
 namespace detail {
