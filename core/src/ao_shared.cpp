@@ -60,8 +60,9 @@ struct PoolSums {
   double X[2] = {0, 0};           // sum n d
   double XX[3] = {0, 0, 0};       // sum n d d^T (xx, xy, yy)
   double XY[2] = {0, 0};          // sum d y (y = the vertex's sum of ray values)
-  void add(double n, double y, double dx, double dy) {
-    W += n; Y += y;
+  double VW = 0;                  // sum n var (unbounded values)
+  void add(double n, double y, double dx, double dy, double var) {
+    W += n; Y += y; VW += n * var;
     X[0] += n * dx; X[1] += n * dy;
     XX[0] += n * dx * dx; XX[1] += n * dx * dy; XX[2] += n * dy * dy;
     XY[0] += dx * y; XY[1] += dy * y;
@@ -102,12 +103,13 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   constexpr int kMaxScales = 65;
   double A[kMaxScales], VarV[kMaxScales], V[kMaxScales];  // estimate, its variance / v, and v, per accepted scale
   PoolSums sums;
-  sums.add(own.n, own.sum, 0.0, 0.0);
+  sums.add(own.n, own.sum, 0.0, 0.0, own.var);
   Pooled p;
   p.vertices = 1;
   p.bent = own.bent;
   if (own.n == 0) return p;
-  auto vOf = [](const PoolSums& s) {
+  auto vOf = [&o](const PoolSums& s) {
+    if (!o.bounded) return s.VW / s.W;  // the pool's mean sample variance
     const double pt = (s.Y + 1.0) / (s.W + 2.0);  // Laplace: never 0 after rays that all agreed
     return pt * (1.0 - pt);
   };
@@ -115,7 +117,8 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   VarV[0] = 1.0 / sums.W;
   V[0] = vOf(sums);
   int chosen = 0;
-  const int R = std::min(o.maxRings, kMaxScales - 1);
+  const bool test = o.fixedRings < 0;
+  const int R = std::min(test ? o.maxRings : o.fixedRings, kMaxScales - 1);
   for (int h = 1; h <= R; ++h) {
     PoolSums grown = sums;
     glm::vec3 db(0.f);
@@ -127,11 +130,11 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     // scale's. For nested least-squares fits of one model the larger is the
     // efficient one, so Var(a_h' - a_h) = Var(a_h') - Var(a_h) (Hausman 1978).
     bool agree = true;
-    for (int s = 0; s <= chosen && agree; ++s) {
+    for (int s = 0; s <= chosen && agree && test; ++s) {
       const double var = std::max(0.0, v * (VarV[s] - f.varOverV));
       agree = std::fabs(f.a - A[s]) <= o.gamma * std::sqrt(var);
     }
-    if (!agree) break;
+    if (test && !agree) break;
     chosen = h;
     A[h] = f.a;
     VarV[h] = f.varOverV;
@@ -140,7 +143,7 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     p.vertices += added;
     p.bent += db;
   }
-  p.value = float(std::clamp(A[chosen], 0.0, 1.0));
+  p.value = float(o.bounded ? std::clamp(A[chosen], 0.0, 1.0) : std::max(A[chosen], 0.0));
   p.stdError = float(std::sqrt(V[chosen] * VarV[chosen]));
   p.rays = uint32_t(sums.W);
   p.rings = chosen;
@@ -203,7 +206,7 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
     nextRing(i, g, normals, rays, poolable, o, sc);
     for (uint32_t u : sc.frontier) {
       const glm::vec3 d = positions[u] - pi;
-      grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+      grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b), rays[u].var);
       db += rays[u].bent;
     }
     return uint32_t(sc.frontier.size());
@@ -332,7 +335,7 @@ Pooled poolListed(uint32_t i, const uint32_t* list, const std::vector<PoolPoint>
     for (uint32_t k = 0; k < count; ++k) {
       const PoolPoint& q = pts[member[k]];
       const glm::vec3 d = q.p - pi;
-      grown.add(q.n, q.sum, glm::dot(d, frame.t), glm::dot(d, frame.b));
+      grown.add(q.n, q.sum, glm::dot(d, frame.t), glm::dot(d, frame.b), 0.0);  // AO: bounded values
       if (bent) db += rays[member[k]].bent;  // zero unless bent normals are asked for
     }
     member += count;
@@ -405,7 +408,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
       for (size_t i = 0; i < nv; ++i)
         if (poolable[i] && !(mine[i] && part.contains(i, nv))) {
           const double* x = &exchange[5 * i];
-          rays[i] = {uint32_t(x[0]), x[1], glm::vec3(float(x[2]), float(x[3]), float(x[4]))};
+          rays[i] = {uint32_t(x[0]), x[1], 0.0, glm::vec3(float(x[2]), float(x[3]), float(x[4]))};
         }
     }
     st.castSeconds += cast.seconds();
@@ -487,6 +490,58 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   st.meanPooledVertices = traced ? pooledVertices / double(traced) : 0.0;
   st.meanRings = traced ? rings / double(traced) : 0.0;
   return st;
+}
+
+std::vector<glm::vec3> poolMeans(const Scene& s, const std::vector<glm::vec3>& normals,
+                                 const std::vector<glm::vec3>& means, const std::vector<VertexRays>& lumIn,
+                                 const PoolOptions& o, const VertexPart& part, RunStats* stats) {
+  const size_t nv = s.vertexCount();
+  std::vector<VertexRays> lum(lumIn);
+  std::vector<glm::vec3> own(means);
+  if (!part.all()) {
+    if (!part.sumOverParts) throw std::logic_error("pooling split over parts needs their sum (VertexPart::sumOverParts)");
+    // One non-zero term per vertex (its part's): the sums are exact.
+    std::vector<double> x(6 * nv, 0.0);
+    for (size_t v = 0; v < nv; ++v)
+      if (part.contains(v, nv) && lum[v].n > 0) {
+        double* e = &x[6 * v];
+        e[0] = lum[v].n, e[1] = lum[v].sum, e[2] = lum[v].var, e[3] = own[v].r, e[4] = own[v].g, e[5] = own[v].b;
+      }
+    part.sumOverParts(x);
+    for (size_t v = 0; v < nv; ++v) {
+      const double* e = &x[6 * v];
+      lum[v] = VertexRays{uint32_t(e[0]), e[1], e[2], glm::vec3(0.f)};
+      own[v] = glm::vec3(float(e[3]), float(e[4]), float(e[5]));
+    }
+  }
+  std::vector<uint8_t> poolable(nv);
+  for (size_t v = 0; v < nv; ++v) poolable[v] = lum[v].n > 0;
+  // Each channel as sums of rays for the fit (the variances are not used at
+  // a fixed scale).
+  std::vector<VertexRays> channel[3];
+  for (int c = 0; c < 3; ++c) {
+    channel[c].resize(nv);
+    for (size_t v = 0; v < nv; ++v) channel[c][v] = VertexRays{lum[v].n, double(own[v][c]) * lum[v].n, 0.0, glm::vec3(0.f)};
+  }
+  const VertexGraph g = VertexGraph::build(s);
+  std::vector<glm::vec3> out(means);
+  std::atomic<uint64_t> pooled{0}, counted{0};
+  parallelBlocks(nv, Progress(nullptr), "pooling", [&](size_t b, size_t e) {
+    PoolScratch sc;
+    uint64_t pv = 0, n = 0;
+    for (size_t v = b; v < e; ++v) {
+      if (!poolable[v] || !part.contains(v, nv)) continue;
+      const Pooled p = poolVertex(uint32_t(v), g, s.positions, normals, lum, poolable, o, sc);
+      PoolOptions at = o;
+      at.fixedRings = p.rings;
+      for (int c = 0; c < 3; ++c)
+        out[v][c] = poolVertex(uint32_t(v), g, s.positions, normals, channel[c], poolable, at, sc).value;
+      pv += p.vertices, ++n;
+    }
+    pooled += pv, counted += n;
+  });
+  if (stats && counted.load() > 0) stats->add("gather_pool_vertices", double(pooled.load()) / double(counted.load()));
+  return out;
 }
 
 }  // namespace gi

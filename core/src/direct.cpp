@@ -285,7 +285,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
 
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
                                    uint32_t key, const std::function<glm::vec3(const GatherHit&)>& value,
-                                   const VertexPart& part, const Progress& progress) {
+                                   const VertexPart& part, const Progress& progress, std::vector<VertexRays>* lum) {
   std::vector<glm::vec3> faceN(s.faceCount());
   for (size_t f = 0; f < s.faceCount(); ++f) {
     const glm::vec3 n = faceNormalUnnormalized(s, f);
@@ -293,22 +293,32 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
   }
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  if (lum) lum->assign(s.vertexCount(), VertexRays{});
   parallelBlocks(s.vertexCount(), progress, "final gather at vertices", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
       if (!mat.valid[v] || !part.contains(v, s.vertexCount())) continue;
       SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
       const Frame frame(mat.n[v]);
       glm::dvec3 sum(0.0);
+      double syy = 0;  // of the rays' luminances
       Ray ray;
       ray.o = origins[v];
       for (int k = 0; k < rays; ++k) {
         ray.d = frame.toWorld(cosineHemisphere(seq.next()));
         ray.tfar = std::numeric_limits<float>::infinity();
         const Hit h = caster.intersect(ray);
-        if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f)
-          sum += glm::dvec3(value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k)}));
+        if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f) {
+          const glm::vec3 x = value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k)});
+          sum += glm::dvec3(x);
+          syy += double(luminance(x)) * luminance(x);
+        }
       }
       H[v] = glm::vec3(sum / double(rays));
+      if (lum) {
+        const double sy = luminance(glm::vec3(sum)), m = sy / rays;
+        const double var = rays > 1 ? std::max(0.0, syy / rays - m * m) * rays / (rays - 1) : 0.0;
+        (*lum)[v] = VertexRays{uint32_t(rays), sy, var, glm::vec3(0.f)};
+      }
     }
   });
   return H;

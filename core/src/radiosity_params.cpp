@@ -89,6 +89,16 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
        .help = "Rays per vertex for the final gather of the indirect light (cosine-weighted).",
        .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+      {.name = "gather_share_rings", .label = "Final gather: shared with neighbours (rings)",
+       .help = "Neighbouring vertices see almost the same surroundings, so each vertex may pool the gather rays of "
+               "its neighbours up to this many mesh rings away (1: its direct neighbours, about 7 vertices; 2: about "
+               "19), through neighbours whose normals lie within 10 degrees of its own (so pools stop at creases). "
+               "A first-order fit over the pool removes the bias of a steady gradient, and Lepski's rule stops a "
+               "pool from growing where its estimate departs from the smaller pools' by more than their noise "
+               "explains. For dense meshes (a scan, a finely meshed room), where it halves the gather's error at "
+               "the same rays; next to an object just above the surface or a concave edge a vertex may take some "
+               "of its neighbours' light (up to several percent). 0: every vertex uses its own rays only.",
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 8},
       seedSpec("form-factor, shadow and final-gather rays"),
       {.name = "refine", .label = "Adaptive mesh refinement",
        .help = "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
@@ -119,6 +129,7 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.linkRays = v.getInt("link_rays");
   o.vertexOutput = kRadiosityVertexOutputs.get(v, "vertex_output");
   o.gatherRays = v.getInt("gather_rays");
+  o.gatherShareRings = v.getInt("gather_share_rings");
   o.refine = v.getBool("refine");
   o.refinement = RefineOptions::fromParams(v);
   o.ambientTerm = v.getBool("ambient_term");

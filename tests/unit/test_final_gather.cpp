@@ -14,6 +14,7 @@
 #include <memory>
 #include <vector>
 
+#include "gi/ao_shared.h"
 #include "gi/color.h"
 #include "gi/pathtrace.h"
 #include "gi/radiosity.h"
@@ -83,4 +84,59 @@ TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
     EXPECT_LT(std::fabs(mean), 0.01);
     EXPECT_LT(rms, 0.025);
   }
+}
+
+// Sharing the gather between neighbours (gather_share_rings) on the Cornell
+// box at 10k patches (5,233 vertices, 2 cm apart): 256 gather rays per
+// vertex, pooled up to 2 rings or not, against the same patch solution
+// gathered with 4,096 rays per vertex without pooling (the solution is the
+// same bits whatever the gather; the 4,096-ray gather's own noise is about
+// a quarter of the 256-ray one's). Errors relative to max(value, a tenth of
+// the mean). Pooling must cut the RMS error over all vertices, and must not
+// raise it where the gathered light is not smooth: at the vertices whose
+// value differs from the mean of their neighbours' by more than 3% in the
+// 4,096-ray gather (the blocks' feet, the room's edges, around the light).
+// Measured: all vertices 1.70% -> 1.40%; the 1,140 rough ones 2.50% ->
+// 2.37%, though there single vertices lose: 11 are more than 5 points worse
+// (at most 7%, on the ceiling next to a wall and by the light), 129 more
+// than 2 points. The 1.5k box (vertices 5 cm apart) gains nothing: its
+// light changes too much across a pool.
+TEST(FinalGather, SharingWithNeighboursCutsTheNoiseNotTheDetail) {
+  auto sf = scenes::cornellBox(20.0);
+  const Scene& s = sf.scene;
+  auto caster = makeEmbreeCaster(s);
+  auto run = [&](int rays, int rings) {
+    RadiosityOptions o;
+    o.solver = RadiositySolver::GaussSeidel;
+    o.gatherRays = rays;
+    o.gatherShareRings = rings;
+    return solveRadiosity(s, *caster, o);
+  };
+  const RadiosityResult truth = run(4096, 0), own = run(256, 0), shared = run(256, 2);
+  const VertexGraph g = VertexGraph::build(s);
+  double meanB = 0;
+  int counted = 0;
+  for (size_t v = 0; v < s.vertexCount(); ++v)
+    if (g.degree(uint32_t(v)) > 0) meanB += luminance(truth.Bvertex[v]), ++counted;
+  meanB /= counted;
+  double eOwn = 0, eShared = 0, rOwn = 0, rShared = 0;
+  int n = 0, rough = 0;
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    const double t = luminance(truth.Bvertex[v]);
+    if (!(t > 0) || g.degree(uint32_t(v)) == 0) continue;
+    double nb = 0;
+    for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) nb += luminance(truth.Bvertex[g.nbr[k]]);
+    nb /= double(g.degree(uint32_t(v)));
+    const double scale = std::max(t, 0.1 * meanB);
+    const double dOwn = (luminance(own.Bvertex[v]) - t) / scale, dShared = (luminance(shared.Bvertex[v]) - t) / scale;
+    eOwn += dOwn * dOwn, eShared += dShared * dShared, ++n;
+    if (std::fabs(nb / t - 1) > 0.03) rOwn += dOwn * dOwn, rShared += dShared * dShared, ++rough;
+  }
+  eOwn = std::sqrt(eOwn / n), eShared = std::sqrt(eShared / n);
+  rOwn = std::sqrt(rOwn / rough), rShared = std::sqrt(rShared / rough);
+  std::printf("%d vertices: own rays %.4f, shared %.4f; %d rough: own %.4f, shared %.4f; pools of %.1f vertices\n", n,
+              eOwn, eShared, rough, rOwn, rShared, shared.stats.get("gather_pool_vertices"));
+  EXPECT_LT(eShared, 0.9 * eOwn);
+  EXPECT_GT(rough, 30);
+  EXPECT_LT(rShared, rOwn);
 }

@@ -235,11 +235,17 @@ TEST(SplitRun, SharedAmbientOcclusion) {
 }
 
 // Without the parts' sum a split shared run cannot see its neighbours' rays: refused.
-TEST(SplitRun, SharedAmbientOcclusionNeedsThePartsSum) {
+TEST(SplitRun, PoolingNeedsThePartsSum) {
   FilterInput in = inputOf(cornell(), FilterKind::AmbientOcclusion, {{"estimator", "1"}, {"rays_per_vertex", "8"}});
   FilterResult r = prepareFilter(FilterKind::AmbientOcclusion, in);
   in.vertices = VertexPart{0, 2, 64, true, nullptr};
   EXPECT_THROW(estimateFilter(FilterKind::AmbientOcclusion, in, r), std::logic_error);
+  // So is a split radiosity run that pools its gather.
+  FilterInput rin = inputOf(cornell(), FilterKind::Radiosity,
+                            {{"emitter_source", "1"}, {"gather_rays", "8"}, {"gather_share_rings", "1"}});
+  FilterResult rr = prepareFilter(FilterKind::Radiosity, rin);
+  rin.vertices = VertexPart{0, 2, 64, true, nullptr};
+  EXPECT_THROW(estimateFilter(FilterKind::Radiosity, rin, rr), std::logic_error);
 }
 
 TEST(SplitRun, ObscuranceAndSky) {
@@ -264,6 +270,10 @@ TEST(SplitRun, RadiosityFinalGatherAndFaces) {
                                                 {"gather_rays", "16"}, {"face_output", "true"}};
   expectSplitEqualsWhole(m, FilterKind::Radiosity, p, 3, 17, true);
   expectSplitEqualsWhole(m, FilterKind::Radiosity, p, 2, 64, false);
+  // Pooling the gather across the parts' borders: the parts exchange their rays' sums.
+  std::map<std::string, std::string> shared = p;
+  shared["gather_share_rings"] = "2";
+  expectSplitEqualsWhole(m, FilterKind::Radiosity, shared, 3, 17, true);
   // Refinement decides from every vertex's value at the coarser levels: each part refines alike.
   std::map<std::string, std::string> refine = p;
   refine["refine"] = "true", refine["refine_max_depth"] = "1";

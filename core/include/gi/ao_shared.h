@@ -51,7 +51,9 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_part.h"
 
 namespace gi {
 
@@ -68,6 +70,7 @@ struct VertexGraph {
 struct VertexRays {
   uint32_t n = 0;
   double sum = 0.0;
+  double var = 0.0;   // unbounded values (not PoolOptions::bounded): their sample variance
   glm::vec3 bent{0.f};
 };
 
@@ -75,6 +78,8 @@ struct PoolOptions {
   int maxRings = 3;           // largest neighbourhood, in mesh rings
   float normalCos = 0.9848f;  // cos of the normal tolerance (10 degrees)
   double gamma = 1.0;         // Lepski's threshold in standard errors (tests: 2 lets pooling bias through)
+  bool bounded = true;        // values in [0,1] (variance bound p(1-p)); else any >= 0, with VertexRays::var
+  int fixedRings = -1;        // >= 0: pool exactly this many rings (no test), as chosen for another quantity
 };
 
 struct Pooled {
@@ -97,5 +102,24 @@ struct PoolScratch {
 Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
                   const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
                   const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& scratch);
+
+// Pooling for estimates that are means of unbounded values, such as the
+// final gather of a radiosity solution (irradiance, RGB): each vertex's own
+// estimate means[v] from lum[v].n rays, whose luminances have the sum
+// lum[v].sum and the sample variance lum[v].var. The scale is chosen on the
+// luminance, as above with v the pool's n-weighted mean variance, and each
+// channel is fitted at that scale with the same weights. For quasi-Monte
+// Carlo rays the variance per ray over n overstates the error of their
+// mean, so Lepski's rule lets through differences somewhat larger than the
+// noise actually left: near a discontinuity of the pooled quantity (the
+// edge of an object just above the surface) a pool may carry some of it
+// (tests/unit/test_final_gather.cpp measures both sides). Vertices with
+// lum[v].n = 0 neither pool nor are pooled (they keep means[v]). A split
+// run (part not whole) exchanges every vertex's sums through
+// part.sumOverParts first, so the pools are the whole run's; each part
+// pools its own vertices. Adds the mean pool size to `stats`.
+std::vector<glm::vec3> poolMeans(const Scene& s, const std::vector<glm::vec3>& normals,
+                                 const std::vector<glm::vec3>& means, const std::vector<VertexRays>& lum,
+                                 const PoolOptions& o, const VertexPart& part, RunStats* stats = nullptr);
 
 }  // namespace gi

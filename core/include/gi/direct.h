@@ -14,6 +14,7 @@
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/run.h"
+#include "gi/ao_shared.h"
 #include "gi/scene.h"
 #include "gi/vertex_part.h"
 
@@ -72,10 +73,13 @@ struct GatherHit {
 // Final gather at every vertex: the mean over `rays` cosine-weighted rays of
 // value(hit), for hits on a face's front (0 otherwise) — an irradiance
 // estimate when value is the radiosity leaving the hit point. Only the
-// vertices of `part` (the others 0).
+// vertices of `part` (the others 0). `lum` (if given) receives each
+// vertex's rays for pooling (poolMeans): their count, the sum of their
+// values' luminance and its sample variance per ray.
 std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat, int rays,
                                    uint32_t key, const std::function<glm::vec3(const GatherHit&)>& value,
-                                   const VertexPart& part = VertexPart(), const Progress& progress = Progress(nullptr));
+                                   const VertexPart& part = VertexPart(), const Progress& progress = Progress(nullptr),
+                                   std::vector<VertexRays>* lum = nullptr);
 
 namespace detail {
 class DirectLight;

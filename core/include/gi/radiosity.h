@@ -65,6 +65,7 @@ struct RadiosityOptions {
   int linkRays = 4;               // hierarchical: visibility rays per link
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
+  int gatherShareRings = 0;       // final gather: neighbourhood (mesh rings) whose rays a vertex may pool; 0: none
   bool refine = false;            // adaptive mesh refinement (solveRadiosityAdaptive)
   RefineOptions refinement;       // its limits, thresholds and seed (RefineOptions::fromParams)
   VertexPart vertices;            // which vertices' final gather to compute (a split run; the patch
