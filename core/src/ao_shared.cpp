@@ -131,7 +131,11 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     // efficient one, so Var(a_h' - a_h) = Var(a_h') - Var(a_h) (Hausman 1978).
     bool agree = true;
     for (int s = 0; s <= chosen && agree && test; ++s) {
-      const double var = std::max(0.0, v * (VarV[s] - f.varOverV));
+      // Unbounded values: each estimate's variance with its own pool's
+      // variance per ray (a vertex whose own rays all agreed, hidden under
+      // an object, keeps its value however its neighbours' rays spread).
+      const double var = o.bounded ? std::max(0.0, v * (VarV[s] - f.varOverV))
+                                   : std::max(0.0, V[s] * VarV[s] - v * f.varOverV);
       agree = std::fabs(f.a - A[s]) <= o.gamma * std::sqrt(var);
     }
     if (test && !agree) break;

@@ -107,8 +107,12 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
 // final gather of a radiosity solution (irradiance, RGB): each vertex's own
 // estimate means[v] from lum[v].n rays, whose luminances have the sum
 // lum[v].sum and the sample variance lum[v].var. The scale is chosen on the
-// luminance, as above with v the pool's n-weighted mean variance, and each
-// channel is fitted at that scale with the same weights. For quasi-Monte
+// luminance, as above with v the pool's n-weighted mean variance, except
+// that Lepski's rule compares two scales with each one's own v,
+// Var(a_h' - a_h) = v_h' c_h' - v_h c_h (a vertex whose own rays all agreed,
+// hidden under an object, then keeps its value however its neighbours'
+// rays spread), and each channel is fitted at that scale with the same
+// weights. For quasi-Monte
 // Carlo rays the variance per ray over n overstates the error of their
 // mean, so Lepski's rule lets through differences somewhat larger than the
 // noise actually left: near a discontinuity of the pooled quantity (the
