@@ -310,7 +310,10 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
         if (h.valid() && glm::dot(ray.d, faceN[h.face]) < 0.f) {
           const glm::vec3 x = value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k)});
           sum += glm::dvec3(x);
-          syy += double(luminance(x)) * luminance(x);
+          if (lum) {
+            const double y = luminance(x);
+            syy += y * y;
+          }
         }
       }
       H[v] = glm::vec3(sum / double(rays));

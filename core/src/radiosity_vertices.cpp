@@ -83,9 +83,12 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     return reflectedAt(reflectedAt, g.face, g.point, g.t, u, hash3(bits[0] ^ seed, bits[1], bits[2] ^ g.face),
                        kNearLevels);
   };
+  // The rays' luminance statistics only where the vertices pool them.
+  const bool share = opt.gatherShareRings > 0;
   std::vector<VertexRays> lum;
-  std::vector<glm::vec3> Hi = finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices, progress, &lum);
-  if (opt.gatherShareRings > 0) {
+  std::vector<glm::vec3> Hi =
+      finalGather(s, caster, mat, opt.gatherRays, seed, seen, opt.vertices, progress, share ? &lum : nullptr);
+  if (share) {
     PoolOptions po;
     po.bounded = false;
     po.maxRings = opt.gatherShareRings;
@@ -96,12 +99,12 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   return Hi;
 }
 
+}  // namespace
+
 // Vertex values B = E + rho (H_direct + H_indirect) with the exact direct
 // light at each vertex and the indirect light gathered (final gather:
 // visibility at the vertex itself, no leaks under objects that cut through
 // patches) or interpolated from the incident patches.
-}  // namespace
-
 void radiosityVertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res,
                            const Progress& progress) {
   Timer vt;
@@ -122,6 +125,5 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   res.stats.note(gather ? "vertices: direct light and a final gather of the patch solution at each vertex"
                         : "vertices: direct light at each vertex, indirect interpolated from the patches");
 }
-
 
 }  // namespace gi

@@ -112,12 +112,12 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
 // Var(a_h' - a_h) = v_h' c_h' - v_h c_h (a vertex whose own rays all agreed,
 // hidden under an object, then keeps its value however its neighbours'
 // rays spread), and each channel is fitted at that scale with the same
-// weights. For quasi-Monte
-// Carlo rays the variance per ray over n overstates the error of their
-// mean, so Lepski's rule lets through differences somewhat larger than the
-// noise actually left: near a discontinuity of the pooled quantity (the
-// edge of an object just above the surface) a pool may carry some of it
-// (tests/unit/test_final_gather.cpp measures both sides). Vertices with
+// weights. For quasi-Monte Carlo rays the variance per ray over n
+// overstates the error of their mean, so Lepski's rule lets through
+// differences somewhat larger than the noise actually left: near a
+// discontinuity of the pooled quantity (the edge of an object just above
+// the surface) a pool may carry some of it (tests/unit/test_final_gather.cpp
+// measures both sides). Vertices with
 // lum[v].n = 0 neither pool nor are pooled (they keep means[v]). A split
 // run (part not whole) exchanges every vertex's sums through
 // part.sumOverParts first, so the pools are the whole run's; each part

@@ -61,8 +61,8 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
                                               const VertexPart& part = VertexPart());
 
 // One gather ray's hit: the face, the point and its distance, and which
-// vertex cast it as its how-manyth ray (for a sample of its own that is
-// stratified with the vertex's other rays: gatherSample).
+// vertex cast it as its how-manyth ray (so that what the hit samples in
+// turn can be stratified with the vertex's other rays).
 struct GatherHit {
   uint32_t face;
   glm::vec3 point;
