@@ -14,6 +14,7 @@
 #include "gi/form_factors.h"
 #include "gi/luminaires.h"
 #include "gi/sampling.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -110,9 +111,11 @@ namespace detail {
 // cosine-weighted directions by MIS (one shadow ray each).
 class DirectLight {
  public:
-  // sampled: always the MIS light samples.
-  DirectLight(const Scene& s, const RayCaster& c, bool sampled = false)
-      : s_(s), caster_(c), lights_(s), lums_(s), eps_(float(sceneScale(s).rayEpsilon)) {
+  // sampled: always the MIS light samples. portals: the light of the sky
+  // through these openings' portals instead of the emitters'.
+  DirectLight(const Scene& s, const RayCaster& c, bool sampled = false, const SkyOpenings* portals = nullptr)
+      : s_(s), caster_(c), lights_(s), lums_(portals ? Luminaires(s, *portals) : Luminaires(s)),
+        eps_(float(sceneScale(s).rayEpsilon)), portals_(portals != nullptr) {
     exact_ = !sampled && lums_.usable();
     unoccluded_ = pairwiseUnoccluded(s);
     if (exact_) {
@@ -126,7 +129,7 @@ class DirectLight {
       }
     }
   }
-  bool empty() const { return lights_.empty(); }
+  bool empty() const { return portals_ ? lums_.count() == 0 : lights_.empty(); }
   bool exact() const { return exact_; }
   float eps() const { return eps_; }
   // Points per patch for `lightSamples` shadow rays. Power sampling: one
@@ -200,6 +203,7 @@ class DirectLight {
   float eps_;
   std::vector<uint32_t> lumOfFace_;
   std::vector<double> lumRadius_;
+  bool portals_ = false;
   bool exact_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
 
@@ -219,10 +223,11 @@ glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint
 }
 
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                             const Progress& progress, RunStats* stats) {
+                                             const Progress& progress, RunStats* stats, const SkyOpenings* portals) {
   if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
-  const DirectLight direct(s, caster);
+  if (portals && !portals->any()) return H;
+  const DirectLight direct(s, caster, false, portals);
   if (direct.empty()) return H;
   const auto ok = usableFaceMask(s);
   const int budget = lightSamples / direct.maxPoints(lightSamples);
@@ -260,10 +265,12 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
 }
 
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                              const Progress& progress, const VertexPart& part) {
+                                              const Progress& progress, const VertexPart& part,
+                                              const SkyOpenings* portals) {
   const VertexMaterial mat = vertexMaterial(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
-  const DirectLight direct(s, caster);
+  if (portals && !portals->any()) return H;
+  const DirectLight direct(s, caster, false, portals);
   if (direct.empty()) return H;
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, direct.eps());
   // A vertex is one point: with luminaires, all of light_samples in penumbra.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <unordered_map>
 
@@ -9,6 +10,7 @@
 #include "gi/form_factor_analytic.h"
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -178,11 +180,50 @@ Luminaires::Luminaires(const Scene& s) : s_(s), planeTol_(kPlaneTolerance * scen
     if (g.size() == 1 || planar(L)) { lum_.push_back(std::move(L)); continue; }
     for (uint32_t f : g) lum_.push_back(build({f}));  // curved: one luminaire per triangle
   }
+  firstPortal_ = lum_.size();
+}
+
+Luminaires::Luminaires(const Scene& s, const SkyOpenings& openings)
+    : s_(s), planeTol_(kPlaneTolerance * sceneScale(s).diagonal) {
+  addPortals(openings);
+}
+
+void Luminaires::addPortals(const SkyOpenings& op) {
+  openings_ = &op;
+  for (const SkyPortal& P : op.portals) {
+    Luminaire L;
+    L.portal = true;
+    L.E = op.E;
+    L.normal = P.normal;
+    L.origin = P.centre;
+    const size_t m = P.corners.size();
+    for (size_t k = 0; k < m; ++k) {
+      L.boundary.push_back({P.corners[k], P.corners[(k + 1) % m]});
+      L.corners.push_back(P.corners[k]);
+    }
+    for (size_t k = 1; k + 1 < m; ++k) {  // the convex outline's fan
+      L.tris.push_back({P.corners[0], P.corners[k], P.corners[k + 1]});
+      L.area += 0.5 * glm::length(glm::cross(P.corners[k] - P.corners[0], P.corners[k + 1] - P.corners[0]));
+      L.cdf.push_back(L.area);
+    }
+    boundingRectangle(L);
+    const size_t step = std::max<size_t>(1, (m + kProbes - 1) / kProbes);
+    for (size_t k = 0; k < m; k += step) L.probes.push_back(L.corners[k] + 1e-3 * (L.origin - L.corners[k]));
+    lum_.push_back(std::move(L));
+  }
+}
+
+bool Luminaires::counts(size_t L, const glm::vec3& x, const glm::vec3& w) const {
+  if (!lum_[L].portal || portals() < 2) return true;
+  return openings_->crossed(x, w) == int(L - firstPortal_);
 }
 
 double Luminaires::formFactor(size_t i, const glm::dvec3& x, const glm::dvec3& n) const {
   const Luminaire& L = lum_[i];
-  if (glm::dot(L.normal, x - L.origin) <= 0.0) return 0.0;  // behind or in its plane: it emits one-sided
+  // Behind or in its plane: an emitter emits one-sided, a portal lets the
+  // sky in from both.
+  const double side = glm::dot(L.normal, x - L.origin);
+  if (L.portal ? side == 0.0 : side <= 0.0) return 0.0;
   bool anyFront = false, allFront = true;
   for (const glm::dvec3& p : L.corners) {
     const bool front = glm::dot(n, p - x) >= 0.0;
@@ -200,6 +241,7 @@ double Luminaires::formFactor(size_t i, const glm::dvec3& x, const glm::dvec3& n
     F += pointToTriangleFormFactor(x, n, glm::dvec3(s_.positions[t.x]), glm::dvec3(s_.positions[t.y]),
                                    glm::dvec3(s_.positions[t.z]));
   }
+  for (const auto& t : L.tris) F += pointToTriangleFormFactor(x, n, t[0], t[1], t[2]);
   return F;
 }
 
@@ -217,8 +259,13 @@ bool Luminaires::point(size_t i, glm::vec2 u, glm::vec3* y) const {
   }
   float ux;
   const size_t k = invertCdf(L.cdf, double(u.x), &ux);
-  const auto& t = s_.triangles[L.faces[k]];
   const glm::vec2 b = uniformTriangle({ux, u.y});
+  if (L.portal) {
+    const auto& t = L.tris[k];
+    *y = glm::vec3(double(b.x) * t[0] + double(b.y) * t[1] + double(1.f - b.x - b.y) * t[2]);
+    return true;
+  }
+  const auto& t = s_.triangles[L.faces[k]];
   *y = b.x * s_.positions[t.x] + b.y * s_.positions[t.y] + (1.f - b.x - b.y) * s_.positions[t.z];
   return true;
 }
@@ -249,7 +296,10 @@ void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const g
   Ray rays[kBlock];
   float kern[kBlock];
   uint8_t occ[kBlock];
-  const glm::vec3 nL(lums.list()[L].normal);
+  const Luminaire& lum = lums.list()[L];
+  const glm::vec3 nL(lum.normal);
+  // A portal: seen from either side, and its rays must leave the scene.
+  const float sgn = !lum.portal || glm::dot(glm::dvec3(x) - lum.origin, lum.normal) > 0.0 ? -1.f : 1.f;
   // Points outside the polygon (drawn in its bounding rectangle) are
   // skipped: at most 4 count draws, a quarter of them inside at least.
   for (int done = 0, draws = 0; done < count && draws < 4 * count;) {
@@ -264,17 +314,18 @@ void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const g
       if (!(r2 > 0.f)) continue;
       const float r = std::sqrt(r2);
       w /= r;
-      const float kxy = std::max(0.f, glm::dot(n, w)) * std::max(0.f, -glm::dot(nL, w)) / r2;
+      const float kxy = std::max(0.f, glm::dot(n, w)) * std::max(0.f, sgn * glm::dot(nL, w)) / r2;
       if (!(kxy > 0.f)) continue;  // behind x's tangent plane: outside the clipped polygon
       rays[used].o = x;
       rays[used].d = w;
-      rays[used].tfar = r * (1.f - 1e-4f) - eps;
+      rays[used].tfar = lum.portal ? std::numeric_limits<float>::infinity() : r * (1.f - 1e-4f) - eps;
       kern[used++] = kxy;
     }
     done += m;
     caster.occludedBatch(rays, size_t(used), occ);
     for (int j = 0; j < used; ++j) {
-      const double kj = kern[j], vis = rays[j].tfar <= 0.f || !occ[j] ? 1.0 : 0.0;
+      const double kj = kern[j],
+                   vis = (rays[j].tfar <= 0.f || !occ[j]) && lums.counts(L, rays[j].o, rays[j].d) ? 1.0 : 0.0;
       v.k += kj;
       v.kv += kj * vis;
       v.k2 += kj * kj;

@@ -25,6 +25,12 @@ namespace gi {
 
 namespace {
 
+// The sky still sampled by cosine rays per patch (not where its openings'
+// portals carry all of it).
+bool skyRays(const RadiosityOptions& opt, const SkyOpenings& openings) {
+  return opt.outside.sky() && (!openings.any() || openings.rest);
+}
+
 using RowFn = std::function<const FormFactorRow&(uint32_t)>;
 
 // The direct light's numbers and notes (luminaires, method) after the solver's.
@@ -438,10 +444,11 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   const size_t n = s.faceCount();
   Timer directTimer;
   RunStats directStats;
+  const SkyOpenings openings = findSkyOpenings(s, caster, opt.outside, opt.formFactors.seed);
   const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1),
                                                  &directStats),
                         patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed,
-                                              progress.sub(0.1, 0.2)));
+                                              progress.sub(0.1, 0.2), &openings));
   const double directSeconds = directTimer.seconds();
   HierarchySettings hs;
   hs.epsilon = opt.hierarchyEpsilon;
@@ -472,10 +479,11 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (opt.hierarchyEpsilon == 0 && n > 20000)
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
-  if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0));
+  if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &openings);
   res.stats.add("direct_light_seconds", directSeconds);
   appendStats(res.stats, directStats);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
+  openings.report(res.stats);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays(opt, openings)) + int(opt.outside.sun())));
   res.stats.add("patches", double(u.n));
   res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
   res.stats.add("seconds", timer.seconds());
@@ -535,8 +543,10 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   Timer directTimer;
   RunStats directStats;
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05), &directStats),
-                        patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, ffs.seed, progress.sub(0.05, 0.1)));
+  const SkyOpenings openings = findSkyOpenings(s, caster, opt.outside, ffs.seed);
+  const Setup u =
+      setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05), &directStats),
+            patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, ffs.seed, progress.sub(0.05, 0.1), &openings));
   const double directSeconds = directTimer.seconds();
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = mem.fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
@@ -544,10 +554,12 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
                                                               : std::nullopt;
   RadiosityResult res = mem.fits ? solveInMemory(s, u, ff, mem, solver, opt, progress)
                                  : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
-  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage) radiosityVertexValues(s, caster, opt, res);
+  if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage)
+    radiosityVertexValues(s, caster, opt, res, Progress(nullptr), &openings);
   res.stats.add("direct_light_seconds", directSeconds);
   appendStats(res.stats, directStats);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(opt.outside.sky()) + int(opt.outside.sun())));
+  openings.report(res.stats);
+  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays(opt, openings)) + int(opt.outside.sun())));
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));

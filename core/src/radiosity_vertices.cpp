@@ -106,7 +106,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
 // visibility at the vertex itself, no leaks under objects that cut through
 // patches) or interpolated from the incident patches.
 void radiosityVertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res,
-                           const Progress& progress) {
+                           const Progress& progress, const SkyOpenings* openings) {
   Timer vt;
   const VertexMaterial mat = vertexMaterial(s);
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
@@ -115,7 +115,7 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   std::vector<glm::vec3> Hd =
       vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, d), opt.vertices);
   const std::vector<glm::vec3> Hout = vertexSkySunIrradiance(s, caster, opt.outside, opt.lightSamples,
-                                                             opt.formFactors.seed, opt.vertices, progress.sub(d, o));
+                                                             opt.formFactors.seed, opt.vertices, progress.sub(d, o), openings);
   for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
   const std::vector<glm::vec3> Hi =
       gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect);

@@ -11,8 +11,9 @@
 namespace gi {
 
 // Fills res.Bvertex from the patch solution in res (Rgather, Hindirect,
-// ambient) and the vertices' own direct light; only opt.vertices' vertices.
+// ambient) and the vertices' own direct light (the sky through `openings`'
+// portals with it, as for the patches); only opt.vertices' vertices.
 void radiosityVertexValues(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, RadiosityResult& res,
-                           const Progress& progress = Progress(nullptr));
+                           const Progress& progress = Progress(nullptr), const SkyOpenings* openings = nullptr);
 
 }  // namespace gi

@@ -50,16 +50,18 @@ namespace {
 
 // Sample k of a padded sequence: dimension `skyDim` for the sky's cosine
 // direction, skyDim + 1 for the direction in the sun's cone.
+// With openings: the sky only where it is still sampled by cosine rays,
+// and only through no portal (the portals' light is the direct light's).
 glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const Frame& frame,
                        const glm::vec3& n, const Frame& sunFrame, float sunCos, const PaddedSobol& smp, uint32_t k,
-                       uint32_t skyDim) {
+                       uint32_t skyDim, const SkyOpenings* op) {
   glm::vec3 H(0.f);
   Ray ray;
   ray.o = x;
-  if (o.sky()) {
+  if (o.sky() && (!op || op->rest)) {
     ray.d = frame.toWorld(cosineHemisphere(smp(k, skyDim)));
     ray.tfar = std::numeric_limits<float>::infinity();
-    if (!caster.occluded(ray)) H += o.skyRadiance * float(M_PI);
+    if (!caster.occluded(ray) && (!op || op->crossed(ray.o, ray.d) < 0)) H += o.skyRadiance * float(M_PI);
   }
   if (o.sun()) {
     ray.d = sunFrame.toWorld(uniformCone(smp(k, skyDim + 1), sunCos));
@@ -72,25 +74,41 @@ glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3
 
 }  // namespace
 
-glm::vec3 skySunIrradianceAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
-                             int rays, uint32_t key) {
+namespace {
+
+constexpr uint32_t kPortalSalt = 0x50f7a1u;  // the portals' shadow rays: other seeds than the emitters'
+
+glm::vec3 skySunAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n, int rays,
+                   uint32_t key, const SkyOpenings* op) {
   if (!o.any() || rays < 1) return glm::vec3(0.f);
   const PaddedSobol smp(hash3(key, 0x5c1u, 0x5e2u));
   const Frame frame(n), sunFrame(o.sunDirection);
   const float sunCos = o.sunCos();
   glm::dvec3 sum(0.0);
-  for (int k = 0; k < rays; ++k) sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 0));
+  for (int k = 0; k < rays; ++k)
+    sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 0, op));
   return glm::vec3(sum / double(rays));
 }
 
+}  // namespace
+
+glm::vec3 skySunIrradianceAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
+                             int rays, uint32_t key) {
+  return skySunAt(o, caster, x, n, rays, key, nullptr);
+}
+
 std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
-                                             uint32_t seed, const Progress& progress) {
-  std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
-  if (!o.any() || rays < 1) return H;
+                                             uint32_t seed, const Progress& progress, const SkyOpenings* openings) {
+  if (openings && !openings->any()) openings = nullptr;
+  // The sky through the portals, as the light of luminaires (its own seeds).
+  std::vector<glm::vec3> H = openings && rays >= 1 ? patchDirectIrradiance(s, caster, rays, seed ^ kPortalSalt,
+                                                                           progress.sub(0.0, 0.5), nullptr, openings)
+                                                   : std::vector<glm::vec3>(s.faceCount(), glm::vec3(0.f));
+  if (!o.any() || rays < 1 || (openings && !openings->rest && !o.sun())) return H;
   const auto ok = usableFaceMask(s);
   const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos();
   const Frame sunFrame(o.sunDirection);
-  parallelBlocks(s.faceCount(), progress, "sky and sun", [&](size_t b, size_t e) {
+  parallelBlocks(s.faceCount(), openings ? progress.sub(0.5, 1.0) : progress, "sky and sun", [&](size_t b, size_t e) {
     for (size_t f = b; f < e; ++f) {
       if (!ok[f]) continue;
       const auto& t = s.triangles[f];
@@ -103,24 +121,29 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
         const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
         const glm::vec3 x =
             w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
-        sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 1));
+        sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 1, openings));
       }
-      H[f] = glm::vec3(sum / double(rays));
+      H[f] += glm::vec3(sum / double(rays));
     }
   });
   return H;
 }
 
 std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
-                                              uint32_t seed, const VertexPart& part, const Progress& progress) {
-  std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
-  if (!o.any() || rays < 1) return H;
+                                              uint32_t seed, const VertexPart& part, const Progress& progress,
+                                              const SkyOpenings* openings) {
+  if (openings && !openings->any()) openings = nullptr;
+  std::vector<glm::vec3> H = openings && rays >= 1 ? vertexDirectIrradiance(s, caster, rays, seed ^ kPortalSalt,
+                                                                            progress.sub(0.0, 0.5), part, openings)
+                                                   : std::vector<glm::vec3>(s.vertexCount(), glm::vec3(0.f));
+  if (!o.any() || rays < 1 || (openings && !openings->rest && !o.sun())) return H;
   const VertexMaterial mat = vertexMaterial(s);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(sceneScale(s).rayEpsilon));
-  parallelBlocks(s.vertexCount(), progress, "sky and sun at vertices", [&](size_t b, size_t e) {
+  parallelBlocks(s.vertexCount(), openings ? progress.sub(0.5, 1.0) : progress, "sky and sun at vertices",
+                 [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v)
       if (mat.valid[v] && part.contains(v, s.vertexCount()))
-        H[v] = skySunIrradianceAt(o, caster, origins[v], mat.n[v], rays, hash3(uint32_t(v), seed, 0x5c4u));
+        H[v] += skySunAt(o, caster, origins[v], mat.n[v], rays, hash3(uint32_t(v), seed, 0x5c4u), openings);
   });
   return H;
 }

@@ -20,6 +20,8 @@
 
 namespace gi {
 
+struct SkyOpenings;  // gi/sky.h
+
 struct DirectOptions {
   int lightSamples = 64;  // shadow rays per vertex
   uint32_t seed = 0;
@@ -49,16 +51,20 @@ VertexMaterial vertexMaterial(const Scene& s);
 // distance to the luminaires), each with up to lightSamples / P shadow rays
 // per luminaire in penumbra (16 and the corners elsewhere); with more, lightSamples
 // power-proportional light samples with MIS. *stats (if given) gets the
-// luminaires found, the method and the shadow rays.
+// luminaires found, the method and the shadow rays. With `portals`
+// (findSkyOpenings), the light of the sky through its portals instead, the
+// portals taken as luminaires (what patchSkySunIrradiance adds).
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                             const Progress& progress = Progress(nullptr), RunStats* stats = nullptr);
+                                             const Progress& progress = Progress(nullptr), RunStats* stats = nullptr,
+                                             const SkyOpenings* portals = nullptr);
 
 // The same at every vertex (used for the per-vertex output), or at the
 // vertices of one part (the others 0); with luminaires, one point with up
 // to lightSamples shadow rays per luminaire in penumbra.
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                               const Progress& progress = Progress(nullptr),
-                                              const VertexPart& part = VertexPart());
+                                              const VertexPart& part = VertexPart(),
+                                              const SkyOpenings* portals = nullptr);
 
 // One gather ray's hit: the face, the point and its distance, and which
 // vertex cast it as its how-manyth ray (so that what the hit samples in

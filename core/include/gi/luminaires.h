@@ -61,6 +61,7 @@
 namespace gi {
 
 class RayCaster;
+struct SkyOpenings;
 
 // Inverts a cumulative table (non-decreasing, last entry the total) at
 // x = u * total: the entry k with cdf[k-1] <= x < cdf[k], and in *rescaled
@@ -93,6 +94,11 @@ struct Luminaire {
   glm::dvec3 origin{0.0};                               // a point of its plane
   glm::vec3 E{0.f};                                     // emitted radiosity (RGB, W/m^2)
   double area = 0.0;
+  // An opening to the sky (gi/sky.h): no faces of its own but the fan of
+  // its outline in `tris`; seen from both sides; its shadow rays must leave
+  // the scene, and count only for the lowest-index portal they cross.
+  bool portal = false;
+  std::vector<std::array<glm::dvec3, 3>> tris;
 };
 
 class Luminaires {
@@ -104,11 +110,19 @@ class Luminaires {
   static constexpr size_t kRectEdges = 64;     // boundary edges at most for drawing points in the bounding rectangle
 
   explicit Luminaires(const Scene& s);
+  // The openings' portals alone, as luminaires of the sky's radiosity
+  // (`openings` must outlive this).
+  Luminaires(const Scene& s, const SkyOpenings& openings);
   const std::vector<Luminaire>& list() const { return lum_; }
   size_t count() const { return lum_.size(); }
   size_t emitterFaces() const { return faces_; }
-  // The luminaire method applies: some emitters and at most kMaxLuminaires luminaires.
+  // The luminaire method applies: some emitters (or sky portals) and at most kMaxLuminaires luminaires.
   bool usable() const { return !lum_.empty() && lum_.size() <= size_t(kMaxLuminaires); }
+  size_t portals() const { return lum_.size() - firstPortal_; }
+  // A shadow ray from x along w that reached luminaire L (and, for a portal,
+  // left the scene) counts for L: always for an emitter; for a portal, when
+  // L is the lowest-index portal the ray crosses.
+  bool counts(size_t L, const glm::vec3& x, const glm::vec3& w) const;
 
   // Unoccluded F from the point x (unit normal n) to luminaire L; 0 behind L's plane.
   double formFactor(size_t L, const glm::dvec3& x, const glm::dvec3& n) const;
@@ -120,6 +134,9 @@ class Luminaires {
   const Scene& s_;
   std::vector<Luminaire> lum_;
   size_t faces_ = 0;
+  size_t firstPortal_ = 0;
+  const SkyOpenings* openings_ = nullptr;
+  void addPortals(const SkyOpenings& openings);
   double planeTol_ = 0.0;
 };
 

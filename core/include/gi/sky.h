@@ -42,21 +42,69 @@ struct SkySun {
   static SkySun fromParams(const ParamValues& v);
 };
 
+// The sky through openings (portals). In a closed room with a window every
+// cosine ray that reaches the sky passes through the window, a few percent
+// of them: 256 rays leave the sky's share of a vertex 40% noisy. An opening
+// of the mesh (a planar, convex boundary loop that no face covers and
+// through which rays reach the sky) is taken as a luminaire of the sky's
+// radiosity E_sky = pi L_sky, seen from either side:
+//   H_sky(x) = E_sky F(x -> P) V(x, P) + E_sky <V_rest>_{w ~ cos/pi},
+// F the exact point-to-polygon factor and V the fraction of shadow rays
+// through P that leave the scene (gi/luminaires.h: stratified rays, more in
+// penumbra), as portal sampling of an environment does (Bitterli, Novak and
+// Jarosz 2015, "Portal-masked environment map sampling"; pbrt-v4's portal
+// light). Every direction that leaves the scene is counted once: for the
+// portal of lowest index it crosses, or, crossing none, by the cosine rays
+// (V_rest). Where probe rays from the patches find no other way out, or
+// one that carries below kRestShare of the sky's light at 95% confidence,
+// the cosine rays are skipped (the log says so and what the probes found).
+struct SkyPortal {
+  std::vector<glm::dvec3> corners;  // convex, counter-clockwise about normal
+  glm::dvec3 normal{0.0};           // unit
+  glm::dvec3 centre{0.0};
+  double area = 0.0;
+};
+
+struct SkyOpenings {
+  static constexpr size_t kMaxPortals = 8;          // the largest openings; smaller ones stay with the cosine rays
+  static constexpr double kMinAreaShare = 1e-3;     // of the scene's surface area, at least
+  static constexpr int kProbeFaces = 4096;          // patches the probe rays leave from
+  static constexpr int kProbeRays = 64;             // cosine rays from each
+  static constexpr double kRestShare = 0.005;       // sky light outside the openings that may be left out
+  std::vector<SkyPortal> portals;
+  glm::vec3 E{0.f};      // pi L_sky: what the portals emit
+  bool rest = true;      // the cosine rays are still needed (no portals, or the probes found another way out)
+  size_t loops = 0;      // boundary loops of the mesh looked at
+  uint64_t probeRays = 0, probeEscapes = 0, probeRest = 0;
+  bool any() const { return !portals.empty(); }
+  // The lowest index of a portal the ray from o along d crosses (t > 0), -1 for none.
+  int crossed(const glm::vec3& o, const glm::vec3& d) const;
+  void report(RunStats& st) const;
+};
+
+// The openings of s to the sky o (none without a sky).
+SkyOpenings findSkyOpenings(const Scene& s, const RayCaster& caster, const SkySun& o, uint32_t seed);
+
 // H_out at x (already lifted off the surface) with unit normal n: `rays`
 // cosine-weighted rays for the sky and `rays` in the sun's cone, keyed by `key`.
 glm::vec3 skySunIrradianceAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
                              int rays, uint32_t key);
 
 // The mean of H_out over each face (rays from points spread over the face;
-// 0 for unusable faces and without sky and sun).
+// 0 for unusable faces and without sky and sun). With `openings`, the sky
+// through its portals is left out (the direct light adds it, as a
+// luminaire), and so are the cosine rays where it found no other way out.
 std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
-                                             uint32_t seed, const Progress& progress = Progress(nullptr));
+                                             uint32_t seed, const Progress& progress = Progress(nullptr),
+                                             const SkyOpenings* openings = nullptr);
 
 // H_out at every vertex of `part` (the others, and vertices without a usable
-// face, 0), from the per-vertex ray origins (vertexRayOrigins).
+// face, 0), from the per-vertex ray origins (vertexRayOrigins); `openings`
+// as for the patches.
 std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
                                               uint32_t seed, const VertexPart& part = VertexPart(),
-                                              const Progress& progress = Progress(nullptr));
+                                              const Progress& progress = Progress(nullptr),
+                                              const SkyOpenings* openings = nullptr);
 
 // The power entering the scene from outside, as luminance: sum over faces
 // of A_f luminance(H_out,f) (local units of area).
