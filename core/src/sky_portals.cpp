@@ -123,10 +123,10 @@ void SkyOpenings::report(RunStats& st) const {
   st.add("sky_portals", double(portals.size()));
   st.add("sky_probe_rays", double(probeRays));
   double area = 0;
-  for (const SkyPortal& P : portals) area += P.area;
+  for (const SkyPortal& P : portals) area += P.area * unit * unit;
   char b[400];
   std::snprintf(b, sizeof b,
-                "sky: %zu opening%s of the mesh (%.3g in all, of %zu boundary loops) lit as luminaires of the sky's "
+                "sky: %zu opening%s of the mesh (%.3g m^2 in all, of %zu boundary loops) lit as luminaires of the sky's "
                 "radiosity; of %llu probe rays from the patches %llu left the scene, %llu outside the openings: %s",
                 portals.size(), portals.size() == 1 ? "" : "s", area, loops, (unsigned long long)probeRays,
                 (unsigned long long)probeEscapes, (unsigned long long)probeRest,
@@ -140,6 +140,7 @@ SkyOpenings findSkyOpenings(const Scene& s, const RayCaster& caster, const SkySu
   SkyOpenings out;
   if (!o.sky() || s.faceCount() == 0) return out;
   out.E = o.skyRadiance * float(M_PI);
+  out.unit = s.unit;
   // Many emitter luminaires: the direct light samples the emitters by power
   // and takes no portals.
   if (Luminaires(s).count() > size_t(Luminaires::kMaxLuminaires)) return out;

@@ -75,6 +75,7 @@ struct SkyOpenings {
   glm::vec3 E{0.f};      // pi L_sky: what the portals emit
   bool rest = true;      // the cosine rays are still needed (no portals, or the probes found another way out)
   size_t loops = 0;      // boundary loops of the mesh looked at
+  double unit = 1.0;     // the scene's world length of one local unit (SkyPortal is in local units)
   uint64_t probeRays = 0, probeEscapes = 0, probeRest = 0;
   bool any() const { return !portals.empty(); }
   // The lowest index of a portal the ray from o along d crosses (t > 0), -1 for none.
