@@ -200,7 +200,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   const size_t nSampled = set.linkRays <= kMaxSampledRays ? size_t(std::max(0, set.linkRays)) : 0;
   // kHierarchyBytesPerNode counts 4 sampled source points per node.
   const double baseBytes = double(nn) * (kHierarchyBytesPerNode + 4.0 * (double(nSampled) - 4.0));
-  const size_t maxLinks = size_t(std::max(1.0, (set.memoryBytes - baseBytes) / kHierarchyBytesPerLink));
+  const double byMemory = (set.memoryBytes - baseBytes) / kHierarchyBytesPerLink;
+  const bool capped = set.maxLinks < byMemory;  // the link cap, not the memory, is the limit
+  const size_t maxLinks = size_t(std::max(1.0, std::min(byMemory, set.maxLinks)));
   std::vector<uint32_t> srcTri(nn * nSampled, 0);
   if (!unoccluded)
     parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
@@ -380,7 +382,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
                   maxSweeps, sol.residual, tolerance);
     sol.stats.warn(b);
   }
-  if (budgetHit)
+  if (budgetHit && capped)
+    sol.stats.note("links capped at " + std::to_string(maxLinks) + " (max_links): refined best first, the " +
+                   "links that may carry the most power split first; some carry more than epsilon of the power");
+  else if (budgetHit)
     sol.stats.warn("link refinement stopped at the memory budget (" + std::to_string(links.size()) +
                    " links): some links carry more than epsilon of the power; raise memory_budget_mb");
   // Energy account: emitted power = absorbed + escaped; absorbed from the

@@ -77,6 +77,12 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        .help = "Hierarchical solver only. Rays between paired points of a link's two nodes; the fraction that "
                "passes scales the link's unoccluded form factor (cost: links x rays).",
        .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
+      {.name = "max_links", .label = "Hierarchical: links at most",
+       .help = "Hierarchical solver only. The links stop being refined at this many, refined again best first: the "
+               "link that may carry the most power is split first, so what stays coarse carries the least. Time and "
+               "memory grow with the links (about 56 bytes each); on large scans the final gather hides what coarser "
+               "links lose. 0: automatic, 8 per patch and at least 2 million (small scenes are not capped).",
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 2000000000},
       {.name = "vertex_output", .label = "Vertex values",
        .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
                "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
@@ -127,6 +133,7 @@ RadiosityOptions RadiosityOptions::fromParams(const ParamValues& v) {
   o.memoryBudgetMB = v.getFloat("memory_budget_mb");
   o.hierarchyEpsilon = v.getFloat("hierarchy_epsilon");
   o.linkRays = v.getInt("link_rays");
+  o.maxLinks = double(v.getInt("max_links"));
   o.vertexOutput = kRadiosityVertexOutputs.get(v, "vertex_output");
   o.gatherRays = v.getInt("gather_rays");
   o.gatherShareRings = v.getInt("gather_share_rings");

@@ -112,13 +112,19 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   const bool gather = opt.vertexOutput == RadiosityVertexOutput::FinalGather;
   // Progress: shadow rays, sky and sun, then the gather's many more rays.
   const double d = gather ? 0.25 : 0.8, o = gather ? 0.35 : 1.0;
+  Timer st;
   std::vector<glm::vec3> Hd =
       vertexDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, d), opt.vertices);
+  res.stats.add("vertex_direct_seconds", st.seconds());
+  Timer ot;
   const std::vector<glm::vec3> Hout = vertexSkySunIrradiance(s, caster, opt.outside, opt.lightSamples,
                                                              opt.formFactors.seed, opt.vertices, progress.sub(d, o), openings);
+  if (opt.outside.any()) res.stats.add("vertex_sky_sun_seconds", ot.seconds());
   for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
+  Timer gt;
   const std::vector<glm::vec3> Hi =
       gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect);
+  if (gather) res.stats.add("final_gather_seconds", gt.seconds());
   for (size_t v = 0; v < s.vertexCount(); ++v)
     res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient) : glm::vec3(0.f);
   res.stats.add("vertex_output_seconds", vt.seconds());
