@@ -454,7 +454,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   hs.epsilon = opt.hierarchyEpsilon;
   hs.linkRays = opt.linkRays;
   hs.memoryBytes = budget - double(n) * kSolverBytesPerPatch;
-  hs.maxLinks = opt.maxLinks > 0 ? opt.maxLinks : hierarchyAutoLinks(n);
+  if (opt.maxLinks > 0) hs.maxLinks = opt.maxLinks;
   hs.enteringPower = u.Pout;
   // Progress: direct light 0-20%, the hierarchy to 70% (to 100% without per-vertex values), the vertices after.
   const bool vertices = opt.vertexOutput != RadiosityVertexOutput::PatchAverage;

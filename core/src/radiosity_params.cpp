@@ -78,10 +78,11 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "passes scales the link's unoccluded form factor (cost: links x rays).",
        .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
       {.name = "max_links", .label = "Hierarchical: links at most",
-       .help = "Hierarchical solver only. The links stop being refined at this many, refined again best first: the "
-               "link that may carry the most power is split first, so what stays coarse carries the least. Time and "
-               "memory grow with the links (about 56 bytes each); on large scans the final gather hides what coarser "
-               "links lose. 0: automatic, 8 per patch and at least 2 million (small scenes are not capped).",
+       .help = "Hierarchical solver only. The links stop being refined at this many (as at the memory budget), "
+               "refined again best first: the link that may carry the most power is split first, so what stays "
+               "coarse carries the least. Time and memory grow with the links (about 56 bytes each); fewer links "
+               "cost accuracy (a 100k-triangle scan room: 12M links 1.6%, 2M links 3.1%). 0: no cap but the "
+               "memory budget.",
        .type = ParamType::Int, .def = 0, .min = 0, .max = 2000000000},
       {.name = "vertex_output", .label = "Vertex values",
        .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "

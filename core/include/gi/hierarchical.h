@@ -30,7 +30,6 @@
 // box, the sampled sources 0.4%, against epsilon 0).
 // Memory: O(n) nodes plus the links.
 #pragma once
-#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -67,17 +66,6 @@ struct HierarchicalSolution {
 HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, const std::vector<glm::vec3>& Hd,
                                        const HierarchySettings& set, int bounces, double tolerance, int maxIterations,
                                        const Progress& progress = Progress(nullptr));
-
-// The automatic cap on the links: kAutoLinksPerPatch per patch, at least
-// kAutoLinksFloor. Where the cap stops the refinement, it is redone best
-// first, so what is left coarse carries the least power; measured on scan
-// rooms (README, "At scale"): from 100k triangles the error no longer falls
-// with more links, while their time grows with them.
-inline constexpr double kAutoLinksPerPatch = 8;
-inline constexpr double kAutoLinksFloor = 2e6;
-inline double hierarchyAutoLinks(size_t patches) {
-  return std::max(kAutoLinksFloor, kAutoLinksPerPatch * double(patches));
-}
 
 // Bytes per node and per link the solver holds at its peak (for the memory
 // plan): a node's geometry, its four per-sweep values and the triangles
