@@ -279,20 +279,30 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     const uint64_t newSplits = ref.splits;
     splits += newSplits;
     budgetHit |= ref.budgetHit;
+    // Grouped by receiver (a stable order: deterministic sums), before the
+    // form factors, so that a receiver's points are computed once per group.
+    {
+      std::vector<size_t> idx(next.size());
+      std::iota(idx.begin(), idx.end(), size_t(0));
+      std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return next[a].p < next[b].p; });
+      links.resize(next.size());
+      std::vector<uint8_t> fr(next.size());
+      for (size_t k = 0; k < idx.size(); ++k) {
+        links[k] = next[idx[k]];
+        fr[k] = nextFresh[idx[k]];
+      }
+      std::vector<Link>().swap(next);
+      nextFresh.swap(fr);
+    }
     Timer ft;
-    std::vector<uint64_t> blockRays(next.size(), 0);
-    parallelBlocks(next.size(), pr, "link form factors", [&](size_t b, size_t e) {
+    std::vector<uint64_t> blockRays(links.size(), 0);
+    parallelBlocks(links.size(), pr, "link form factors", [&](size_t b, size_t e) {
+      NodePointCache points;
       for (size_t k = b; k < e; ++k)
-        if (nextFresh[k]) linkFormFactor(g, t, caster, next[k], set.linkRays, unoccluded, eps, blockRays[k]);
+        if (nextFresh[k]) linkFormFactor(g, t, caster, links[k], set.linkRays, unoccluded, eps, blockRays[k], points);
     });
     for (uint64_t r : blockRays) rays += r;
     ffSeconds += ft.seconds();
-    // Grouped by receiver (a stable order: deterministic sums).
-    std::vector<size_t> idx(next.size());
-    std::iota(idx.begin(), idx.end(), size_t(0));
-    std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return next[a].p < next[b].p; });
-    links.resize(next.size());
-    for (size_t k = 0; k < idx.size(); ++k) links[k] = next[idx[k]];
     return newSplits;
   };
 

@@ -163,13 +163,12 @@ bool boxBehind(const Node& box, const glm::dvec3& x0, const glm::vec3& n) {
 // darker and hidden), and the area mean times the visible fraction carries
 // too little (7-8% on the links from clusters in the Cornell-like room).
 void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, Link& link, int linkRays,
-                    bool unoccluded, float eps, uint64_t& rays) {
+                    bool unoccluded, float eps, uint64_t& rays, NodePointCache& points) {
   const uint32_t p = link.p, q = link.q;
   const Node &np = t.nodes[p], &nq = t.nodes[q];
-  glm::dvec3 xp[kPoints], xq[kPoints];
-  glm::vec3 npn[kPoints], nqn[kPoints];
-  nodePoints(g, t, np, xp, npn);
-  nodePoints(g, t, nq, xq, nqn);
+  const NodePointSet &pp = points.receiver(g, t, p), &pq = points.source(g, t, q);
+  const glm::dvec3 *xp = pp.x, *xq = pq.x;
+  const glm::vec3 *npn = pp.n, *nqn = pq.n;
   auto corners = [&](const Node& nd, glm::dvec3 v[3]) {
     const glm::uvec3 tri = g.s.triangles[t.order[nd.first]];
     for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(g.s.positions[tri[k]]);
