@@ -279,17 +279,19 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     const uint64_t newSplits = ref.splits;
     splits += newSplits;
     budgetHit |= ref.budgetHit;
-    // Grouped by receiver (a stable order: deterministic sums), before the
-    // form factors, so that a receiver's points are computed once per group.
+    // Grouped by receiver (a stable counting sort: deterministic sums),
+    // before the form factors, so that a receiver's points are computed once
+    // per group.
     {
-      std::vector<size_t> idx(next.size());
-      std::iota(idx.begin(), idx.end(), size_t(0));
-      std::stable_sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return next[a].p < next[b].p; });
+      std::vector<size_t> at(nn + 1, 0);
+      for (const Link& l : next) ++at[l.p + 1];
+      for (size_t k = 0; k < nn; ++k) at[k + 1] += at[k];
       links.resize(next.size());
       std::vector<uint8_t> fr(next.size());
-      for (size_t k = 0; k < idx.size(); ++k) {
-        links[k] = next[idx[k]];
-        fr[k] = nextFresh[idx[k]];
+      for (size_t k = 0; k < next.size(); ++k) {
+        const size_t d = at[next[k].p]++;
+        links[d] = next[k];
+        fr[d] = nextFresh[k];
       }
       std::vector<Link>().swap(next);
       nextFresh.swap(fr);
