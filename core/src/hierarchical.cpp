@@ -218,7 +218,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   std::vector<double> Rmax(nn, 0.0);
   std::vector<glm::dvec3> Rbar(nn, glm::dvec3(0.0)), Hg(nn, glm::dvec3(0.0)), Hacc(nn, glm::dvec3(0.0));
   uint64_t rays = 0, splits = 0;
-  double ffSeconds = 0;
+  double ffSeconds = 0, refineSeconds = 0, solveSeconds = 0;
   bool budgetHit = false;
 
   // Pull: area means of R and maxima of its luminance, bottom-up.
@@ -247,6 +247,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
     Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, nextFresh};
     pr.report(0.0, "refining links");
+    Timer rt;
     if (first) {
       ref.refine(0, 0);
     } else {
@@ -296,6 +297,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
       std::vector<Link>().swap(next);
       nextFresh.swap(fr);
     }
+    refineSeconds += rt.seconds();
     Timer ft;
     std::vector<uint64_t> blockRays(links.size(), 0);
     parallelBlocks(links.size(), pr, "link form factors", [&](size_t b, size_t e) {
@@ -345,6 +347,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   const int maxSweeps = fixed ? bounces : (maxIterations > 0 ? maxIterations : autoIterations(rhoMax, tolerance));
   std::vector<glm::vec3> Rn(nf), H(nf, glm::vec3(0.f));
   auto solveSweeps = [&](int sweeps, const Progress& pr) {
+    Timer st;
     index();
     for (int it = 0; it < sweeps; ++it) {
       sol.Rprev = sol.R;
@@ -362,6 +365,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
                       : std::min(1.0, std::log(sol.residual + 1e-300) / std::log(tolerance)), "solving");
       if (!fixed && sol.residual < tolerance) break;
     }
+    solveSeconds += st.seconds();
   };
 
   sol.Rprev.assign(nf, glm::vec3(0.f));  // bounces = 0: no sweep, nothing indirect to gather
@@ -422,6 +426,8 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   sol.stats.add("refinement_rounds", double(rounds));
   sol.stats.add("link_rays", double(rays));
   sol.stats.add("link_form_factor_seconds", ffSeconds);
+  sol.stats.add("link_refinement_seconds", refineSeconds);
+  sol.stats.add("hierarchy_sweep_seconds", solveSeconds);
   sol.stats.add("hierarchy_MB", (baseBytes + double(links.size()) * kHierarchyBytesPerLink) / 1048576.0);
   sol.stats.add("hierarchy_seconds", timer.seconds());
   return sol;
