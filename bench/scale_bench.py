@@ -21,7 +21,7 @@ triangles with the fitted slopes (numpy, matplotlib: /usr/bin/python3).
 
 usage: python3 bench/scale_bench.py [--build build] [--sizes 10000,30000,100000,300000,1000000]
                                     [--out bench/scale_bench_results.json] [--plot docs/img/scale_bench.png]
-                                    [--replot]
+                                    [--ref_paths 4096] [--radiosity_args "..."] [--replot]
 """
 import argparse
 import json
@@ -46,18 +46,22 @@ def measure(a, tmp, target):
     out = os.path.join(tmp, "out.ply")
     usage, load0 = [], os.getloadavg()[0]
     gi = os.path.join(a.build, "tools", "gi")
-    j, wall, rss = hr_bench.run(gi, mesh, out, "Hierarchical", lights + ["--memory_budget_mb", str(a.budget)],
+    extra = a.radiosity_args.split() if a.radiosity_args else []
+    j, wall, rss = hr_bench.run(gi, mesh, out, "Hierarchical", lights + ["--memory_budget_mb", str(a.budget)] + extra,
                                 "Final gather", usage)
     st = j.get("stats", j)
     row = {"target": target, "triangles": int(j["scene"]["faces"]), "vertices": int(j["scene"]["vertices"]),
            "seconds": wall, "cpu_seconds": usage[0], "peak_MB": rss, "load_before": load0,
-           "memory_budget_mb": a.budget, "sample": a.sample,
+           "memory_budget_mb": a.budget, "sample": a.sample, "radiosity_args": a.radiosity_args,
            "load_after": os.getloadavg()[0],
            "stats": {k: st.get(k) for k in ("hierarchy_levels", "links", "links_patch_to_patch", "link_splits",
                                             "refinement_rounds", "link_rays", "gather_rays", "shadow_rays",
                                             "hierarchy_MB", "memory_estimate_MB", "direct_light_seconds",
                                             "link_form_factor_seconds", "hierarchy_seconds",
-                                            "vertex_output_seconds", "seconds")}}
+                                            "vertex_output_seconds", "link_refinement_seconds",
+                                            "hierarchy_sweep_seconds", "vertex_direct_seconds",
+                                            "vertex_sky_sun_seconds", "final_gather_seconds", "sky_portals",
+                                            "seconds")}}
     print("%8d triangles: %7.1f s wall, %7.1f s CPU, %6.0f MB (load %.1f)"
           % (row["triangles"], wall, usage[0], rss, load0), file=sys.stderr, flush=True)
     values = hr_bench.vertex_values(out)
@@ -117,6 +121,9 @@ def main():
     ap.add_argument("--min_sample", type=int, default=200)
     ap.add_argument("--ref_paths", type=int, default=4096)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--radiosity_args", default="",
+                    help="more `gi radiosity` options for every run, e.g. \"--gather_rays 128 --gather_share_rings 2\" "
+                         "(recorded in each row; give such runs their own --out and --plot)")
     ap.add_argument("--out", default="bench/scale_bench_results.json")
     ap.add_argument("--plot", default="docs/img/scale_bench.png")
     ap.add_argument("--replot", action="store_true", help="only redraw the plot from --out")
