@@ -83,32 +83,56 @@ struct Refiner {
   }
 
   // Budget-limited refinement, best first: the link that may carry the most
-  // power is split first, so that where the budget stops the refinement the
-  // coarse links left are the weakest ones everywhere (depth-first order
-  // would leave whole parts of the scene on coarse links). `start`: the
-  // links to refine (kept ones carry their index into `old`, fresh ones
-  // kNoHit); the links made are added to out.
+  // power is split first (to within an eighth of an octave: candidates are
+  // kept in buckets of power, 2^(1/8) apart, each a stack), so that where
+  // the budget stops the refinement the coarse links left are the weakest
+  // ones everywhere (depth-first order would leave whole parts of the scene
+  // on coarse links). A bucket queue instead of a binary heap: pushing and
+  // popping are O(1), where the heap's O(log n) cache misses over tens of
+  // millions of candidates took most of a 1M-triangle run's refinement.
+  // `start`: the links to refine (kept ones carry their index into `old`,
+  // fresh ones kNoHit); the links made are added to out.
   struct Candidate {
     double power;
     uint32_t p, q, old;
-    bool operator<(const Candidate& o) const {  // max-heap: most power first, then a fixed order
-      return power != o.power ? power < o.power : (p != o.p ? p > o.p : q > o.q);
+  };
+  struct BucketQueue {
+    static constexpr int kPerOctave = 8, kBuckets = 8192;  // 2^(-512) .. 2^(512); infinity: the top one
+    std::vector<std::vector<Candidate>> bucket = std::vector<std::vector<Candidate>>(kBuckets);
+    int top = -1;
+    size_t size = 0;
+    static int index(double power) {
+      if (!(power < std::numeric_limits<double>::infinity())) return kBuckets - 1;
+      if (!(power > 0)) return 0;
+      return std::clamp(int(std::floor(std::log2(power) * kPerOctave)) + kBuckets / 2, 0, kBuckets - 2);
+    }
+    void push(const Candidate& c) {
+      const int b = index(c.power);
+      bucket[size_t(b)].push_back(c);
+      top = std::max(top, b);
+      ++size;
+    }
+    Candidate pop() {
+      while (bucket[size_t(top)].empty()) --top;
+      const Candidate c = bucket[size_t(top)].back();
+      bucket[size_t(top)].pop_back();
+      --size;
+      return c;
     }
   };
-  void refineBestFirst(std::vector<Candidate> heap, const std::vector<Link>& old) {
-    std::make_heap(heap.begin(), heap.end());
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end());
-      const Candidate c = heap.back();
-      heap.pop_back();
+  void refineBestFirst(const std::vector<Candidate>& start, const std::vector<Link>& old) {
+    BucketQueue queue;
+    for (const Candidate& c : start) queue.push(c);
+    while (queue.size) {
+      const Candidate c = queue.pop();
       const Node &np = t.nodes[c.p], &nq = t.nodes[c.q];
       if (c.p == c.q) {  // a node with itself is always split (as refine does)
         if (np.leaf()) continue;
         for (uint32_t a : {np.left, np.right})
-          for (uint32_t b : {np.left, np.right}) push(heap, a, b);
+          for (uint32_t b : {np.left, np.right}) push(queue, a, b);
         continue;
       }
-      if (acceptable(c.p, c.q) || out.size() + heap.size() + 1 >= maxLinks) {
+      if (acceptable(c.p, c.q) || out.size() + queue.size + 1 >= maxLinks) {
         budgetHit |= !acceptable(c.p, c.q);
         if (c.old != kNoHit) add(old[c.old], false);
         else add(Link{c.p, c.q, 0.f}, true);
@@ -116,18 +140,17 @@ struct Refiner {
       }
       ++splits;
       if (splitsReceiver(np, nq)) {
-        push(heap, np.left, c.q);
-        push(heap, np.right, c.q);
+        push(queue, np.left, c.q);
+        push(queue, np.right, c.q);
       } else {
-        push(heap, c.p, nq.left);
-        push(heap, c.p, nq.right);
+        push(queue, c.p, nq.left);
+        push(queue, c.p, nq.right);
       }
     }
   }
-  void push(std::vector<Candidate>& heap, uint32_t p, uint32_t q) const {
+  void push(BucketQueue& queue, uint32_t p, uint32_t q) const {
     if (p != q && culled(p, q)) return;
-    heap.push_back({p == q ? std::numeric_limits<double>::infinity() : power(p, q), p, q, kNoHit});
-    std::push_heap(heap.begin(), heap.end());
+    queue.push({p == q ? std::numeric_limits<double>::infinity() : power(p, q), p, q, kNoHit});
   }
 
   // Links covering every triangle pair of (p, q), split where needed.
@@ -275,7 +298,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
           else start.push_back({ref.power(links[k].p, links[k].q), links[k].p, links[k].q, uint32_t(k)});
         }
       }
-      ref.refineBestFirst(std::move(start), links);
+      ref.refineBestFirst(start, links);
     }
     const uint64_t newSplits = ref.splits;
     splits += newSplits;
