@@ -114,8 +114,10 @@ struct Refiner {
     }
     Candidate pop() {
       while (bucket[size_t(top)].empty()) --top;
-      const Candidate c = bucket[size_t(top)].back();
-      bucket[size_t(top)].pop_back();
+      std::vector<Candidate>& b = bucket[size_t(top)];
+      const Candidate c = b.back();
+      b.pop_back();
+      if (b.empty()) std::vector<Candidate>().swap(b);  // its memory back: the peak stays the heap's
       --size;
       return c;
     }
