@@ -25,12 +25,6 @@ namespace gi {
 
 namespace {
 
-// The sky still sampled by cosine rays per patch (not where its openings'
-// portals carry all of it).
-bool skyRays(const RadiosityOptions& opt, const SkyOpenings& openings) {
-  return opt.outside.sky() && (!openings.any() || openings.rest);
-}
-
 using RowFn = std::function<const FormFactorRow&(uint32_t)>;
 
 // The direct light's numbers and notes (luminaires, method) after the solver's.
@@ -83,6 +77,34 @@ Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd, const std::vector<
                                 "faces (or mark them by face quality) and choose the matching 'Emitters' option, or "
                                 "set sky_irradiance or sun_irradiance");
   return u;
+}
+
+// The patches' direct light, the same for every solver: the emitters', and
+// the sky's and the sun's (through the openings' portals where there are
+// any), timed, with its log entries kept for the end of the run.
+struct DirectSetup {
+  SkyOpenings openings;
+  Setup u;
+  RunStats stats;
+  double seconds = 0;
+  // Its numbers and notes after the solver's, and the shadow rays per patch.
+  void report(const RadiosityOptions& opt, RunStats& st) const {
+    st.add("direct_light_seconds", seconds);
+    appendStats(st, stats);
+    openings.report(st);
+    const bool skyRays = opt.outside.sky() && (!openings.any() || openings.rest);  // the cosine rays still cast
+    st.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays) + int(opt.outside.sun())));
+  }
+};
+DirectSetup directSetup(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, uint32_t seed,
+                        const Progress& emitters, const Progress& outside) {
+  Timer timer;
+  DirectSetup d;
+  d.openings = findSkyOpenings(s, caster, opt.outside, seed);
+  d.u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, seed, emitters, &d.stats),
+              patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, seed, outside, &d.openings));
+  d.seconds = timer.seconds();
+  return d;
 }
 
 glm::vec3 gather(const FormFactorRow& r, const std::vector<glm::vec3>& B) {
@@ -442,14 +464,9 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   Timer timer;
   const double budget = opt.memoryBudgetMB * 1048576.0;
   const size_t n = s.faceCount();
-  Timer directTimer;
-  RunStats directStats;
-  const SkyOpenings openings = findSkyOpenings(s, caster, opt.outside, opt.formFactors.seed);
-  const Setup u = setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, opt.formFactors.seed, progress.sub(0.0, 0.1),
-                                                 &directStats),
-                        patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, opt.formFactors.seed,
-                                              progress.sub(0.1, 0.2), &openings));
-  const double directSeconds = directTimer.seconds();
+  const DirectSetup direct =
+      directSetup(s, caster, opt, opt.formFactors.seed, progress.sub(0.0, 0.1), progress.sub(0.1, 0.2));
+  const Setup& u = direct.u;
   HierarchySettings hs;
   hs.epsilon = opt.hierarchyEpsilon;
   hs.linkRays = opt.linkRays;
@@ -480,11 +497,8 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (opt.hierarchyEpsilon == 0 && n > 20000)
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
-  if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &openings);
-  res.stats.add("direct_light_seconds", directSeconds);
-  appendStats(res.stats, directStats);
-  openings.report(res.stats);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays(opt, openings)) + int(opt.outside.sun())));
+  if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &direct.openings);
+  direct.report(opt, res.stats);
   res.stats.add("patches", double(u.n));
   res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
   res.stats.add("seconds", timer.seconds());
@@ -542,13 +556,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   Timer timer;
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
-  Timer directTimer;
-  RunStats directStats;
-  const SkyOpenings openings = findSkyOpenings(s, caster, opt.outside, ffs.seed);
-  const Setup u =
-      setup(s, patchDirectIrradiance(s, caster, opt.lightSamples, ffs.seed, progress.sub(0.0, 0.05), &directStats),
-            patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, ffs.seed, progress.sub(0.05, 0.1), &openings));
-  const double directSeconds = directTimer.seconds();
+  const DirectSetup direct = directSetup(s, caster, opt, ffs.seed, progress.sub(0.0, 0.05), progress.sub(0.05, 0.1));
+  const Setup& u = direct.u;
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = mem.fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
   const auto slow = ff.method() == FormFactorMethod::Hemicube ? hemicubeCostWarning(u.n, ffs.hemicubeResolution)
@@ -556,11 +565,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   RadiosityResult res = mem.fits ? solveInMemory(s, u, ff, mem, solver, opt, progress)
                                  : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage)
-    radiosityVertexValues(s, caster, opt, res, Progress(nullptr), &openings);
-  res.stats.add("direct_light_seconds", directSeconds);
-  appendStats(res.stats, directStats);
-  openings.report(res.stats);
-  res.stats.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays(opt, openings)) + int(opt.outside.sun())));
+    radiosityVertexValues(s, caster, opt, res, Progress(nullptr), &direct.openings);
+  direct.report(opt, res.stats);
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));
