@@ -96,6 +96,9 @@ class EmbreeCaster final : public RayCaster {
     const auto ok = usableFaceMask(s);
     for (size_t f = 0; f < ok.size(); ++f)
       if (ok[f]) primToFace_.push_back(uint32_t(f));
+    // With every face usable, a primitive is its face: no lookup (a cache
+    // miss per hit on a large mesh).
+    identity_ = primToFace_.size() == s.faceCount();
     if (!primToFace_.empty()) {
       RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
       auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -135,7 +138,7 @@ class EmbreeCaster final : public RayCaster {
     rtcIntersect1(scene_.get(), &ctx, &rh);
     Hit h;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
-      h.t = rh.ray.tfar; h.face = primToFace_[rh.hit.primID]; h.u = rh.hit.u; h.v = rh.hit.v;
+      h.t = rh.ray.tfar; h.face = faceOf(rh.hit.primID); h.u = rh.hit.u; h.v = rh.hit.v;
       h.ng = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
     }
     return h;
@@ -177,7 +180,7 @@ class EmbreeCaster final : public RayCaster {
     auto hitOf = [&](unsigned geomID, unsigned primID, float t, float u, float v, float nx, float ny, float nz) {
       Hit h;
       if (geomID != RTC_INVALID_GEOMETRY_ID) {
-        h.t = t; h.face = primToFace_[primID]; h.u = u; h.v = v;
+        h.t = t; h.face = faceOf(primID); h.u = u; h.v = v;
         h.ng = {nx, ny, nz};
       }
       return h;
@@ -253,6 +256,8 @@ class EmbreeCaster final : public RayCaster {
   SceneHandle scene_;
   BatchMode mode_;
   std::vector<uint32_t> primToFace_;
+  bool identity_ = false;
+  uint32_t faceOf(unsigned primID) const { return identity_ ? uint32_t(primID) : primToFace_[primID]; }
 };
 
 }  // namespace

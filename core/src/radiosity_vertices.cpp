@@ -45,14 +45,22 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   const DirectLightAt directAt(s, caster, 4);
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-  std::vector<float> nearT(s.faceCount());
-  for (size_t f = 0; f < s.faceCount(); ++f) nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
+  // Per face, what a gather ray reads at its hit, in one place (one cache
+  // line per hit on a large mesh): the reflected radiosity and the distance
+  // within which the hit is near.
+  struct FaceRead {
+    glm::vec3 R;
+    float nearT;
+  };
+  std::vector<FaceRead> faceRead(s.faceCount());
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    faceRead[f] = {res.Rgather[f], float(2.0 * std::sqrt(2.0 * faceArea(s, f)))};
   std::atomic<uint64_t> nearHits{0};
   // The light reflected at y on face f, seen from t away; u: a 2D sample
   // for its own gather ray.
   const auto reflectedAt = [&](const auto& self, uint32_t f, const glm::vec3& y, float t, glm::vec2 u, uint32_t key,
                                int levels) -> glm::vec3 {
-    if (!refineNear || t > nearT[f]) return res.Rgather[f];
+    if (!refineNear || t > faceRead[f].nearT) return faceRead[f].R;
     nearHits.fetch_add(1, std::memory_order_relaxed);
     const glm::vec3 n = faceN[f], o = y + n * eps;
     glm::vec3 Hi = res.Hindirect[f];
@@ -76,7 +84,8 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   // sequence of the vertex, so the rays of one vertex's near hits are
   // stratified together.
   auto seen = [&](const GatherHit& g) {
-    if (!refineNear || g.t > nearT[g.face]) return res.Rgather[g.face];
+    const FaceRead& fr = faceRead[g.face];
+    if (!refineNear || g.t > fr.nearT) return fr.R;
     uint32_t bits[3];
     std::memcpy(bits, &g.point, sizeof bits);
     const glm::vec2 u = PaddedSobol(hash3(g.vertex, seed, 0xfbu))(g.ray, 1);
