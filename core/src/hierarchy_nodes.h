@@ -87,7 +87,7 @@ struct NodePointSet {
 };
 class NodePointCache {
  public:
-  explicit NodePointCache(size_t slots = 256) : sources_(slots) {}
+  explicit NodePointCache(size_t slots = 4096) : sources_(slots) {}
   const NodePointSet& receiver(const Geometry& g, const Tree& t, uint32_t k) { return fill(g, t, k, receiver_); }
   const NodePointSet& source(const Geometry& g, const Tree& t, uint32_t k) {
     return fill(g, t, k, sources_[k % sources_.size()]);
