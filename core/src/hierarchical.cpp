@@ -5,6 +5,7 @@
 #include "gi/hierarchical.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -324,13 +325,15 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     }
     refineSeconds += rt.seconds();
     Timer ft;
-    std::vector<uint64_t> blockRays(links.size(), 0);
+    std::atomic<uint64_t> ffRays{0};  // a count: its sum does not depend on the order
     parallelBlocks(links.size(), pr, "link form factors", [&](size_t b, size_t e) {
       NodePointCache points;
+      uint64_t r = 0;
       for (size_t k = b; k < e; ++k)
-        if (nextFresh[k]) linkFormFactor(g, t, caster, links[k], set.linkRays, unoccluded, eps, blockRays[k], points);
+        if (nextFresh[k]) linkFormFactor(g, t, caster, links[k], set.linkRays, unoccluded, eps, r, points);
+      ffRays += r;
     });
-    for (uint64_t r : blockRays) rays += r;
+    rays += ffRays.load();
     ffSeconds += ft.seconds();
     return newSplits;
   };
