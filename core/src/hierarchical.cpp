@@ -12,6 +12,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include "gi/color.h"
 #include "gi/form_factor_analytic.h"
 #include "gi/radiosity.h"
@@ -262,6 +264,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
       }
     }
   };
+  // Each thread's kept node points, for all the rounds (one per task would
+  // refill megabytes for a few thousand links: small scenes ran 1.5x slower).
+  tbb::enumerable_thread_specific<NodePointCache> pointCaches;
   // The links refined against the current R: new ones get their F computed
   // (in parallel; each link's rays are fixed by its nodes: deterministic).
   auto refineLinks = [&](bool first, const std::vector<glm::vec3>& Rcur, const Progress& pr) {
@@ -327,7 +332,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     Timer ft;
     std::atomic<uint64_t> ffRays{0};  // a count: its sum does not depend on the order
     parallelBlocks(links.size(), pr, "link form factors", [&](size_t b, size_t e) {
-      NodePointCache points;
+      NodePointCache& points = pointCaches.local();
       uint64_t r = 0;
       for (size_t k = b; k < e; ++k)
         if (nextFresh[k]) linkFormFactor(g, t, caster, links[k], set.linkRays, unoccluded, eps, r, points);
