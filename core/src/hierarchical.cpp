@@ -12,7 +12,9 @@
 #include <numeric>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 #include "gi/color.h"
 #include "gi/form_factor_analytic.h"
@@ -35,10 +37,16 @@ struct Refiner {
   double threshold;                  // epsilon x emitted power
   size_t maxLinks;
   std::vector<Link>& out;
-  std::vector<uint8_t>& fresh;       // 1: F still to compute
-  size_t reserved = 0;               // links still to be carried over after this one (later rounds)
+  std::vector<uint8_t>* fresh;       // 1: F still to compute (null: all fresh, not recorded)
   uint64_t splits = 0;
   bool budgetHit = false;
+  // A part of a parallel depth-first refinement (refineDepthFirst): the
+  // links made by all parts together, published every kPublish, and the
+  // flag that stops every part once they pass the budget.
+  std::atomic<size_t>* made = nullptr;
+  std::atomic<bool>* stop = nullptr;
+  size_t unpublished = 0;
+  static constexpr size_t kPublish = 4096;
 
   // Whether a link p <- q may stay as it is (BF criterion and separation).
   // A receiving cluster spreads what it gathers evenly over its triangles,
@@ -68,7 +76,12 @@ struct Refiner {
 
   void add(const Link& l, bool isFresh) {
     out.push_back(l);
-    fresh.push_back(isFresh ? 1 : 0);
+    if (fresh) fresh->push_back(isFresh ? 1 : 0);
+    if (made && ++unpublished == kPublish) {
+      if (made->fetch_add(kPublish, std::memory_order_relaxed) + kPublish > maxLinks)
+        stop->store(true, std::memory_order_relaxed);
+      unpublished = 0;
+    }
   }
 
   // The power a link may carry (what BF refinement bounds): the order in
@@ -115,6 +128,10 @@ struct Refiner {
       top = std::max(top, b);
       ++size;
     }
+    int topBucket() {  // the highest non-empty bucket (size > 0)
+      while (bucket[size_t(top)].empty()) --top;
+      return top;
+    }
     Candidate pop() {
       while (bucket[size_t(top)].empty()) --top;
       std::vector<Candidate>& b = bucket[size_t(top)];
@@ -125,41 +142,82 @@ struct Refiner {
       return c;
     }
   };
+  // What a popped candidate becomes, decided without touching the queue or
+  // the links (so that a batch is decided in parallel): a self pair's
+  // children, or whether the link is acceptable and, if not, the two
+  // children of its split (culled ones dropped, their power computed).
+  struct Decision {
+    bool self = false, acceptable = false;
+    int children = 0;
+    Candidate child[4];
+  };
+  void decide(const Candidate& c, Decision& d) const {
+    const Node &np = t.nodes[c.p], &nq = t.nodes[c.q];
+    d.self = c.p == c.q;
+    d.acceptable = false;
+    d.children = 0;
+    const auto child = [&](uint32_t p, uint32_t q) {
+      if (p != q && culled(p, q)) return;
+      d.child[d.children++] = {p == q ? std::numeric_limits<double>::infinity() : power(p, q), p, q, kNoHit};
+    };
+    if (d.self) {  // a node with itself is always split (as refine does)
+      if (np.leaf()) return;
+      for (uint32_t a : {np.left, np.right})
+        for (uint32_t b : {np.left, np.right}) child(a, b);
+      return;
+    }
+    d.acceptable = acceptable(c.p, c.q);
+    if (d.acceptable) return;
+    if (splitsReceiver(np, nq)) {
+      child(np.left, c.q);
+      child(np.right, c.q);
+    } else {
+      child(c.p, nq.left);
+      child(c.p, nq.right);
+    }
+  }
+  // The candidates are taken from the top bucket in batches of up to
+  // kBatch (all within an eighth of an octave of each other), decided in
+  // parallel (the nodes' reads, which wait on memory, are most of the
+  // time), then applied in order: the links, the budget and the queue see
+  // them one by one, so the result does not depend on the threads.
+  static constexpr size_t kBatch = 4096, kParallelBatch = 512;
   void refineBestFirst(const std::vector<Candidate>& start, const std::vector<Link>& old) {
     BucketQueue queue;
     for (const Candidate& c : start) queue.push(c);
+    std::vector<Candidate> batch;
+    std::vector<Decision> dec;
     while (queue.size) {
-      const Candidate c = queue.pop();
-      const Node &np = t.nodes[c.p], &nq = t.nodes[c.q];
-      if (c.p == c.q) {  // a node with itself is always split (as refine does)
-        if (np.leaf()) continue;
-        for (uint32_t a : {np.left, np.right})
-          for (uint32_t b : {np.left, np.right}) push(queue, a, b);
-        continue;
-      }
-      if (acceptable(c.p, c.q) || out.size() + queue.size + 1 >= maxLinks) {
-        budgetHit |= !acceptable(c.p, c.q);
-        if (c.old != kNoHit) add(old[c.old], false);
-        else add(Link{c.p, c.q, 0.f}, true);
-        continue;
-      }
-      ++splits;
-      if (splitsReceiver(np, nq)) {
-        push(queue, np.left, c.q);
-        push(queue, np.right, c.q);
-      } else {
-        push(queue, c.p, nq.left);
-        push(queue, c.p, nq.right);
+      batch.clear();
+      const int top = queue.topBucket();
+      while (batch.size() < kBatch && queue.size && queue.topBucket() == top) batch.push_back(queue.pop());
+      dec.resize(batch.size());
+      if (batch.size() >= kParallelBatch)
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, batch.size(), 128), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i < r.end(); ++i) decide(batch[i], dec[i]);
+        });
+      else
+        for (size_t i = 0; i < batch.size(); ++i) decide(batch[i], dec[i]);
+      for (size_t i = 0; i < batch.size(); ++i) {
+        const Candidate& c = batch[i];
+        const Decision& d = dec[i];
+        if (!d.self) {
+          const size_t waiting = queue.size + (batch.size() - i - 1);
+          if (d.acceptable || out.size() + waiting + 1 >= maxLinks) {
+            budgetHit |= !d.acceptable;
+            if (c.old != kNoHit) add(old[c.old], false);
+            else add(Link{c.p, c.q, 0.f}, true);
+            continue;
+          }
+          ++splits;
+        }
+        for (int k = 0; k < d.children; ++k) queue.push(d.child[k]);
       }
     }
   }
-  void push(BucketQueue& queue, uint32_t p, uint32_t q) const {
-    if (p != q && culled(p, q)) return;
-    queue.push({p == q ? std::numeric_limits<double>::infinity() : power(p, q), p, q, kNoHit});
-  }
-
   // Links covering every triangle pair of (p, q), split where needed.
   void refine(uint32_t p, uint32_t q) {
+    if (stop && stop->load(std::memory_order_relaxed)) return;
     if (p == q) {  // a node with itself: a flat triangle sees nothing of itself
       const Node& n = t.nodes[p];
       if (n.leaf()) return;
@@ -170,8 +228,7 @@ struct Refiner {
       return;
     }
     if (culled(p, q)) return;
-    if (acceptable(p, q) || out.size() + reserved >= maxLinks) {
-      budgetHit |= !acceptable(p, q);
+    if (acceptable(p, q)) {  // (the budget: refineDepthFirst, refineAgain)
       add(Link{p, q, 0.f}, true);
       return;
     }
@@ -186,6 +243,129 @@ struct Refiner {
     }
   }
 };
+
+// Refiner::refine(p0, q0) on all threads, with the same links in the same
+// order: the recursion's first levels are unfolded, in its order, into a
+// frontier of at least kFrontier independent pairs (kept links among them),
+// each pair is refined on its own into its own links, and these are joined
+// in the frontier's order. No part sees the budget alone: where the links
+// together pass it, ref.budgetHit is set and no link is added (the caller
+// then refines again, best first, as after a sequential pass that hit it).
+constexpr size_t kFrontier = 1024;
+void refineDepthFirst(Refiner& ref, uint32_t p0, uint32_t q0) {
+  struct Item {
+    uint32_t p, q;
+    bool link;  // acceptable: a link as it is
+  };
+  std::vector<Item> frontier{{p0, q0, false}}, next;
+  uint64_t splits = 0;
+  for (bool grew = true; grew && frontier.size() < kFrontier;) {
+    grew = false;
+    next.clear();
+    for (const Item& it : frontier) {
+      const uint32_t p = it.p, q = it.q;
+      if (it.link) {
+        next.push_back(it);
+        continue;
+      }
+      const Node &np = ref.t.nodes[p], &nq = ref.t.nodes[q];
+      if (p == q) {
+        if (np.leaf()) continue;
+        for (uint32_t a : {np.left, np.right})
+          for (uint32_t b : {np.left, np.right}) next.push_back({a, b, false});
+        grew = true;
+        continue;
+      }
+      if (ref.culled(p, q)) continue;
+      if (ref.acceptable(p, q)) {
+        next.push_back({p, q, true});
+        continue;
+      }
+      ++splits;
+      grew = true;
+      if (ref.splitsReceiver(np, nq)) {
+        next.push_back({np.left, q, false});
+        next.push_back({np.right, q, false});
+      } else {
+        next.push_back({p, nq.left, false});
+        next.push_back({p, nq.right, false});
+      }
+    }
+    frontier.swap(next);
+  }
+  std::vector<std::vector<Link>> parts(frontier.size());
+  std::vector<uint64_t> partSplits(frontier.size(), 0);
+  std::atomic<size_t> made{0};
+  std::atomic<bool> stop{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, frontier.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (frontier[i].link || stop.load(std::memory_order_relaxed)) continue;
+      Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], nullptr};
+      part.made = &made;
+      part.stop = &stop;
+      part.refine(frontier[i].p, frontier[i].q);
+      partSplits[i] = part.splits;
+    }
+  });
+  size_t total = 0;
+  for (size_t i = 0; i < frontier.size(); ++i) total += frontier[i].link ? 1 : parts[i].size();
+  if (stop.load() || ref.out.size() + total > ref.maxLinks) {
+    ref.budgetHit = true;
+    return;
+  }
+  ref.out.reserve(ref.out.size() + total);
+  for (size_t i = 0; i < frontier.size(); ++i) {
+    if (frontier[i].link) {
+      ref.add(Link{frontier[i].p, frontier[i].q, 0.f}, true);
+      continue;
+    }
+    for (const Link& l : parts[i]) ref.add(l, true);
+    std::vector<Link>().swap(parts[i]);
+    splits += partSplits[i];
+  }
+  ref.splits += splits;
+}
+
+// A later round on all threads, with the same links in the same order as
+// the sequential loop: each old link is kept where it is acceptable, else
+// refined; the old links are cut into parts refined on their own and
+// joined in order. As in refineDepthFirst, where the links together pass
+// the budget, ref.budgetHit is set and no link is added.
+void refineAgain(Refiner& ref, const std::vector<Link>& old) {
+  const size_t n = old.size(), nParts = std::min<size_t>(n, kFrontier), step = nParts ? (n + nParts - 1) / nParts : 0;
+  std::vector<std::vector<Link>> parts(nParts);
+  std::vector<std::vector<uint8_t>> partFresh(nParts);
+  std::vector<uint64_t> partSplits(nParts, 0);
+  std::atomic<size_t> made{0};
+  std::atomic<bool> stop{false};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nParts, 1), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], &partFresh[i]};
+      part.made = &made;
+      part.stop = &stop;
+      for (size_t k = i * step; k < std::min(n, (i + 1) * step) && !stop.load(std::memory_order_relaxed); ++k) {
+        if (part.acceptable(old[k].p, old[k].q)) part.add(old[k], false);
+        else part.refine(old[k].p, old[k].q);
+      }
+      partSplits[i] = part.splits;
+    }
+  });
+  size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  if (stop.load() || ref.out.size() + total > ref.maxLinks) {
+    ref.budgetHit = true;
+    return;
+  }
+  ref.out.reserve(ref.out.size() + total);
+  if (ref.fresh) ref.fresh->reserve(ref.fresh->size() + total);
+  for (size_t i = 0; i < nParts; ++i) {
+    ref.out.insert(ref.out.end(), parts[i].begin(), parts[i].end());
+    if (ref.fresh) ref.fresh->insert(ref.fresh->end(), partFresh[i].begin(), partFresh[i].end());
+    std::vector<Link>().swap(parts[i]);
+    std::vector<uint8_t>().swap(partFresh[i]);
+    ref.splits += partSplits[i];
+  }
+}
 
 }  // namespace
 
@@ -276,19 +456,13 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     // in a bright room the reflected power is many times the emitted).
     double leaving = P;
     for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
-    Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, nextFresh};
+    Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, &nextFresh};
     pr.report(0.0, "refining links");
     Timer rt;
     if (first) {
-      ref.refine(0, 0);
+      refineDepthFirst(ref, 0, 0);
     } else {
-      // The links still to come keep their share of the budget: a link is
-      // split only into what they leave.
-      for (size_t k = 0; k < links.size(); ++k) {
-        ref.reserved = links.size() - k - 1;
-        if (ref.acceptable(links[k].p, links[k].q) || next.size() + ref.reserved >= maxLinks) ref.add(links[k], false);
-        else ref.refine(links[k].p, links[k].q);
-      }
+      refineAgain(ref, links);
     }
     if (ref.budgetHit) {
       // The budget stopped the depth-first refinement: again, best first
@@ -296,7 +470,6 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
       std::vector<Link>().swap(next);
       std::vector<uint8_t>().swap(nextFresh);
       ref.splits = 0;
-      ref.reserved = 0;
       std::vector<Refiner::Candidate> start;
       if (first) {
         start.push_back({std::numeric_limits<double>::infinity(), 0, 0, kNoHit});
