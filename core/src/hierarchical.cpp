@@ -40,7 +40,7 @@ struct Refiner {
   std::vector<uint8_t>* fresh;       // 1: F still to compute (null: all fresh, not recorded)
   uint64_t splits = 0;
   bool budgetHit = false;
-  // A part of a parallel depth-first refinement (refineDepthFirst): the
+  // A part of a refinement on all threads (refineInParts): the
   // links made by all parts together, published every kPublish, and the
   // flag that stops every part once they pass the budget.
   std::atomic<size_t>* made = nullptr;
@@ -133,8 +133,7 @@ struct Refiner {
       return top;
     }
     Candidate pop() {
-      while (bucket[size_t(top)].empty()) --top;
-      std::vector<Candidate>& b = bucket[size_t(top)];
+      std::vector<Candidate>& b = bucket[size_t(topBucket())];
       const Candidate c = b.back();
       b.pop_back();
       if (b.empty()) std::vector<Candidate>().swap(b);  // its memory back: the peak stays the heap's
@@ -228,7 +227,7 @@ struct Refiner {
       return;
     }
     if (culled(p, q)) return;
-    if (acceptable(p, q)) {  // (the budget: refineDepthFirst, refineAgain)
+    if (acceptable(p, q)) {  // (the budget: refineInParts)
       add(Link{p, q, 0.f}, true);
       return;
     }
@@ -244,95 +243,15 @@ struct Refiner {
   }
 };
 
-// Refiner::refine(p0, q0) on all threads, with the same links in the same
-// order: the recursion's first levels are unfolded, in its order, into a
-// frontier of at least kFrontier independent pairs (kept links among them),
-// each pair is refined on its own into its own links, and these are joined
-// in the frontier's order. No part sees the budget alone: where the links
-// together pass it, ref.budgetHit is set and no link is added (the caller
-// then refines again, best first, as after a sequential pass that hit it).
-constexpr size_t kFrontier = 1024;
-void refineDepthFirst(Refiner& ref, uint32_t p0, uint32_t q0) {
-  struct Item {
-    uint32_t p, q;
-    bool link;  // acceptable: a link as it is
-  };
-  std::vector<Item> frontier{{p0, q0, false}}, next;
-  uint64_t splits = 0;
-  for (bool grew = true; grew && frontier.size() < kFrontier;) {
-    grew = false;
-    next.clear();
-    for (const Item& it : frontier) {
-      const uint32_t p = it.p, q = it.q;
-      if (it.link) {
-        next.push_back(it);
-        continue;
-      }
-      const Node &np = ref.t.nodes[p], &nq = ref.t.nodes[q];
-      if (p == q) {
-        if (np.leaf()) continue;
-        for (uint32_t a : {np.left, np.right})
-          for (uint32_t b : {np.left, np.right}) next.push_back({a, b, false});
-        grew = true;
-        continue;
-      }
-      if (ref.culled(p, q)) continue;
-      if (ref.acceptable(p, q)) {
-        next.push_back({p, q, true});
-        continue;
-      }
-      ++splits;
-      grew = true;
-      if (ref.splitsReceiver(np, nq)) {
-        next.push_back({np.left, q, false});
-        next.push_back({np.right, q, false});
-      } else {
-        next.push_back({p, nq.left, false});
-        next.push_back({p, nq.right, false});
-      }
-    }
-    frontier.swap(next);
-  }
-  std::vector<std::vector<Link>> parts(frontier.size());
-  std::vector<uint64_t> partSplits(frontier.size(), 0);
-  std::atomic<size_t> made{0};
-  std::atomic<bool> stop{false};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, frontier.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (frontier[i].link || stop.load(std::memory_order_relaxed)) continue;
-      Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], nullptr};
-      part.made = &made;
-      part.stop = &stop;
-      part.refine(frontier[i].p, frontier[i].q);
-      partSplits[i] = part.splits;
-    }
-  });
-  size_t total = 0;
-  for (size_t i = 0; i < frontier.size(); ++i) total += frontier[i].link ? 1 : parts[i].size();
-  if (stop.load() || ref.out.size() + total > ref.maxLinks) {
-    ref.budgetHit = true;
-    return;
-  }
-  ref.out.reserve(ref.out.size() + total);
-  for (size_t i = 0; i < frontier.size(); ++i) {
-    if (frontier[i].link) {
-      ref.add(Link{frontier[i].p, frontier[i].q, 0.f}, true);
-      continue;
-    }
-    for (const Link& l : parts[i]) ref.add(l, true);
-    std::vector<Link>().swap(parts[i]);
-    splits += partSplits[i];
-  }
-  ref.splits += splits;
-}
-
-// A later round on all threads, with the same links in the same order as
-// the sequential loop: each old link is kept where it is acceptable, else
-// refined; the old links are cut into parts refined on their own and
-// joined in order. As in refineDepthFirst, where the links together pass
-// the budget, ref.budgetHit is set and no link is added.
-void refineAgain(Refiner& ref, const std::vector<Link>& old) {
-  const size_t n = old.size(), nParts = std::min<size_t>(n, kFrontier), step = nParts ? (n + nParts - 1) / nParts : 0;
+// Refinement on all threads with the result of one: `work(i, part)` fills
+// part i of nParts with its links (kept or refined), the parts run on any
+// thread, each into its own links, and are joined in order. No part sees
+// the budget alone: the parts count their links together and all stop
+// once they pass it; then ref.budgetHit is set and no link is added (the
+// caller refines again, best first, as after a sequential pass that hit it).
+constexpr size_t kParts = 1024;
+template <class Work>
+void refineInParts(Refiner& ref, size_t nParts, const Work& work) {
   std::vector<std::vector<Link>> parts(nParts);
   std::vector<std::vector<uint8_t>> partFresh(nParts);
   std::vector<uint64_t> partSplits(nParts, 0);
@@ -340,13 +259,11 @@ void refineAgain(Refiner& ref, const std::vector<Link>& old) {
   std::atomic<bool> stop{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nParts, 1), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (stop.load(std::memory_order_relaxed)) return;
       Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], &partFresh[i]};
       part.made = &made;
       part.stop = &stop;
-      for (size_t k = i * step; k < std::min(n, (i + 1) * step) && !stop.load(std::memory_order_relaxed); ++k) {
-        if (part.acceptable(old[k].p, old[k].q)) part.add(old[k], false);
-        else part.refine(old[k].p, old[k].q);
-      }
+      work(i, part);
       partSplits[i] = part.splits;
     }
   });
@@ -365,6 +282,57 @@ void refineAgain(Refiner& ref, const std::vector<Link>& old) {
     std::vector<uint8_t>().swap(partFresh[i]);
     ref.splits += partSplits[i];
   }
+}
+
+// Refiner::refine(p0, q0) on all threads, with the same links in the same
+// order: the recursion's first levels are unfolded, in its order (each
+// pair as best first decides it), into at least kParts independent pairs
+// (kept links among them), refined in parts.
+void refineDepthFirst(Refiner& ref, uint32_t p0, uint32_t q0) {
+  struct Item {
+    uint32_t p, q;
+    bool link;  // acceptable: a link as it is
+  };
+  std::vector<Item> frontier{{p0, q0, false}}, next;
+  uint64_t splits = 0;
+  Refiner::Decision d;
+  for (bool grew = true; grew && frontier.size() < kParts;) {
+    grew = false;
+    next.clear();
+    for (const Item& it : frontier) {
+      if (it.link) {
+        next.push_back(it);
+        continue;
+      }
+      ref.decide({0.0, it.p, it.q, kNoHit}, d);
+      grew = true;
+      if (!d.self && d.acceptable) {
+        next.push_back({it.p, it.q, true});
+        continue;
+      }
+      splits += d.self ? 0 : 1;
+      for (int k = 0; k < d.children; ++k) next.push_back({d.child[k].p, d.child[k].q, false});
+    }
+    frontier.swap(next);
+  }
+  refineInParts(ref, frontier.size(), [&](size_t i, Refiner& part) {
+    if (frontier[i].link) part.add(Link{frontier[i].p, frontier[i].q, 0.f}, true);
+    else part.refine(frontier[i].p, frontier[i].q);
+  });
+  if (!ref.budgetHit) ref.splits += splits;
+}
+
+// A later round on all threads, with the same links in the same order as
+// one thread: each old link is kept where it is acceptable, else refined;
+// the old links are cut into parts.
+void refineAgain(Refiner& ref, const std::vector<Link>& old) {
+  const size_t n = old.size(), nParts = std::min(n, kParts), step = nParts ? (n + nParts - 1) / nParts : 0;
+  refineInParts(ref, nParts, [&](size_t i, Refiner& part) {
+    for (size_t k = i * step; k < std::min(n, (i + 1) * step) && !part.stop->load(std::memory_order_relaxed); ++k) {
+      if (part.acceptable(old[k].p, old[k].q)) part.add(old[k], false);
+      else part.refine(old[k].p, old[k].q);
+    }
+  });
 }
 
 }  // namespace
