@@ -100,12 +100,14 @@ class EmbreeCaster final : public RayCaster {
     // miss per hit on a large mesh).
     identity_ = primToFace_.size() == s.faceCount();
     if (!primToFace_.empty()) {
-      RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                             3 * sizeof(float), s.positions.size()));
-      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                3 * sizeof(uint32_t), primToFace_.size()));
-      if (!vb || !ib) { rtcReleaseGeometry(g); check("allocating buffers"); throw std::runtime_error("Embree: out of memory"); }
+      // The buffers are ours (std::vector: large ones go to huge pages in
+      // the tool, gi/huge_pages.h), shared with Embree for the scene's
+      // life; the vertices padded so that the last one can be read with a
+      // 16-byte load, as Embree requires.
+      vertices_.assign(3 * s.positions.size() + 4, 0.f);
+      indices_.resize(3 * primToFace_.size());
+      float* vb = vertices_.data();
+      uint32_t* ib = indices_.data();
       for (size_t i = 0; i < s.positions.size(); ++i) {
         const auto& p = s.positions[i];
         const bool fin = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
@@ -115,6 +117,11 @@ class EmbreeCaster final : public RayCaster {
         const auto& t = s.triangles[primToFace_[k]];
         ib[3 * k] = t.x; ib[3 * k + 1] = t.y; ib[3 * k + 2] = t.z;
       }
+      RTCGeometry g = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, vb, 0, 3 * sizeof(float),
+                                 s.positions.size());
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, ib, 0, 3 * sizeof(uint32_t),
+                                 primToFace_.size());
       rtcCommitGeometry(g);
       rtcAttachGeometry(scene_.get(), g);
       rtcReleaseGeometry(g);
@@ -253,6 +260,8 @@ class EmbreeCaster final : public RayCaster {
   }
   ErrorSink errors_;  // outlives the device (declared first)
   Device device_;
+  std::vector<float> vertices_;    // shared with the scene: outlive it (declared before it)
+  std::vector<uint32_t> indices_;
   SceneHandle scene_;
   BatchMode mode_;
   std::vector<uint32_t> primToFace_;

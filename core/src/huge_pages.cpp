@@ -1,0 +1,55 @@
+// Transparent huge pages for large blocks (gi/huge_pages.h).
+#include "gi/huge_pages.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <cstdlib>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace gi {
+
+void adviseHugePages(void* p, std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  static const bool off = std::getenv("GI_NO_HUGEPAGES") != nullptr;  // for measuring what it gains
+  if (off || !p || bytes < kHugePageMinBytes) return;
+  constexpr std::uintptr_t kPage = 4096;
+  const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
+  const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
+  if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_HUGEPAGE);  // advice only: its failure changes nothing
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+bool hugePagesAdvised(const void* p) {
+#if defined(__linux__)
+  std::FILE* f = std::fopen("/proc/self/smaps", "r");
+  if (!f) return false;
+  const auto x = reinterpret_cast<std::uintptr_t>(p);
+  char line[512];
+  bool inside = false, advised = false;
+  while (std::fgets(line, sizeof line, f)) {
+    unsigned long lo, hi;
+    if (std::sscanf(line, "%lx-%lx ", &lo, &hi) == 2) {  // a mapping's first line (field lines start with a name)
+      inside = x >= lo && x < hi;
+      continue;
+    }
+    if (inside && std::strncmp(line, "VmFlags:", 8) == 0) {
+      advised = std::strstr(line, " hg") != nullptr;
+      break;
+    }
+  }
+  std::fclose(f);
+  return advised;
+#else
+  (void)p;
+  return false;
+#endif
+}
+
+}  // namespace gi

@@ -1,0 +1,65 @@
+// Transparent huge pages (gi/huge_pages.h): the advice reaches the kernel
+// for large blocks only, and never touches the contents.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <vector>
+
+#include "gi/huge_pages.h"
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace {
+
+bool smapsReadable() { return std::ifstream("/proc/self/smaps").good(); }
+
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+// A mapping of its own, so that no other block shares its flags.
+struct Mapping {
+  explicit Mapping(size_t n) : bytes(n) {
+    void* m = mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    p = m == MAP_FAILED ? nullptr : static_cast<uint8_t*>(m);
+  }
+  ~Mapping() {
+    if (p) munmap(p, bytes);
+  }
+  size_t bytes;
+  uint8_t* p = nullptr;
+};
+#endif
+
+}  // namespace
+
+TEST(HugePages, LargeBlocksAreAdvisedSmallOnesNot) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (!smapsReadable() || std::getenv("GI_NO_HUGEPAGES")) GTEST_SKIP() << "no /proc/self/smaps, or switched off";
+  const size_t big = size_t(8) << 20;
+  Mapping a(big), b(gi::kHugePageMinBytes / 2);
+  ASSERT_NE(a.p, nullptr);
+  ASSERT_NE(b.p, nullptr);
+  EXPECT_FALSE(gi::hugePagesAdvised(a.p));
+  // Advised from an unaligned start: the whole pages inside are.
+  gi::adviseHugePages(a.p + 100, big - 100);
+  EXPECT_TRUE(gi::hugePagesAdvised(a.p + big / 2));
+  EXPECT_TRUE(gi::hugePagesAdvised(a.p + big - 1));
+  EXPECT_FALSE(gi::hugePagesAdvised(a.p)) << "the partial first page is left alone";
+  gi::adviseHugePages(b.p, b.bytes);
+  EXPECT_FALSE(gi::hugePagesAdvised(b.p)) << "below kHugePageMinBytes nothing is advised";
+#else
+  GTEST_SKIP() << "Linux only";
+#endif
+}
+
+TEST(HugePages, AdviceKeepsTheContents) {
+  std::vector<uint32_t> v(size_t(4) << 20);
+  for (size_t i = 0; i < v.size(); ++i) v[i] = uint32_t(i * 2654435761u);
+  gi::adviseHugePages(v.data(), v.size() * sizeof(uint32_t));
+  size_t wrong = 0;
+  for (size_t i = 0; i < v.size(); ++i) wrong += v[i] != uint32_t(i * 2654435761u);
+  EXPECT_EQ(wrong, 0u);
+  gi::adviseHugePages(nullptr, size_t(1) << 30);  // nothing to advise: no effect, no crash
+}

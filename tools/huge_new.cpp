@@ -1,0 +1,60 @@
+// The tool's global operator new: large blocks are advised for transparent
+// huge pages (gi/huge_pages.h) before anything touches them, so every large
+// array of a run (the scene, the hierarchy's nodes and links, the gather's
+// tables) is backed by 2 MiB pages where the system allows. A replacement
+// of operator new is the program's to make, so the tool makes it; the
+// MeshLab plugins run inside MeshLab's process and leave its allocator as
+// it is. Deletion is the standard library's (free). Left out under the
+// sanitizers, which bring their own operator new. GI_NO_HUGEPAGES=1 in the
+// environment turns it off (to measure what it gains).
+#include <algorithm>
+#include <cstdlib>
+#include <new>
+
+#include "gi/huge_pages.h"
+
+#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+namespace {
+// glibc serves blocks below its mmap threshold from the heap, whose pages
+// an earlier block may already have touched (too late for the advice), and
+// raises that threshold up to 32 MB as large blocks are freed. A fixed
+// threshold at the advised size gives every advised block fresh pages.
+[[maybe_unused]] const int kFixedMmapThreshold =
+    std::getenv("GI_NO_HUGEPAGES") ? 0 : mallopt(M_MMAP_THRESHOLD, int(gi::kHugePageMinBytes));
+}  // namespace
+#endif
+
+void* operator new(std::size_t n) {
+  for (;;) {
+    if (void* p = std::malloc(n ? n : 1)) {
+      if (n >= gi::kHugePageMinBytes) gi::adviseHugePages(p, n);
+      return p;
+    }
+    const std::new_handler h = std::get_new_handler();
+    if (!h) throw std::bad_alloc();
+    h();
+  }
+}
+
+void* operator new[](std::size_t n) { return ::operator new(n); }
+
+void* operator new(std::size_t n, std::align_val_t al) {
+  const std::size_t a = std::max(sizeof(void*), std::size_t(al));
+  for (;;) {
+    void* p = nullptr;
+    if (posix_memalign(&p, a, n ? n : 1) == 0) {
+      if (n >= gi::kHugePageMinBytes) gi::adviseHugePages(p, n);
+      return p;
+    }
+    const std::new_handler h = std::get_new_handler();
+    if (!h) throw std::bad_alloc();
+    h();
+  }
+}
+
+void* operator new[](std::size_t n, std::align_val_t al) { return ::operator new(n, al); }
+
+#endif
