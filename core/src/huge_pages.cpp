@@ -1,13 +1,15 @@
 // Transparent huge pages for large blocks (gi/huge_pages.h).
 #include "gi/huge_pages.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <unistd.h>
 #endif
 
 namespace gi {
@@ -16,9 +18,9 @@ void adviseHugePages(void* p, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   static const bool off = std::getenv("GI_NO_HUGEPAGES") != nullptr;  // for measuring what it gains
   if (off || !p || bytes < kHugePageMinBytes) return;
-  constexpr std::uintptr_t kPage = 4096;
-  const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
-  const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
+  static const std::uintptr_t page = std::uintptr_t(std::max(4096L, sysconf(_SC_PAGESIZE)));
+  const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + page - 1) & ~(page - 1);
+  const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(page - 1);
   if (b > a) madvise(reinterpret_cast<void*>(a), b - a, MADV_HUGEPAGE);  // advice only: its failure changes nothing
 #else
   (void)p;

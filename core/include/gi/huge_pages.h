@@ -19,7 +19,7 @@ namespace gi {
 // span (on the 1M room 256 KiB gained more than 2 MiB, within the noise).
 inline constexpr std::size_t kHugePageMinBytes = std::size_t(256) << 10;
 
-// Asks the kernel to back the whole 4 KiB pages of [p, p + bytes) with huge
+// Asks the kernel to back the whole pages of [p, p + bytes) with huge
 // pages as they are first touched. Best effort: a no-op off Linux, where
 // the system forbids it, or below kHugePageMinBytes. Never changes the
 // memory's contents.
