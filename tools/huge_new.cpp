@@ -4,16 +4,30 @@
 // tables) is backed by 2 MiB pages where the system allows. A replacement
 // of operator new is the program's to make, so the tool makes it; the
 // MeshLab plugins run inside MeshLab's process and leave its allocator as
-// it is. Deletion is the standard library's (free). Left out under the
-// sanitizers, which bring their own operator new. GI_NO_HUGEPAGES=1 in the
-// environment turns it off (to measure what it gains).
+// it is. Deletion is the standard library's (free). GI_NO_HUGEPAGES=1 in
+// the environment turns it off (to measure what it gains).
 #include <algorithm>
 #include <cstdlib>
 #include <new>
 
 #include "gi/huge_pages.h"
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+// The sanitizers pair their own operator new with their operator delete
+// (a malloc'd block given to their delete is an error): tools/CMakeLists.txt
+// leaves this file out of a GI_SANITIZE build, and the test below keeps it
+// out of any other sanitized one (GCC's macros, Clang's __has_feature).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define GI_HUGE_NEW 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define GI_HUGE_NEW 0
+#endif
+#endif
+#ifndef GI_HUGE_NEW
+#define GI_HUGE_NEW 1
+#endif
+
+#if GI_HUGE_NEW
 
 #if defined(__GLIBC__)
 #include <malloc.h>
