@@ -37,30 +37,19 @@ namespace {
 // raises that threshold up to 32 MB as large blocks are freed. A fixed
 // threshold at the advised size gives every advised block fresh pages.
 [[maybe_unused]] const int kFixedMmapThreshold =
-    std::getenv("GI_NO_HUGEPAGES") ? 0 : mallopt(M_MMAP_THRESHOLD, int(gi::kHugePageMinBytes));
+    gi::hugePagesSwitchedOff() ? 0 : mallopt(M_MMAP_THRESHOLD, int(gi::kHugePageMinBytes));
 }  // namespace
 #endif
 
-void* operator new(std::size_t n) {
-  for (;;) {
-    if (void* p = std::malloc(n ? n : 1)) {
-      if (n >= gi::kHugePageMinBytes) gi::adviseHugePages(p, n);
-      return p;
-    }
-    const std::new_handler h = std::get_new_handler();
-    if (!h) throw std::bad_alloc();
-    h();
-  }
-}
-
-void* operator new[](std::size_t n) { return ::operator new(n); }
-
-void* operator new(std::size_t n, std::align_val_t al) {
-  const std::size_t a = std::max(sizeof(void*), std::size_t(al));
+namespace {
+// malloc (align 0) or posix_memalign, the new_handler loop of the standard,
+// then the advice for a large block.
+void* allocate(std::size_t n, std::size_t align) {
+  if (n == 0) n = 1;
   for (;;) {
     void* p = nullptr;
-    if (posix_memalign(&p, a, n ? n : 1) == 0) {
-      if (n >= gi::kHugePageMinBytes) gi::adviseHugePages(p, n);
+    if (align == 0 ? (p = std::malloc(n)) != nullptr : posix_memalign(&p, align, n) == 0) {
+      if (n >= gi::kHugePageMinBytes) gi::adviseHugePages(p, n);  // most blocks are small: no call
       return p;
     }
     const std::new_handler h = std::get_new_handler();
@@ -68,7 +57,15 @@ void* operator new(std::size_t n, std::align_val_t al) {
     h();
   }
 }
+}  // namespace
 
-void* operator new[](std::size_t n, std::align_val_t al) { return ::operator new(n, al); }
+void* operator new(std::size_t n) { return allocate(n, 0); }
+void* operator new[](std::size_t n) { return allocate(n, 0); }
+void* operator new(std::size_t n, std::align_val_t al) {
+  return allocate(n, std::max(sizeof(void*), std::size_t(al)));
+}
+void* operator new[](std::size_t n, std::align_val_t al) {
+  return allocate(n, std::max(sizeof(void*), std::size_t(al)));
+}
 
 #endif

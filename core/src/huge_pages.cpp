@@ -14,10 +14,11 @@
 
 namespace gi {
 
+bool hugePagesSwitchedOff() { return std::getenv("GI_NO_HUGEPAGES") != nullptr; }
+
 void adviseHugePages(void* p, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  static const bool off = std::getenv("GI_NO_HUGEPAGES") != nullptr;  // for measuring what it gains
-  if (off || !p || bytes < kHugePageMinBytes) return;
+  if (!p || bytes < kHugePageMinBytes || hugePagesSwitchedOff()) return;
   static const std::uintptr_t page = std::uintptr_t(std::max(4096L, sysconf(_SC_PAGESIZE)));
   const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + page - 1) & ~(page - 1);
   const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(page - 1);

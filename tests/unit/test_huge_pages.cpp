@@ -1,6 +1,9 @@
 // Transparent huge pages (gi/huge_pages.h): the advice reaches the kernel
-// for large blocks only, and never touches the contents.
+// for large blocks only, not when switched off, and never touches the
+// contents. The project builds on Linux only, where /proc/self/smaps shows
+// each mapping's advice.
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 
 #include <cstdint>
 #include <cstdlib>
@@ -9,15 +12,8 @@
 
 #include "gi/huge_pages.h"
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace {
 
-bool smapsReadable() { return std::ifstream("/proc/self/smaps").good(); }
-
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
 // A mapping of its own, so that no other block shares its flags.
 struct Mapping {
   explicit Mapping(size_t n) : bytes(n) {
@@ -30,13 +26,12 @@ struct Mapping {
   size_t bytes;
   uint8_t* p = nullptr;
 };
-#endif
 
 }  // namespace
 
 TEST(HugePages, LargeBlocksAreAdvisedSmallOnesNot) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (!smapsReadable() || std::getenv("GI_NO_HUGEPAGES")) GTEST_SKIP() << "no /proc/self/smaps, or switched off";
+  ASSERT_TRUE(std::ifstream("/proc/self/smaps").good());
+  unsetenv("GI_NO_HUGEPAGES");  // whatever the test's environment says
   const size_t big = size_t(8) << 20;
   Mapping a(big), b(gi::kHugePageMinBytes / 2);
   ASSERT_NE(a.p, nullptr);
@@ -49,9 +44,19 @@ TEST(HugePages, LargeBlocksAreAdvisedSmallOnesNot) {
   EXPECT_FALSE(gi::hugePagesAdvised(a.p)) << "the partial first page is left alone";
   gi::adviseHugePages(b.p, b.bytes);
   EXPECT_FALSE(gi::hugePagesAdvised(b.p)) << "below kHugePageMinBytes nothing is advised";
-#else
-  GTEST_SKIP() << "Linux only";
-#endif
+}
+
+TEST(HugePages, SwitchedOffAdvisesNothing) {
+  ASSERT_TRUE(std::ifstream("/proc/self/smaps").good());
+  const size_t big = size_t(8) << 20;
+  Mapping a(big);
+  ASSERT_NE(a.p, nullptr);
+  setenv("GI_NO_HUGEPAGES", "1", 1);
+  EXPECT_TRUE(gi::hugePagesSwitchedOff());
+  gi::adviseHugePages(a.p, big);
+  unsetenv("GI_NO_HUGEPAGES");
+  EXPECT_FALSE(gi::hugePagesAdvised(a.p + big / 2));
+  EXPECT_FALSE(gi::hugePagesSwitchedOff());
 }
 
 TEST(HugePages, AdviceKeepsTheContents) {

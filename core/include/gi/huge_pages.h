@@ -21,10 +21,14 @@ namespace gi {
 // span (on the 1M room 256 KiB gained more than 2 MiB, within the noise).
 inline constexpr std::size_t kHugePageMinBytes = std::size_t(256) << 10;
 
+// Whether GI_NO_HUGEPAGES is set in the environment: then nothing is
+// advised (to measure what the advice gains). Read on every call.
+bool hugePagesSwitchedOff();
+
 // Asks the kernel to back the whole pages of [p, p + bytes) with huge
 // pages as they are first touched. Best effort: a no-op off Linux, where
-// the system forbids it, or below kHugePageMinBytes. Never changes the
-// memory's contents.
+// the system forbids it, below kHugePageMinBytes or when switched off.
+// Never changes the memory's contents.
 void adviseHugePages(void* p, std::size_t bytes);
 
 // Whether the kernel was asked to back the page holding p with huge pages
