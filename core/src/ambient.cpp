@@ -3,11 +3,13 @@
 #include "ambient_internal.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
-#include <unordered_map>
+
+#include <tbb/parallel_sort.h>
 
 #include "gi/color.h"
 #include "gi/open_space.h"
@@ -224,7 +226,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   AmbientOptions opt = optWorld;
   opt.maxDistance = optWorld.maxDistance / scene.unit;  // local units (Scene::unit)
   Timer timer;
-  const SceneReport rep = analyzeScene(scene);
+  const SceneReport rep = analyzeScene(scene, /*duplicateFaces=*/false);  // AO does not depend on them
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const size_t nv = scene.vertexCount();
   const std::vector<glm::vec3> normals =
@@ -244,17 +246,27 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   }
   size_t duplicates = 0, open = 0, invalid = 0;
   if (opt.mergeDuplicates) {
-    struct Key { float v[6]; bool operator==(const Key& o) const { return std::memcmp(v, o.v, sizeof v) == 0; } };
-    struct KeyHash { size_t operator()(const Key& k) const { uint32_t h = 0; for (float f : k.v) { uint32_t b; std::memcpy(&b, &f, 4); h = hashCombine(h, b); } return h; } };
-    std::unordered_map<Key, uint32_t, KeyHash> first;
-    first.reserve(nv);
+    // Sorted by the bits of their six coordinates (+ 0 folds -0 into 0), in
+    // parallel; each run of equal keys is represented by its lowest index.
+    struct Keyed { std::array<uint32_t, 6> k; uint32_t i; };
+    std::vector<Keyed> keys;
+    keys.reserve(nv);
     for (size_t i = 0; i < nv; ++i) {
       if (status[i] != kTrace) continue;
       const auto& p = scene.positions[i];
       const auto& n = normals[i];
-      Key k{{p.x + 0.f, p.y + 0.f, p.z + 0.f, n.x + 0.f, n.y + 0.f, n.z + 0.f}};  // + 0 folds -0 into 0
-      auto [it, inserted] = first.emplace(k, uint32_t(i));
-      if (!inserted) { status[i] = kDuplicate; rep_of[i] = it->second; ++duplicates; }
+      const float v[6] = {p.x + 0.f, p.y + 0.f, p.z + 0.f, n.x + 0.f, n.y + 0.f, n.z + 0.f};
+      Keyed k;
+      std::memcpy(k.k.data(), v, sizeof v);
+      k.i = uint32_t(i);
+      keys.push_back(k);
+    }
+    tbb::parallel_sort(keys.begin(), keys.end(), [](const Keyed& a, const Keyed& b) { return a.k != b.k ? a.k < b.k : a.i < b.i; });
+    for (size_t k = 1, first = 0; k < keys.size(); ++k) {
+      if (keys[k].k != keys[first].k) { first = k; continue; }
+      status[keys[k].i] = kDuplicate;
+      rep_of[keys[k].i] = keys[first].i;
+      ++duplicates;
     }
   }
   const VertexPart& part = opt.vertices;

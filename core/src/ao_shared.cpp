@@ -117,6 +117,15 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   VarV[0] = 1.0 / sums.W;
   V[0] = vOf(sums);
   int chosen = 0;
+  // Bounded values: the variance per ray reported is the largest of the
+  // pools examined (the chosen scale, the larger ones pooled on the way and
+  // the first one Lepski's rule refused). A small pool whose rays happened to
+  // agree (no occluded ray among 56, under neighbours that do see occlusion)
+  // would otherwise report a small error and stop the vertex early with a
+  // value biased towards 1 (measured on a 470k-vertex scan at a target of
+  // 0.02: +0.029 mean error on such vertices, errors 1.4 times the reported
+  // ones in the band of AO 0.95 to 0.98).
+  double vMax = V[0];
   const bool test = o.fixedRings < 0;
   const int R = std::min(test ? o.maxRings : o.fixedRings, kMaxScales - 1);
   for (int h = 1; h <= R; ++h) {
@@ -126,6 +135,7 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     if (added == 0) break;
     const Fit f = fit(grown);
     const double v = vOf(grown);
+    vMax = std::max(vMax, v);
     // Lepski: the new estimate within gamma standard errors of every smaller
     // scale's. For nested least-squares fits of one model the larger is the
     // efficient one, so Var(a_h' - a_h) = Var(a_h') - Var(a_h) (Hausman 1978).
@@ -148,7 +158,7 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     p.bent += db;
   }
   p.value = float(o.bounded ? std::clamp(A[chosen], 0.0, 1.0) : std::max(A[chosen], 0.0));
-  p.stdError = float(std::sqrt(V[chosen] * VarV[chosen]));
+  p.stdError = float(std::sqrt((o.bounded ? vMax : V[chosen]) * VarV[chosen]));
   p.rays = uint32_t(sums.W);
   p.rings = chosen;
   return p;

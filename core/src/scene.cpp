@@ -179,7 +179,7 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
   return n;
 }
 
-SceneReport analyzeScene(const Scene& s) {
+SceneReport analyzeScene(const Scene& s, bool duplicateFaces) {
   SceneReport r;
   r.vertices = s.vertexCount();
   r.faces = s.faceCount();
@@ -209,7 +209,7 @@ SceneReport analyzeScene(const Scene& s) {
   // Duplicated faces: the same three corner positions (in any order) as an
   // earlier usable face. Coplanar copies hide each other at random in ray
   // casting, so exact energy accounting does not hold for them.
-  {
+  if (duplicateFaces) {
     // Corners with equal positions get one id (the vertices in position
     // order), then faces are compared as sorted id triples: integers, where
     // sorting the faces by their nine coordinates cost 0.2 s a call at a

@@ -124,6 +124,9 @@ const TestScene& scene() {
   return t;
 }
 
+// The bound on mean (error / reported standard error)^2 (see below).
+constexpr double kMaxMeanZ2 = 1.5;
+
 struct Errors {
   double rms = 0;     // RMS of (shared - reference)
   double meanZ2 = 0;  // mean of (shared - reference)^2 / se_shared^2
@@ -163,11 +166,17 @@ Errors errors(const AmbientResult& a, const AmbientResult& ref, const std::vecto
 //  - Tail: |error| > 4 max(target, se) for at most 1% of the vertices (a
 //    normal error: 6e-5; the margin covers the heavier tails of few pooled
 //    rays and the reference's own error).
-//  - mean z^2 <= 2, z = error / reported standard error: the reported
-//    standard errors cover the errors (about 1 for honest ones, less for the
-//    binomial upper bound; the reference's error adds < 0.1). With Lepski's
-//    threshold at 2 standard errors instead of 1 the thin disc's region gives
-//    2.5 here (the pooling bias it lets through under the disc's rim).
+//  - mean z^2 <= kMaxMeanZ2 = 1.5, z = error / reported standard error: the
+//    reported standard errors cover the errors. The reported variance is an
+//    upper bound by construction (the binomial bound, taken at the largest
+//    pool examined), so an honest estimate has E z^2 <= 1; the reference's
+//    error adds < 0.1, and a region's mean over its >= 20 independent pools
+//    (693 vertices and more, about 35 per pool) has a relative standard
+//    deviation of about sqrt(2/20) = 0.32: 1.5 is 1.5 of those above 1.
+//    Measured: 0.33 to 0.95 (before the variance was taken at the largest
+//    pool: up to 1.38). With Lepski's threshold at 2 standard errors instead
+//    of 1 the thin disc's region gave 2.5 (the pooling bias it lets through
+//    under the disc's rim).
 // Pooling across the rim of the disc (normal tolerance ignored) or across the
 // crease breaks these bounds: see SharingCarelesslyFails below.
 TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
@@ -180,7 +189,7 @@ TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
     const Errors e = errors(a, ref, r.v, target);
     EXPECT_LE(e.rms, 1.25 * target) << r.name;
     EXPECT_LE(e.tail, 0.01) << r.name;
-    EXPECT_LE(e.meanZ2, 2.0) << r.name;
+    EXPECT_LE(e.meanZ2, kMaxMeanZ2) << r.name;
     // Every vertex reports meeting the target or the maximum ray count.
     for (size_t i : r.v)
       ASSERT_TRUE(a.stdError[i] <= target + 1e-6 || a.rays[i] >= 4096) << r.name << " vertex " << i;
@@ -188,7 +197,7 @@ TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
 }
 
 // Fixed ray counts: the pooled estimate's error against the reference is
-// covered by its reported standard error (mean z^2 <= 2 as above) in every
+// covered by its reported standard error (mean z^2 <= kMaxMeanZ2 as above) in every
 // region, at 16 and 64 rays per vertex.
 TEST(AOShared, ReportedStandardErrorsCoverTheErrors) {
   const TestScene& t = scene();
@@ -199,7 +208,7 @@ TEST(AOShared, ReportedStandardErrorsCoverTheErrors) {
     const AmbientResult a = run(t.s, o);
     for (const Region& r : regions(t)) {
       const Errors e = errors(a, ref, r.v, 0.0);
-      EXPECT_LE(e.meanZ2, 2.0) << r.name << ", " << n << " rays";
+      EXPECT_LE(e.meanZ2, kMaxMeanZ2) << r.name << ", " << n << " rays";
     }
   }
 }
@@ -207,7 +216,9 @@ TEST(AOShared, ReportedStandardErrorsCoverTheErrors) {
 // The checks above have power: sharing made careless (the normal tolerance
 // ignored, so pools cross the disc's rim and reach its other side, and
 // neighbourhoods of 8 rings) fails them where interpolation is wrong
-// (measured: mean z^2 2.4 at the sphere's contact, 1.8 at the thin disc).
+// (measured: mean z^2 1.78 at the sphere's contact, where the honest run
+// gives 0.68, and 1.21 at the thin disc; 2.4 and 1.8 before the variance was
+// taken at the largest pool examined).
 TEST(AOShared, SharingCarelesslyFails) {
   const TestScene& t = scene();
   const AmbientResult& ref = reference(t.s);
@@ -218,7 +229,7 @@ TEST(AOShared, SharingCarelesslyFails) {
   std::string seen;
   for (size_t k = 0; k < 3; ++k) {
     const Errors e = errors(a, ref, rs[k].v, target);
-    fails = fails || e.rms > 1.25 * target || e.tail > 0.01 || e.meanZ2 > 2.0;
+    fails = fails || e.rms > 1.25 * target || e.tail > 0.01 || e.meanZ2 > kMaxMeanZ2;
     seen += rs[k].name + ": rms " + std::to_string(e.rms) + ", mean z^2 " + std::to_string(e.meanZ2) + "\n";
   }
   EXPECT_TRUE(fails) << seen;
@@ -347,6 +358,13 @@ TEST(AOShared, LepskiStopsAtAStep) {
   const Pooled p = f.pool();
   EXPECT_EQ(p.vertices, 1u);
   EXPECT_EQ(p.value, 1.f);
+  // Its standard error is not the one of 256 rays that all agreed
+  // (sqrt(p~(1 - p~)/256) = 0.0039, p~ = 257/258) but takes the variance per
+  // ray of the refused pool, p~ = 257/1794: sqrt(p~(1 - p~)/256) = 0.0219.
+  // An adaptive run would otherwise stop such a vertex as soon as its own
+  // rays happened to agree.
+  const double pw = 257.0 / 1794.0;
+  EXPECT_NEAR(p.stdError, std::sqrt(pw * (1.0 - pw) / 256.0), 1e-6);
 }
 
 // A linear field is pooled and the first-order fit returns the centre's value
