@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "ambient_internal.h"
 #include "gi/sampling.h"
@@ -290,9 +291,16 @@ class RingLists {
     std::atomic<size_t> entries{0};
     tbb::enumerable_thread_specific<PoolScratch> scratch;
     tbb::enumerable_thread_specific<std::vector<uint32_t>> members;
+    // Each thread's share of the expected entries (a regular triangulation:
+    // 6h vertices in ring h, so 3R(R+1) in R rings, plus R + 1 counts), and a
+    // quarter more. Reserved, not touched: pages a list never reaches cost
+    // nothing (measured at 470k vertices: building the lists 0.34 -> 0.25 s).
+    const size_t threads = size_t(std::max(1, tbb::this_task_arena::max_concurrency()));
+    const size_t reserve = std::min(maxEntries, nv * size_t(1 + R + 3 * R * (R + 1)) * 5 / 4) / threads + 4096;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
       if (entries.load(std::memory_order_relaxed) > maxEntries) return;
       std::vector<uint32_t>& list = lists_.local();
+      if (list.capacity() == 0) list.reserve(reserve);  // no copies while the lists grow
       std::vector<uint32_t>& ring = members.local();
       PoolScratch& sc = scratch.local();
       uint32_t counts[65];
