@@ -324,7 +324,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
         continue;
       }
       if (status[i] != kTrace) continue;
-      const VertexOut o = kernel.run(uint32_t(i), origins[i], normals[i]);
+      const VertexOut o = kernel.run(uint32_t(part.meshIndex(i)), origins[i], normals[i]);  // keyed by the mesh's index
       res.value[i] = o.value;
       res.stdError[i] = o.stdError;
       res.rays[i] = o.rays;

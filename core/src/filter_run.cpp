@@ -21,6 +21,7 @@
 #include "gi/radiosity.h"
 #include "gi/render.h"
 #include "gi/thickness.h"
+#include "gi/vertex_order.h"
 
 namespace gi {
 
@@ -109,10 +110,33 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
   const ParamValues& v = in.values;
   AmbientOptions opt = AmbientOptions::fromParams(mode, v);
   opt.vertices = in.vertices;
+  // Large meshes are computed with their vertices in a spatial order
+  // (gi/vertex_order.h): each vertex keeps its rays, keyed by its index in
+  // the mesh, and the results go back in the mesh's order.
+  const Timer ordering;
+  const VertexOrder order = spatialVertexOrder(in.scene, kSpatialOrderFrom);
+  Scene reordered;
+  if (!order.identity()) {
+    reordered = reorderVertices(in.scene, order);
+    opt.vertices.ids = order.meshIndex;
+  }
+  const Scene& scene = order.identity() ? in.scene : reordered;
+  const double orderSeconds = ordering.seconds();
   const Timer bvh;
-  const auto caster = makeEmbreeCaster(in.scene, opt.batch);
+  const auto caster = makeEmbreeCaster(scene, opt.batch);
   const double bvhSeconds = bvh.seconds();
-  AmbientResult r = computeAmbient(in.scene, *caster, opt, progress);
+  AmbientResult r = computeAmbient(scene, *caster, opt, progress);
+  if (!order.identity()) {
+    const Timer back;
+    r.value = toMeshOrder(r.value, order);
+    r.stdError = toMeshOrder(r.stdError, order);
+    r.rays = toMeshOrder(r.rays, order);
+    r.rgb = toMeshOrder(r.rgb, order);
+    r.bentNormal = toMeshOrder(r.bentNormal, order);
+    for (auto& [key, value] : r.stats.numbers)
+      if (key == "seconds") value += orderSeconds + back.seconds();  // the filter's time includes the reordering
+    r.stats.add("vertex_order_seconds", orderSeconds);
+  }
   res.stats = std::move(r.stats);
   res.stats.add("bvh_seconds", bvhSeconds);  // building the ray caster, not in "seconds"
   if (mode == AmbientMode::Sky) {

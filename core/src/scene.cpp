@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "gi/color.h"
 
 namespace gi {
@@ -142,25 +145,59 @@ static bool finite3(const glm::vec3& p) { return std::isfinite(p.x) && std::isfi
 std::vector<uint8_t> usableFaceMask(const Scene& s) {
   const size_t nv = s.positions.size();
   std::vector<uint8_t> ok(s.faceCount(), 0);
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    const auto& t = s.triangles[f];
-    if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) continue;
-    if (!finite3(s.positions[t.x]) || !finite3(s.positions[t.y]) || !finite3(s.positions[t.z])) continue;
-    glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
-    double l2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
-    double area2 = glm::length(glm::cross(b - a, c - a));
-    // Degenerate: zero area, or height below float resolution of its longest edge.
-    if (!(area2 > 1e-12 * l2) || l2 == 0.0) continue;
-    ok[f] = 1;
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.faceCount(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t f = r.begin(); f < r.end(); ++f) {
+      const auto& t = s.triangles[f];
+      if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) continue;
+      if (!finite3(s.positions[t.x]) || !finite3(s.positions[t.y]) || !finite3(s.positions[t.z])) continue;
+      glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+      double l2 = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+      double area2 = glm::length(glm::cross(b - a, c - a));
+      // Degenerate: zero area, or height below float resolution of its longest edge.
+      if (!(area2 > 1e-12 * l2) || l2 == 0.0) continue;
+      ok[f] = 1;
+    }
+  });
   return ok;
 }
 
+namespace {
+// acc[t[k]] += term k of face f (c(f, terms) fills the face's three) for
+// every usable face f in ascending order, skipping unused terms; count[t[k]] counts
+// the terms added. The terms are computed in parallel, a block of faces at a
+// time, and added in face order: the bits of the sequential loop, for any
+// number of threads (a mesh's normals at 3.8M faces: 0.57 -> 0.25 s on 2
+// cores).
+struct CornerTerm {
+  glm::dvec3 v{0.0};
+  bool used = false;
+};
+template <class Term>
+void addCornerTerms(const Scene& s, const std::vector<uint8_t>& ok, std::vector<glm::dvec3>& acc,
+                    std::vector<int>* count, Term&& c) {
+  constexpr size_t kBlock = size_t(1) << 16;
+  std::vector<CornerTerm> terms(3 * std::min(kBlock, s.faceCount()));
+  for (size_t b = 0; b < s.faceCount(); b += kBlock) {
+    const size_t e = std::min(s.faceCount(), b + kBlock);
+    tbb::parallel_for(tbb::blocked_range<size_t>(b, e, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t f = r.begin(); f < r.end(); ++f)
+        if (ok[f]) c(f, &terms[3 * (f - b)]);
+        else terms[3 * (f - b)] = terms[3 * (f - b) + 1] = terms[3 * (f - b) + 2] = CornerTerm{};
+    });
+    for (size_t f = b; f < e; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const CornerTerm& t = terms[3 * (f - b) + k];
+        if (!t.used) continue;
+        acc[s.triangles[f][k]] += t.v;
+        if (count) ++(*count)[s.triangles[f][k]];
+      }
+  }
+}
+}  // namespace
+
 std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
   std::vector<glm::dvec3> acc(s.positions.size(), glm::dvec3(0.0));
-  const auto ok = usableFaceMask(s);
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f]) continue;
+  addCornerTerms(s, usableFaceMask(s), acc, nullptr, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
     const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
@@ -168,14 +205,16 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
       // Angle-weighted (Thürmer and Wüthrich 1998): independent of tessellation.
       glm::dvec3 e1 = glm::normalize(p[(k + 1) % 3] - p[k]), e2 = glm::normalize(p[(k + 2) % 3] - p[k]);
       double angle = std::acos(std::clamp(glm::dot(e1, e2), -1.0, 1.0));
-      acc[t[k]] += angle * n;
+      out[k] = {angle * n, true};
     }
-  }
+  });
   std::vector<glm::vec3> n(acc.size());
-  for (size_t i = 0; i < acc.size(); ++i) {
-    double l = glm::length(acc[i]);
-    n[i] = l > 0.0 ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, acc.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      double l = glm::length(acc[i]);
+      n[i] = l > 0.0 ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
+    }
+  });
   return n;
 }
 
@@ -282,26 +321,26 @@ std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::v
   const size_t nv = s.vertexCount();
   std::vector<glm::dvec3> pull(nv, glm::dvec3(0.0));
   std::vector<int> count(nv, 0);
-  const auto ok = usableFaceMask(s);
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f]) continue;
+  addCornerTerms(s, usableFaceMask(s), pull, &count, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 c = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
     for (int k = 0; k < 3; ++k) {
       const glm::dvec3 d = c - glm::dvec3(s.positions[t[k]]);
       const double l = glm::length(d);
-      if (l > 0) { pull[t[k]] += d / l; ++count[t[k]]; }
+      out[k] = l > 0 ? CornerTerm{d / l, true} : CornerTerm{};
     }
-  }
+  });
   std::vector<glm::vec3> o(nv);
-  for (size_t i = 0; i < nv; ++i) {
-    const glm::dvec3 n(normals[i]);
-    glm::dvec3 p = count[i] ? pull[i] / double(count[i]) : glm::dvec3(0.0);
-    p -= n * glm::dot(p, n);  // tangential part only
-    const double l = glm::length(p);
-    const glm::dvec3 shift = l > 0.2 ? p / l : glm::dvec3(0.0);  // symmetric one-rings need no pull
-    o[i] = glm::vec3(glm::dvec3(s.positions[i]) + double(eps) * (n + shift));
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const glm::dvec3 n(normals[i]);
+      glm::dvec3 p = count[i] ? pull[i] / double(count[i]) : glm::dvec3(0.0);
+      p -= n * glm::dot(p, n);  // tangential part only
+      const double l = glm::length(p);
+      const glm::dvec3 shift = l > 0.2 ? p / l : glm::dvec3(0.0);  // symmetric one-rings need no pull
+      o[i] = glm::vec3(glm::dvec3(s.positions[i]) + double(eps) * (n + shift));
+    }
+  });
   return o;
 }
 }  // namespace gi

@@ -54,7 +54,7 @@ std::vector<std::string> mergeTexts(const std::vector<RunStats>& parts, std::vec
 bool VertexPart::contains(size_t v, size_t n) const {
   if (!inSubset(v)) return false;
   if (parts <= 1) return true;
-  const uint64_t k = v / chunk;
+  const uint64_t k = meshIndex(v) / chunk;
   if (interleaved) return k % parts == part;
   const uint64_t K = (uint64_t(n) + chunk - 1) / chunk;
   return k * parts / K == part;
@@ -63,7 +63,7 @@ bool VertexPart::contains(size_t v, size_t n) const {
 std::vector<uint32_t> VertexPart::vertices(size_t n) const {
   std::vector<uint32_t> v;
   v.reserve(parts ? n / parts + chunk : n);
-  if (subset) {
+  if (subset || ids) {
     for (size_t i = 0; i < n; ++i)
       if (contains(i, n)) v.push_back(uint32_t(i));
     return v;
@@ -76,7 +76,7 @@ std::vector<uint32_t> VertexPart::vertices(size_t n) const {
 
 size_t VertexPart::count(size_t n) const {
   size_t c = 0;
-  if (subset) {
+  if (subset || ids) {
     for (size_t i = 0; i < n; ++i) c += contains(i, n) ? 1 : 0;
     return c;
   }

@@ -12,6 +12,8 @@
 #include <thread>
 
 #include "gi/filter_run.h"
+#include "gi/scan.h"
+#include "gi/vertex_order.h"
 #include "gi/vertex_part.h"
 #include "mesh_io.h"
 
@@ -232,6 +234,22 @@ TEST(SplitRun, SharedAmbientOcclusion) {
   expectSplitEqualsWhole(welded, FilterKind::AmbientOcclusion, adaptive, 4, 50, false);
   expectSplitEqualsWhole(welded, FilterKind::AmbientObscurance, {{"estimator", "1"}, {"rays_per_vertex", "16"}}, 2, 13, true);
   expectSplitEqualsWhole(unwelded(welded), FilterKind::AmbientOcclusion, adaptive, 3, 16, true);
+}
+
+// A mesh large enough to be computed in its spatial order (gi/vertex_order.h):
+// each part still computes the chunks of the mesh's indices it was given, and
+// the shared estimator's exchanges between parts (in the reordered copy's
+// places, the same in every part) give the whole run's pools.
+TEST(SplitRun, AmbientOcclusionOfAReorderedMesh) {
+  io::LoadedMesh m;
+  scenes::ScanOptions o;
+  o.levels = 3;
+  m.scene = scenes::displacedScan(io::loadMesh(std::string(GI_TEST_MESHES) + "/bunny.ply").scene, o);  // 118k vertices
+  ASSERT_GE(m.scene.vertexCount(), kSpatialOrderFrom);
+  expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion, {{"rays_per_vertex", "4"}}, 2, 1024, true);
+  expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion,
+                         {{"estimator", "1"}, {"target_error", "0.05"}, {"min_rays", "4"}, {"max_rays", "32"}}, 3, 4096,
+                         false);
 }
 
 // Without the parts' sum a split shared run cannot see its neighbours' rays: refused.

@@ -32,10 +32,21 @@ struct VertexPart {
   // Unset: every vertex of the part; else only those marked 1 (the same
   // subset in every part).
   std::shared_ptr<const std::vector<uint8_t>> subset;
+  // Set when the computation runs on a copy of the mesh with its vertices
+  // reordered (gi/vertex_order.h): the mesh's index of each vertex of the
+  // copy. Chunks, parts and the subset stay those of the mesh's indices, so a
+  // part computes the same vertices in either order. Null: the indices are
+  // the mesh's.
+  std::shared_ptr<const std::vector<uint32_t>> ids;
 
   bool all() const { return parts <= 1; }  // one part (a subset may still narrow it)
+  // The mesh's index of vertex v.
+  size_t meshIndex(size_t v) const { return ids ? (*ids)[v] : v; }
   // Whether vertex v is in the subset (true without one), whichever part holds it.
-  bool inSubset(size_t v) const { return !subset || (v < subset->size() && (*subset)[v]); }
+  bool inSubset(size_t v) const {
+    const size_t m = meshIndex(v);
+    return !subset || (m < subset->size() && (*subset)[m]);
+  }
   // Whether vertex v of n belongs to this part.
   bool contains(size_t v, size_t n) const;
   // This part's vertices of n, ascending.
