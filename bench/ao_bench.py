@@ -296,14 +296,16 @@ class Bench:
         np.save(path, q.astype(np.float32))
         return path
 
-    def meshlab(self, scene, mesh, nv, ref, views, tex, repeats, cached_only=False):
+    def meshlab(self, scene, mesh, nv, ref, views, tex, repeats, cached_only=False, fresh=False):
         """MeshLab's filter at one setting (cached by mesh); with `cached_only` a setting not in the cache is left
-        out (returns False) instead of run."""
+        out (returns False) instead of run; with `fresh` it is run now whatever the cache holds, and the cache is
+        left as it was."""
         key = "|".join(["meshlab", scene, signature(mesh), str(views), str(tex)])
         if key not in self.cache and cached_only:
             print("%-14s MeshLab %d views, %d^2: not in the cache, left out" % (scene, views, tex), flush=True)
             return False
-        if key not in self.cache:
+        kept = self.cache.get(key)
+        if key not in self.cache or fresh:
             script = os.path.join(self.tmp, "mlao.mlx")
             with open(script, "w") as f:
                 f.write(MESHLAB_AO_SCRIPT.format(views=views, tex=tex))
@@ -322,9 +324,16 @@ class Bench:
                 loads[-1] = {"before": loads[-1], "after": load_average()}
             q = 4.0 * vertex_property(out, "quality")  # MeshLab averages V max(0, n.d) over the sphere: open = 0.25
             self.cache[key] = {"seconds": statistics.median(times), "wall": statistics.median(walls),
-                               "runs": repeats, "load_average": loads, "quality_file": self.keep(q, key)}
-            self.save_cache()
+                               "runs": repeats, "load_average": loads,
+                               "quality_file": self.keep(q, key + ("|fresh" if fresh else ""))}
+            if not fresh:
+                self.save_cache()
         c = self.cache[key]
+        if fresh:  # this run's values, the cache's entry back
+            if kept is None:
+                del self.cache[key]
+            else:
+                self.cache[key] = kept
         if ref is not None:  # None: filling the cache only (--peers-only)
             self.add(scene, nv, "MeshLab AO (CPU, depth %d)" % tex, "reqViews", views, c["seconds"], c["wall"],
                      np.load(c["quality_file"]), ref, {"load_average": c.get("load_average")})
