@@ -54,7 +54,7 @@ def main():
            "started": time.strftime("%Y-%m-%dT%H:%MZ", time.gmtime()), "rows": [], "summary": []}
     for scene, mesh in meshes.items():
         nv = len(ao_bench.vertex_property(mesh, "x"))
-        ref_rays = 8192 if nv < 5000 else 4096 if nv < ao_bench.LARGE else 1024 if nv < 300000 else 512 if nv < 1000000 else 256
+        ref_rays = ao_bench.reference_rays(nv)
         ref = b.reference(scene, mesh, "angle", ref_rays)
         ref_ml = b.reference(scene, mesh, "area", ref_rays)
         rows = {"before": [], "after": []}

@@ -340,6 +340,12 @@ class Bench:
         return True
 
 
+def reference_rays(nv, quick=False):
+    """Rays per run of a mesh's reference (two runs are averaged): fewer on larger meshes."""
+    rays = 8192 if nv < 5000 else 4096 if nv < LARGE else 1024 if nv < 300000 else 512 if nv < 1000000 else 256
+    return min(rays, 1024) if quick else rays
+
+
 def time_to_reach(rows, target, key="filter_seconds"):
     """Filter time (or another cost, `key`) at which the RMS error reaches `target` (log-log interpolation between
     the two settings around it, each curve sorted by cost), or None if it never does."""
@@ -538,9 +544,7 @@ def main():
         large = nv > LARGE
         repeats = 1 if (a.quick or large) else 3
         ml_repeats = a.meshlab_repeats or repeats
-        ref_rays = 8192 if nv < 5000 else 4096 if nv < LARGE else 1024 if nv < 300000 else 512 if nv < 1000000 else 256
-        if a.quick:
-            ref_rays = min(ref_rays, 1024)
+        ref_rays = reference_rays(nv, a.quick)
         if a.max_ref_rays_total:  # a power of two with rays x vertices within the cap, at least 16
             while ref_rays > 16 and ref_rays * nv > a.max_ref_rays_total:
                 ref_rays //= 2

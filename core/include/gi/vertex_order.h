@@ -12,8 +12,8 @@
 //
 // A filter computes on the reordered copy and writes its results back in the
 // mesh's order; every random number stays keyed by the mesh's index of its
-// vertex (AmbientOptions::vertexIds, VertexPart::ids), so a vertex gets the
-// same rays in either order.
+// vertex (VertexPart::ids, read through VertexPart::meshIndex), so a vertex
+// gets the same rays in either order.
 #pragma once
 #include <cstdint>
 #include <memory>
