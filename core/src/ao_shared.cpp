@@ -11,9 +11,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "ambient_internal.h"
+#include "gi/huge_pages.h"
 #include "gi/sampling.h"
 
 namespace gi {
@@ -191,18 +193,39 @@ void startRings(uint32_t i, size_t vertexCount, PoolScratch& sc) {
   sc.frontier.assign(1, i);
 }
 
-void nextRing(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
-              const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
-              PoolScratch& sc) {
+// Who may join a vertex's rings (poolable, with rays) and its normal: read
+// from the run's arrays, or from one packed array (one read per neighbour,
+// for building every vertex's lists at once). Both give the same rings.
+struct ArrayNodes {
+  const std::vector<glm::vec3>& normals;
+  const std::vector<VertexRays>& rays;
+  const std::vector<uint8_t>& poolable;
+  glm::vec3 normal(uint32_t u) const { return normals[u]; }
+  bool usable(uint32_t u) const { return poolable[u] && rays[u].n != 0; }
+  size_t size() const { return normals.size(); }
+};
+struct PackedNodes {
+  struct Node {
+    glm::vec3 n;
+    uint32_t usable;
+  };
+  std::vector<Node> nodes;
+  glm::vec3 normal(uint32_t u) const { return nodes[u].n; }
+  bool usable(uint32_t u) const { return nodes[u].usable != 0; }
+  size_t size() const { return nodes.size(); }
+};
+
+template <class Nodes>
+void nextRing(uint32_t i, const VertexGraph& g, const Nodes& nodes, const PoolOptions& o, PoolScratch& sc) {
   const uint32_t now = sc.now;
-  const glm::vec3 ni = normals[i];
+  const glm::vec3 ni = nodes.normal(i);
   sc.next.clear();
   for (uint32_t v : sc.frontier)
     for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k) {
       const uint32_t u = g.nbr[k];
       if (sc.stamp[u] == now) continue;
       sc.stamp[u] = now;
-      if (!poolable[u] || rays[u].n == 0 || glm::dot(normals[u], ni) < o.normalCos) continue;
+      if (!nodes.usable(u) || glm::dot(nodes.normal(u), ni) < o.normalCos) continue;
       sc.next.push_back(u);
     }
   sc.frontier.swap(sc.next);
@@ -211,14 +234,13 @@ void nextRing(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& no
 // Calls visit(h, u) for every vertex u of ring h = 1, ..., maxRings in the
 // order poolVertex pools them, and returns the number of rings found (the
 // search stops at an empty ring, as poolVertex does).
-template <class Visit>
-int searchRings(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& normals,
-                const std::vector<VertexRays>& rays, const std::vector<uint8_t>& poolable, const PoolOptions& o,
-                int maxRings, PoolScratch& sc, Visit&& visit) {
-  startRings(i, normals.size(), sc);
+template <class Nodes, class Visit>
+int searchRings(uint32_t i, const VertexGraph& g, const Nodes& nodes, const PoolOptions& o, int maxRings,
+                PoolScratch& sc, Visit&& visit) {
+  startRings(i, nodes.size(), sc);
   int h = 1;
   for (; h <= maxRings; ++h) {
-    nextRing(i, g, normals, rays, poolable, o, sc);
+    nextRing(i, g, nodes, o, sc);
     if (sc.frontier.empty()) break;
     for (uint32_t u : sc.frontier) visit(h, u);
   }
@@ -234,7 +256,7 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
   const Frame frame(normals[i]);
   return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
     if (h == 1) startRings(i, normals.size(), sc);
-    nextRing(i, g, normals, rays, poolable, o, sc);
+    nextRing(i, g, ArrayNodes{normals, rays, poolable}, o, sc);
     for (uint32_t u : sc.frontier) {
       const glm::vec3 d = positions[u] - pi;
       grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b), rays[u].var);
@@ -285,6 +307,19 @@ void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint
   r.n += count;
 }
 
+// The sum of f(i) over the vertices, in parallel (f may also update vertex
+// i's own entries; integer sums: the same in any order).
+template <class F>
+size_t countVertices(size_t nv, F&& f) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, nv, 1 << 14), size_t(0),
+      [&](const tbb::blocked_range<size_t>& r, size_t acc) {
+        for (size_t i = r.begin(); i < r.end(); ++i) acc += f(i);
+        return acc;
+      },
+      [](size_t a, size_t b) { return a + b; });
+}
+
 // How many slices parallelBlocks cuts `work` into: one per `perSlice`, 1 to 64.
 size_t slices(size_t work, size_t perSlice) { return std::clamp<size_t>(work / perSlice, 1, 64); }
 
@@ -297,12 +332,23 @@ size_t slices(size_t work, size_t perSlice) { return std::clamp<size_t>(work / p
 class RingLists {
  public:
   // The lists of the vertices with mine[i] = 1; false (none kept) if they
-  // would take more than maxBytes.
+  // would take more than maxBytes. onList(i, list) is called with each
+  // vertex's list as soon as it is written (while it is in the cache: the
+  // first round pools there).
+  template <class OnList>
   bool build(const VertexGraph& g, const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,
              const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine, const PoolOptions& o,
-             size_t maxBytes) {
+             size_t maxBytes, OnList&& onList) {
     const size_t nv = normals.size(), maxEntries = maxBytes / sizeof(uint32_t);
     const int R = std::min(o.maxRings, 64);
+    // What the search reads of a neighbour, in one place: one read instead
+    // of three arrays (the same rings: ArrayNodes).
+    PackedNodes nodes;
+    nodes.nodes.resize(nv);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t u = r.begin(); u < r.end(); ++u)
+        nodes.nodes[u] = {normals[u], uint32_t(poolable[u] && rays[u].n != 0)};
+    });
     std::vector<std::pair<std::vector<uint32_t>*, size_t>> at(nv, {nullptr, 0});
     std::atomic<size_t> entries{0};
     tbb::enumerable_thread_specific<PoolScratch> scratch;
@@ -325,14 +371,16 @@ class RingLists {
         if (!mine[i]) continue;
         ring.clear();
         std::fill(counts, counts + R + 1, 0u);
-        const int rings = searchRings(uint32_t(i), g, normals, rays, poolable, o, R, sc, [&](int h, uint32_t u) {
+        const int rings = searchRings(uint32_t(i), g, nodes, o, R, sc, [&](int h, uint32_t u) {
           ++counts[h];
           ring.push_back(u);
         });
-        at[i] = {&list, list.size()};
+        const size_t start = list.size();
+        at[i] = {&list, start};
         list.push_back(uint32_t(rings));
         list.insert(list.end(), counts + 1, counts + 1 + rings);
         list.insert(list.end(), ring.begin(), ring.end());
+        onList(uint32_t(i), list.data() + start);
       }
       entries += list.size() - before;
     });
@@ -387,6 +435,10 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
                                  const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
                                  const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine,
                                  AmbientResult& res, const Progress& progress) {
+  // The estimator's arrays (the vertex graph, the rings' lists, the rays
+  // and pools) are written once and then read near where they were last
+  // read: 4 KiB pages, whose first touch costs less (gi/huge_pages.h).
+  const HugePageAdvicePause smallPages;
   const size_t nv = scene.vertexCount();
   const VertexPart& part = o.vertices;
   const bool split = !part.all();
@@ -406,7 +458,9 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   std::vector<uint32_t> want(nv, 0), pooledWith(nv, 0);  // pooledWith: ray counts at the last pooling
   for (size_t i = 0; i < nv; ++i)
     if (mine[i]) want[i] = first;
-  std::vector<uint32_t> repool, marked(nv, 0);  // the vertices to pool again; the round that marked each
+  std::vector<uint32_t> frontier;                                 // the vertices marked last
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> grown;   // and those they mark, per thread
+  std::vector<std::atomic<uint32_t>> marked(nv);  // the round that last marked each vertex to pool again
   std::vector<Pooled> pooled(nv);
   std::vector<double> exchange;
   tbb::enumerable_thread_specific<PoolScratch> scratch;
@@ -423,8 +477,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     // between slices): each slice ends in a wait for the slowest thread,
     // which on a machine shared with other jobs costs a time slice of the
     // scheduler, and the later adaptive rounds cast few rays.
-    size_t work = 0;
-    for (size_t i = 0; i < nv; ++i) work += want[i] - std::min(want[i], rays[i].n);
+    const size_t work = countVertices(nv, [&](size_t i) -> size_t { return want[i] - std::min(want[i], rays[i].n); });
     parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (want[i] > rays[i].n)
@@ -452,63 +505,87 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     }
     st.castSeconds += cast.seconds();
     Timer pool;
+    if (listed)
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i) { points[i].n = rays[i].n; points[i].sum = rays[i].sum; }
+      });
+    bool pooledAll = false;
     if (round == 0) {
       // Lists of rings need every poolable vertex to have rays from now on.
       bool settled = true;
       for (size_t i = 0; i < nv; ++i) settled = settled && !(poolable[i] && rays[i].n == 0);
-      listed = settled && ringLists.build(g, normals, rays, poolable, mine, po, o.shareRingBytes);
-      if (listed) {
+      if (settled) {
         points.resize(nv);
-        for (size_t i = 0; i < nv; ++i) points[i].p = scene.positions[i];
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i < r.end(); ++i) points[i] = {scene.positions[i], rays[i].n, rays[i].sum};
+        });
+        // The first pooling of every vertex happens as its list is written.
+        listed = ringLists.build(g, normals, rays, poolable, mine, po, o.shareRingBytes,
+                                 [&](uint32_t i, const uint32_t* list) {
+                                   pooled[i] = poolListed(i, list, points, normals, rays, o.bentNormals, po);
+                                 });
+        pooledAll = listed;
       }
     }
-    if (listed)
-      for (size_t i = 0; i < nv; ++i) { points[i].n = rays[i].n; points[i].sum = rays[i].sum; }
     // Pooled (again): every vertex within reach of one whose rays changed,
-    // found from those vertices outwards (late rounds change few).
+    // found from those vertices outwards (late rounds change few), ring by
+    // ring in parallel. Two threads may both take a vertex into the next
+    // ring: it is then walked twice, which marks nothing more.
     const uint32_t stamp = uint32_t(round) + 1;
-    repool.clear();
-    for (size_t i = 0; i < nv; ++i)
-      if (rays[i].n != pooledWith[i]) {
-        pooledWith[i] = rays[i].n;
-        marked[i] = stamp;
-        repool.push_back(uint32_t(i));
-      }
-    size_t begin = 0;
-    for (int ring = 0; ring < po.maxRings; ++ring) {
-      const size_t end = repool.size();
-      for (size_t k = begin; k < end; ++k) {
-        const uint32_t v = repool[k];
-        for (uint32_t e = g.offset[v]; e < g.offset[v + 1]; ++e) {
-          const uint32_t u = g.nbr[e];
-          if (marked[u] != stamp) { marked[u] = stamp; repool.push_back(u); }
+    for (auto& found : grown) found.clear();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<uint32_t>& out = grown.local();
+      for (size_t i = r.begin(); i < r.end(); ++i)
+        if (rays[i].n != pooledWith[i]) {
+          pooledWith[i] = rays[i].n;
+          marked[i].store(stamp, std::memory_order_relaxed);
+          out.push_back(uint32_t(i));
         }
+    });
+    size_t marks = 0;
+    for (int ring = 0; ring < po.maxRings && !pooledAll; ++ring) {
+      frontier.clear();
+      for (auto& found : grown) {
+        frontier.insert(frontier.end(), found.begin(), found.end());
+        found.clear();
       }
-      begin = end;
+      if (frontier.empty()) break;
+      marks += frontier.size();
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, frontier.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<uint32_t>& out = grown.local();
+        for (size_t k = r.begin(); k < r.end(); ++k) {
+          const uint32_t v = frontier[k];
+          for (uint32_t e = g.offset[v]; e < g.offset[v + 1]; ++e) {
+            const uint32_t u = g.nbr[e];
+            if (marked[u].load(std::memory_order_relaxed) != stamp) {
+              marked[u].store(stamp, std::memory_order_relaxed);
+              out.push_back(u);
+            }
+          }
+        }
+      });
     }
-    // This part's marked vertices in memory order: a scan of the marks (a
-    // sort of the list cost 0.08 s a round at 1.9M vertices).
-    repool.clear();
-    for (size_t i = 0; i < nv; ++i)
-      if (marked[i] == stamp && mine[i]) repool.push_back(uint32_t(i));
-    parallelBlocks(repool.size(), bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
-      PoolScratch& sc = scratch.local();
-      for (size_t k = b; k < e; ++k) {
-        const uint32_t i = repool[k];
-        pooled[i] = listed ? poolListed(i, ringLists[i], points, normals, rays, o.bentNormals, po)
-                           : poolVertex(i, g, scene.positions, normals, rays, poolable, po, sc);
-      }
-    }, slices(repool.size(), size_t(1) << 16));
+    for (const auto& found : grown) marks += found.size();
+    // This part's marked vertices, found by a scan of the marks in memory
+    // order (a sort of the list cost 0.08 s a round at 1.9M vertices).
+    if (!pooledAll)
+      parallelBlocks(nv, bar.sub(0.8, 1.0), "sharing between neighbours", [&](size_t b, size_t e) {
+        PoolScratch& sc = scratch.local();
+        for (size_t i = b; i < e; ++i) {
+          if (marked[i].load(std::memory_order_relaxed) != stamp || !mine[i]) continue;
+          pooled[i] = listed ? poolListed(uint32_t(i), ringLists[i], points, normals, rays, o.bentNormals, po)
+                             : poolVertex(uint32_t(i), g, scene.positions, normals, rays, poolable, po, sc);
+        }
+      }, slices(marks, size_t(1) << 16));
     ++st.rounds;
     st.poolSeconds += pool.seconds();
     if (!adaptive) break;
     // Vertices above the target cast twice their rays (all parts go on while any does).
-    double more = 0;
-    for (size_t i = 0; i < nv; ++i)
-      if (mine[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays)) {
-        want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
-        more += 1;
-      }
+    double more = double(countVertices(nv, [&](size_t i) -> size_t {
+      if (!(mine[i] && pooled[i].stdError > o.targetError && rays[i].n < uint32_t(o.maxRays))) return 0;
+      want[i] = std::min<uint32_t>(uint32_t(o.maxRays), 2 * rays[i].n);
+      return 1;
+    }));
     if (split) {
       std::vector<double> m{more};
       part.sumOverParts(m);

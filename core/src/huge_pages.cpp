@@ -2,6 +2,7 @@
 #include "gi/huge_pages.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -14,11 +15,18 @@
 
 namespace gi {
 
+namespace {
+std::atomic<int> pauses{0};  // HugePageAdvicePause objects alive
+}  // namespace
+
+HugePageAdvicePause::HugePageAdvicePause() { pauses.fetch_add(1, std::memory_order_relaxed); }
+HugePageAdvicePause::~HugePageAdvicePause() { pauses.fetch_sub(1, std::memory_order_relaxed); }
+
 bool hugePagesSwitchedOff() { return std::getenv("GI_NO_HUGEPAGES") != nullptr; }
 
 void adviseHugePages(void* p, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (!p || bytes < kHugePageMinBytes || hugePagesSwitchedOff()) return;
+  if (!p || bytes < kHugePageMinBytes || pauses.load(std::memory_order_relaxed) > 0 || hugePagesSwitchedOff()) return;
   static const std::uintptr_t page = std::uintptr_t(std::max(4096L, sysconf(_SC_PAGESIZE)));
   const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p) + page - 1) & ~(page - 1);
   const std::uintptr_t b = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(page - 1);

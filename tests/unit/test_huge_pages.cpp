@@ -59,6 +59,28 @@ TEST(HugePages, SwitchedOffAdvisesNothing) {
   EXPECT_FALSE(gi::hugePagesSwitchedOff());
 }
 
+TEST(HugePages, NothingIsAdvisedWhileAPauseLives) {
+  ASSERT_TRUE(std::ifstream("/proc/self/smaps").good());
+  unsetenv("GI_NO_HUGEPAGES");
+  const size_t big = size_t(8) << 20;
+  Mapping a(big), b(big), c(big);
+  ASSERT_NE(a.p, nullptr);
+  ASSERT_NE(b.p, nullptr);
+  ASSERT_NE(c.p, nullptr);
+  {
+    const gi::HugePageAdvicePause outer;
+    {
+      const gi::HugePageAdvicePause inner;
+      gi::adviseHugePages(a.p, big);
+    }
+    gi::adviseHugePages(b.p, big);  // the outer pause still lives
+  }
+  gi::adviseHugePages(c.p, big);
+  EXPECT_FALSE(gi::hugePagesAdvised(a.p + big / 2));
+  EXPECT_FALSE(gi::hugePagesAdvised(b.p + big / 2));
+  EXPECT_TRUE(gi::hugePagesAdvised(c.p + big / 2)) << "advice resumes when the last pause ends";
+}
+
 TEST(HugePages, AdviceKeepsTheContents) {
   std::vector<uint32_t> v(size_t(4) << 20);
   for (size_t i = 0; i < v.size(); ++i) v[i] = uint32_t(i * 2654435761u);
