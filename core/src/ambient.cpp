@@ -226,11 +226,14 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   AmbientOptions opt = optWorld;
   opt.maxDistance = optWorld.maxDistance / scene.unit;  // local units (Scene::unit)
   Timer timer;
-  const SceneReport rep = analyzeScene(scene, /*duplicateFaces=*/false);  // AO does not depend on them
+  // Which faces the ray caster builds: one pass over the faces for the
+  // analysis, the normals, the ray origins and the shared estimator's graph.
+  const std::vector<uint8_t> usable = usableFaceMask(scene);
+  const SceneReport rep = analyzeScene(scene, /*duplicateFaces=*/false, &usable);  // AO does not depend on them
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const size_t nv = scene.vertexCount();
   const std::vector<glm::vec3> normals =
-      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
+      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene, &usable);
 
   // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
   enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart };
@@ -296,7 +299,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (opt.mode == AmbientMode::Sky) res.rgb.assign(nv, glm::vec3(0.f));
   if (opt.bentNormals) res.bentNormal = normals;
   const AmbientKernel kernel(caster, opt);
-  const std::vector<glm::vec3> origins = vertexRayOrigins(scene, normals, float(rep.rayEpsilon));
+  const std::vector<glm::vec3> origins = vertexRayOrigins(scene, normals, float(rep.rayEpsilon), &usable);
   // The shared estimator pools neighbours' rays; the cone's ratio estimator and sky lighting stay per vertex.
   const bool shared = opt.estimator == AOEstimator::Shared && opt.mode != AmbientMode::Sky && !opt.useCone;
   if (opt.estimator == AOEstimator::Shared && !shared)
@@ -314,7 +317,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
         if (opt.bentNormals) res.bentNormal[i] = normals[i];
       }
     }
-    shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, poolable, mine, res, progress.sub(0.05, 1.0));
+    shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, poolable, mine, usable, res,
+                                       progress.sub(0.05, 1.0));
   }
   parallelBlocks(shared ? 0 : nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {

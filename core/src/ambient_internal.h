@@ -18,11 +18,11 @@ struct SharedStats {
 // bentNormal in res. poolable[i] = 1 for every vertex that casts rays in the
 // whole run (mine and, in a split run, the other parts' vertices, whose rays
 // arrive through o.vertices.sumOverParts after each round; a vertex that casts
-// none there counts as not poolable). `o` is in local units (Scene::unit);
-// occlusion or obscurance, no cone.
+// none there counts as not poolable); usable = usableFaceMask(scene). `o` is
+// in local units (Scene::unit); occlusion or obscurance, no cone.
 SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
                                  const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
                                  const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine,
-                                 AmbientResult& res, const Progress& progress);
+                                 const std::vector<uint8_t>& usable, AmbientResult& res, const Progress& progress);
 
 }  // namespace gi

@@ -20,9 +20,10 @@
 
 namespace gi {
 
-VertexGraph VertexGraph::build(const Scene& s) {
+VertexGraph VertexGraph::build(const Scene& s, const std::vector<uint8_t>* usable) {
   const size_t nv = s.vertexCount();
-  const auto ok = usableFaceMask(s);
+  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
+  const std::vector<uint8_t>& ok = usable ? *usable : own;
   VertexGraph g;
   // Every corner lists the face's other two corners, in parallel: the counts
   // and the slots are taken atomically, so the order within a vertex's range
@@ -434,7 +435,7 @@ Pooled poolListed(uint32_t i, const uint32_t* list, const std::vector<PoolPoint>
 SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& o,
                                  const std::vector<glm::vec3>& normals, const std::vector<glm::vec3>& origins,
                                  const std::vector<uint8_t>& poolable, const std::vector<uint8_t>& mine,
-                                 AmbientResult& res, const Progress& progress) {
+                                 const std::vector<uint8_t>& usable, AmbientResult& res, const Progress& progress) {
   // The estimator's arrays (the vertex graph, the rings' lists, the rays
   // and pools) are written once and then read near where they were last
   // read: 4 KiB pages, whose first touch costs less (gi/huge_pages.h).
@@ -445,7 +446,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
   if (split && !part.sumOverParts)
     throw std::logic_error("the shared AO estimator split over parts needs their sum (VertexPart::sumOverParts)");
   Timer graphTimer;
-  const VertexGraph g = VertexGraph::build(scene);
+  const VertexGraph g = VertexGraph::build(scene, &usable);
   SharedStats st;
   st.poolSeconds = graphTimer.seconds();
   PoolOptions po;

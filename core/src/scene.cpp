@@ -195,9 +195,10 @@ void addCornerTerms(const Scene& s, const std::vector<uint8_t>& ok, std::vector<
 }
 }  // namespace
 
-std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
+std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<uint8_t>* usable) {
   std::vector<glm::dvec3> acc(s.positions.size(), glm::dvec3(0.0));
-  addCornerTerms(s, usableFaceMask(s), acc, nullptr, [&s](size_t f, CornerTerm* out) {
+  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
+  addCornerTerms(s, usable ? *usable : own, acc, nullptr, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
     const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
@@ -218,7 +219,7 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s) {
   return n;
 }
 
-SceneReport analyzeScene(const Scene& s, bool duplicateFaces) {
+SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<uint8_t>* usable) {
   SceneReport r;
   r.vertices = s.vertexCount();
   r.faces = s.faceCount();
@@ -231,7 +232,8 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces) {
     lo = glm::min(lo, s.toWorld(s.positions[i]));
     hi = glm::max(hi, s.toWorld(s.positions[i]));
   }
-  const auto ok = usableFaceMask(s);
+  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
+  const std::vector<uint8_t>& ok = usable ? *usable : own;
   for (size_t f = 0; f < r.faces; ++f) {
     const auto& t = s.triangles[f];
     if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) { ++r.invalidFaces; continue; }
@@ -317,11 +319,13 @@ std::string SceneReport::summary() const {
 }  // namespace gi
 
 namespace gi {
-std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps) {
+std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps,
+                                        const std::vector<uint8_t>* usable) {
   const size_t nv = s.vertexCount();
   std::vector<glm::dvec3> pull(nv, glm::dvec3(0.0));
   std::vector<int> count(nv, 0);
-  addCornerTerms(s, usableFaceMask(s), pull, &count, [&s](size_t f, CornerTerm* out) {
+  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
+  addCornerTerms(s, usable ? *usable : own, pull, &count, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 c = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
     for (int k = 0; k < 3; ++k) {

@@ -73,7 +73,7 @@ namespace gi {
 struct VertexGraph {
   std::vector<uint32_t> offset;  // vertexCount + 1
   std::vector<uint32_t> nbr;
-  static VertexGraph build(const Scene& s);
+  static VertexGraph build(const Scene& s, const std::vector<uint8_t>* usable = nullptr);  // usable: usableFaceMask(s) if known
   size_t degree(uint32_t v) const { return offset[v + 1] - offset[v]; }
 };
 

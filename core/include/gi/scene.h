@@ -68,8 +68,10 @@ glm::vec3 faceNormalUnnormalized(const Scene& s, size_t f);  // cross product, |
 double faceArea(const Scene& s, size_t f);
 // Unit face normals (winding order); +z for degenerate faces.
 std::vector<glm::vec3> unitFaceNormals(const Scene& s);
-// Angle-weighted vertex normals from the faces; zero vector for isolated vertices.
-std::vector<glm::vec3> computeVertexNormals(const Scene& s);
+// Angle-weighted vertex normals from the faces; zero vector for isolated
+// vertices. `usable`: usableFaceMask(s), where the caller already has it (a
+// pass over every face less; computed here otherwise). The same below.
+std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<uint8_t>* usable = nullptr);
 
 struct SceneReport {
   size_t vertices = 0, faces = 0;
@@ -91,7 +93,7 @@ struct SceneReport {
 // Counts every defect and computes the scale used for ray offsets. Without
 // duplicateFaces (left 0) it skips the one part that sorts every face
 // (0.1 s at a million faces): for algorithms that do not depend on it.
-SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true);
+SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::vector<uint8_t>* usable = nullptr);
 // Only the scale (one pass over the vertices): what the algorithms need for
 // their ray offsets, without the defect counts of a full report.
 struct SceneScale {
@@ -111,5 +113,6 @@ namespace gi {
 // where the one-ring is lopsided (mesh borders, the edge where a floor meets a
 // separate wall sheet), pulled by eps into the incident faces, so that rays
 // cannot slip under an adjacent wall at t = 0 and leak.
-std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps);
+std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps,
+                                        const std::vector<uint8_t>* usable = nullptr);
 }  // namespace gi
