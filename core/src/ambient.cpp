@@ -165,8 +165,10 @@ void checkOptions(const AmbientOptions& o) {
   if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
 }
 
-// Warnings for settings that make the result meaningless (RunStats::warn).
-void warnMeaningless(const Scene& scene, const AmbientOptions& o, const AmbientResult& res, RunStats& st) {
+// Warnings for settings that make the result meaningless (RunStats::warn);
+// usable = usableFaceMask(scene).
+void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, const AmbientOptions& o,
+                     const AmbientResult& res, RunStats& st) {
   auto num = [](double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3g", v);
@@ -176,9 +178,8 @@ void warnMeaningless(const Scene& scene, const AmbientOptions& o, const AmbientR
     // Rays start eps off the surface (and eps into the face at lopsided one-rings).
     const double eps = sceneScale(scene).rayEpsilon;
     std::vector<float> edges;
-    const auto ok = usableFaceMask(scene);
     for (size_t f = 0; f < scene.faceCount(); ++f)
-      if (ok[f])
+      if (usable[f])
         for (int k = 0; k < 3; ++k)
           edges.push_back(glm::length(scene.positions[scene.triangles[f][k]] - scene.positions[scene.triangles[f][(k + 1) % 3]]));
     float median = 0.f;
@@ -384,7 +385,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)
     st.note(std::to_string(rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite) + " degenerate/invalid faces ignored");
-  warnMeaningless(scene, opt, res, st);
+  warnMeaningless(scene, usable, opt, res, st);
   return res;
 }
 

@@ -22,8 +22,8 @@ namespace gi {
 
 VertexGraph VertexGraph::build(const Scene& s, const std::vector<uint8_t>* usable) {
   const size_t nv = s.vertexCount();
-  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
-  const std::vector<uint8_t>& ok = usable ? *usable : own;
+  std::vector<uint8_t> own;
+  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
   VertexGraph g;
   // Every corner lists the face's other two corners, in parallel: the counts
   // and the slots are taken atomically, so the order within a vertex's range

@@ -161,6 +161,12 @@ std::vector<uint8_t> usableFaceMask(const Scene& s) {
   return ok;
 }
 
+const std::vector<uint8_t>& usableFaces(const Scene& s, const std::vector<uint8_t>* known, std::vector<uint8_t>& own) {
+  if (known) return *known;
+  own = usableFaceMask(s);
+  return own;
+}
+
 namespace {
 // acc[t[k]] += term k of face f (c(f, terms) fills the face's three) for
 // every usable face f in ascending order, skipping unused terms;
@@ -197,8 +203,8 @@ void addCornerTerms(const Scene& s, const std::vector<uint8_t>& ok, std::vector<
 
 std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<uint8_t>* usable) {
   std::vector<glm::dvec3> acc(s.positions.size(), glm::dvec3(0.0));
-  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
-  addCornerTerms(s, usable ? *usable : own, acc, nullptr, [&s](size_t f, CornerTerm* out) {
+  std::vector<uint8_t> own;
+  addCornerTerms(s, usableFaces(s, usable, own), acc, nullptr, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
     const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
@@ -232,8 +238,8 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
     lo = glm::min(lo, s.toWorld(s.positions[i]));
     hi = glm::max(hi, s.toWorld(s.positions[i]));
   }
-  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
-  const std::vector<uint8_t>& ok = usable ? *usable : own;
+  std::vector<uint8_t> own;
+  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
   for (size_t f = 0; f < r.faces; ++f) {
     const auto& t = s.triangles[f];
     if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) { ++r.invalidFaces; continue; }
@@ -324,8 +330,8 @@ std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::v
   const size_t nv = s.vertexCount();
   std::vector<glm::dvec3> pull(nv, glm::dvec3(0.0));
   std::vector<int> count(nv, 0);
-  const std::vector<uint8_t> own = usable ? std::vector<uint8_t>() : usableFaceMask(s);
-  addCornerTerms(s, usable ? *usable : own, pull, &count, [&s](size_t f, CornerTerm* out) {
+  std::vector<uint8_t> own;
+  addCornerTerms(s, usableFaces(s, usable, own), pull, &count, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 c = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
     for (int k = 0; k < 3; ++k) {

@@ -105,6 +105,9 @@ SceneScale sceneScale(const Scene& s);
 inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
+// For the functions that take the mask from a caller who already has it:
+// *known if given, else usableFaceMask(s) computed into `own`.
+const std::vector<uint8_t>& usableFaces(const Scene& s, const std::vector<uint8_t>* known, std::vector<uint8_t>& own);
 
 }  // namespace gi
 
