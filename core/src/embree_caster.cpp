@@ -127,9 +127,12 @@ class EmbreeCaster final : public RayCaster {
       rtcReleaseGeometry(g);
     }
     // Robust (watertight) traversal: rays through a shared edge or vertex never
-    // slip between two triangles, which would leak light into closed rooms.
+    // slip between two triangles, which would leak light into closed rooms
+    // (measured without it: 166 of 1.92M AO rays escape a box of six walls,
+    // README). No build quality is set: Embree 3 builds a robust scene with
+    // its binned SAH builder whatever the quality asked (spatial splits, the
+    // high quality, exist only for its non-robust layout).
     rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
     rtcCommitScene(scene_.get());
     check("building the BVH");
   }
