@@ -152,10 +152,16 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     if (d > 0 && area_[j] / (M_PI * d * d) < kNegligibleF) { ++far; continue; }
     const auto& tj = s_.triangles[j];
     const glm::dvec3 pa(s_.positions[tj.x]), pb(s_.positions[tj.y]), pc(s_.positions[tj.z]);
-    // j wholly behind (or in) i's plane, or i wholly behind j's: F = 0 at every point of i.
-    if (std::max({glm::dot(n, pa - src.a), glm::dot(n, pb - src.a), glm::dot(n, pc - src.a)}) <= 0) continue;
+    // j wholly behind (or in) i's plane, or i wholly behind j's: F = 0 at
+    // every point of i. "In" up to the scene's ray offset: coplanar faces
+    // whose corners were rounded off the plane (a face and its duplicate,
+    // refined) are coplanar, as the rays, which start that far off the
+    // surface, see them; otherwise the rounding gives such a pair F of about
+    // 0.5 and refines it to the last level (measured).
+    const double inPlane = double(eps_);
+    if (std::max({glm::dot(n, pa - src.a), glm::dot(n, pb - src.a), glm::dot(n, pc - src.a)}) <= inPlane) continue;
     const glm::dvec3 nj(normal_[j]);
-    if (std::max({glm::dot(nj, src.a - pa), glm::dot(nj, src.b - pa), glm::dot(nj, src.c - pa)}) <= 0) continue;
+    if (std::max({glm::dot(nj, src.a - pa), glm::dot(nj, src.b - pa), glm::dot(nj, src.c - pa)}) <= inPlane) continue;
     auto g = [&](const glm::dvec3& x) {
       return glm::dot(nj, x - pa) > 0 ? pointToTriangleFormFactor(x, n, pa, pb, pc) : 0.0;  // 0 where j faces away
     };

@@ -359,6 +359,34 @@ TEST(FormFactors, FarPairsSkipped) {
   EXPECT_NEAR(F / Aa, Falone / Aa, 5e-3);
 }
 
+// Coplanar faces whose corners were rounded off the plane (a face and its
+// duplicate after refinement: corners a few float steps apart, 1e-9 here)
+// are coplanar for the analytic factor, F = 0 between them, as for exactly
+// coplanar ones and as the rays see them (they start a ray offset, 1.4e-5
+// here, off the surface); before, the rounding gave such a pair F of about
+// 0.5 and refined it to the last level (found by the filters' fuzz target).
+// A face facing the other 10 ray offsets away is not coplanar: two
+// coincident triangles facing each other across a gap of 1.4e-4 of their
+// size see each other almost wholly (F above 0.99).
+TEST(FormFactors, AnalyticRoundedCoplanarPairsAreCoplanar) {
+  auto rowOf = [](double lift, bool reversed) {
+    std::vector<glm::dvec3> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, lift}, {1, 0, lift}, {0, 1, lift}};
+    std::vector<glm::uvec3> t = {{0, 1, 2}, reversed ? glm::uvec3(3, 5, 4) : glm::uvec3(3, 4, 5)};
+    const Scene s = Scene::fromAbsolute(p, t);
+    auto caster = makeEmbreeCaster(s);
+    return FormFactors(s, *caster, {FormFactorMethod::Analytic, 0, 16, 64, 0}).row(0);
+  };
+  for (bool reversed : {false, true}) {
+    EXPECT_TRUE(rowOf(0.0, reversed).j.empty()) << reversed;
+    EXPECT_TRUE(rowOf(1e-9, reversed).j.empty()) << reversed;
+  }
+  const double eps = sceneScale(Scene::fromAbsolute({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}})).rayEpsilon;
+  EXPECT_GT(eps, 1e-6);  // the ray offset, about 1.4e-5 for this size
+  const FormFactorRow apart = rowOf(10 * eps, true);
+  ASSERT_EQ(apart.j.size(), 1u);
+  EXPECT_GT(apart.F[0], 0.99f);
+}
+
 // Coaxial disks (docs/design.md, "Analytic references"): r_i = r_j = L gives F = (S - sqrt(S^2 - 4)) / 2
 // with S = 1 + (1 + R^2) / R^2 = 3, F = 0.381966; for the 64-gon disks used
 // here the polygon's area is 0.9984 of the circle's (below 1e-3 in F). Each
