@@ -39,7 +39,7 @@ two_v = [(-1, -1, -1), (1, -1, -1), (1, -1, 1), (-1, -1, 1), (-0.5, 0.5, -0.5), 
 two_f = [(0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7)]
 two = scene(two_v, two_f, 0)
 for k, name in enumerate(FILTERS):
-    for label, body, nv, options in (("box", box, len(box_v), bytes([1, 2])), ("two", two, len(two_v), bytes([2, 1]))):
+    for label, body, nv, options in (("box", box, len(box_v), bytes([1, 2])), ("two", two, len(two_v), bytes([3, 1]))):
         if name == "errormap":  # value, its standard error, the reference and its standard error
             body += bytes([coord(0.5)] * nv + [coord(0.25)] * nv + [coord(0.75)] * nv + [coord(0.25)] * nv)
         with open(os.path.join(out, "%s_%s" % (name, label)), "wb") as f:
