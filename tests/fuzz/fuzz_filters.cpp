@@ -62,7 +62,6 @@ using Params = std::map<std::string, std::string>;
 // from the input's bytes.
 Params budget(gi::FilterKind kind, Bytes& in) {
   const uint8_t a = in.u8(), b = in.u8();
-  const std::string sky = "1";
   switch (kind) {
     case gi::FilterKind::AmbientOcclusion:
       return {{"rays_per_vertex", "8"}, {"estimator", std::to_string(a % 2)}, {"target_error", b % 2 ? "0.2" : "0"},
@@ -76,21 +75,21 @@ Params budget(gi::FilterKind kind, Bytes& in) {
     case gi::FilterKind::Radiosity:
       return {{"rays_per_patch", "16"}, {"form_factor_method", std::to_string(a % 3)}, {"solver", std::to_string(b % 4)},
               {"hemicube_resolution", "16"}, {"max_iterations", "20"}, {"gather_rays", "4"}, {"link_rays", "2"},
-              {"max_links", "2000"}, {"sky_irradiance", sky}, {"refine", a & 8 ? "true" : "false"},
+              {"max_links", "2000"}, {"sky_irradiance", "1"}, {"refine", a & 8 ? "true" : "false"},
               {"refine_max_patches", "100"}, {"vertex_output", std::to_string((a >> 4) % 3)}};
     case gi::FilterKind::PhotonMapping:
       return {{"photons", "500"}, {"gather_rays", "2"}, {"final_gather", a & 1 ? "true" : "false"},
-              {"progressive", a & 2 ? "true" : "false"}, {"passes", "2"}, {"sky_irradiance", sky},
+              {"progressive", a & 2 ? "true" : "false"}, {"passes", "2"}, {"sky_irradiance", "1"},
               {"photon_layer", "true"}, {"photon_layer_max", "100"}, {"light_samples", "2"}};
     case gi::FilterKind::PathTracedReference:
       return {{"samples_per_vertex", "4"}, {"min_samples", "4"}, {"max_samples", "8"}, {"max_depth", "3"},
-              {"sky_irradiance", sky}};
+              {"sky_irradiance", "1"}};
     case gi::FilterKind::FormFactorsOfFace:
       return {{"face_index", std::to_string(a % 4)}, {"form_factor_method", std::to_string(b % 3)},
               {"rays_per_patch", "16"}, {"hemicube_resolution", "16"}};
     case gi::FilterKind::RayTracedView:
       return {{"mode", std::to_string(a % 4)}, {"width", "8"}, {"height", "6"}, {"samples_per_pixel", "1"},
-              {"caustic_photons", "200"}, {"gather_rays", "2"}, {"max_depth", "3"}, {"sky_irradiance", sky},
+              {"caustic_photons", "200"}, {"gather_rays", "2"}, {"max_depth", "3"}, {"sky_irradiance", "1"},
               {"light_samples", "1"}};
     case gi::FilterKind::HemicubeOfFace:
       return {{"face_index", std::to_string(a % 4)}, {"hemicube_resolution", "8"}, {"nusselt_resolution", "16"}};
@@ -101,10 +100,9 @@ Params budget(gi::FilterKind kind, Bytes& in) {
   }
 }
 
-template <class T>
-void finiteAll(const std::vector<T>& v, const std::string& kind, const char* what) {
-  for (const auto& x : v)
-    if (!std::isfinite(double(x))) finding(kind, what);
+void finiteAll(const std::vector<float>& v, const std::string& kind, const char* what) {
+  for (float x : v)
+    if (!std::isfinite(x)) finding(kind, what);
 }
 void finiteVecs(const std::vector<glm::vec3>& v, const std::string& kind, const char* what) {
   for (const auto& x : v)
@@ -191,9 +189,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       finiteAll(l.quality, name, "a non-finite quality in a new layer");
       finiteVecs(l.normals, name, "a non-finite normal in a new layer");
     }
-    for (const auto& im : r.images)
-      for (const auto& px : im.image.px)
-        if (!std::isfinite(px.x) || !std::isfinite(px.y) || !std::isfinite(px.z)) finding(name, "a non-finite pixel");
+    for (const auto& im : r.images) finiteVecs(im.image.px, name, "a non-finite pixel");
     if (verbose) std::fprintf(stderr, "%s: %zu vertices, %zu faces: computed\n", name.c_str(), nv, nf);
   } catch (const std::invalid_argument& e) {
     // unusable input or parameters: the documented refusal
