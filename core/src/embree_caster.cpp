@@ -2,7 +2,9 @@
 // callback installed before anything else, primitives limited to usable faces.
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -72,6 +74,9 @@ class SceneHandle {
 // are in local units, Scene::unit), so meeting one is an error to report,
 // never a reason to abort MeshLab.
 constexpr float kFltLarge = 1.844e18f;
+// The largest local coordinate a scene may have: far above any scene built by
+// Scene::fromAbsolute, far below where the squares of lengths overflow a float.
+constexpr float kMaxLocalCoordinate = 1099511627776.f;  // 2^40
 inline bool representable(const glm::vec3& o, const glm::vec3& d) {
   return std::fabs(o.x) <= kFltLarge && std::fabs(o.y) <= kFltLarge && std::fabs(o.z) <= kFltLarge &&
          std::fabs(d.x) <= kFltLarge && std::fabs(d.y) <= kFltLarge && std::fabs(d.z) <= kFltLarge;
@@ -108,10 +113,23 @@ class EmbreeCaster final : public RayCaster {
       indices_.resize(3 * primToFace_.size());
       float* vb = vertices_.data();
       uint32_t* ib = indices_.data();
+      float extent = 0.f;
       for (size_t i = 0; i < s.positions.size(); ++i) {
         const auto& p = s.positions[i];
         const bool fin = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
         vb[3 * i] = fin ? p.x : 0.f; vb[3 * i + 1] = fin ? p.y : 0.f; vb[3 * i + 2] = fin ? p.z : 0.f;
+        if (fin) extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+      }
+      // Scene::fromAbsolute keeps local coordinates within about 2^21; a
+      // scene filled directly with world coordinates of 1e30 would overflow
+      // the squared lengths of rays and light samples (inf, then NaN or
+      // undefined conversions). Refused here, before any algorithm uses it.
+      if (extent > kMaxLocalCoordinate) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "the scene's coordinates reach %.3g local units, beyond the %.3g rays can "
+                      "represent: a scene is built in local units (Scene::fromAbsolute)", double(extent),
+                      double(kMaxLocalCoordinate));
+        throw std::runtime_error(buf);
       }
       for (size_t k = 0; k < primToFace_.size(); ++k) {
         const auto& t = s.triangles[primToFace_[k]];

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -481,3 +482,27 @@ TEST(RayCaster, UnusableFacesAreExcludedAndIndicesKept) {
 }
 
 }  // namespace
+
+// A scene filled directly with world coordinates (not through
+// Scene::fromAbsolute) so large that squared lengths overflow a float: the
+// caster refuses it with a message, so no algorithm meets inf radii or
+// light samples (found by the filters' fuzz target). A scene at the edge
+// of the accepted range still builds.
+TEST(RayCaster, RefusesCoordinatesBeyondLocalUnits) {
+  gi::Scene s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1e30f, 0, 0}, {1e30f, 1, 0}, {1e30f, 0, 1}};
+  s.triangles = {{0, 1, 2}, {3, 4, 5}};
+  try {
+    gi::makeEmbreeCaster(s);
+    ADD_FAILURE() << "a scene at 1e30 local units was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("local units"), std::string::npos) << e.what();
+  }
+  for (auto& p : s.positions)
+    if (p.x > 1.f) p.x = 1e12f;  // below 2^40
+  const auto c = gi::makeEmbreeCaster(s);
+  gi::Ray r;
+  r.o = {0.25f, 0.25f, 1.f};
+  r.d = {0, 0, -1};
+  EXPECT_EQ(c->intersect(r).face, 0u);
+}
