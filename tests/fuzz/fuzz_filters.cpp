@@ -112,7 +112,9 @@ void finiteVecs(const std::vector<glm::vec3>& v, const std::string& kind, const 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const bool verbose = std::getenv("GI_FUZZ_VERBOSE") != nullptr;  // what each input did, on stderr
+  // GI_FUZZ_VERBOSE=1: what each input did, on stderr; 2: also the scene and
+  // the parameters (to rebuild a finding as a PLY and a `gi` command line).
+  static const int verbose = std::getenv("GI_FUZZ_VERBOSE") ? std::atoi(std::getenv("GI_FUZZ_VERBOSE")) : 0;
   Bytes in{data, size};
   static const gi::FilterKind kKinds[] = {
       gi::FilterKind::AmbientOcclusion, gi::FilterKind::AmbientObscurance, gi::FilterKind::SkyLighting,
@@ -136,6 +138,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     triangles.push_back({a, b, c});
   }
   fi.scene = gi::Scene::fromAbsolute(points, triangles);  // as the front ends fill it
+  if (verbose >= 2) {
+    std::fprintf(stderr, "%s", name.c_str());
+    for (const auto& [k, v] : params) std::fprintf(stderr, " --%s %s", k.c_str(), v.c_str());
+    std::fprintf(stderr, "\n");
+    for (const auto& q : points) std::fprintf(stderr, "v %.9g %.9g %.9g\n", q.x, q.y, q.z);
+    for (const auto& t : triangles) std::fprintf(stderr, "f %u %u %u\n", t.x + 1, t.y + 1, t.z + 1);
+  }
   const uint8_t extras = in.u8();
   if (extras & 1)
     for (size_t f = 0; f < nf; ++f) fi.attrs.faceColor.push_back({in.u8(), in.u8(), in.u8()});
