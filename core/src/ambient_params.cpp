@@ -96,6 +96,10 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                          "smaller neighbourhoods' within one standard error: on dense meshes neighbours see almost "
                          "the same hemisphere, so the same error needs fewer rays; at creases, contact shadows and "
                          "thin features the neighbourhood stays small. The standard error counts every ray pooled. "
+                         "Which to choose (measured, README): from about 100k vertices, shared with a target error "
+                         "(e.g. 0.02, minimum rays 8) reaches a given error with 6 to 8 times fewer rays and about "
+                         "a third of the time; on meshes of a few thousand to 30k vertices, or where the occlusion "
+                         "changes from vertex to vertex, per vertex is as fast or faster. "
                          "The cone option is always per vertex.",
                  .type = ParamType::Enum, .def = kAOEstimators.index(AOEstimator::PerVertex),
                  .choices = kAOEstimators.choices()});
