@@ -64,8 +64,11 @@ Params budget(gi::FilterKind kind, Bytes& in) {
   const uint8_t a = in.u8(), b = in.u8();
   switch (kind) {
     case gi::FilterKind::AmbientOcclusion:
-      return {{"rays_per_vertex", "8"}, {"estimator", std::to_string(a % 2)}, {"target_error", b % 2 ? "0.2" : "0"},
-              {"max_rays", "32"}, {"bent_normals", a & 2 ? "true" : "false"}, {"use_cone", a & 4 ? "true" : "false"}};
+      // 128 rays per vertex (a & 8): the per-vertex estimator's proof that a
+      // vertex is open for rays of any length runs from there.
+      return {{"rays_per_vertex", a & 8 ? "128" : "8"}, {"estimator", std::to_string(a % 2)},
+              {"target_error", b % 2 ? "0.2" : "0"}, {"max_rays", "32"}, {"bent_normals", a & 2 ? "true" : "false"},
+              {"use_cone", a & 4 ? "true" : "false"}};
     case gi::FilterKind::AmbientObscurance:
       return {{"rays_per_vertex", "8"}, {"estimator", std::to_string(a % 2)}, {"max_rays", "32"}};
     case gi::FilterKind::SkyLighting:
