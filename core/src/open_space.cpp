@@ -83,28 +83,6 @@ struct SceneBelowTest::Impl {
   const std::vector<glm::vec3>* normals = nullptr;
   float eps;
 
-  // The point farthest in direction d (branch and bound over the boxes).
-  glm::dvec3 farthest(const glm::dvec3& d) const {
-    const glm::dvec3 ad = glm::abs(d);
-    double best = -HUGE_VAL;
-    glm::dvec3 at(0.0);
-    int32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const Node& k = nodes[size_t(stack[--top])];
-      if (glm::dot(d, glm::dvec3(k.centre)) + glm::dot(ad, glm::dvec3(k.half)) * (1.0 + 1e-6) <= best) continue;
-      if (k.left < 0) {
-        for (uint32_t i = k.begin; i < k.end; ++i)
-          if (const double h = glm::dot(d, glm::dvec3(pts[i])); h > best) { best = h; at = glm::dvec3(pts[i]); }
-        continue;
-      }
-      stack[top++] = k.left + 1;
-      stack[top++] = k.left;
-    }
-    return at;
-  }
-
   // Fills nodes[id] over pts[b, e), split at the median of its box's longest side.
   void build(size_t id, uint32_t b, uint32_t e) {
     glm::vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
@@ -155,8 +133,14 @@ SceneBelowTest::SceneBelowTest(const Scene& s, float eps, const std::vector<glm:
     m.build(0, 0, uint32_t(m.pts.size()));
     for (int x = -1; x <= 1; ++x)
       for (int y = -1; y <= 1; ++y)
-        for (int z = -1; z <= 1; ++z)
-          if (x || y || z) m.extremes.push_back(m.farthest(glm::dvec3(x, y, z)));
+        for (int z = -1; z <= 1; ++z) {
+          if (!(x || y || z)) continue;
+          const glm::dvec3 d(x, y, z);
+          const auto far = std::max_element(m.pts.begin(), m.pts.end(), [&d](const glm::vec3& u, const glm::vec3& v) {
+            return glm::dot(d, glm::dvec3(u)) < glm::dot(d, glm::dvec3(v));
+          });
+          m.extremes.push_back(glm::dvec3(*far));
+        }
   }
 }
 
@@ -178,23 +162,26 @@ bool SceneBelowTest::sceneBelow(uint32_t v) const {
   // above their plane: no search for them.
   for (const glm::dvec3& q : m.extremes)
     if (glm::dot(nd, q - pd) > limit) return false;
-  int32_t stack[128];
+  if (bound(m.nodes[0]) <= limit) return true;
+  int32_t stack[128];  // nodes whose box reaches above the limit
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Impl::Node& k = m.nodes[size_t(stack[--top])];
-    if (bound(k) <= limit) continue;
     if (k.left < 0) {
       for (uint32_t i = k.begin; i < k.end; ++i)
         if (glm::dot(nd, glm::dvec3(m.pts[i]) - pd) > limit) return false;
       continue;
     }
-    // The child reaching higher above the plane last, so that it is searched
-    // first: a vertex that is not open meets a point above its plane soon.
+    // The children reaching above the limit, the higher one pushed last so
+    // that it is searched first: a vertex that is not open meets a point
+    // above its plane soon.
     const int32_t a = k.left, b = k.left + 1;
-    const bool aFirst = bound(m.nodes[size_t(a)]) >= bound(m.nodes[size_t(b)]);
-    stack[top++] = aFirst ? b : a;
-    stack[top++] = aFirst ? a : b;
+    const double ha = bound(m.nodes[size_t(a)]), hb = bound(m.nodes[size_t(b)]);
+    const bool aFirst = ha >= hb;
+    const double hLast = aFirst ? hb : ha, hFirst = aFirst ? ha : hb;
+    if (hLast > limit) stack[top++] = aFirst ? b : a;
+    if (hFirst > limit) stack[top++] = aFirst ? a : b;
   }
   return true;
 }

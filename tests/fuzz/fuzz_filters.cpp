@@ -116,7 +116,7 @@ void finiteVecs(const std::vector<glm::vec3>& v, const std::string& kind, const 
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // GI_FUZZ_VERBOSE=1: what each input did, on stderr; 2: also the scene and
-  // the parameters (to rebuild a finding as a PLY and a `gi` command line).
+  // the parameters (to rerun a finding with `gi`: the scene as OBJ lines).
   static const int verbose = std::getenv("GI_FUZZ_VERBOSE") ? std::atoi(std::getenv("GI_FUZZ_VERBOSE")) : 0;
   Bytes in{data, size};
   static const gi::FilterKind kKinds[] = {
