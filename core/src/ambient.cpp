@@ -234,8 +234,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const SceneReport rep = analyzeScene(scene, /*duplicateFaces=*/false, &usable);  // AO does not depend on them
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const size_t nv = scene.vertexCount();
-  const std::vector<glm::vec3> normals =
-      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene, &usable);
+  const std::vector<glm::vec3> normals = vertexNormalsForRays(scene, &usable);
 
   // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
   enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart };
@@ -245,7 +244,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     rep_of[i] = uint32_t(i);
     const glm::vec3& n = normals[i];
     const glm::vec3& p = scene.positions[i];
-    const bool ok = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(n.x) &&
+    const bool ok = finite3(p) && finite3(n) &&
                     glm::dot(n, n) > 0.5f;
     if (!ok) status[i] = kInvalid;
   }

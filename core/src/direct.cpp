@@ -35,7 +35,7 @@ VertexMaterial vertexMaterial(const Scene& s) {
       w[v] += a;
     }
   }
-  m.n = s.vertexNormals.size() == nv ? s.vertexNormals : computeVertexNormals(s);
+  m.n = vertexNormalsForRays(s);
   m.rho.resize(nv);
   m.E.resize(nv);
   m.valid.resize(nv);

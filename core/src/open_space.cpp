@@ -48,7 +48,9 @@ OpenSpaceTest::~OpenSpaceTest() = default;
 bool OpenSpaceTest::hemisphereEmpty(const glm::vec3& p, const glm::vec3& n, float maxDistance) const {
   const Impl& m = *impl_;
   if (m.cloud.pts.empty()) return true;
-  const float R = maxDistance + m.maxRadius + m.eps;
+  // Ray origins lie within sqrt(2) eps of p (lifted by eps, and pulled by
+  // eps into the faces at lopsided one-rings): reach 2 eps beyond maxDistance.
+  const float R = maxDistance + m.maxRadius + 2.f * m.eps;
   std::vector<std::pair<uint32_t, float>> found;
   nanoflann::SearchParams params;
   params.sorted = false;

@@ -265,7 +265,7 @@ std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, in
   const EmitterSampler lights(s);
   if (lights.empty() || rays < 1) return V;
   const float eps = float(sceneScale(s).rayEpsilon);
-  const std::vector<glm::vec3> normals = s.vertexNormals.size() == nv ? s.vertexNormals : computeVertexNormals(s);
+  const std::vector<glm::vec3> normals = vertexNormalsForRays(s);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, normals, eps);
   parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {

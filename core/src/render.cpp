@@ -42,8 +42,6 @@ void validate(const RenderOptions& o) {
   if (!o.renderImage && !o.vertexRadiance) throw std::invalid_argument("neither an image nor vertex radiance was asked for");
 }
 
-bool finite3(const glm::vec3& v) { return std::isfinite(v.r) && std::isfinite(v.g) && std::isfinite(v.b); }
-
 // One sample of the radiance along `ray`, whose first surface point is sp.
 glm::vec3 sampleRadiance(const Context& ctx, RenderMode mode, const Ray& ray, const SurfacePoint& sp, Sampler& smp,
                          Counts& c, uint64_t& nonFinite) {
@@ -145,7 +143,7 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
   const size_t nv = s.vertexCount();
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-  const std::vector<glm::vec3> vn = s.vertexNormals.size() == nv ? s.vertexNormals : computeVertexNormals(s);
+  const std::vector<glm::vec3> vn = vertexNormalsForRays(s);
   std::vector<uint32_t> start(nv + 1, 0), faces;
   for (size_t f = 0; f < s.faceCount(); ++f)
     if (ok[f])

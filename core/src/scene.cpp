@@ -140,7 +140,6 @@ double faceArea(const Scene& s, size_t f) {
   return 0.5 * glm::length(glm::cross(b - a, c - a));
 }
 
-static bool finite3(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
 
 std::vector<uint8_t> usableFaceMask(const Scene& s) {
   const size_t nv = s.positions.size();
@@ -222,6 +221,18 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<ui
       n[i] = l > 0.0 ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
     }
   });
+  return n;
+}
+
+std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<uint8_t>* usable) {
+  if (s.vertexNormals.size() != s.vertexCount()) return computeVertexNormals(s, usable);
+  std::vector<glm::vec3> n = s.vertexNormals;
+  for (glm::vec3& v : n) {
+    const glm::dvec3 d(v);
+    const double l2 = glm::dot(d, d);
+    if (!(l2 > 0.0) || !std::isfinite(l2)) v = glm::vec3(0.f);  // also NaN, and a component of Inf
+    else if (std::fabs(l2 - 1.0) > 1e-6) v = glm::vec3(d / std::sqrt(l2));  // unit ones keep their bits
+  }
   return n;
 }
 

@@ -135,8 +135,7 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   const SceneReport rep = analyzeScene(scene);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const size_t nv = scene.vertexCount();
-  const std::vector<glm::vec3> normals =
-      scene.vertexNormals.size() == nv ? scene.vertexNormals : computeVertexNormals(scene);
+  const std::vector<glm::vec3> normals = vertexNormalsForRays(scene);
   std::vector<glm::vec3> inward(nv);
   for (size_t i = 0; i < nv; ++i) inward[i] = -normals[i];
   // Origins just inside the surface (and into the incident faces at borders).
@@ -150,7 +149,7 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   for (size_t i = 0; i < nv; ++i) {
     const glm::vec3& p = scene.positions[i];
     const glm::vec3& n = normals[i];
-    valid[i] = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(n.x) &&
+    valid[i] = finite3(p) && finite3(n) &&
                glm::dot(n, n) > 0.5f;
   }
   const ThicknessKernel kernel(caster, opt);

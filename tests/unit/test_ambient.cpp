@@ -368,3 +368,132 @@ TEST(AmbientOcclusion, SceneBelowTangentPlaneMatchesBruteForce) {
   o.raysPerVertex = 64;
   EXPECT_EQ(computeAmbient(bunny, *caster, o).stats.get("skipped_open"), 0.0);
 }
+
+namespace {
+
+// A sharp cone standing on its base: apex 0 at (0, 0, h), k rim vertices,
+// the base's centre last.
+Scene sharpCone(int k, float radius, float h) {
+  Scene s;
+  s.positions.push_back({0.f, 0.f, h});
+  for (int i = 0; i < k; ++i) {
+    const float a = 6.2831853f * float(i) / float(k);
+    s.positions.push_back({radius * std::cos(a), radius * std::sin(a), 0.f});
+  }
+  s.positions.push_back({0.f, 0.f, 0.f});
+  for (int i = 0; i < k; ++i) {
+    const uint32_t a = 1 + uint32_t(i), b = 1 + uint32_t((i + 1) % k);
+    s.triangles.push_back({0u, a, b});
+    s.triangles.push_back({uint32_t(k + 1), b, a});
+  }
+  return s;
+}
+
+// AO per vertex with the open-vertex proofs on and off.
+std::pair<AmbientResult, AmbientResult> withAndWithoutProof(const Scene& s, AmbientOptions o) {
+  auto caster = makeEmbreeCaster(s);
+  o.skipOpenVertices = true;
+  AmbientResult on = computeAmbient(s, *caster, o);
+  o.skipOpenVertices = false;
+  AmbientResult off = computeAmbient(s, *caster, o);
+  return {std::move(on), std::move(off)};
+}
+
+}  // namespace
+
+// A library caller's vertex normals need not be unit length: they are scaled
+// to it, so the rays' frames, their origins and the open-vertex proofs agree.
+// (Unscaled, a cone's apex with a normal of length 0.75 got 1 with the proof
+// and 0 without, its ray origin under the surface; a tilted flat plate's
+// centre 1 against 0.988, rays leaving below its plane.)
+TEST(AmbientOcclusionStress, UserNormalsOfAnyLengthActAsUnit) {
+  AmbientOptions o;
+  o.raysPerVertex = 256;  // per vertex, rays of any length: the scene-below proof runs
+  for (float len : {0.75f, 1.5f}) {
+    Scene cone = sharpCone(16, 0.1f, 1.f);
+    cone.vertexNormals = computeVertexNormals(cone);
+    cone.vertexNormals[0] *= len;
+    const auto [on, off] = withAndWithoutProof(cone, o);
+    EXPECT_EQ(on.value[0], 1.f) << "apex, |n| " << len;
+    EXPECT_EQ(off.value[0], 1.f) << "apex, |n| " << len;
+    EXPECT_EQ(on.value, off.value) << "|n| " << len;
+
+    Scene plate;  // 9 x 9 vertices in a plane tilted to the normal (0.6, 0, 0.8)
+    const glm::vec3 e1(0.8f, 0.f, -0.6f), e2(0.f, 1.f, 0.f);
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i) plate.positions.push_back(e1 * (float(i) / 8.f) + e2 * (float(j) / 8.f));
+    for (uint32_t j = 0; j < 8; ++j)
+      for (uint32_t i = 0; i < 8; ++i) {
+        const uint32_t a = j * 9 + i;
+        plate.triangles.push_back({a, a + 1, a + 10});
+        plate.triangles.push_back({a, a + 10, a + 9});
+      }
+    plate.vertexNormals = computeVertexNormals(plate);
+    for (auto& n : plate.vertexNormals) n *= len;
+    const auto [pon, poff] = withAndWithoutProof(plate, o);
+    for (size_t v = 0; v < plate.vertexCount(); ++v) {
+      EXPECT_EQ(pon.value[v], 1.f) << "vertex " << v << ", |n| " << len;
+      EXPECT_EQ(poff.value[v], 1.f) << "vertex " << v << ", |n| " << len;
+    }
+  }
+}
+
+// A normal with an infinite or NaN component makes its vertex invalid (0, no
+// rays), with the proof or without (the proof said 1 for (0, 0, inf); the
+// rays threw on a non-finite ray origin).
+TEST(AmbientOcclusionStress, NonFiniteUserNormalIsInvalid) {
+  AmbientOptions o;
+  o.raysPerVertex = 256;
+  for (const glm::vec3 bad : {glm::vec3(0.f, 0.f, INFINITY), glm::vec3(NAN, 0.f, 1.f), glm::vec3(0.f)}) {
+    Scene cone = sharpCone(16, 0.1f, 1.f);
+    cone.vertexNormals = computeVertexNormals(cone);
+    cone.vertexNormals[0] = bad;
+    const auto [on, off] = withAndWithoutProof(cone, o);
+    EXPECT_EQ(on.value[0], 0.f);
+    EXPECT_EQ(on.rays[0], 0);
+    EXPECT_EQ(on.stats.get("skipped_invalid"), 1.0);
+    EXPECT_EQ(on.value, off.value);
+  }
+}
+
+// The proof for rays limited to max_distance searches far enough for ray
+// origins pulled into the faces at a lopsided one-ring (sqrt(2) eps from the
+// vertex): a single floor triangle's corner under a fin whose tip passes its
+// ray origin, with the fin's centre just beyond the reach of a search for
+// origins at eps. It got 1 with the proof and 0.2 with rays.
+TEST(AmbientOcclusion, OpenWithinReachCoversPulledOrigins) {
+  Scene s;
+  auto add = [&s](const glm::dvec3& p) {
+    s.positions.push_back(glm::vec3(p));
+    return uint32_t(s.positions.size() - 1);
+  };
+  for (double sign : {-1.0, 1.0}) {  // two tiny far triangles set the scene's size, hence eps
+    const glm::dvec3 q(0.6 * sign);
+    const uint32_t a = add(q), b = add(q + glm::dvec3(1e-4, 0, 0)), c = add(q + glm::dvec3(0, 1e-4, 0));
+    s.triangles.push_back({a, b, c});
+  }
+  const double eps = sceneScale(s).rayEpsilon;
+  const uint32_t p = add({0, 0, 0});
+  const uint32_t f1 = add({3 * eps, 0, 0}), f2 = add({0, 3 * eps, 0});
+  s.triangles.push_back({p, f1, f2});
+  const glm::dvec3 o = eps * glm::dvec3(std::sqrt(0.5), std::sqrt(0.5), 1.0);  // p's ray origin
+  // The fin: a long thin triangle in a plane just above o, its axis 20 degrees
+  // below the direction of the pull, its tip 0.1 eps behind o.
+  const double th = 0.25 * M_PI + 20.0 * M_PI / 180.0;
+  const glm::dvec3 h = glm::normalize(glm::dvec3(1, 1, 0));
+  const glm::dvec3 ax = std::sin(th) * h + std::cos(th) * glm::dvec3(0, 0, 1);
+  const glm::dvec3 m = glm::normalize(glm::dvec3(0, 0, 1) - ax.z * ax);
+  const glm::dvec3 w = glm::cross(m, ax);
+  const double L = 75 * eps, W = 0.55 * L;
+  const glm::dvec3 tip = o + 0.03 * eps * m - 0.1 * eps * ax;
+  const uint32_t t0 = add(tip), t1 = add(tip + L * ax + W * w), t2 = add(tip + L * ax - W * w);
+  s.triangles.push_back({t0, t1, t2});
+  ASSERT_EQ(sceneScale(s).rayEpsilon, eps);  // the fin stays inside the box
+  AmbientOptions opt;
+  opt.raysPerVertex = 256;
+  opt.maxDistance = 0.1 * eps;
+  opt.mergeDuplicates = false;
+  const auto [on, off] = withAndWithoutProof(s, opt);
+  EXPECT_LT(off.value[p], 0.5f);  // the fin covers most of what p's rays reach
+  EXPECT_EQ(on.value, off.value);
+}

@@ -1,5 +1,6 @@
 // The engine's scene: triangles with per-face materials. No Qt, no MeshLab.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -72,6 +73,12 @@ std::vector<glm::vec3> unitFaceNormals(const Scene& s);
 // vertices. `usable`: usableFaceMask(s), where the caller already has it (a
 // pass over every face less; computed here otherwise). The same below.
 std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<uint8_t>* usable = nullptr);
+// The vertex normals every per-vertex estimator uses: s.vertexNormals if it
+// has one per vertex (a library caller's own), each scaled to unit length in
+// double (the estimators' frames, ray origins and open-vertex proofs assume
+// it) and set to zero where it is zero or not finite (such a vertex then
+// counts as invalid); else computeVertexNormals(s, usable).
+std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<uint8_t>* usable = nullptr);
 
 struct SceneReport {
   size_t vertices = 0, faces = 0;
@@ -105,6 +112,8 @@ SceneScale sceneScale(const Scene& s);
 inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
+// All three components finite (no NaN, no Inf).
+inline bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 // For the functions that take the mask from a caller who already has it:
 // *known if given, else usableFaceMask(s) computed into `own`.
 const std::vector<uint8_t>& usableFaces(const Scene& s, const std::vector<uint8_t>* known, std::vector<uint8_t>& own);
