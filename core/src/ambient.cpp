@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include <tbb/parallel_sort.h>
@@ -157,13 +158,56 @@ class AmbientKernel {
   float tfar_, coneCos_, sunCos_;
 };
 
-void checkOptions(const AmbientOptions& o) {
+// The parameter table refuses all of these; a library caller filling
+// AmbientOptions directly gets the same refusals. Returns the options with
+// the cone's and the sun's directions scaled to unit length.
+AmbientOptions checkedOptions(const AmbientOptions& in) {
+  AmbientOptions o = in;
+  auto finiteColour = [](const glm::vec3& c) { return finite3(c) && c.r >= 0.f && c.g >= 0.f && c.b >= 0.f; };
+  // A direction of unit length keeps its bits (the table's are unit already).
+  auto unit = [](const glm::vec3& d) -> std::optional<glm::vec3> {
+    const double l2 = glm::dot(glm::dvec3(d), glm::dvec3(d));
+    if (std::isfinite(l2) && std::fabs(l2 - 1.0) <= 1e-6) return d;
+    return unitDirection(d);
+  };
+  if (!(o.targetError >= 0.0) || !std::isfinite(o.targetError))
+    throw std::invalid_argument("target_error must be a finite number >= 0");
+  if (o.targetError > 0.0 && (o.minRays < 1 || o.maxRays < 1))
+    throw std::invalid_argument("min_rays and max_rays must be >= 1");
   if (o.targetError > 0.0 && o.minRays > o.maxRays)
     throw std::invalid_argument("min_rays (" + std::to_string(o.minRays) + ") exceeds max_rays (" + std::to_string(o.maxRays) + ")");
   if (o.mode == AmbientMode::Obscurance && !(o.maxDistance > 0.0))
     throw std::invalid_argument("obscurance needs a maximum distance > 0 (its falloff is relative to it)");
   if (!(o.maxDistance >= 0.0)) throw std::invalid_argument("max_distance must be >= 0");
   if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
+  if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
+  if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
+    throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");
+  if (o.mode == AmbientMode::Obscurance && !(o.falloffExponent > 0.f && std::isfinite(o.falloffExponent)))
+    throw std::invalid_argument("the falloff exponent must be a finite number > 0");
+  if (o.useCone) {
+    if (!(o.coneAngleDeg > 0.f && o.coneAngleDeg <= 180.f))
+      throw std::invalid_argument("cone_angle must lie in (0, 180] degrees");
+    const auto d = unit(o.coneDirection);
+    if (!d) throw std::invalid_argument("cone_direction must be a finite, nonzero vector");
+    o.coneDirection = *d;
+  }
+  if (o.mode == AmbientMode::Sky) {
+    if (!(o.skyIrradiance >= 0.f && std::isfinite(o.skyIrradiance)) ||
+        !(o.sunIrradiance >= 0.f && std::isfinite(o.sunIrradiance)))
+      throw std::invalid_argument("sky_irradiance and sun_irradiance must be finite numbers >= 0");
+    if (!finiteColour(o.skyRadiantColor) || !finiteColour(o.sunColor))
+      throw std::invalid_argument("the sky's and the sun's colours must be finite and >= 0");
+    if (o.sunIrradiance > 0.f) {
+      const auto d = unit(o.sunDirection);
+      if (!d) throw std::invalid_argument("sun_direction must be a finite, nonzero vector");
+      o.sunDirection = *d;
+      if (!(o.sunAngularRadiusDeg >= 0.f && o.sunAngularRadiusDeg <= 90.f))
+        throw std::invalid_argument("sun_angular_radius must lie in [0, 90] degrees");
+      if (o.sunRays < 1) throw std::invalid_argument("sun_rays must be >= 1");
+    }
+  }
+  return o;
 }
 
 // Warnings for settings that make the result meaningless (RunStats::warn);
@@ -224,8 +268,7 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
 
 AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& optWorld,
                              const Progress& progress) {
-  checkOptions(optWorld);
-  AmbientOptions opt = optWorld;
+  AmbientOptions opt = checkedOptions(optWorld);
   opt.maxDistance = optWorld.maxDistance / scene.unit;  // local units (Scene::unit)
   Timer timer;
   // Which faces the ray caster builds: one pass over the faces for the

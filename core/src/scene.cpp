@@ -226,12 +226,18 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<ui
 
 std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<uint8_t>* usable) {
   if (s.vertexNormals.size() != s.vertexCount()) return computeVertexNormals(s, usable);
+  std::vector<uint8_t> own;
+  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
+  std::vector<uint8_t> onFace(s.vertexCount(), 0);
+  for (size_t f = 0; f < ok.size(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) onFace[s.triangles[f][k]] = 1;
   std::vector<glm::vec3> n = s.vertexNormals;
-  for (glm::vec3& v : n) {
-    const glm::dvec3 d(v);
+  for (size_t i = 0; i < n.size(); ++i) {
+    const glm::dvec3 d(n[i]);
     const double l2 = glm::dot(d, d);
-    if (!(l2 > 0.0) || !std::isfinite(l2)) v = glm::vec3(0.f);  // also NaN, and a component of Inf
-    else if (std::fabs(l2 - 1.0) > 1e-6) v = glm::vec3(d / std::sqrt(l2));  // unit ones keep their bits
+    if (!onFace[i] || !(l2 > 0.0) || !std::isfinite(l2)) n[i] = glm::vec3(0.f);  // also NaN, and a component of Inf
+    else if (std::fabs(l2 - 1.0) > 1e-6) n[i] = glm::vec3(d / std::sqrt(l2));   // unit ones keep their bits
   }
   return n;
 }

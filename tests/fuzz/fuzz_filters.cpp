@@ -7,7 +7,8 @@
 // scene's sizes, finite values) or throw std::invalid_argument or
 // std::runtime_error (the documented refusals); anything else (a crash, a
 // sanitizer report, another exception, a NaN written out, a hang) is a
-// finding.
+// finding. For ambient occlusion per vertex, the open-vertex proofs must
+// also leave every value as the rays give it (openVertexOracle).
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -15,12 +16,15 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
+#include "gi/ambient.h"
 #include "gi/filter_run.h"
 #include "gi/filters.h"
 #include "gi/params.h"
+#include "gi/raycaster.h"
 #include "gi/scene.h"
 
 namespace {
@@ -110,6 +114,32 @@ void finiteAll(const std::vector<float>& v, const std::string& kind, const char*
 void finiteVecs(const std::vector<glm::vec3>& v, const std::string& kind, const char* what) {
   for (const auto& x : v)
     if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) finding(kind, what);
+}
+
+// A differential oracle for the open-vertex proofs (gi/open_space.h): per
+// vertex at 128 rays (where the proof for rays of any length runs), with rays
+// of any length or limited, and half the time the input's own vertex normals
+// (a library caller's: any length, hostile values), the values with the
+// proofs must be exactly those without, or both runs refuse.
+void openVertexOracle(gi::Scene s, Bytes& in) {
+  const uint8_t how = in.u8();
+  if (how & 1)
+    for (size_t i = 0; i < s.vertexCount(); ++i) s.vertexNormals.push_back({in.coord(), in.coord(), in.coord()});
+  gi::AmbientOptions o;
+  o.raysPerVertex = 128;
+  o.maxDistance = how & 2 ? 0.0 : 0.25 * double(1 + (how >> 2));
+  auto run = [&](bool skip) -> std::optional<std::vector<float>> {
+    try {
+      const auto caster = gi::makeEmbreeCaster(s);
+      o.skipOpenVertices = skip;
+      return gi::computeAmbient(s, *caster, o).value;
+    } catch (const std::invalid_argument&) {
+      return std::nullopt;
+    } catch (const std::runtime_error&) {
+      return std::nullopt;
+    }
+  };
+  if (run(true) != run(false)) finding("ambient occlusion", "the open-vertex proofs changed a value");
 }
 
 }  // namespace
@@ -203,6 +233,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     for (const auto& im : r.images) finiteVecs(im.image.px, name, "a non-finite pixel");
     if (verbose) std::fprintf(stderr, "%s: %zu vertices, %zu faces: computed\n", name.c_str(), nv, nf);
+    if (kind == gi::FilterKind::AmbientOcclusion && params.at("estimator") == "0") openVertexOracle(fi.scene, in);
   } catch (const std::invalid_argument& e) {
     // unusable input or parameters: the documented refusal
     if (verbose) std::fprintf(stderr, "%s: %zu vertices, %zu faces: refused: %s\n", name.c_str(), nv, nf, e.what());

@@ -240,16 +240,17 @@ TEST(Scene, VertexNormalsOfClosedCubePointOutwards) {
 
 // A caller's vertex normals reach the ray estimators at unit length (scaled
 // in double; unit ones keep their bits), or as zero where they are zero or
-// not finite (the vertex is then invalid); without them, the computed ones.
+// not finite, or the vertex is on no usable face (it is then invalid);
+// without them, the computed ones.
 TEST(Scene, VertexNormalsForRaysAreUnitOrZero) {
   gi::Scene s;
-  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 2, 0}, {3, 3, 0}};
-  s.triangles = {{0, 1, 2}};
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {1, 2, 0}, {5, 5, 5}};
+  s.triangles = {{0, 1, 2}, {3, 4, 5}};
   EXPECT_EQ(gi::vertexNormalsForRays(s), gi::computeVertexNormals(s));
   const glm::vec3 unit = glm::normalize(glm::vec3(0.3f, -0.2f, 0.9f));
-  s.vertexNormals = {{0, 0, 2}, {3, 4, 0}, unit, {kInf, 0, 0}, {kNaN, 0, 1}, {0, 0, 0}};
+  s.vertexNormals = {{0, 0, 2}, {3, 4, 0}, unit, {kInf, 0, 0}, {kNaN, 0, 1}, {0, 0, 0}, {0, 0, 1}};
   const std::vector<glm::vec3> n = gi::vertexNormalsForRays(s);
-  ASSERT_EQ(n.size(), 6u);
+  ASSERT_EQ(n.size(), 7u);
   EXPECT_EQ(n[0], glm::vec3(0, 0, 1));
   EXPECT_NEAR(n[1].x, 0.6f, 1e-7f);
   EXPECT_NEAR(n[1].y, 0.8f, 1e-7f);
@@ -258,4 +259,5 @@ TEST(Scene, VertexNormalsForRaysAreUnitOrZero) {
   EXPECT_EQ(n[3], glm::vec3(0.f));
   EXPECT_EQ(n[4], glm::vec3(0.f));
   EXPECT_EQ(n[5], glm::vec3(0.f));
+  EXPECT_EQ(n[6], glm::vec3(0.f));  // isolated
 }

@@ -76,8 +76,9 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<ui
 // The vertex normals every per-vertex estimator uses: s.vertexNormals if it
 // has one per vertex (a library caller's own), each scaled to unit length in
 // double (the estimators' frames, ray origins and open-vertex proofs assume
-// it) and set to zero where it is zero or not finite (such a vertex then
-// counts as invalid); else computeVertexNormals(s, usable).
+// it) and set to zero where it is zero or not finite, or where the vertex is
+// on no usable face, as a computed one would be (such a vertex then counts
+// as invalid); else computeVertexNormals(s, usable).
 std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<uint8_t>* usable = nullptr);
 
 struct SceneReport {
