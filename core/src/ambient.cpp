@@ -111,7 +111,17 @@ class AmbientKernel {
 
  private:
   double stdError(const Moments& w, int n, double num, double den, double numSq, double denSq, double numDen) const {
-    if (!o_.useCone) return w.stdError();
+    if (!o_.useCone) {
+      // Rays that all agreed (all 32 first rays of a vertex escaped, past a
+      // thin occluder seen edge-on) have a sample variance of 0: then the
+      // variance of a Bernoulli variable at the Laplace estimate
+      // (sum + 1) / (n + 2) stands in, as in the shared estimator. Reporting
+      // 0 stopped such vertices with errors of 20 reported standard errors.
+      const double se = w.stdError();
+      if (se > 0.0 || w.n < 1) return se;
+      const double p = (w.sum + 1.0) / (w.n + 2.0);
+      return std::sqrt(p * (1.0 - p) / w.n);
+    }
     if (den <= 0.0 || n < 2) return 0.0;
     // Ratio estimator R = sum(f c) / sum(c): delta-method variance of mean(f c - R c) / mean(c).
     const double R = num / den, N = n;

@@ -361,7 +361,11 @@ TEST(AmbientOcclusion, SceneBelowTangentPlaneMatchesBruteForce) {
   const double open = skipped.stats.get("skipped_open");
   EXPECT_GT(open, 0.05 * double(bunny.vertexCount()));
   EXPECT_EQ(skipped.value, traced.value);
-  EXPECT_EQ(skipped.stdError, traced.stdError);
+  // The same standard errors where rays were cast; a proven vertex reports 0
+  // (its rays, all escaping, report the Laplace bound instead).
+  for (size_t v = 0; v < bunny.vertexCount(); ++v)
+    if (skipped.rays[v] > 0) EXPECT_EQ(skipped.stdError[v], traced.stdError[v]) << v;
+    else EXPECT_EQ(skipped.stdError[v], 0.f) << v;
   EXPECT_EQ(skipped.stats.get("rays"), traced.stats.get("rays") - 256.0 * open);
   // Below 128 rays per vertex the proof costs more than it saves: not run.
   o.skipOpenVertices = true;

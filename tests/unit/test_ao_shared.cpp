@@ -75,7 +75,8 @@ struct Region {
 std::vector<Region> regions(const TestScene& t) {
   Region crease{"crease and its contact shadow (floor within 0.15 of the wall, wall below 0.15)", {}},
       contact{"sphere resting on the floor (floor within 0.3 of the contact point, sphere below z = 0.1)", {}},
-      thin{"thin disc (both sides and the rim) and the floor under it", {}}, all{"all vertices", {}};
+      thin{"thin disc (both sides and the rim) and the floor under it", {}},
+      edge{"the floor along the disc's shadow edge (0.3 to 0.45 from its axis)", {}}, all{"all vertices", {}};
   for (size_t i = 0; i < t.end; ++i) {
     const glm::dvec3 p = t.s.toWorld(t.s.positions[i]);
     all.v.push_back(i);
@@ -84,8 +85,9 @@ std::vector<Region> regions(const TestScene& t) {
     if ((i < t.wall0 && dContact < 0.3) || (i >= t.sphere0 && i < t.disc0 && p.z < 0.1)) contact.v.push_back(i);
     const double dDisc = glm::length(glm::dvec2(p.x - kDiscCentre.x, p.y - kDiscCentre.y));
     if (i >= t.disc0 || (i < t.wall0 && dDisc < 0.45)) thin.v.push_back(i);
+    if (i < t.wall0 && dDisc > 0.3 && dDisc < 0.45) edge.v.push_back(i);
   }
-  return {crease, contact, thin, all};
+  return {crease, contact, thin, edge, all};
 }
 
 AmbientResult run(const Scene& s, const AmbientOptions& o) {
@@ -126,6 +128,7 @@ const TestScene& scene() {
 
 // The bound on mean (error / reported standard error)^2 (see below).
 constexpr double kMaxMeanZ2 = 1.5;
+constexpr double kEdgeMeanZ2 = 2.0;  // the floor along the disc's shadow edge: see below
 
 struct Errors {
   double rms = 0;     // RMS of (shared - reference)
@@ -173,10 +176,17 @@ Errors errors(const AmbientResult& a, const AmbientResult& ref, const std::vecto
 //    error adds < 0.1, and a region's mean over its >= 20 independent pools
 //    (693 vertices and more, about 35 per pool) has a relative standard
 //    deviation of about sqrt(2/20) = 0.32: 1.5 is 1.5 of those above 1.
-//    Measured: 0.33 to 0.95 (before the variance was taken at the largest
+//    Measured: 0.19 to 0.65 (before the variance was taken at the largest
 //    pool: up to 1.38). With Lepski's threshold at 2 standard errors instead
 //    of 1 the thin disc's region gave 2.5 (the pooling bias it lets through
 //    under the disc's rim).
+//  - The one exception, mean z^2 <= kEdgeMeanZ2 = 2.0: the floor along the
+//    disc's shadow edge (567 vertices), where the occlusion bends across a
+//    band a few rings wide and the first-order fit is biased by a fraction
+//    of a standard error at every vertex. The bias term of the reported
+//    error (the last ring's step, ao_pool_internal.h) brought it from 3.3 to
+//    1.85; reaching 1 (the step from the own rays at every scale) cost 12%
+//    more rays at equal error on scan_470k.
 // Pooling across the rim of the disc (normal tolerance ignored) or across the
 // crease breaks these bounds: see SharingCarelesslyFails below.
 TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
@@ -189,7 +199,7 @@ TEST(AOShared, AdaptiveTargetHoldsEverywhereAgainstTheReference) {
     const Errors e = errors(a, ref, r.v, target);
     EXPECT_LE(e.rms, 1.25 * target) << r.name;
     EXPECT_LE(e.tail, 0.01) << r.name;
-    EXPECT_LE(e.meanZ2, kMaxMeanZ2) << r.name;
+    EXPECT_LE(e.meanZ2, r.name.rfind("the floor along", 0) == 0 ? kEdgeMeanZ2 : kMaxMeanZ2) << r.name;
     // Every vertex reports meeting the target or the maximum ray count.
     for (size_t i : r.v)
       ASSERT_TRUE(a.stdError[i] <= target + 1e-6 || a.rays[i] >= 4096) << r.name << " vertex " << i;
@@ -380,4 +390,23 @@ TEST(AOShared, FirstOrderFitFollowsAGradient) {
   EXPECT_NEAR(p.value, 0.5f, 1e-5f);
   // Its standard error: the fit's variance at the centre over v = p~(1 - p~).
   EXPECT_GT(p.stdError, std::sqrt(0.25f / (6.f * 1024.f)) * 0.9f);
+}
+
+// The per-vertex estimator's adaptive stop is honest along the same shadow
+// edge: a vertex whose first rays all escape past the thin disc, seen edge-on,
+// no longer reports 0 (the Laplace bound stands in), so it casts more rays.
+// Before, such vertices stopped at 32 rays reporting 0, off by 20 and more
+// reported standard errors.
+TEST(AOShared, PerVertexAdaptiveHonestAtTheShadowEdge) {
+  const TestScene& t = scene();
+  const AmbientResult& ref = reference(t.s);
+  AmbientOptions o = shared(0.02);
+  o.estimator = AOEstimator::PerVertex;
+  o.minRays = 32;
+  const AmbientResult a = run(t.s, o);
+  for (const Region& r : regions(t)) {
+    const Errors e = errors(a, ref, r.v, 0.02);
+    EXPECT_LE(e.meanZ2, kMaxMeanZ2) << r.name;
+    EXPECT_LE(e.tail, 0.01) << r.name;
+  }
 }
