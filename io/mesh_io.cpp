@@ -13,6 +13,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include "atomic_file.h"
 #include "mesh_parts.h"
 #include "vertex_file.h"
 
@@ -257,11 +258,13 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
     if (hasFC) w.u8(attrs.faceColor[f].r), w.u8(attrs.faceColor[f].g), w.u8(attrs.faceColor[f].b);
     if (hasFQ) w.f32(attrs.faceQuality[f]);
   }
-  std::ofstream os(path, std::ios::binary | std::ios::trunc);
-  if (!os) failWrite(path, "the file cannot be created");
-  os.write(w.buf.data(), std::streamsize(w.buf.size()));
-  os.close();
-  if (!os) failWrite(path, "writing failed (disk full?)");
+  writeAtomically(path, [&](const std::string& temp) {
+    std::ofstream os(temp, std::ios::binary | std::ios::trunc);
+    if (!os) failWrite(path, std::string("the file cannot be created (") + std::strerror(errno) + ")");
+    os.write(w.buf.data(), std::streamsize(w.buf.size()));
+    os.close();
+    if (!os) failWrite(path, std::string("writing failed (") + std::strerror(errno) + ")");
+  });
 }
 
 void appendMesh(LoadedMesh& into, const LoadedMesh& other) {

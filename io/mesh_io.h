@@ -37,6 +37,7 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other);
 // "quality" (float, if given), faces with colour and quality if attrs has them,
 // and optionally normals and named per-vertex attributes (a scalar as
 // "property float NAME", a vector as NAME_x, NAME_y, NAME_z).
+// Written whole or not at all (atomic_file.h).
 struct PlyExtras {
   std::vector<glm::vec3> normals;  // written as nx, ny, nz if not empty
   std::vector<VertexAttribute> attributes;

@@ -5,6 +5,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "atomic_file.h"
+#include "json_text.h"
+
 namespace gi::io {
 
 using json = nlohmann::json;
@@ -67,8 +70,7 @@ void writeResultFile(const std::string& path, const ResultKey& key, const Filter
   j["stats"] = numbers;
   j["notes"] = r.stats.notes;
   j["warnings"] = r.stats.warnings;
-  std::ofstream f(path);
-  if (!(f << j.dump())) throw std::runtime_error("cannot write " + path);
+  writeFileAtomically(path, dumpJson(j));
 }
 
 ResultKey readResultFile(const std::string& path, FilterResult& r) {

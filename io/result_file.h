@@ -19,6 +19,8 @@ struct ResultKey {
   std::string parameters;  // gi::describe(...) of every parameter
 };
 
+// Written whole or not at all (atomic_file.h); bytes of names that are not
+// UTF-8 become U+FFFD (json_text.h).
 void writeResultFile(const std::string& path, const ResultKey& key, const FilterResult& r);
 // Reads the arrays, attributes and statistics into r (which keeps its scene
 // report and set-up log) and returns the file's key. Throws

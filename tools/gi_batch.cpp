@@ -3,8 +3,10 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,10 +16,14 @@
 #include <sstream>
 #include <tbb/global_control.h>
 
+#include "atomic_file.h"
+#include "gi/filter_files.h"
 #include "gi/filter_run.h"
 #include "gi/filters.h"
 #include "gi_cluster.h"
+#include "gi_files.h"
 #include "gi_output.h"
+#include "json_text.h"
 #include "mesh_io.h"
 #include "vertex_file.h"
 
@@ -119,6 +125,9 @@ const FilterDesc& findFilter(const std::string& name) {
 }
 
 std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSpec>& specs, const std::string& filter) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw std::invalid_argument("the manifest " + path + " is a folder: give a file listing the meshes, or --dir for a folder of meshes");
   std::ifstream f(path);
   if (!f) throw std::invalid_argument("cannot read the manifest " + path);
   const fs::path base = fs::path(path).parent_path();
@@ -139,6 +148,8 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
     j.where = where;
     jobs.push_back(j);
   }
+  if (f.bad()) throw std::invalid_argument("cannot read the manifest " + path + ": " + std::strerror(errno));
+  if (jobs.empty()) throw std::invalid_argument("the manifest " + path + " lists no mesh");
   return jobs;
 }
 
@@ -150,6 +161,7 @@ std::vector<Job> readFolder(const std::string& dir, const std::string& pattern) 
     if (e.is_regular_file() && fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0)
       names.push_back(e.path().filename().string());
   if (ec) throw std::invalid_argument("cannot list " + dir + ": " + ec.message());
+  if (names.empty()) throw std::invalid_argument("no file in " + dir + " matches --glob '" + pattern + "'");
   std::sort(names.begin(), names.end());
   std::vector<Job> jobs;
   for (const std::string& n : names) jobs.push_back({(fs::path(dir) / n).string(), {}, n + ": ", ""});
@@ -212,14 +224,12 @@ json readJson(const fs::path& p) {
   }
 }
 
-// Written beside and renamed into place: a file that exists is complete.
-void writeJson(const fs::path& p, const json& j) {
-  const fs::path tmp = p.string() + ".part";
-  {
-    std::ofstream f(tmp);
-    if (!(f << j.dump(2) << "\n")) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, p);
+// Written whole or not at all: a file that exists is complete.
+void writeJson(const fs::path& p, const json& j) { io::writeFileAtomically(p.string(), io::dumpJson(j, 2) + "\n"); }
+
+std::string reportName(const Args& a, size_t shard, size_t shards, bool explicitShard) {
+  const std::string part = std::to_string(shard) + "-of-" + std::to_string(shards) + ".json";
+  return !a.reportOnly ? "report-" + part : explicitShard ? "report-only-" + part : "report.json";
 }
 
 json statsJson(const RunStats& s) {
@@ -246,10 +256,9 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   in.attributes = std::move(mesh.attributes);
   in.readVertexFile = io::readVertexFile;
   FilterResult r = runFilter(d.kind, in);
-  const fs::path tmp = ply.string() + ".part";
-  writeResultPly(tmp.string(), in.scene, mesh.attrs, fileNormals, r);
+  // The layers first: a result PLY that exists has its layers beside it. Each file is written whole or not at all.
   const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
-  fs::rename(tmp, ply);
+  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r);
   json s;
   s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
   s["resolved"] = describe(specs, in.values);
@@ -261,6 +270,44 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   if (!layers.empty()) s["layers"] = layers;
   s["seconds"] = timer.seconds();
   return s;
+}
+
+// Every output the batch may write (each mesh's PLY, summary and new layers,
+// the report) against its inputs (the meshes, a reference file, the
+// manifest and the parameter file) and one another, before any mesh is
+// computed (gi_files.h).
+void checkFiles(const Args& a, const FilterDesc& d, const Texts& common, const std::vector<Job>& jobs, size_t shard,
+                size_t shards, bool explicitShard) {
+  const auto specs = filterSpecs(d.kind);
+  std::vector<files::Named> inputs, outputs;
+  if (!a.manifest.empty()) inputs.push_back({a.manifest, "--manifest"});
+  if (!a.paramsFile.empty()) inputs.push_back({a.paramsFile, "--params"});
+  for (const Job& j : jobs) {
+    inputs.push_back({j.input, ""});
+    // The files its parameters name (the values as given; one that does not parse fails that mesh alone).
+    ParamValues v = defaultValues(specs, 1.0);
+    Texts params = common;
+    for (const auto& [n, t] : j.overrides) params[n] = t;
+    for (const auto& [n, t] : params) {
+      try {
+        v.set(n, parseValue(*findSpec(specs, n), t, 1.0));
+      } catch (const std::invalid_argument&) {
+      }
+    }
+    FilterFiles plan;
+    try {
+      plan = filterFiles(d.kind, v);
+    } catch (const std::exception&) {
+    }
+    for (const NamedFile& f : plan.reads) inputs.push_back({f.path, "--" + f.parameter});
+    const std::string ply = (fs::path(a.outDir) / (j.stem + ".ply")).string();
+    if (a.reportOnly) continue;
+    outputs.push_back({ply, "the result of " + j.input});
+    outputs.push_back({(fs::path(a.outDir) / (j.stem + ".json")).string(), "the summary of " + j.input});
+    for (const std::string& name : plan.layers) outputs.push_back({layerPath(ply, name), "a layer of " + j.input});
+  }
+  outputs.push_back({(fs::path(a.outDir) / reportName(a, shard, shards, explicitShard)).string(), "the report"});
+  files::check(inputs, outputs);
 }
 
 }  // namespace
@@ -329,11 +376,7 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   std::error_code ec;
   fs::create_directories(a.outDir, ec);
   if (!fs::is_directory(a.outDir)) throw std::invalid_argument("cannot create the output folder " + a.outDir);
-  for (const Job& j : jobs) {
-    const fs::path ply = fs::path(a.outDir) / (j.stem + ".ply");
-    if (fs::exists(ply, ec) && fs::exists(j.input, ec) && fs::equivalent(ply, j.input, ec))
-      throw std::invalid_argument("the result " + ply.string() + " would overwrite its input: choose another output folder");
-  }
+  checkFiles(a, d, common, jobs, shard, shards, explicitShard);
   int threads = a.threads;
   if (threads == 0 && std::getenv("SLURM_CPUS_PER_TASK")) threads = std::max(1, std::atoi(std::getenv("SLURM_CPUS_PER_TASK")));
   std::unique_ptr<tbb::global_control> cap;
@@ -413,10 +456,9 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   rep["failures"] = failures;
   rep["rays_all"] = raysAll;
   rep["compute_seconds_all"] = computeAll;
-  const std::string part = std::to_string(shard) + "-of-" + std::to_string(shards) + ".json";
-  const std::string name = !a.reportOnly ? "report-" + part : explicitShard ? "report-only-" + part : "report.json";
+  const std::string name = reportName(a, shard, shards, explicitShard);
   writeJson(fs::path(a.outDir) / name, rep);
-  if (a.json) std::cout << rep.dump(2) << std::endl;
+  if (a.json) std::cout << io::dumpJson(rep, 2) << std::endl;
   if (!a.quiet) {
     char b[300];
     if (a.reportOnly)

@@ -4,25 +4,29 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cerrno>
+#include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <tbb/global_control.h>
 
+#include "gi/filter_files.h"
 #include "gi/filter_run.h"
 #include "gi/filters.h"
 #include "gi/refine.h"
 #include "gi/scene_setup.h"
+#include "atomic_file.h"
 #include "gi_batch.h"
 #include "gi_cluster.h"
 #include "gi_course.h"
+#include "gi_files.h"
 #include "gi_output.h"
+#include "json_text.h"
 #include "mesh_io.h"
 #include "result_file.h"
 #include "vertex_file.h"
@@ -130,6 +134,58 @@ ParamValues resolve(const std::vector<ParamSpec>& specs, const CommonArgs& a, do
   return v;
 }
 
+// The files a run reads and writes, as its parameters name them (gi/filter_files.h).
+struct RunFiles {
+  std::vector<files::Named> inputs, outputs;
+};
+
+RunFiles runFiles(FilterKind kind, const CommonArgs& a, const ParamValues& v) {
+  RunFiles f;
+  f.inputs.push_back({a.input, ""});
+  for (const std::string& l : a.layers) f.inputs.push_back({l, "--layer"});
+  const FilterFiles plan = filterFiles(kind, v);
+  for (const NamedFile& r : plan.reads) f.inputs.push_back({r.path, "--" + r.parameter});
+  if (!a.output.empty()) {
+    f.outputs.push_back({a.output, "--output"});
+    for (const std::string& name : plan.layers) f.outputs.push_back({layerPath(a.output, name), "the layer " + name + " beside --output"});
+  }
+  if (!a.saveResult.empty()) f.outputs.push_back({a.saveResult, "--save-result"});
+  for (const NamedFile& w : plan.writes) f.outputs.push_back({w.path, "--" + w.parameter});
+  return f;
+}
+
+// What a computed result writes: the PLY, its new layers, the saved result,
+// the files and images its parameters asked for.
+std::vector<files::Named> resultOutputs(const CommonArgs& a, const FilterResult& r) {
+  std::vector<files::Named> out;
+  if (!a.output.empty()) {
+    out.push_back({a.output, "--output"});
+    for (const FilterLayer& L : r.layers) out.push_back({layerPath(a.output, L.name), "the layer " + L.name + " beside --output"});
+  }
+  if (!a.saveResult.empty()) out.push_back({a.saveResult, "--save-result"});
+  for (const FilterFile& f : r.files) out.push_back({f.path, "a file the parameters name"});
+  for (const FilterImage& img : r.images)
+    if (!img.path.empty()) {
+      out.push_back({img.path, "an image the parameters name"});
+      out.push_back({pfmPath(img.path), "an image the parameters name"});
+    }
+  return out;
+}
+
+// The values runFiles needs before the mesh is loaded (strings, choices,
+// switches): a text that does not parse keeps its default here, and resolve
+// reports it once the mesh is loaded.
+ParamValues valuesBeforeLoading(const std::vector<ParamSpec>& specs, const CommonArgs& a) {
+  ParamValues v = defaultValues(specs, 1.0);
+  for (const auto& [name, text] : a.raw) {
+    try {
+      v.set(name, parseValue(*findSpec(specs, name), text, 1.0));
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  return v;
+}
+
 // Loads the input (and --layer files) as one scene, runs the filter through
 // gi::runFilter (or reuses a cached result of the same prepared scene and
 // parameters), writes the PLY and prints the log or the JSON summary.
@@ -139,6 +195,12 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   std::unique_ptr<tbb::global_control> threads;
   if (a.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(a.threads));
   Timer timer;
+  std::optional<RunFiles> early;  // every file, before the mesh is loaded
+  try {
+    early = runFiles(kind, a, valuesBeforeLoading(specs, a));
+  } catch (const std::exception&) {  // a value filterFiles cannot use: resolve reports it
+  }
+  if (early) files::check(early->inputs, early->outputs);
   io::LoadedMesh mesh = io::loadMesh(a.input);
   // Layers as in MeshLab: named by file name, for the mirror/glass patterns.
   auto baseName = [](const std::string& p) { const size_t k = p.find_last_of('/'); return k == std::string::npos ? p : p.substr(k + 1); };
@@ -152,6 +214,9 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);  // written back unchanged
   mesh.scene.vertexNormals.clear();
   in.values = resolve(specs, a, sceneDiagonal(mesh.scene));
+  RunFiles planned = runFiles(kind, a, in.values);
+  files::check(planned.inputs, planned.outputs);
+  const std::vector<files::Named> inputs = planned.inputs;
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
   in.attributes = std::move(mesh.attributes);  // what an earlier run left (PLY properties), e.g. a first pass
@@ -174,13 +239,22 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
       r.stats.note("reused the cached result " + cached);
     }
   }
+  if (!reused && !cached.empty() && writer) {  // the cache file is written after the computation: check it now
+    planned.outputs.push_back({cached, "--cache"});
+    files::check(inputs, planned.outputs);
+  }
   if (!reused) {
     cluster::compute(kind, in, r, progress, a.split);
     if (!writer) return 0;
-    if (!cached.empty() && !r.refined && r.layers.empty()) {  // a cached result holds no geometry
-      io::writeResultFile(cached, key, r);
-      r.stats.note("cached as " + cached);
-    }
+  }
+  const bool caching = !reused && !cached.empty() && !r.refined && r.layers.empty();  // a cached result holds no geometry
+  // The files the result names, checked as the plan was before anything is written.
+  std::vector<files::Named> outputs = resultOutputs(a, r);
+  if (caching) outputs.push_back({cached, "--cache"});
+  files::check(inputs, outputs);
+  if (caching) {
+    io::writeResultFile(cached, key, r);
+    r.stats.note("cached as " + cached);
   }
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
@@ -191,7 +265,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   } else if (!r.layers.empty()) {
     r.stats.note("the new layers are written only beside an output (-o)");
   }
-  writeOutputFiles(r);
+  writeOutputFiles(r, files::atomicWriter());
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {
@@ -212,7 +286,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     if (!r.setupLog.empty()) j["setup"] = r.setupLog;
     j["log"] = lines;
     if (const json m = cluster::report(); !m.is_null()) j["mpi"] = m;
-    std::cout << j.dump(2) << std::endl;
+    std::cout << io::dumpJson(j, 2) << std::endl;
   } else if (!a.quiet) {
     for (const std::string& l : lines) std::cerr << l << "\n";
     if (!a.output.empty()) std::cerr << "wrote " << a.output << "\n";
@@ -243,11 +317,36 @@ int listFilters(bool asJson) {
     all.push_back({{"cli", d.cliName}, {"meshlab", d.meshlabName}, {"plugin", d.plugin}, {"summary", d.summary},
                    {"writes", writes}, {"parameters", params}});
   }
-  if (asJson) std::cout << all.dump(2) << std::endl;
+  if (asJson) std::cout << io::dumpJson(all, 2) << std::endl;
   return 0;
 }
 
+// MeshLab reads a script's numbers in single precision (docs/design.md,
+// "Precision of parameters"): a number beyond the largest float would be
+// written as inf. Each Float and Distance value, and each distance's range
+// (its maximum fraction of the diagonal), must be finite as a float.
+void checkSinglePrecision(const std::vector<ParamSpec>& specs, const ParamValues& v, double diag, const std::string& mesh) {
+  const double largest = std::numeric_limits<float>::max();
+  for (const ParamSpec& p : specs) {
+    if (p.type != ParamType::Float && p.type != ParamType::Distance) continue;
+    const double x = std::fabs(v.getFloat(p.name));
+    const double range = p.type == ParamType::Distance ? (p.max > 0 ? p.max : 1.0) * diag : 0.0;
+    if (x <= largest && range <= largest) continue;
+    auto num = [](double y) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%g", y);
+      return std::string(b);
+    };
+    throw std::invalid_argument("cannot write --" + p.name + " into the script: " +
+                                (x > largest ? "its value is " + num(x) : "its range reaches " + num(range)) +
+                                ", beyond the largest single-precision number (3.4e+38) that MeshLab reads (the "
+                                "bounding-box diagonal" + (mesh.empty() ? "" : " of " + mesh) + " is " + num(diag) + ")");
+  }
+}
+
 int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
+  const bool toFile = !a.output.empty() && a.output != "-";
+  if (toFile) files::check({{a.mesh, "--mesh"}}, {{a.output, "--output"}});
   double diag = 1.0;
   if (!a.mesh.empty()) {
     diag = sceneDiagonal(io::loadMesh(a.mesh).scene);
@@ -259,14 +358,13 @@ int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
                        p.name.c_str(), p.def * 100);
   }
   std::vector<ScriptStep> steps;
-  for (FilterKind k : kinds) steps.push_back({k, resolve(filterSpecs(k), a, diag)});
-  const std::string text = mlxScript(steps, diag);
-  if (a.output.empty() || a.output == "-") {
-    std::cout << text;
-  } else {
-    std::ofstream f(a.output);
-    if (!(f << text)) throw std::runtime_error("cannot write " + a.output);
+  for (FilterKind k : kinds) {
+    steps.push_back({k, resolve(filterSpecs(k), a, diag)});
+    checkSinglePrecision(filterSpecs(k), steps.back().values, diag, a.mesh);
   }
+  const std::string text = mlxScript(steps, diag);
+  if (toFile) io::writeFileAtomically(a.output, text);
+  else std::cout << text;
   return 0;
 }
 
@@ -278,26 +376,6 @@ int failOneLine(std::string what) {
   while (!what.empty() && what.back() == ' ') what.pop_back();
   std::fprintf(stderr, "gi: error: %s\n", what.c_str());
   return 1;
-}
-
-// An output that cannot be written is reported before the computation, not after it.
-void checkOutputPath(const std::string& path, const std::string& option) {
-  namespace fs = std::filesystem;
-  if (path.empty()) throw std::invalid_argument(option + " is empty: give a file name");
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  const std::string cannot = "cannot write " + path + ": ";
-  if (fs::is_directory(st)) throw std::invalid_argument(cannot + "it is a directory");
-  if (fs::exists(st)) {
-    if (access(path.c_str(), W_OK) != 0) throw std::invalid_argument(cannot + std::strerror(errno));
-    return;
-  }
-  const fs::path parent = fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
-  const fs::file_status pst = fs::status(parent, ec);
-  if (!fs::exists(pst)) throw std::invalid_argument(cannot + "the folder " + parent.string() + " does not exist");
-  if (!fs::is_directory(pst)) throw std::invalid_argument(cannot + parent.string() + " is not a folder");
-  if (access(parent.c_str(), W_OK | X_OK) != 0)
-    throw std::invalid_argument(cannot + "the folder " + parent.string() + " is not writable (" + std::strerror(errno) + ")");
 }
 
 int runCli(int argc, char** argv) {
@@ -359,9 +437,9 @@ int runCli(int argc, char** argv) {
     return cluster::abandon() ? failOneLine(e.what()) : 1;
   }
   try {
-    for (const auto& [opt, path] : outputs)
-      if (opt->count() > 0) checkOutputPath(*path, opt->get_name());
-    if (scriptOutput->count() > 0 && a.output != "-") checkOutputPath(a.output, "--output");
+    for (const auto& [opt, path] : outputs)  // an empty name given is refused here; runCommand checks the rest
+      if (opt->count() > 0) files::checkWritable({*path, opt->get_name()});
+    if (scriptOutput->count() > 0 && a.output != "-") files::checkWritable({a.output, "--output"});
     for (auto& [sub, kind] : subs)
       if (sub->parsed()) return runCommand(kind, a);
     if (list->parsed()) return listFilters(a.json);

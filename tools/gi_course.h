@@ -16,7 +16,7 @@ struct TableArgs {
 
 CLI::App* addFormFactorTable(CLI::App& app, TableArgs& a);
 // Prints the table (or JSON); 0 when every method is within its tolerance, 2
-// when one is not (the table says which).
+// when one is not (the table marks it, and one line on stderr names them).
 int formFactorTable(const TableArgs& a);
 
 }  // namespace gi::course

@@ -13,6 +13,7 @@
 #include "gi/ambient.h"
 #include "gi/direct.h"
 #include "gi/error_map.h"
+#include "gi/filter_files.h"
 #include "gi/form_factors.h"
 #include "gi/hemicube_view.h"
 #include "gi/output.h"
@@ -460,21 +461,7 @@ const VertexAttribute* FilterInput::attribute(const std::string& name) const {
   return nullptr;
 }
 
-void writeOutputFiles(const FilterResult& r) {
-  for (const FilterFile& f : r.files) {
-    std::ofstream out(f.path, std::ios::binary);
-    out << f.text;
-    out.close();
-    if (!out) throw std::runtime_error("cannot write " + f.path);
-  }
-  for (const FilterImage& img : r.images) {
-    if (img.path.empty()) continue;
-    writePng(img.path, img.image, img.exposure);
-    const size_t dot = img.path.find_last_of('.'), slash = img.path.find_last_of('/');
-    const std::string stem = dot != std::string::npos && (slash == std::string::npos || dot > slash) ? img.path.substr(0, dot) : img.path;
-    writePfm(stem + ".pfm", img.image);
-  }
-}
+void writeOutputFiles(const FilterResult& r) { writeOutputFiles(r, nullptr); }
 
 std::string layerPath(const std::string& outputPly, const std::string& layerName) {
   const size_t slash = outputPly.find_last_of('/'), dot = outputPly.find_last_of('.');

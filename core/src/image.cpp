@@ -35,6 +35,23 @@ bool littleEndian() {
 
 uint32_t byteSwap(uint32_t x) { return (x >> 24) | ((x >> 8) & 0xff00u) | ((x << 8) & 0xff0000u) | (x << 24); }
 
+// libpng's own handlers print on stderr ("libpng error: Write Error"), which
+// would break a front end's one-line error: its error and warning go here
+// instead, the error with the errno of the write that failed.
+struct PngFailure {
+  char message[128];
+  int err;
+};
+
+[[noreturn]] void pngError(png_structp png, png_const_charp message) {
+  auto* f = static_cast<PngFailure*>(png_get_error_ptr(png));
+  f->err = errno;
+  std::snprintf(f->message, sizeof f->message, "%s", message ? message : "");
+  png_longjmp(png, 1);
+}
+
+void pngWarning(png_structp, png_const_charp) {}
+
 }  // namespace
 
 float imageExposure(const Image& img, double exposureParam, const std::vector<uint8_t>& mask) {
@@ -64,7 +81,8 @@ void writePng(const std::string& path, const Image& img, float exposure) {
   std::vector<png_bytep> rows(size_t(img.height));
   for (int y = 0; y < img.height; ++y)
     rows[size_t(y)] = const_cast<png_bytep>(bytes.data() + size_t(y) * size_t(img.width) * 3);
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  PngFailure failure{{0}, 0};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &failure, pngError, pngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
@@ -74,8 +92,10 @@ void writePng(const std::string& path, const Image& img, float exposure) {
   // built before this point, so the jump skips none.
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    throw std::runtime_error("libpng failed writing '" + path + "' (disk full?)");
+    throw std::runtime_error("could not write '" + path + "': " +
+                             (failure.err != 0 ? std::string(std::strerror(failure.err)) : "libpng: " + std::string(failure.message)));
   }
+  errno = 0;  // what a failing write leaves for pngError
   png_init_io(png, f.get());
   png_set_IHDR(png, info, png_uint_32(img.width), png_uint_32(img.height), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);

@@ -170,6 +170,15 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
   auto bad = [&](const std::string& why) {
     return std::invalid_argument("--" + s.name + " '" + text + "': " + why);
   };
+  // The engine and MeshLab keep these values in single precision (docs/design.md,
+  // "Precision of parameters"): a value that is not 0 must not become 0 there
+  // (for a distance, 0 means no limit) nor overflow to infinity.
+  auto single = [&](double x) {
+    const float f = float(x);
+    if (x != 0.0 && std::isfinite(x) && f == 0.f) throw bad("rounds to 0 in single precision (smallest: 1.4e-45)");
+    if (std::isfinite(x) && !std::isfinite(f)) throw bad("beyond the largest single-precision number (3.4e+38)");
+    return x;
+  };
   try {
     switch (s.type) {
       case ParamType::Bool:
@@ -187,14 +196,14 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         size_t pos = 0;
         double x = std::stod(text, &pos);
         if (pos != text.size()) throw bad("expected a number");
-        return x;
+        return single(x);
       }
       case ParamType::Distance: {
         size_t pos = 0;
         double x = std::stod(text, &pos);
-        if (pos + 1 == text.size() && text[pos] == '%') return x * 0.01 * diagonal;
+        if (pos + 1 == text.size() && text[pos] == '%') return single(x * 0.01 * diagonal);
         if (pos != text.size()) throw bad("expected a length or a percentage of the bbox diagonal like 10%");
-        return x;
+        return single(x);
       }
       case ParamType::Enum: {
         for (size_t i = 0; i < s.choices.size(); ++i)

@@ -222,6 +222,11 @@ def case_inputs(a, tmp):
     one_line(["render", "--dir", meshes, "-o", out], "image", "a filter that writes an image")
     one_line(["ao", "--dir", meshes, "-o", out, "--rays_per_vertex"], "needs a value", "a parameter without value")
     one_line(["ao", "--dir", meshes, "-o", meshes], "overwrite", "results that would overwrite their inputs")
+    one_line(["ao", "--manifest", meshes, "-o", out], "is a folder", "a folder as the manifest")
+    one_line(["ao", "--dir", meshes, "--glob", "*.xyz", "-o", out], "*.xyz", "a pattern that matches no mesh")
+    with open(bad, "w") as f:
+        f.write("# only a comment\n")
+    one_line(["ao", "--manifest", bad, "-o", out], "lists no mesh", "a manifest that lists no mesh")
 
 
 CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs}

@@ -3,6 +3,9 @@
 status 1 and ONE line on stderr saying what is wrong; never a crash, a hang,
 a partly loaded mesh or an output file. Each row of CASES: what is damaged,
 the files (written here), the arguments, a fragment the line must hold.
+Then the outputs (hostile_outputs.py): one that would overwrite an input,
+cannot be written or fails half-way, names that are not UTF-8, numbers
+beyond single precision, empty batches.
 
 usage: hostile_input.py --gi BUILD/tools/gi [--report] [--mlx-run BUILD/mlx-run]
   --report   print a table of what happens instead of failing on the first miss
@@ -19,6 +22,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import hostile_outputs  # noqa: E402
 from plyread import read_ply  # noqa: E402
 
 TRI = [(0, 0, 0), (1, 0, 0), (0, 1, 0)]
@@ -289,6 +293,8 @@ def main():
             print("%s: %s (must load) -> %s" % ("ok" if ok else "FAIL", cid, describe(rc, err)))
             if not ok:
                 failures.append("%s (%s): should load" % (cid, what))
+        # Outputs: overwriting an input, failed and unwritable writes, names and numbers (hostile_outputs.py).
+        failures += hostile_outputs.check_all(os.path.abspath(o.gi), os.path.join(tmp, "outputs"))
         if o.mlx_run:
             meshlabserver_record(o, tmp)
     if failures and not o.report:

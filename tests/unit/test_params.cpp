@@ -257,6 +257,18 @@ TEST(Params, ParseIntOutsideIntRangeIsRefused) {
   EXPECT_TRUE(refused);
 }
 
+// A value that is not 0 must stay non-zero and finite in single precision,
+// where the engine and MeshLab keep it: 1e-50 became 0, which for a
+// distance means no limit at all.
+TEST(Params, ParseRefusesValuesLostInSinglePrecision) {
+  for (const char* t : {"1e-50", "-1e-50", "1e-300", "1e39"}) expectParseError("ratio", t);
+  for (const char* t : {"1e-50", "1e-300", "1e39", "1e-49%", "1e40%"}) expectParseError("radius", t);
+  EXPECT_EQ(std::get<double>(parse("ratio", "0")), 0.0);
+  EXPECT_EQ(std::get<double>(parse("radius", "0%")), 0.0);
+  EXPECT_EQ(std::get<double>(parse("ratio", "1e-40")), 1e-40);  // a subnormal float, not 0
+  EXPECT_EQ(std::get<double>(parse("radius", "3e38")), 3e38);
+}
+
 // -------------------------------------------------------------- filters ----
 
 // Minimal XML well-formedness check: tags balanced and nested, attributes

@@ -1,0 +1,29 @@
+// Output files written whole or not at all: the bytes go to a temporary file
+// beside the target, which is flushed, synced and checked, then renamed over
+// the target; on any failure the temporary is removed and the target keeps
+// what it held (README, "Command-line tool": a failed write never leaves a
+// partial file in place of a good one).
+#pragma once
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace gi::io {
+
+// Writes `path` by calling `write` with the temporary to fill (a file that
+// exists, empty, with the target's permissions). Throws std::runtime_error
+// "cannot write PATH: WHY" naming `path`, not the temporary. A target that
+// is a symbolic link is written where the link points; one that exists and
+// is not a regular file (/dev/null, a pipe) is written in place.
+void writeAtomically(const std::string& path, const std::function<void(const std::string& temp)>& write);
+void writeFileAtomically(const std::string& path, std::string_view bytes);
+
+// Why a file cannot be created beside `path` (the strerror text; empty: it
+// can): a temporary there is created and removed, which also finds a folder
+// that refuses new files to root (/proc) or a read-only file system.
+std::string cannotCreateBeside(const std::string& path);
+
+// `path` followed through symbolic links (the file a write lands in).
+std::string linkTarget(const std::string& path);
+
+}  // namespace gi::io

@@ -1,0 +1,270 @@
+"""The command-line tool's outputs against its contract (run by
+hostile_input.py): an output that is the same file as an input or another
+output (under any name or link), that cannot be written, or whose write
+fails half-way gets exit 1 and ONE line on stderr before anything is
+computed or replaced; the file that was there keeps its bytes and no
+temporary is left. Also: names that are not UTF-8 in JSON, numbers beyond
+single precision in scripts and parameters, empty batches, and the form
+factor table's exit status 2.
+
+Each check returns a list of failures (empty: passed); hostile_input.py
+prints them with its own cases.
+"""
+import json
+import os
+import resource
+import signal
+import struct
+import subprocess
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+MESHES = os.path.join(HERE, "..", "..", "test_meshes")
+FAST = {"ao": ["--rays_per_vertex", "8"], "radiosity": ["--rays_per_patch", "16", "--form_factor_method", "Monte Carlo"],
+        "photonmap": ["--photons", "2000"], "render": ["--width", "32", "--height", "24", "--samples_per_pixel", "1"],
+        "hemicube": ["--face_index", "0", "--hemicube_resolution", "16", "--nusselt_resolution", "16"]}
+
+
+def fast(args):
+    """args with the fast settings of FAST its options do not give themselves."""
+    extra, opts = [], FAST.get(args[0], [])
+    for k in range(0, len(opts), 2):
+        if opts[k] not in args:
+            extra += opts[k:k + 2]
+    return args + extra
+
+
+def run(cmd, limit=None, timeout=120, cwd=None):
+    """(exit status, stdout bytes, stderr lines); limit: RLIMIT_FSIZE in bytes (writes beyond it fail with EFBIG)."""
+    def small_files():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    try:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout, cwd=cwd,
+                           preexec_fn=small_files if limit else None)
+    except subprocess.TimeoutExpired:
+        return None, b"", ["timeout"]
+    return p.returncode, p.stdout, [l for l in p.stderr.decode("utf-8", "replace").splitlines() if l.strip()]
+
+
+def snapshot(d):
+    """Every file under d (links as their target text) with its bytes."""
+    out = {}
+    for root, _, names in os.walk(d):
+        for n in names:
+            p = os.path.join(root, n)
+            out[os.path.relpath(p, d)] = ("link", os.readlink(p)) if os.path.islink(p) else open(p, "rb").read()
+    return out
+
+
+def one_error(rc, lines, fragment, status=1):
+    if rc != status or len(lines) != 1 or not lines[0].startswith("gi: error: ") or fragment not in lines[0]:
+        return "expected exit %d and one line holding %r; got exit %s, %r" % (status, fragment, rc, lines[:3])
+    return None
+
+
+def cornell(d, name="in.ply"):
+    with open(os.path.join(MESHES, "cornell_box.ply"), "rb") as f:
+        data = f.read()
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+    return name
+
+
+# --------------------------------------------------------------- overwrite --
+# (id, set-up in the folder, arguments relative to it). Refused before any
+# work: exit 1, one line "... would overwrite ...", every file as it was.
+def setup_links(d):
+    cornell(d)
+    os.symlink("in.ply", os.path.join(d, "link.ply"))
+    os.link(os.path.join(d, "in.ply"), os.path.join(d, "hard.ply"))
+    os.makedirs(os.path.join(d, "sub"))
+
+
+OVERWRITE = [
+    ("same_name", ["ao", "in.ply", "-o", "in.ply"]),
+    ("dot_slash", ["ao", "in.ply", "-o", "./in.ply"]),
+    ("dot_dot", ["ao", "in.ply", "-o", "sub/../in.ply"]),
+    ("parent_folder", ["ao", "in.ply", "-o", "../case_parent_folder/in.ply"]),
+    ("symlink", ["ao", "in.ply", "-o", "link.ply"]),
+    ("hard_link", ["ao", "in.ply", "-o", "hard.ply"]),
+    ("save_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", "in.ply"]),
+    ("residual_csv", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", "in.ply"]),
+    ("export_system", ["radiosity", "in.ply", "-o", "p_B.mtx", "--export_system", "p"]),  # p_F.mtx, ..., p_B.mtx
+    ("image_path", ["render", "in.ply", "--image_path", "in.ply"]),
+    ("image_pfm", ["render", "in.ply", "--image_path", "in.png", "--layer", "in.pfm"]),
+    ("hemicube_image", ["hemicube", "in.ply", "--image_path", "link.ply"]),
+    ("layer", ["radiosity", "in.ply", "--layer", "lay.ply", "-o", "lay.ply"]),
+    ("reference_file", ["errormap", "in.ply", "-o", "refc.ply", "--reference_source", "PLY file",
+                        "--reference_file", "refc.ply"]),
+    ("photon_layer", ["photonmap", "o.Photons.ply", "-o", "o.ply", "--photon_layer", "true"]),
+    ("script_mesh", ["script", "ao", "--mesh", "in.ply", "-o", "hard.ply"]),
+    ("two_outputs", ["render", "in.ply", "-o", "o.ply", "--image_path", "o.ply"]),
+    ("output_and_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", "./o.ply"]),
+]
+
+
+def check_overwrite(gi, tmp):
+    failures = []
+    for cid, args in OVERWRITE:
+        d = os.path.join(tmp, "case_" + cid)
+        os.makedirs(d)
+        setup_links(d)
+        for extra in ("lay.ply", "refc.ply", "o.Photons.ply", "in.pfm"):
+            if extra in args:
+                cornell(d, extra)
+        before = snapshot(tmp)
+        argv = fast(args) + ([] if args[0] == "script" else ["-q"])
+        rc, _, lines = run([gi] + argv, cwd=d)
+        why = one_error(rc, lines, "would overwrite")
+        if not why and snapshot(tmp) != before:
+            why = "the files changed"
+        print("%s: output %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:1]))
+        if why:
+            failures.append("output %s (%s): %s" % (cid, " ".join(args), why))
+    return failures
+
+
+# ---------------------------------------------------- failed and early writes --
+def check_failed_writes(gi, tmp):
+    """A write that fails (writes beyond 100 bytes fail, as on a full disk) keeps the old file and leaves no temporary."""
+    failures = []
+    cases = [("ply", ["ao", "in.ply", "-o", "good.ply"], "good.ply"),
+             ("save_result", ["ao", "in.ply", "--save-result", "good.json"], "good.json"),
+             # 160 x 120 noisy pixels: libpng's own write fails (it printed "libpng error: Write Error" first)
+             ("png", ["render", "in.ply", "--image_path", "good.png", "--width", "160", "--height", "120"], "good.png"),
+             ("csv", ["radiosity", "in.ply", "--residual_csv", "good.csv"], "good.csv"),
+             ("script", ["script", "ao", "--mesh", "in.ply", "-o", "good.mlx"], "good.mlx")]
+    for cid, args, good in cases:
+        d = os.path.join(tmp, "full_" + cid)
+        os.makedirs(d)
+        cornell(d)
+        with open(os.path.join(d, good), "wb") as f:
+            f.write(b"the good file\n")
+        before = snapshot(d)
+        argv = fast(args) + (["--emitter_source", "1"] if args[0] in ("render", "radiosity") else [])
+        rc, _, lines = run([gi] + argv + ([] if args[0] == "script" else ["-q"]), limit=100, cwd=d)
+        why = one_error(rc, lines, good)
+        if not why and snapshot(d) != before:
+            why = "files changed or a temporary was left: %s" % sorted(snapshot(d))
+        print("%s: failed write %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:2]))
+        if why:
+            failures.append("failed write %s: %s" % (cid, why))
+    return failures
+
+
+def check_early(gi, tmp):
+    """An output that cannot be written is reported before the computation: nothing else written, no progress."""
+    failures = []
+    cases = [("image_folder", ["render", "in.ply", "-o", "o.ply", "--image_path", "/nonexistent/i.png"], "/nonexistent"),
+             ("hemicube_folder", ["hemicube", "in.ply", "-o", "o.ply", "--image_path", "/nonexistent/i.png"], "/nonexistent"),
+             ("csv_folder", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", "/nonexistent/r.csv"], "/nonexistent"),
+             ("export_folder", ["radiosity", "in.ply", "-o", "o.ply", "--export_system", "/nonexistent/p"], "/nonexistent"),
+             ("proc", ["ao", "in.ply", "-o", "/proc/x.ply"], "/proc/x.ply"),
+             ("cache_folder", ["ao", "in.ply", "-o", "o.ply", "--cache", "/nonexistent/c"], "/nonexistent")]
+    for cid, args, fragment in cases:
+        d = os.path.join(tmp, "early_" + cid)
+        os.makedirs(d)
+        cornell(d)
+        argv = fast(args) + (["--emitter_source", "1"] if args[0] in ("render", "radiosity") else [])
+        rc, _, lines = run([gi] + argv, cwd=d)  # no -q: progress lines would show a computation
+        why = one_error(rc, lines, fragment)
+        if not why and sorted(os.listdir(d)) != ["in.ply"]:
+            why = "files were written: %s" % sorted(os.listdir(d))
+        print("%s: early %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:2]))
+        if why:
+            failures.append("unwritable output %s: %s" % (cid, why))
+    return failures
+
+
+# ------------------------------------------------------- names, numbers ... --
+def check_latin1_names(gi, tmp):
+    """A file name that is not UTF-8 (Latin-1 e-acute) in --json, --save-result, --cache and gi batch."""
+    failures = []
+    d = os.path.join(tmp, "latin1")
+    os.makedirs(os.path.join(d, "meshes"))
+    name = b"caf\xe9.ply"
+    cornell(d, os.fsdecode(name))
+    cornell(os.path.join(d, "meshes"), os.fsdecode(name))
+    gi_b, mesh = os.fsencode(gi), os.path.join(os.fsencode(d), name)
+    out = os.path.join(os.fsencode(d), b"o.ply")
+    fast = [b"--rays_per_vertex", b"8", b"-q"]
+
+    def expect(what, ok, detail):
+        print("%s: non-UTF-8 name, %s" % ("ok" if ok else "FAIL", what))
+        if not ok:
+            failures.append("non-UTF-8 name, %s: %s" % (what, detail))
+
+    rc, stdout, lines = run([gi_b, b"ao", mesh, b"-o", out, b"--json"] + fast)
+    try:
+        ok = rc == 0 and json.loads(stdout.decode("utf-8"))["input"].endswith("caf\ufffd.ply")
+    except ValueError:
+        ok = False
+    expect("--json", ok, "exit %s, %r" % (rc, lines[:1]))
+    saved = os.path.join(os.fsencode(d), b"s.json")
+    rc, _, lines = run([gi_b, b"ao", mesh, b"--save-result", saved] + fast)
+    try:
+        ok = rc == 0 and json.load(open(saved, "rb"))["format"] == "gi-result"
+    except (ValueError, OSError):
+        ok = False
+    expect("--save-result", ok, "exit %s, %r" % (rc, lines[:1]))
+    cache = os.path.join(os.fsencode(d), b"cache")
+    os.makedirs(cache)
+    runs = [run([gi_b, b"ao", mesh, b"-o", out, b"--cache", cache, b"--json"] + fast) for _ in range(2)]
+    ok = all(r[0] == 0 for r in runs) and b"reused the cached result" in runs[1][1]
+    expect("--cache", ok, "exits %s, %r" % ([r[0] for r in runs], runs[0][2][:1]))
+    bout = os.path.join(os.fsencode(d), b"bout")
+    rc, _, lines = run([gi_b, b"batch", b"ao", b"--dir", os.path.join(os.fsencode(d), b"meshes"), b"-o", bout] + fast)
+    try:
+        ok = rc == 0 and json.load(open(os.path.join(bout, b"caf\xe9.json"), "rb"))["status"] == "ok"
+        ok = ok and not [n for n in os.listdir(bout) if n.endswith(b".part") or n.startswith(b".")]
+    except (ValueError, OSError):
+        ok = False
+    expect("gi batch", ok, "exit %s, %r" % (rc, lines[:1]))
+    return failures
+
+
+def huge_ply(path):
+    verts = [(-3e38, -3e38, 0), (3e38, -3e38, 0), (0, 3e38, 3e38)]
+    head = ("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    with open(path, "wb") as f:
+        f.write(head.encode() + b"".join(struct.pack("<3f", *v) for v in verts) + struct.pack("<B3i", 3, 0, 1, 2))
+
+
+def check_numbers_and_batches(gi, tmp):
+    failures = []
+    d = os.path.join(tmp, "numbers")
+    os.makedirs(os.path.join(d, "meshes"))
+    cornell(d)
+    huge_ply(os.path.join(d, "huge.ply"))
+    cases = [  # (what, arguments, fragment, exit status, files that must not appear)
+        ("script of a mesh of +-3e38 (ao)", ["script", "ao", "--mesh", "huge.ply", "-o", "s.mlx"], "single-precision", 1, "s.mlx"),
+        ("script of a mesh of +-3e38 (photonmap)", ["script", "photonmap", "--mesh", "huge.ply", "-o", "s.mlx"],
+         "single-precision", 1, "s.mlx"),
+        ("script of a mesh of +-3e38 (render)", ["script", "render", "--mesh", "huge.ply", "-o", "s.mlx"],
+         "single-precision", 1, "s.mlx"),
+        ("--max_distance 1e-50", ["ao", "in.ply", "-o", "o.ply", "--max_distance", "1e-50", "-q"], "max_distance", 1, "o.ply"),
+        ("--max_distance 1e-49%", ["ao", "in.ply", "-o", "o.ply", "--max_distance", "1e-49%", "-q"], "max_distance", 1, "o.ply"),
+        ("--max_radius 1e-300", ["photonmap", "in.ply", "-o", "o.ply", "--max_radius", "1e-300", "-q"], "max_radius", 1, "o.ply"),
+        ("a folder as the manifest", ["batch", "ao", "--manifest", d, "-o", "bout"], "manifest", 1, "bout/report-0-of-1.json"),
+        ("a pattern matching nothing", ["batch", "ao", "--dir", "meshes", "--glob", "*.xyz", "-o", "bout"], "*.xyz", 1,
+         "bout/report-0-of-1.json"),
+        ("formfactors-table outside its tolerance", ["formfactors-table", "--perpendicular", "1", "1", "1e-3", "--rays", "4096"],
+         "tolerance", 2, None),
+    ]
+    for what, args, fragment, status, absent in cases:
+        rc, _, lines = run([gi] + args, cwd=d)
+        why = one_error(rc, lines, fragment, status)
+        if not why and absent and os.path.exists(os.path.join(d, absent)):
+            why = "%s was written" % absent
+        print("%s: %s -> exit %s, %s" % ("FAIL" if why else "ok", what, rc, lines[:1]))
+        if why:
+            failures.append("%s: %s" % (what, why))
+    return failures
+
+
+def check_all(gi, tmp):
+    failures = []
+    for check in (check_overwrite, check_failed_writes, check_early, check_latin1_names, check_numbers_and_batches):
+        failures += check(gi, tmp)
+    return failures

@@ -1,0 +1,175 @@
+// The files a filter reads and writes (gi/filter_files.h), which a front end
+// checks before it computes: the list agrees with what the run then names;
+// writeOutputFiles goes through the front end's writer; a PNG that cannot be
+// written is one exception and nothing on stderr. And the writer the
+// command-line tool uses (io/atomic_file.h): whole or not at all.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "atomic_file.h"
+#include "gi/error_map.h"
+#include "gi/filter_files.h"
+#include "gi/filter_run.h"
+#include "gi/form_factors.h"
+#include "gi/radiosity.h"
+#include "gi/scenes.h"
+
+using namespace gi;
+namespace fs = std::filesystem;
+
+namespace {
+
+FilterInput input(FilterKind kind, const scenes::SceneFile& sf) {
+  FilterInput in;
+  in.scene = sf.scene;
+  in.attrs = sf.attrs;
+  in.values = defaultValues(filterSpecs(kind), analyzeScene(in.scene).diagonal);
+  return in;
+}
+
+std::set<std::string> written(const FilterFiles& f) {
+  std::set<std::string> s;
+  for (const NamedFile& w : f.writes) s.insert(w.path);
+  return s;
+}
+
+// Every path writeOutputFiles hands its writer, in order.
+std::vector<std::string> pathsWritten(const FilterResult& r) {
+  std::vector<std::string> paths;
+  writeOutputFiles(r, [&](const std::string& path, const std::function<void(const std::string&)>&) { paths.push_back(path); });
+  return paths;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("gi_filter_files_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d / name;
+}
+
+std::string readAll(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+}  // namespace
+
+TEST(FilterFiles, HemicubeNamesItsThreePicturesAndTheirPfm) {
+  FilterInput in = input(FilterKind::HemicubeOfFace, scenes::closedBox(1.0, 2, true));
+  in.values.set("face_index", 0);
+  in.values.set("hemicube_resolution", 16);
+  in.values.set("nusselt_resolution", 16);
+  in.values.set("image_path", std::string("out/hc.png"));
+  const FilterFiles plan = filterFiles(FilterKind::HemicubeOfFace, in.values);
+  const FilterResult r = runFilter(FilterKind::HemicubeOfFace, in);
+  const std::vector<std::string> paths = pathsWritten(r);
+  EXPECT_EQ(std::set<std::string>(paths.begin(), paths.end()), written(plan));
+  EXPECT_EQ(paths.size(), 6u);
+  EXPECT_TRUE(written(plan).count("out/hc_nusselt.pfm"));
+  in.values.set("image_path", std::string());
+  EXPECT_TRUE(filterFiles(FilterKind::HemicubeOfFace, in.values).writes.empty());
+}
+
+TEST(FilterFiles, RadiosityNamesItsCsvAndEveryMatrix) {
+  FilterInput in = input(FilterKind::Radiosity, scenes::cornellBox(150.0));
+  in.values.set("form_factor_method", int(kFormFactorMethods.index(FormFactorMethod::MonteCarlo)));
+  in.values.set("rays_per_patch", 16);
+  in.values.set("residual_csv", std::string("r.csv"));
+  in.values.set("export_system", std::string("dir/sys"));
+  const FilterFiles plan = filterFiles(FilterKind::Radiosity, in.values);
+  const FilterResult r = runFilter(FilterKind::Radiosity, in);
+  ASSERT_EQ(r.files.size(), 7u);  // the CSV and six matrices: the matrix was in memory
+  const std::vector<std::string> paths = pathsWritten(r);
+  EXPECT_EQ(std::set<std::string>(paths.begin(), paths.end()), written(plan));
+  EXPECT_TRUE(plan.reads.empty());
+  EXPECT_TRUE(plan.layers.empty());
+}
+
+TEST(FilterFiles, ReferenceFileOnlyWhenTheReferenceComesFromAFile) {
+  ParamValues v = defaultValues(filterSpecs(FilterKind::ErrorMap), 1.0);
+  v.set("reference_file", std::string("ref.ply"));
+  EXPECT_TRUE(filterFiles(FilterKind::ErrorMap, v).reads.empty());
+  v.set("reference_source", int(kReferenceSources.index(ReferenceSource::File)));
+  const FilterFiles f = filterFiles(FilterKind::ErrorMap, v);
+  ASSERT_EQ(f.reads.size(), 1u);
+  EXPECT_EQ(f.reads[0].path, "ref.ply");
+  EXPECT_EQ(f.reads[0].parameter, "reference_file");
+}
+
+TEST(FilterFiles, PhotonLayerOnlyWhenAsked) {
+  ParamValues v = defaultValues(filterSpecs(FilterKind::PhotonMapping), 1.0);
+  EXPECT_TRUE(filterFiles(FilterKind::PhotonMapping, v).layers.empty());
+  v.set("photon_layer", true);
+  EXPECT_EQ(filterFiles(FilterKind::PhotonMapping, v).layers, std::vector<std::string>{"Photons"});
+  EXPECT_EQ(pfmPath("a.b/c"), "a.b/c.pfm");
+  EXPECT_EQ(pfmPath("dir/img.png"), "dir/img.pfm");
+}
+
+// libpng's default handlers printed "libpng error: Write Error" before our
+// exception, two lines where the command-line tool promises one.
+TEST(FilterFiles, FailedPngIsOneExceptionAndNothingOnStderr) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  Image img(256, 256);  // noise: the compressed rows overflow stdio's buffer, so libpng's own write fails
+  uint32_t h = 1;
+  for (glm::vec3& p : img.px)
+    for (int k = 0; k < 3; ++k) p[k] = float((h = h * 1664525u + 1013904223u) >> 8) / 16777216.f;
+  testing::internal::CaptureStderr();
+  bool threw = false;
+  try {
+    writePng("/dev/full", img, 1.f);
+  } catch (const std::runtime_error& e) {
+    threw = std::string(e.what()).find("/dev/full") != std::string::npos;
+  }
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(threw);
+  EXPECT_EQ(err, "");
+}
+
+TEST(AtomicFile, FailedWriteKeepsTheFileAndLeavesNoTemporary) {
+  const fs::path p = scratch("keep.txt");
+  io::writeFileAtomically(p.string(), "good");
+  ::chmod(p.c_str(), 0640);
+  EXPECT_THROW(io::writeAtomically(p.string(),
+                                   [](const std::string& temp) {
+                                     std::ofstream(temp) << "par";
+                                     throw std::runtime_error("cannot write " + temp + ": disk full");
+                                   }),
+               std::runtime_error);
+  EXPECT_EQ(readAll(p), "good");
+  try {  // the message names the file, not the temporary
+    io::writeAtomically(p.string(), [](const std::string& temp) { throw std::runtime_error("cannot write " + temp); });
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write " + p.string());
+  }
+  io::writeFileAtomically(p.string(), "better");
+  EXPECT_EQ(readAll(p), "better");
+  struct stat st {};
+  ASSERT_EQ(::stat(p.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0640u);  // the replaced file's permissions
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(p.parent_path())) files += e.path().filename() != "keep.txt";
+  EXPECT_EQ(files, 0u);
+  fs::remove_all(p.parent_path());
+}
+
+TEST(AtomicFile, WritesThroughASymbolicLink) {
+  const fs::path target = scratch("target.txt"), link = scratch("link.txt");
+  io::writeFileAtomically(target.string(), "old");
+  fs::create_symlink(target.filename(), link);
+  io::writeFileAtomically(link.string(), "new");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(readAll(target), "new");
+  EXPECT_EQ(io::cannotCreateBeside(target.string()), "");
+  EXPECT_NE(io::cannotCreateBeside((target.parent_path() / "no" / "x").string()), "");
+  fs::remove_all(target.parent_path());
+}

@@ -1,0 +1,89 @@
+#include "gi_files.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+#include "atomic_file.h"
+
+namespace gi::files {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// What makes two paths one file: an existing file's device and inode (so
+// hard links and every spelling of its path agree), else the absolute path
+// with symbolic links and "." and ".." resolved as far as it exists.
+std::string identity(const std::string& path) {
+  const std::string target = io::linkTarget(path);
+  struct stat st {};
+  if (::stat(target.c_str(), &st) == 0)
+    return "file " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(target, ec);
+  const fs::path canonical = fs::weakly_canonical(absolute, ec);
+  return "path " + (ec ? absolute.lexically_normal() : canonical).string();
+}
+
+bool exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+void checkWritable(const Named& out, std::map<std::string, std::string>& folders) {
+  if (out.path.empty()) throw std::invalid_argument(out.what + " is empty: give a file name");
+  const std::string cannot = "cannot write " + out.path + (out.what.empty() ? "" : " (" + out.what + ")") + ": ";
+  const std::string target = io::linkTarget(out.path);
+  struct stat st {};
+  const bool there = ::stat(target.c_str(), &st) == 0;
+  if (there && S_ISDIR(st.st_mode)) throw std::invalid_argument(cannot + "it is a directory");
+  if (there && access(target.c_str(), W_OK) != 0) throw std::invalid_argument(cannot + std::strerror(errno));
+  if (there && !S_ISREG(st.st_mode)) return;  // a device or a pipe, written in place
+  const fs::path parent = fs::path(target).parent_path().empty() ? fs::path(".") : fs::path(target).parent_path();
+  std::error_code ec;
+  const fs::file_status pst = fs::status(parent, ec);
+  if (!fs::exists(pst)) throw std::invalid_argument(cannot + "the folder " + parent.string() + " does not exist");
+  if (!fs::is_directory(pst)) throw std::invalid_argument(cannot + parent.string() + " is not a folder");
+  // The file is written to a temporary beside it and renamed: the folder must take a new file.
+  auto [it, fresh] = folders.emplace(parent.string(), "");
+  if (fresh) it->second = io::cannotCreateBeside(target);
+  if (!it->second.empty())
+    throw std::invalid_argument(cannot + "the folder " + parent.string() + " takes no new file (" + it->second + ")");
+}
+
+}  // namespace
+
+void checkWritable(const Named& out) {
+  std::map<std::string, std::string> folders;
+  checkWritable(out, folders);
+}
+
+void check(const std::vector<Named>& inputs, const std::vector<Named>& outputs) {
+  std::map<std::string, std::string> folders;  // folder -> why it takes no new file ("" if it does)
+  for (const Named& out : outputs) checkWritable(out, folders);
+  std::map<std::string, std::pair<const Named*, bool>> seen;  // identity -> the file, whether an input
+  for (const Named& in : inputs)
+    if (exists(in.path)) seen.emplace(identity(in.path), std::make_pair(&in, true));
+  for (const Named& out : outputs) {
+    const auto [it, fresh] = seen.emplace(identity(out.path), std::make_pair(&out, false));
+    if (fresh) continue;
+    const Named& other = *it->second.first;
+    auto named = [](const Named& f) { return f.path + (f.what.empty() ? "" : " (" + f.what + ")"); };
+    throw std::invalid_argument("the output " + named(out) + " would overwrite the " +
+                                (it->second.second ? "input " : "output ") + named(other));
+  }
+}
+
+FileWriter atomicWriter() {
+  return [](const std::string& path, const std::function<void(const std::string&)>& write) {
+    io::writeAtomically(path, write);
+  };
+}
+
+}  // namespace gi::files
