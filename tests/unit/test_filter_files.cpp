@@ -24,19 +24,14 @@
 #include "gi/form_factors.h"
 #include "gi/radiosity.h"
 #include "gi/scenes.h"
+#include "filter_input.h"
 
 using namespace gi;
 namespace fs = std::filesystem;
 
 namespace {
 
-FilterInput input(FilterKind kind, const scenes::SceneFile& sf) {
-  FilterInput in;
-  in.scene = sf.scene;
-  in.attrs = sf.attrs;
-  in.values = defaultValues(filterSpecs(kind), analyzeScene(in.scene).diagonal);
-  return in;
-}
+FilterInput input(FilterKind kind, const scenes::SceneFile& sf) { return test::filterInput(kind, sf); }
 
 std::set<std::string> written(const FilterFiles& f) {
   std::set<std::string> s;

@@ -13,6 +13,7 @@
 #include "gi/form_factors.h"
 #include "gi/hemicube_view.h"
 #include "gi/scenes.h"
+#include "filter_input.h"
 
 using namespace gi;
 
@@ -25,13 +26,7 @@ const scenes::SceneFile& box() {
   return sf;
 }
 
-FilterInput input(FilterKind kind, const scenes::SceneFile& sf) {
-  FilterInput in;
-  in.scene = sf.scene;
-  in.attrs = sf.attrs;
-  in.values = defaultValues(filterSpecs(kind), analyzeScene(in.scene).diagonal);
-  return in;
-}
+FilterInput input(FilterKind kind, const scenes::SceneFile& sf) { return test::filterInput(kind, sf); }
 
 // The per-patch sums of the cells, in the order the hemicube method adds
 // them (faces 0-4, rows, columns), normalised by the sum of all cells.
