@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
-#include <optional>
 #include <stdexcept>
 
 #include <tbb/parallel_sort.h>
@@ -174,12 +173,6 @@ class AmbientKernel {
 AmbientOptions checkedOptions(const AmbientOptions& in) {
   AmbientOptions o = in;
   auto finiteColour = [](const glm::vec3& c) { return finite3(c) && c.r >= 0.f && c.g >= 0.f && c.b >= 0.f; };
-  // A direction of unit length keeps its bits (the table's are unit already).
-  auto unit = [](const glm::vec3& d) -> std::optional<glm::vec3> {
-    const double l2 = glm::dot(glm::dvec3(d), glm::dvec3(d));
-    if (std::isfinite(l2) && std::fabs(l2 - 1.0) <= 1e-6) return d;
-    return unitDirection(d);
-  };
   if (!(o.targetError >= 0.0) || !std::isfinite(o.targetError))
     throw std::invalid_argument("target_error must be a finite number >= 0");
   if (o.targetError > 0.0 && (o.minRays < 1 || o.maxRays < 1))
@@ -198,7 +191,7 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
   if (o.useCone) {
     if (!(o.coneAngleDeg > 0.f && o.coneAngleDeg <= 180.f))
       throw std::invalid_argument("cone_angle must lie in (0, 180] degrees");
-    const auto d = unit(o.coneDirection);
+    const auto d = unitKeepingBits(o.coneDirection);
     if (!d) throw std::invalid_argument("cone_direction must be a finite, nonzero vector");
     o.coneDirection = *d;
   }
@@ -209,7 +202,7 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
     if (!finiteColour(o.skyRadiantColor) || !finiteColour(o.sunColor))
       throw std::invalid_argument("the sky's and the sun's colours must be finite and >= 0");
     if (o.sunIrradiance > 0.f) {
-      const auto d = unit(o.sunDirection);
+      const auto d = unitKeepingBits(o.sunDirection);
       if (!d) throw std::invalid_argument("sun_direction must be a finite, nonzero vector");
       o.sunDirection = *d;
       if (!(o.sunAngularRadiusDeg >= 0.f && o.sunAngularRadiusDeg <= 90.f))

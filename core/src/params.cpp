@@ -20,6 +20,12 @@ glm::vec3 ParamValues::getDirection(const std::string& n) const {
   return *u;
 }
 
+std::optional<glm::vec3> unitKeepingBits(const glm::vec3& d) {
+  const double l2 = glm::dot(glm::dvec3(d), glm::dvec3(d));
+  if (std::isfinite(l2) && std::fabs(l2 - 1.0) <= 1e-6) return d;
+  return unitDirection(d);
+}
+
 std::optional<glm::vec3> unitDirection(const glm::vec3& d) {
   const glm::dvec3 x(d);
   if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z)) return std::nullopt;

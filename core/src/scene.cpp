@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "gi/color.h"
+#include "gi/params.h"
 
 namespace gi {
 
@@ -233,12 +234,8 @@ std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<ui
     if (ok[f])
       for (int k = 0; k < 3; ++k) onFace[s.triangles[f][k]] = 1;
   std::vector<glm::vec3> n = s.vertexNormals;
-  for (size_t i = 0; i < n.size(); ++i) {
-    const glm::dvec3 d(n[i]);
-    const double l2 = glm::dot(d, d);
-    if (!onFace[i] || !(l2 > 0.0) || !std::isfinite(l2)) n[i] = glm::vec3(0.f);  // also NaN, and a component of Inf
-    else if (std::fabs(l2 - 1.0) > 1e-6) n[i] = glm::vec3(d / std::sqrt(l2));   // unit ones keep their bits
-  }
+  for (size_t i = 0; i < n.size(); ++i)  // zero, NaN or Inf: no normal
+    n[i] = onFace[i] ? unitKeepingBits(n[i]).value_or(glm::vec3(0.f)) : glm::vec3(0.f);
   return n;
 }
 

@@ -56,6 +56,13 @@ def snapshot(d):
     return out
 
 
+def report(failures, label, why, rc, lines, shown=1):
+    """One line per case on stdout; a failing case also joins `failures`."""
+    print("%s: %s -> exit %s, %s" % ("FAIL" if why else "ok", label, rc, lines[:shown]))
+    if why:
+        failures.append("%s: %s" % (label, why))
+
+
 def one_error(rc, lines, fragment, status=1):
     if rc != status or len(lines) != 1 or not lines[0].startswith("gi: error: ") or fragment not in lines[0]:
         return "expected exit %d and one line holding %r; got exit %s, %r" % (status, fragment, rc, lines[:3])
@@ -118,9 +125,7 @@ def check_overwrite(gi, tmp):
         why = one_error(rc, lines, "would overwrite")
         if not why and snapshot(tmp) != before:
             why = "the files changed"
-        print("%s: output %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:1]))
-        if why:
-            failures.append("output %s (%s): %s" % (cid, " ".join(args), why))
+        report(failures, "output %s (%s)" % (cid, " ".join(args)), why, rc, lines)
     return failures
 
 
@@ -146,9 +151,7 @@ def check_failed_writes(gi, tmp):
         why = one_error(rc, lines, good)
         if not why and snapshot(d) != before:
             why = "files changed or a temporary was left: %s" % sorted(snapshot(d))
-        print("%s: failed write %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:2]))
-        if why:
-            failures.append("failed write %s: %s" % (cid, why))
+        report(failures, "failed write " + cid, why, rc, lines, 2)
     return failures
 
 
@@ -170,9 +173,7 @@ def check_early(gi, tmp):
         why = one_error(rc, lines, fragment)
         if not why and sorted(os.listdir(d)) != ["in.ply"]:
             why = "files were written: %s" % sorted(os.listdir(d))
-        print("%s: early %s -> exit %s, %s" % ("FAIL" if why else "ok", cid, rc, lines[:2]))
-        if why:
-            failures.append("unwritable output %s: %s" % (cid, why))
+        report(failures, "unwritable output " + cid, why, rc, lines, 2)
     return failures
 
 
@@ -257,9 +258,7 @@ def check_numbers_and_batches(gi, tmp):
         why = one_error(rc, lines, fragment, status)
         if not why and absent and os.path.exists(os.path.join(d, absent)):
             why = "%s was written" % absent
-        print("%s: %s -> exit %s, %s" % ("FAIL" if why else "ok", what, rc, lines[:1]))
-        if why:
-            failures.append("%s: %s" % (what, why))
+        report(failures, what, why, rc, lines)
     return failures
 
 

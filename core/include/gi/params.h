@@ -65,6 +65,10 @@ class ParamValues {
 // float) or 1e-30 (whose squares underflow) keep their direction; nothing for
 // a zero or non-finite d.
 std::optional<glm::vec3> unitDirection(const glm::vec3& d);
+// unitDirection for a vector that is usually of unit length already (a
+// caller's normal or direction): one whose squared length is within 1e-6 of
+// 1 keeps its bits.
+std::optional<glm::vec3> unitKeepingBits(const glm::vec3& d);
 
 // Defaults of a table for a scene of the given bbox diagonal.
 ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal);
