@@ -70,13 +70,14 @@ Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>
                   const std::vector<uint8_t>& poolable, const PoolOptions& o, PoolScratch& sc) {
   const glm::vec3 pi = positions[i];
   const Frame frame(normals[i]);
-  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
+  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, BentSums& db) -> uint32_t {
     if (h == 1) startRings(i, normals.size(), sc);
     nextRing(i, g, ArrayNodes{normals, rays, poolable}, o, sc);
     for (uint32_t u : sc.frontier) {
       const glm::vec3 d = positions[u] - pi;
-      grown.add(rays[u].n, rays[u].sum, glm::dot(d, frame.t), glm::dot(d, frame.b), rays[u].var);
-      db += rays[u].bent;
+      const double dx = glm::dot(d, frame.t), dy = glm::dot(d, frame.b);
+      grown.add(rays[u].n, rays[u].sum, dx, dy, rays[u].var);
+      db.add(rays[u].bent, dx, dy);
     }
     return uint32_t(sc.frontier.size());
   });

@@ -32,6 +32,26 @@ struct PoolSums {
   }
 };
 
+// The same sums for the vertices' sums of unoccluded directions b (bent
+// normals), fitted like y component by component over PoolSums' design.
+struct BentSums {
+  double B[3] = {0, 0, 0};                   // sum b
+  double BX[2][3] = {{0, 0, 0}, {0, 0, 0}};  // sum d b
+  void add(const glm::vec3& b, double dx, double dy) {
+    for (int c = 0; c < 3; ++c) {
+      B[c] += b[c];
+      BX[0][c] += dx * b[c]; BX[1][c] += dy * b[c];
+    }
+  }
+  BentSums& operator+=(const BentSums& o) {
+    for (int c = 0; c < 3; ++c) {
+      B[c] += o.B[c];
+      BX[0][c] += o.BX[0][c]; BX[1][c] += o.BX[1][c];
+    }
+    return *this;
+  }
+};
+
 // The fitted value at d = 0 and its variance over v: least squares of the
 // vertices' means with weights n (their variances are v / n), i.e.
 // a = Y/W - g.xbar, Var(a) = v (1/W + xbar^T C^-1 xbar) with C the centred
@@ -39,34 +59,53 @@ struct PoolSums {
 struct Fit {
   double a = 0, varOverV = 0;
 };
-inline Fit fit(const PoolSums& s) {
+// The fit of any per-vertex sums y over the pool's design (sum y = Y,
+// sum d y = XY).
+inline Fit fitOf(const PoolSums& s, double Y, const double XY[2]) {
   Fit f;
-  f.a = s.Y / s.W;
+  f.a = Y / s.W;
   f.varOverV = 1.0 / s.W;
   const double mx = s.X[0] / s.W, my = s.X[1] / s.W;
   const double cxx = s.XX[0] - s.W * mx * mx, cxy = s.XX[1] - s.W * mx * my, cyy = s.XX[2] - s.W * my * my;
   const double det = cxx * cyy - cxy * cxy, tr = cxx + cyy;
   if (!(tr > 0.0) || det <= 1e-3 * tr * tr) return f;  // no spread in some direction: no slope
-  const double ry = s.XY[0] - mx * s.Y, rz = s.XY[1] - my * s.Y;
+  const double ry = XY[0] - mx * Y, rz = XY[1] - my * Y;
   const double gx = (cyy * ry - cxy * rz) / det, gy = (cxx * rz - cxy * ry) / det;
-  f.a = s.Y / s.W - (gx * mx + gy * my);
+  f.a = Y / s.W - (gx * mx + gy * my);
   f.varOverV = 1.0 / s.W + (cyy * mx * mx - 2.0 * cxy * mx * my + cxx * my * my) / det;
   return f;
+}
+inline Fit fit(const PoolSums& s) { return fitOf(s, s.Y, s.XY); }
+
+// The bent vector at d = 0 by the same fit, component by component (a mean
+// unoccluded direction per ray, not normalised). A plain sum over the pool
+// leans towards where its rays are: towards an occluder where the vertices
+// nearer it cast more rays (an adaptive run), or where the pool is lopsided;
+// measured on a floor beside a wall (tests/unit/test_bent_normals.cpp).
+inline glm::vec3 fitBent(const PoolSums& s, const BentSums& bs) {
+  glm::vec3 b(0.f);
+  for (int c = 0; c < 3; ++c) {
+    const double xy[2] = {bs.BX[0][c], bs.BX[1][c]};
+    b[c] = float(fitOf(s, bs.B[c], xy).a);
+  }
+  return b;
 }
 
 
 // Lepski's choice of scale for one vertex with own rays `own`. ring(h, grown,
 // db) adds ring h's vertices (those pooled at scale h and not before) to
-// grown and their unoccluded directions to db, and returns how many there
-// were (0: no ring h). Both ways of listing the rings (a search each time,
-// or lists kept across rounds) go through here in the same order, so they
-// give the same bits.
+// grown and, where bent normals are asked for, their unoccluded directions
+// to db, and returns how many there were (0: no ring h). Both ways of
+// listing the rings (a search each time, or lists kept across rounds) go
+// through here in the same order, so they give the same bits.
 template <class Ring>
 Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   constexpr int kMaxScales = 65;
   double A[kMaxScales], VarV[kMaxScales], V[kMaxScales];  // estimate, its variance / v, and v, per accepted scale
   PoolSums sums;
   sums.add(own.n, own.sum, 0.0, 0.0, own.var);
+  BentSums bent;
+  bent.add(own.bent, 0.0, 0.0);
   Pooled p;
   p.vertices = 1;
   p.bent = own.bent;
@@ -93,7 +132,7 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   const int R = std::min(test ? o.maxRings : o.fixedRings, kMaxScales - 1);
   for (int h = 1; h <= R; ++h) {
     PoolSums grown = sums;
-    glm::vec3 db(0.f);
+    BentSums db;
     const uint32_t added = ring(h, grown, db);
     if (added == 0) break;
     const Fit f = fit(grown);
@@ -118,8 +157,9 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     V[h] = v;
     sums = grown;
     p.vertices += added;
-    p.bent += db;
+    bent += db;
   }
+  if (chosen > 0) p.bent = fitBent(sums, bent);
   p.value = float(o.bounded ? std::clamp(A[chosen], 0.0, 1.0) : std::max(A[chosen], 0.0));
   // The reported error also bounds the pool's bias: Lepski's rule lets
   // through a bias up to gamma times the smaller scales' noise, which is

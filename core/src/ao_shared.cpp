@@ -172,14 +172,15 @@ Pooled poolListed(uint32_t i, const uint32_t* list, const std::vector<PoolPoint>
   const Frame frame(normals[i]);
   const uint32_t rings = list[0];
   const uint32_t* member = list + 1 + rings;
-  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, glm::vec3& db) -> uint32_t {
+  return chooseScale(rays[i], o, [&](int h, PoolSums& grown, BentSums& db) -> uint32_t {
     if (uint32_t(h) > rings) return 0;
     const uint32_t count = list[h];
     for (uint32_t k = 0; k < count; ++k) {
       const PoolPoint& q = pts[member[k]];
       const glm::vec3 d = q.p - pi;
-      grown.add(q.n, q.sum, glm::dot(d, frame.t), glm::dot(d, frame.b), 0.0);  // AO: bounded values
-      if (bent) db += rays[member[k]].bent;  // zero unless bent normals are asked for
+      const double dx = glm::dot(d, frame.t), dy = glm::dot(d, frame.b);
+      grown.add(q.n, q.sum, dx, dy, 0.0);  // AO: bounded values
+      if (bent) db.add(rays[member[k]].bent, dx, dy);  // zero unless bent normals are asked for
     }
     member += count;
     return count;

@@ -3,6 +3,8 @@
 //   W(p)   = 1/pi ∫_H rho(d(p, w)) cos(theta) dw      (obscurance, Zhukov et al. 1998;
 //            rho(d) = min(1, d / d_max)^k, Iones et al. 2003 use a similar falloff)
 //   E(p)   = E_sky AO(p) + E_sun <V(p, w) max(0, n.w)>_{w in sun disk}
+//   B(p)   = b / |b|, b = 1/pi ∫_H V(p, w) w cos(theta) dw   (bent normal: the cosine-weighted mean
+//            unoccluded direction, Landis 2002; with obscurance V is replaced by rho)
 // Estimators: cosine-weighted directions from an Owen-scrambled Sobol
 // sequence per vertex (pbrt-v4's AOIntegrator estimator V cos / (pi pdf) = V).
 #pragma once
