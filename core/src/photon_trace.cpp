@@ -165,6 +165,21 @@ class PhotonLights {
   glm::vec3 spotFrame_;
 };
 
+// Photon g of the seed's sequence: its index in a scrambled Sobol sequence
+// of 2^32 points, and the keys of that sequence's scrambles and of its
+// path's random numbers. Each further 2^32 photons (a progressive run of
+// many passes: 10^8 photons a pass reach 2^32 in the 43rd) get fresh keys,
+// an independent randomisation, so no path repeats; the first 2^32 keep the
+// keys they always had. Until 3 December 2026 the index wrapped, and pass 43
+// on retraced the paths of the first passes.
+struct PhotonKeys {
+  uint32_t index, pos, dir, rng;
+};
+PhotonKeys photonKeys(uint32_t seed, uint64_t g, uint32_t posSalt, uint32_t dirSalt) {
+  const uint32_t epoch = uint32_t(g >> 32), s = epoch == 0 ? seed : hash3(seed, epoch, 0xe90cu);
+  return {uint32_t(g), hash32(s ^ posSalt), hash32(s ^ dirSalt), s};
+}
+
 }  // namespace
 
 std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
@@ -180,16 +195,16 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
   std::vector<std::vector<Photon>> blocks(nBlocks);
   std::vector<PhotonTraceStats> bstats(nBlocks);
-  const uint32_t kPos = hash32(opt.seed ^ 0x9e37u), kDir = hash32(opt.seed ^ 0x51edu);
+
   parallelBlocks(nBlocks, progress, "tracing photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       auto& out = blocks[b];
       PhotonTraceStats& st = bstats[b];
       for (size_t i = b * kBlock; i < std::min(count, (b + 1) * kBlock); ++i) {
-        const uint32_t index = uint32_t(first + i);
-        const auto em = lights.sample(sobolOwen2D(index, kPos), sobolOwen2D(index, kDir), double(count));
+        const PhotonKeys k = photonKeys(opt.seed, uint64_t(first) + i, 0x9e37u, 0x51edu);
+        const auto em = lights.sample(sobolOwen2D(k.index, k.pos), sobolOwen2D(k.index, k.dir), double(count));
         glm::vec3 power = em.power;
-        Rng rng(hash3(index, opt.seed, 0x7u));
+        Rng rng(hash3(k.index, k.rng, 0x7u));
         Ray ray;
         ray.o = em.o + em.n * eps;
         ray.d = em.d;
@@ -348,13 +363,13 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
   std::vector<std::vector<Photon>> blocks(nBlocks);
   std::vector<size_t> specular(nBlocks, 0), glossy(nBlocks, 0), missed(nBlocks, 0);
-  const uint32_t kPos = hash32(opt.seed ^ 0xca57u), kDir = hash32(opt.seed ^ 0xca58u);
+
   parallelBlocks(nBlocks, progress, "tracing caustic photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       for (size_t i = b * kBlock; i < std::min(count, (b + 1) * kBlock); ++i) {
-        const uint32_t index = uint32_t(first + i);
-        const auto lp = lights.samplePoint(sobolOwen2D(index, kPos));
-        glm::vec2 u = sobolOwen2D(index, kDir);
+        const PhotonKeys k = photonKeys(opt.seed, uint64_t(first) + i, 0xca57u, 0xca58u);
+        const auto lp = lights.samplePoint(sobolOwen2D(k.index, k.pos));
+        glm::vec2 u = sobolOwen2D(k.index, k.dir);
         Ray ray;
         ray.o = lp.o + lp.n * eps;
         glm::vec3 power;
@@ -363,7 +378,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
         if (!aimAtTargets(targets, lp.o, u, d, pdfW)) {
           // The light point lies within a target's sphere: every direction
           // may reach it; draw them as the global photons do.
-          const auto e = lights.sample(sobolOwen2D(index, kPos), u, double(count));
+          const auto e = lights.sample(sobolOwen2D(k.index, k.pos), u, double(count));
           d = e.d;
           power = e.power;
         } else if (lp.point) {
@@ -375,7 +390,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
           power = lp.L * c / (lp.pdf * pdfW * float(count));
         }
         ray.d = d;
-        Rng rng(hash3(index, opt.seed, 0xc5u));
+        Rng rng(hash3(k.index, k.rng, 0xc5u));
         bool viaSpecular = false;
         for (int depth = 0; depth < opt.maxDepth; ++depth) {
           const Hit h = caster.intersect(ray);
