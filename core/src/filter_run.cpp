@@ -16,6 +16,7 @@
 #include "gi/filter_files.h"
 #include "gi/form_factors.h"
 #include "gi/hemicube_view.h"
+#include "gi/memory_limit.h"
 #include "gi/output.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
@@ -311,6 +312,12 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
 void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) {
   RadiosityOptions opt = RadiosityOptions::fromParams(in.values);
   opt.vertices = in.vertices;
+  // A budget beyond the memory available would let the form-factor matrix
+  // grow until the kernel ends the process: the available memory is the budget.
+  const double availableMB = double(availableMemoryBytes()) / 1048576.0;
+  const bool capped = availableMB > 0 && opt.memoryBudgetMB > availableMB;
+  const double askedMB = opt.memoryBudgetMB;
+  if (capped) opt.memoryBudgetMB = std::floor(availableMB);
   RadiosityResult r;
   if (opt.refine) {
     AdaptiveRadiosity ar = solveRadiosityAdaptive(in.scene, opt, progress);
@@ -322,6 +329,10 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
     r = solveRadiosity(in.scene, *caster, opt, progress);
   }
   res.stats = std::move(r.stats);
+  if (capped)
+    res.stats.warn("memory_budget_mb = " + std::to_string(int64_t(askedMB)) + " exceeds the " +
+                   std::to_string(int64_t(opt.memoryBudgetMB)) + " MB of memory available: the budget was " +
+                   std::to_string(int64_t(opt.memoryBudgetMB)) + " MB");
   res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
   if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
   // Course outputs: snapshots as attributes, the residual per step in the log and a CSV.

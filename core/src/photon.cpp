@@ -26,8 +26,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
   std::vector<ParamSpec> out = {
       {.name = "photons", .label = "Photons emitted",
        .help = "Number of photon paths shot from the lights (in proportion to their power); per pass when "
-               "progressive. More photons: less noise and blur; memory grows linearly (about 50 bytes per stored "
-               "photon with its kd-tree, 1-4 stored per path).",
+               "progressive. More photons: less noise and blur; memory grows linearly (about 56 bytes per stored "
+               "photon with its kd-tree, 1-4 stored per path). A run whose photons would not fit in the memory "
+               "available is refused once they pass it, before the machine runs out.",
        .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000},
       {.name = "k_nearest", .label = "Photons per estimate",
        .help = "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side "

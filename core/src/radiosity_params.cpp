@@ -64,7 +64,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "form-factor row per thread (a hemicube's buffers: 144 MB at resolution 4096), about 1 KB per patch "
                "of the refined mesh with adaptive refinement, and the sparse form-factor matrix, kept while it fits; "
                "beyond that, progressive refinement computes each shooter's row on the fly (more rays, memory linear "
-               "in the patch count). A run that cannot fit even so is refused before it starts.",
+               "in the patch count). A run that cannot fit even so is refused before it starts. A budget above the "
+               "memory available is lowered to it (a warning says so).",
        .type = ParamType::Float, .def = 1024, .min = 1, .max = 1e7},
       {.name = "hierarchy_epsilon", .label = "Hierarchical: link tolerance",
        .help = "Hierarchical solver only. A link between two clusters (or patches) is split into links between "

@@ -76,6 +76,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.causticK = o.causticK;
     po.point = o.point;
     po.seed = o.seed;
+    po.memoryLimitBytes = o.memoryLimitBytes;
     PhotonTraceStats ts;
     std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
     const size_t stored = photons.size();

@@ -64,6 +64,9 @@ struct PhotonOptions {
   SkySun outside;             // sky and sun: photons enter from a disk covering the scene's bounding sphere
   bool lightPathSplit = false;  // also B per light-path kind (light_paths.h)
   uint32_t seed = 0;
+  // Memory the stored photons may take (gi/memory_limit.h); 0: what the
+  // machine has available when the trace starts.
+  size_t memoryLimitBytes = 0;
   static std::vector<ParamSpec> specs();
   static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };

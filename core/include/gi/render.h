@@ -98,6 +98,9 @@ struct RenderOptions {
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;
   uint32_t seed = 0;
+  // Memory the image and the caustic photons may take (gi/memory_limit.h);
+  // 0: what the machine has available when the run starts.
+  size_t memoryLimitBytes = 0;
   // The first pass (two-pass mode): per-vertex radiosity B (linear RGB,
   // W/m^2, emission included) and optionally its direct part Bdirect = E +
   // rho H_direct (photon mapping leaves it as the attribute RadiosityDirect;

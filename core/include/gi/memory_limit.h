@@ -1,0 +1,29 @@
+// How much memory a run may still take, and a clear refusal when a request
+// would need more. A run past the machine's memory does not fail cleanly on
+// Linux: allocations succeed (overcommit) and the kernel's out-of-memory
+// killer ends the process later, MeshLab with every unsaved mesh in it.
+// So the filters whose memory the parameters set, not the mesh (photons
+// stored per pass, the image's pixels), check their need first: against the
+// memory the kernel reports as available to new allocations without
+// swapping (MemAvailable, Linux 3.14 on), within the control group's limit
+// where one is set (cgroup v2 memory.max minus memory.current: a container,
+// a Slurm job).
+#pragma once
+#include <cstddef>
+#include <string>
+
+namespace gi {
+
+// Bytes available to this process now; 0 if unknown (not Linux, no /proc).
+size_t availableMemoryBytes();
+
+// The limit a run checks against: `limit` if nonzero (a caller's own
+// budget), else availableMemoryBytes() (0: unknown, nothing is checked).
+size_t memoryLimitOrAvailable(size_t limit);
+
+// Throws std::invalid_argument, in one sentence, when `bytes` exceeds
+// `limit` (0: no check): "<what> needs about X GB, more than the Y GB of
+// memory available; <remedy>".
+void requireMemory(double bytes, size_t limit, const std::string& what, const std::string& remedy);
+
+}  // namespace gi

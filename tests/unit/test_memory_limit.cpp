@@ -1,0 +1,128 @@
+// Runs whose memory the parameters set are refused, in one sentence, when
+// they would not fit (gi/memory_limit.h): an image's pixels before anything
+// is traced, the photons of a map once they pass the limit (the global map,
+// each progressive pass, the caustic projection), and a radiosity budget
+// above the memory available is lowered to it. A caller's own limit
+// stands in for the machine's, which this machine's 24 GB would not reach
+// at the tables' largest settings.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "filter_input.h"
+#include "gi/memory_limit.h"
+#include "gi/photon.h"
+#include "gi/render.h"
+#include "gi/scenes.h"
+
+using namespace gi;
+
+namespace {
+
+// The exception's text, or "" if `f` returned.
+template <class F>
+std::string refusal(F&& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+// The machine's figure is the kernel's MemAvailable (or less, in a control
+// group): above zero and below MemTotal.
+TEST(MemoryLimit, AvailableIsTheKernelsFigure) {
+  std::ifstream f("/proc/meminfo");
+  std::string key;
+  double total = 0, kb = 0;
+  while (f >> key >> kb) {
+    if (key == "MemTotal:") total = kb * 1024.0;
+    f.ignore(64, '\n');
+  }
+  ASSERT_GT(total, 0.0);
+  const double avail = double(availableMemoryBytes());
+  EXPECT_GT(avail, 16e6);
+  EXPECT_LE(avail, total);
+  EXPECT_EQ(memoryLimitOrAvailable(12345), 12345u);
+}
+
+TEST(MemoryLimit, RefusalIsOneSentence) {
+  EXPECT_EQ(refusal([] { requireMemory(1e9, 2000000000, "x", "y"); }), "");
+  EXPECT_EQ(refusal([] { requireMemory(1e18, 0, "x", "y"); }), "");  // limit unknown: no check
+  const std::string m = refusal([] { requireMemory(6.4e9, 2000000000, "an image of 16384 x 16384 pixels", "lower it"); });
+  EXPECT_EQ(m, "an image of 16384 x 16384 pixels needs about 6.4 GB, more than the 2.0 GB of memory available; lower it");
+}
+
+// 64 x 48 pixels take about 74 KB: refused under 64 KB before any ray, run
+// under 1 MB.
+TEST(MemoryLimit, ImageRefusedBeforeTracing) {
+  const Scene s = scenes::cornellBox(100.0).scene;
+  auto caster = makeEmbreeCaster(s);
+  RenderOptions o;
+  o.mode = RenderMode::Whitted;
+  o.samplesPerPixel = 1;
+  o.camera = Camera::lookAt({278, 273, -800}, {278, 273, 0}, {0, 1, 0}, 40, 64, 48);
+  o.memoryLimitBytes = 64 << 10;
+  const std::string m = refusal([&] { render(s, *caster, o); });
+  EXPECT_TRUE(has(m, "an image of 64 x 48 pixels needs about")) << m;
+  EXPECT_TRUE(has(m, "lower width and height")) << m;
+  int calls = 0;
+  EXPECT_THROW(render(s, *caster, o, Progress([&](int, const std::string&) { return ++calls > 0; })),
+               std::invalid_argument);
+  EXPECT_EQ(calls, 0);  // refused before the progress of any work
+  o.memoryLimitBytes = 1 << 20;
+  EXPECT_EQ(render(s, *caster, o).image.px.size(), size_t(64 * 48));
+}
+
+// 100,000 photons in the Cornell box store about 186,000 (10 MB at 56 bytes):
+// refused under 2 MB, as a map and as each progressive pass, and computed
+// under 64 MB; the caustic projection the same.
+TEST(MemoryLimit, PhotonsRefusedOncePastTheLimit) {
+  const Scene s = scenes::cornellBox(100.0).scene;
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions o;
+  o.photons = 100000;
+  o.lightSamples = 4;
+  o.memoryLimitBytes = 2 << 20;
+  std::string m = refusal([&] { computePhotonMap(s, *caster, o); });
+  EXPECT_TRUE(has(m, "the photon map of 100000 photons needs about")) << m;
+  EXPECT_TRUE(has(m, "lower the photons")) << m;
+  o.progressive = true;
+  o.passes = 2;
+  m = refusal([&] { computePhotonMap(s, *caster, o); });
+  EXPECT_TRUE(has(m, "the photon map of 100000 photons needs about")) << m;
+  o.memoryLimitBytes = 64 << 20;
+  EXPECT_EQ(computePhotonMap(s, *caster, o).H.size(), s.vertexCount());
+
+  const Scene c = scenes::causticCornell(50.0, 10.0, 3, 1.5f);
+  auto cc = makeEmbreeCaster(c);
+  PhotonOptions q;
+  q.memoryLimitBytes = 256 << 10;
+  PhotonTraceStats st;
+  m = refusal([&] { traceCausticPhotons(c, *cc, q, 0, 200000, Progress(nullptr), st); });
+  EXPECT_TRUE(has(m, "the caustic map of 200000 photons needs about")) << m;
+  q.memoryLimitBytes = 64 << 20;
+  EXPECT_FALSE(traceCausticPhotons(c, *cc, q, 0, 200000, Progress(nullptr), st).empty());
+}
+
+// memory_budget_mb at the table's largest (10^7 MB) is more than any machine
+// here has: the run keeps to the memory available and says so, with the
+// same values as at the default budget (the matrix fits either way).
+TEST(MemoryLimit, RadiosityBudgetLoweredToTheMemoryAvailable) {
+  const auto sf = scenes::cornellBox(100.0);
+  FilterInput base = test::filterInput(FilterKind::Radiosity, sf);
+  FilterInput huge = base;
+  huge.values.set("memory_budget_mb", 1e7);
+  const FilterResult a = runFilter(FilterKind::Radiosity, base), b = runFilter(FilterKind::Radiosity, huge);
+  EXPECT_TRUE(a.stats.warnings.empty());
+  ASSERT_EQ(b.stats.warnings.size(), 1u);
+  EXPECT_TRUE(has(b.stats.warnings[0], "memory_budget_mb = 10000000 exceeds the ")) << b.stats.warnings[0];
+  ASSERT_EQ(a.attributes.size(), b.attributes.size());
+  EXPECT_EQ(a.attributes[0].values, b.attributes[0].values);
+}
