@@ -2,14 +2,30 @@
 
 #include <cctype>
 
+#include "gi/filter_files.h"
 #include "gi/filter_run.h"
 #include "gi/filters.h"
 #include "meshlab_bridge.h"
+#include "output_files.h"
 
 namespace gi::ml {
 
 namespace {
 FilterKind kindOf(compat::FilterId f) { return FilterKind(f); }
+
+// The files a run will write, checked before any work as the CLI checks
+// them (io/output_files.h): each can be written, and none is a file the run
+// reads, the file a loaded layer came from, or another output.
+void checkFiles(FilterKind kind, const FilterInput& in, MeshDocument& md) {
+  const FilterFiles plan = filterFiles(kind, in.values);
+  if (plan.writes.empty()) return;
+  std::vector<files::Named> inputs, outputs;
+  for (const NamedFile& f : plan.reads) inputs.push_back({f.path, f.parameter});
+  for (MeshModel* m : compat::meshes(md))
+    if (!m->fullName().isEmpty()) inputs.push_back({m->fullName().toStdString(), "layer " + m->label().toStdString()});
+  for (const NamedFile& f : plan.writes) outputs.push_back({f.path, f.parameter});
+  files::check(inputs, outputs);
+}
 }  // namespace
 
 GiFilterPlugin::GiFilterPlugin(std::string plugin) : plugin_(std::move(plugin)) {}
@@ -65,9 +81,11 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
   guarded(why, logLine, name, [&] {
     BridgeScene b;
     FilterInput in = gatherInput(md, par, kind, b);
+    checkFiles(kind, in, md);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
-    // Everything is computed: only now does the document change.
-    writeOutputFiles(r);
+    // Everything is computed: only now does the document change. Files are
+    // written whole or not at all (a full disk keeps the file that was there).
+    writeOutputFiles(r, files::atomicWriter());
     writeResult(b, r);
     addRasters(md, r);
     addLayers(md, r);

@@ -32,7 +32,7 @@ foreach(u ${_units})
   target_include_directories(${t} SYSTEM PRIVATE "${_src2025}" "${_src2025}/vcglib" ${EIGEN3_INCLUDE_DIR})
   target_compile_definitions(${t} PRIVATE MESHLAB_SCALAR=float MESHLAB_VERSION=2025.07 GI_MESHLAB_2025)
   # Usage requirements only (include folders, Qt's definitions): nothing is linked.
-  target_link_libraries(${t} PRIVATE gi_core gi_io_ply Qt5::Core Qt5::Gui Qt5::Widgets Qt5::OpenGL Qt5::Xml Qt5::Network)
+  target_link_libraries(${t} PRIVATE gi_core gi_io_ply gi_io_files Qt5::Core Qt5::Gui Qt5::Widgets Qt5::OpenGL Qt5::Xml Qt5::Network)
   target_compile_options(${t} PRIVATE ${GI_WARNINGS})
   add_dependencies(gi_meshlab2025_compile_check ${t})
 endforeach()

@@ -21,7 +21,7 @@
 #include "gi/filter_run.h"
 #include "gi/filters.h"
 #include "gi_cluster.h"
-#include "gi_files.h"
+#include "output_files.h"
 #include "gi_output.h"
 #include "json_text.h"
 #include "mesh_io.h"
@@ -275,7 +275,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
 // Every output the batch may write (each mesh's PLY, summary and new layers,
 // the report) against its inputs (the meshes, a reference file, the
 // manifest and the parameter file) and one another, before any mesh is
-// computed (gi_files.h).
+// computed (io/output_files.h).
 void checkFiles(const Args& a, const FilterDesc& d, const Texts& common, const std::vector<Job>& jobs, size_t shard,
                 size_t shards, bool explicitShard) {
   const auto specs = filterSpecs(d.kind);

@@ -24,7 +24,7 @@
 #include "gi_batch.h"
 #include "gi_cluster.h"
 #include "gi_course.h"
-#include "gi_files.h"
+#include "output_files.h"
 #include "gi_output.h"
 #include "json_text.h"
 #include "mesh_io.h"

@@ -159,7 +159,16 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
     p.vertices += added;
     bent += db;
   }
-  if (chosen > 0) p.bent = fitBent(sums, bent);
+  if (chosen > 0) {
+    // The fit extrapolates where a pool is lopsided: where the value's own
+    // fit fell to 0 or below (clamped, no open direction to speak of) or the
+    // fitted direction turns more than 30 degrees from the pool's plain mean
+    // (the correction is a degree or two where the fit holds), the plain
+    // mean stands, which lies within every pooled vertex's hemisphere.
+    const glm::vec3 fitted = fitBent(sums, bent), plain(float(bent.B[0]), float(bent.B[1]), float(bent.B[2]));
+    const float lf = glm::length(fitted), lp = glm::length(plain);
+    p.bent = A[chosen] > 0.0 && lf > 0.f && glm::dot(fitted, plain) >= 0.866f * lf * lp ? fitted : plain;
+  }
   p.value = float(o.bounded ? std::clamp(A[chosen], 0.0, 1.0) : std::max(A[chosen], 0.0));
   // The reported error also bounds the pool's bias: Lepski's rule lets
   // through a bias up to gamma times the smaller scales' noise, which is

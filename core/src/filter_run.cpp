@@ -318,21 +318,29 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   const bool capped = availableMB > 0 && opt.memoryBudgetMB > availableMB;
   const double askedMB = opt.memoryBudgetMB;
   if (capped) opt.memoryBudgetMB = std::floor(availableMB);
+  const std::string lowered = "memory_budget_mb = " + std::to_string(int64_t(askedMB)) + " exceeds the " +
+                              std::to_string(int64_t(opt.memoryBudgetMB)) + " MB of memory available, so the budget was " +
+                              std::to_string(int64_t(opt.memoryBudgetMB)) + " MB";
   RadiosityResult r;
-  if (opt.refine) {
-    AdaptiveRadiosity ar = solveRadiosityAdaptive(in.scene, opt, progress);
-    r = std::move(ar.result);
-    res.refined = std::move(ar.mesh);
-  } else {
-    checkRadiosityMemory(in.scene.faceCount(), opt);  // before the ray-casting structure is built
-    const auto caster = makeEmbreeCaster(in.scene);
-    r = solveRadiosity(in.scene, *caster, opt, progress);
+  try {
+    if (opt.refine) {
+      AdaptiveRadiosity ar = solveRadiosityAdaptive(in.scene, opt, progress);
+      r = std::move(ar.result);
+      res.refined = std::move(ar.mesh);
+    } else {
+      checkRadiosityMemory(in.scene.faceCount(), opt);  // before the ray-casting structure is built
+      const auto caster = makeEmbreeCaster(in.scene);
+      r = solveRadiosity(in.scene, *caster, opt, progress);
+    }
+  } catch (const std::invalid_argument& e) {
+    if (!capped) throw;
+    throw std::invalid_argument(lowered + ": " + e.what());  // raising the budget would not help
   }
   res.stats = std::move(r.stats);
-  if (capped)
-    res.stats.warn("memory_budget_mb = " + std::to_string(int64_t(askedMB)) + " exceeds the " +
-                   std::to_string(int64_t(opt.memoryBudgetMB)) + " MB of memory available: the budget was " +
-                   std::to_string(int64_t(opt.memoryBudgetMB)) + " MB");
+  // The plan follows the budget (the form-factor matrix kept or its rows
+  // computed on the fly, the hierarchy's links), so the values may differ
+  // from a run on a machine with more memory.
+  if (capped) res.stats.warn(lowered + " (the solve's memory plan follows it)");
   res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
   if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
   // Course outputs: snapshots as attributes, the residual per step in the log and a CSV.

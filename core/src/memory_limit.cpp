@@ -27,15 +27,9 @@ long long meminfoKB(const char* key) {
   return -1;
 }
 
-// A number from a cgroup v2 file of this process's group, or -1 ("max",
-// missing, v1).
-long long cgroupValue(const char* file) {
-  std::ifstream self("/proc/self/cgroup");
-  std::string line, path;
-  while (std::getline(self, line))
-    if (line.compare(0, 3, "0::") == 0) path = line.substr(3);  // v2: "0::/the/group"
-  if (path.empty()) return -1;
-  std::ifstream f("/sys/fs/cgroup" + path + "/" + file);
+// The first number in a file, or -1 (missing, "max", not a number).
+long long fileNumber(const std::string& path) {
+  std::ifstream f(path);
   std::string v;
   if (!(f >> v) || v == "max") return -1;
   try {
@@ -45,9 +39,65 @@ long long cgroupValue(const char* file) {
   }
 }
 
-std::string gigabytes(double bytes) {
+// The value of `key` in a memory.stat file, or 0.
+long long statValue(const std::string& path, const std::string& key) {
+  std::ifstream f(path);
+  std::string k;
+  long long v = 0;
+  while (f >> k >> v)
+    if (k == key) return v;
+  return 0;
+}
+
+// What a memory control group still allows: its limit less what it holds
+// that the kernel cannot reclaim (its usage counts the file cache, which a
+// group that has read or written files fills up to its limit; the inactive
+// part is reclaimed first). -1 without a limit there.
+double groupRoom(const std::string& dir, const char* limitFile, const char* usageFile, const char* inactiveKey) {
+  const long long limit = fileNumber(dir + "/" + limitFile);
+  if (limit < 0 || limit >= (1LL << 60)) return -1;  // v1 writes "no limit" as a huge number
+  const long long usage = fileNumber(dir + "/" + usageFile);
+  if (usage < 0) return -1;
+  const double held = std::max(0.0, double(usage) - double(statValue(dir + "/memory.stat", inactiveKey)));
+  return std::max(0.0, double(limit) - held);
+}
+
+// The least room over this process's memory control group and its parents
+// (cgroup v2: a container's or a job's limit is often set on a parent), or
+// the v1 memory controller's group; -1 without any limit.
+double cgroupRoom() {
+  std::ifstream self("/proc/self/cgroup");
+  std::string line, v2, v1;
+  while (std::getline(self, line)) {
+    if (line.compare(0, 3, "0::") == 0) v2 = line.substr(3);
+    const size_t m = line.find(":memory:");
+    if (m != std::string::npos) v1 = line.substr(m + 8);
+  }
+  double room = -1;
+  auto least = [&room](double r) {
+    if (r >= 0 && (room < 0 || r < room)) room = r;
+  };
+  if (!v1.empty()) {
+    // Inside a container the group's path may not be mounted: its root is.
+    const std::string base = "/sys/fs/cgroup/memory";
+    const std::string dir = std::ifstream(base + v1 + "/memory.limit_in_bytes").good() ? base + v1 : base;
+    least(groupRoom(dir, "memory.limit_in_bytes", "memory.usage_in_bytes", "total_inactive_file"));
+  } else if (!v2.empty()) {
+    for (std::string path = v2;; path = path.substr(0, path.rfind('/'))) {
+      least(groupRoom("/sys/fs/cgroup" + path, "memory.max", "memory.current", "inactive_file"));
+      if (path.empty() || path == "/") break;
+      if (path.rfind('/') == 0) path = "/";  // the next round reads the root
+    }
+  }
+  return room;
+}
+
+// "6.4 GB", "12 GB", "75 MB", "74 KB".
+std::string amount(double bytes) {
   char b[32];
-  std::snprintf(b, sizeof b, bytes < 10e9 ? "%.1f" : "%.0f", bytes / 1e9);
+  if (bytes >= 1e9) std::snprintf(b, sizeof b, bytes < 10e9 ? "%.1f GB" : "%.0f GB", bytes / 1e9);
+  else if (bytes >= 1e6) std::snprintf(b, sizeof b, "%.0f MB", bytes / 1e6);
+  else std::snprintf(b, sizeof b, "%.0f KB", bytes / 1e3);
   return b;
 }
 
@@ -56,11 +106,8 @@ std::string gigabytes(double bytes) {
 size_t availableMemoryBytes() {
   const long long kb = meminfoKB("MemAvailable");
   double avail = kb >= 0 ? double(kb) * 1024.0 : 0.0;
-  const long long max = cgroupValue("memory.max"), cur = cgroupValue("memory.current");
-  if (max >= 0 && cur >= 0) {
-    const double left = max > cur ? double(max - cur) : 1.0;
-    avail = avail > 0 ? std::min(avail, left) : left;
-  }
+  const double room = cgroupRoom();
+  if (room >= 0) avail = avail > 0 ? std::min(avail, room) : room;
   return size_t(avail);
 }
 
@@ -68,8 +115,8 @@ size_t memoryLimitOrAvailable(size_t limit) { return limit != 0 ? limit : availa
 
 void requireMemory(double bytes, size_t limit, const std::string& what, const std::string& remedy) {
   if (limit == 0 || !(bytes > double(limit))) return;
-  throw std::invalid_argument(what + " needs about " + gigabytes(bytes) + " GB, more than the " +
-                              gigabytes(double(limit)) + " GB of memory available; " + remedy);
+  throw std::invalid_argument(what + " needs about " + amount(bytes) + ", more than the " + amount(double(limit)) +
+                              " of memory available; " + remedy);
 }
 
 }  // namespace gi

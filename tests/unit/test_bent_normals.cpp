@@ -5,6 +5,7 @@
 // are held to the spread of their own runs over several seeds.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -167,8 +168,8 @@ const SeedStats& perVertex128() {
 }  // namespace
 
 // The reference itself: with no wall, AO 1 and m1 = (0, 0, 2/3);
-// an infinitely long wall leaves the half-space facing away from it, the
-// cosine-weighted mean of which is (-2/(3 pi), 0, 1/3) at AO 1/2 whatever the
+// an infinitely long wall leaves the half-space facing away from it (x > 0),
+// the cosine-weighted mean of which is (2/(3 pi), 0, 1/3) at AO 1/2 whatever the
 // distance (a wall 10^6 H wide stands in for it). With the floor beside the
 // wall the sums follow from the same half-space (Lambert, Arvo 1995).
 TEST(BentNormals, ExactMomentsCheckOut) {
@@ -227,5 +228,63 @@ TEST(BentNormals, SharedFitsTheLeanLikeTheValue) {
     if (o == &fixed) {
       EXPECT_LE(st.rmsDeg, 0.5 * perVertex128().rmsDeg);
     }
+  }
+}
+
+// A height field pitted with 40 steep Gaussian pits (121 x 121 vertices): at
+// the pits' bottoms the pools are lopsided and the fit extrapolates, once
+// to an AO below 0 (clamped) and a direction into the surface (14 vertices
+// with bent . n < 0 at 32 rays, as low as -0.96, before the plain mean
+// stood in for such fits). Every bent normal must lie above its tangent
+// plane, as the per-vertex estimator's always do.
+TEST(BentNormals, SharedNeverPointsIntoTheSurface) {
+  const int N = 120;
+  uint32_t state = 1;
+  auto uniform = [&state](double a, double b) {
+    state = state * 1664525u + 1013904223u;
+    return a + (b - a) * double(state >> 8) / double(1u << 24);
+  };
+  struct Pit { double x, y, r, d; };
+  std::vector<Pit> pits;
+  for (int k = 0; k < 40; ++k) pits.push_back({uniform(-1, 1), uniform(-1, 1), uniform(0.03, 0.15), uniform(0.1, 0.6)});
+  std::vector<glm::dvec3> pts;
+  std::vector<glm::uvec3> tris;
+  for (int j = 0; j <= N; ++j)
+    for (int i = 0; i <= N; ++i) {
+      const double x = -1 + 2.0 * i / N, y = -1 + 2.0 * j / N;
+      double z = 0;
+      for (const Pit& p : pits) {
+        const double q = ((x - p.x) * (x - p.x) + (y - p.y) * (y - p.y)) / (p.r * p.r);
+        z -= p.d * std::exp(-q * q);
+      }
+      pts.push_back({x, y, z});
+    }
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < N; ++i) {
+      const uint32_t a = uint32_t(j * (N + 1) + i), b = a + 1, c = a + uint32_t(N) + 2, d = a + uint32_t(N) + 1;
+      tris.push_back({a, b, c});
+      tris.push_back({a, c, d});
+    }
+  const Scene s = Scene::fromAbsolute(pts, tris);
+  const std::vector<glm::vec3> n = computeVertexNormals(s);
+  auto caster = makeEmbreeCaster(s);
+  for (int variant = 0; variant < 3; ++variant) {
+    AmbientOptions o;
+    o.estimator = AOEstimator::Shared;
+    o.bentNormals = true;
+    o.raysPerVertex = variant == 0 ? 32 : 64;
+    if (variant == 2) {
+      o.targetError = 0.05;
+      o.minRays = 8;
+    }
+    const AmbientResult r = computeAmbient(s, *caster, o);
+    size_t below = 0;
+    float worst = 1.f;
+    for (size_t i = 0; i < n.size(); ++i) {
+      const float c = glm::dot(r.bentNormal[i], n[i]);
+      below += c <= 0.f;
+      worst = std::min(worst, c);
+    }
+    EXPECT_EQ(below, 0u) << "variant " << variant << ", lowest bent . n " << worst;
   }
 }

@@ -57,6 +57,8 @@ TEST(MemoryLimit, RefusalIsOneSentence) {
   EXPECT_EQ(refusal([] { requireMemory(1e18, 0, "x", "y"); }), "");  // limit unknown: no check
   const std::string m = refusal([] { requireMemory(6.4e9, 2000000000, "an image of 16384 x 16384 pixels", "lower it"); });
   EXPECT_EQ(m, "an image of 16384 x 16384 pixels needs about 6.4 GB, more than the 2.0 GB of memory available; lower it");
+  EXPECT_EQ(refusal([] { requireMemory(73728, 65536, "x", "y"); }),
+            "x needs about 74 KB, more than the 66 KB of memory available; y");
 }
 
 // 64 x 48 pixels take about 74 KB: refused under 64 KB before any ray, run
@@ -113,10 +115,12 @@ TEST(MemoryLimit, PhotonsRefusedOncePastTheLimit) {
 
 // memory_budget_mb at the table's largest (10^7 MB) is more than any machine
 // here has: the run keeps to the memory available and says so, with the
-// same values as at the default budget (the matrix fits either way).
+// same values as at a budget of 64 MB (the matrix fits either way); a run
+// refused under the lowered budget says it was lowered.
 TEST(MemoryLimit, RadiosityBudgetLoweredToTheMemoryAvailable) {
   const auto sf = scenes::cornellBox(100.0);
   FilterInput base = test::filterInput(FilterKind::Radiosity, sf);
+  base.values.set("memory_budget_mb", 64.0);
   FilterInput huge = base;
   huge.values.set("memory_budget_mb", 1e7);
   const FilterResult a = runFilter(FilterKind::Radiosity, base), b = runFilter(FilterKind::Radiosity, huge);
@@ -125,4 +129,10 @@ TEST(MemoryLimit, RadiosityBudgetLoweredToTheMemoryAvailable) {
   EXPECT_TRUE(has(b.stats.warnings[0], "memory_budget_mb = 10000000 exceeds the ")) << b.stats.warnings[0];
   ASSERT_EQ(a.attributes.size(), b.attributes.size());
   EXPECT_EQ(a.attributes[0].values, b.attributes[0].values);
+  // 10^8 patches of refinement need more than any machine has.
+  huge.values.set("refine", true);
+  huge.values.set("refine_max_depth", 12);
+  huge.values.set("refine_max_patches", 100000000);
+  const std::string m = refusal([&] { runFilter(FilterKind::Radiosity, huge); });
+  EXPECT_TRUE(has(m, "memory_budget_mb = 10000000 exceeds the ") && has(m, "so the budget was")) << m;
 }

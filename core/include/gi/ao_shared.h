@@ -102,7 +102,7 @@ struct Pooled {
   uint32_t rays = 0;      // rays pooled (N_h)
   uint32_t vertices = 0;  // vertices pooled
   int rings = 0;          // chosen scale h
-  glm::vec3 bent{0.f};    // mean unoccluded direction at the vertex, fitted over the pool like the value (not normalised)
+  glm::vec3 bent{0.f};    // unoccluded directions at the vertex, fitted over the pool like the value (only its direction is used)
 };
 
 // Per-thread scratch for the neighbourhood search.

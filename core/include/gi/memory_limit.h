@@ -5,9 +5,10 @@
 // So the filters whose memory the parameters set, not the mesh (photons
 // stored per pass, the image's pixels), check their need first: against the
 // memory the kernel reports as available to new allocations without
-// swapping (MemAvailable, Linux 3.14 on), within the control group's limit
-// where one is set (cgroup v2 memory.max minus memory.current: a container,
-// a Slurm job).
+// swapping (MemAvailable, Linux 3.14 on), within the memory control group's
+// limit where one is set (a container, a Slurm job): the limit less what the
+// group holds beyond its reclaimable file cache, the least over the group
+// and its parents (cgroup v2), or the v1 memory controller's figures.
 #pragma once
 #include <cstddef>
 #include <string>
@@ -23,7 +24,7 @@ size_t memoryLimitOrAvailable(size_t limit);
 
 // Throws std::invalid_argument, in one sentence, when `bytes` exceeds
 // `limit` (0: no check): "<what> needs about X GB, more than the Y GB of
-// memory available; <remedy>".
+// memory available; <remedy>" (MB or KB for smaller amounts).
 void requireMemory(double bytes, size_t limit, const std::string& what, const std::string& remedy);
 
 }  // namespace gi

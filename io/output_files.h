@@ -1,10 +1,10 @@
-// The files one run of `gi` reads and writes, checked before anything is
-// computed (README, "Command-line tool"): every output can be created (its
-// folder exists and takes a new file), and no output is the same file as an
-// input or as another output, however it is named (in.ply, ./in.ply,
-// ../dir/in.ply, a symbolic or a hard link). Every subcommand checks its
-// files here; each output is then written whole or not at all
-// (io/atomic_file.h).
+// The files one run reads and writes, checked before anything is computed
+// (README, "Command-line tool"): every output can be created (its folder
+// exists and takes a new file), and no output is the same file as an input
+// or as another output, however it is named (in.ply, ./in.ply,
+// ../dir/in.ply, a symbolic or a hard link). Every subcommand of `gi` and
+// every MeshLab filter checks its files here; each output is then written
+// whole or not at all (io/atomic_file.h).
 #pragma once
 #include <string>
 #include <vector>

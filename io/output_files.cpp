@@ -1,4 +1,4 @@
-#include "gi_files.h"
+#include "output_files.h"
 
 #include <sys/stat.h>
 #include <unistd.h>
