@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "gi/color.h"
 #include "gi/luminaires.h"
@@ -44,6 +46,14 @@ EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
 
 bool PointLight::on() const { return luminance(intensity) > 0.f; }
 float PointLight::cosSpot() const { return std::cos(glm::radians(std::clamp(spotAngleDeg, 0.f, 180.f))); }
+
+void PointLight::check() const {
+  if (!on()) return;
+  if (!(double(spotAngleDeg) >= kMinSpotAngleDeg && spotAngleDeg <= 180.f))
+    throw std::invalid_argument("spot_angle = " + std::to_string(spotAngleDeg) +
+                                ": the spot's half angle must lie in [0.1, 180] degrees (narrower cones hold no "
+                                "direction but the axis in single precision, and would emit nothing)");
+}
 
 glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n) {
   if (!L.on()) return glm::vec3(0.f);

@@ -137,6 +137,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
                           const Progress& progress) {
   PathTraceOptions opt = optWorld;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
+  opt.point.check();
   if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
     throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
   Timer timer;

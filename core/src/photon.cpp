@@ -407,6 +407,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   PhotonOptions opt = optWorld;  // distances and the point light in local units (Scene::unit)
   opt.maxRadius = optWorld.maxRadius / s.unit;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
+  opt.point.check();
   if (opt.photons < 1 || opt.kNearest < 1 || opt.kNearest > 512 || opt.causticK < 1 || opt.causticK > 512 || opt.passes < 1)
     throw std::invalid_argument("photons and passes must be >= 1, k_nearest and caustic_k in [1, 512]");
   Timer timer;

@@ -81,6 +81,7 @@ class PhotonLights {
       skyPower_ = o.outside.sky() ? 4.0 * M_PI * double(luminance(o.outside.skyRadiance)) * disk : 0.0;
       sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk : 0.0;
     }
+    o.point.check();
     cosSpot_ = o.point.cosSpot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
     pointPower_ = double(luminance(o.point.intensity)) * 2.0 * M_PI * (1.0 - cosSpot_);

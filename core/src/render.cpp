@@ -44,6 +44,7 @@ void validate(const RenderOptions& o) {
     throw std::invalid_argument("caustic_photons must be >= 1 and caustic_k in [1, 512]");
   if (!(o.whittedMinWeight >= 0.f && o.whittedMinWeight <= 1.f))
     throw std::invalid_argument("whitted_min_weight must lie in [0, 1]");
+  o.point.check();
   if (!o.renderImage && !o.vertexRadiance) throw std::invalid_argument("neither an image nor vertex radiance was asked for");
 }
 

@@ -111,8 +111,8 @@ std::vector<ParamSpec> pointLightSpecs() {
        .type = ParamType::Direction, .defVec = glm::vec3(0.f, -1.f, 0.f)},
       {.name = "spot_angle", .label = "Spot half angle (deg)",
        .help = "Half angle of the spot's cone (uniform intensity inside, none outside); 180 = a point light shining "
-               "every way.",
-       .type = ParamType::Float, .def = 180.0, .min = 0.0, .max = 180.0},
+               "every way. At least 0.1: a narrower cone holds no direction but its axis in single precision.",
+       .type = ParamType::Float, .def = 180.0, .min = PointLight::kMinSpotAngleDeg, .max = 180.0},
   };
 }
 

@@ -15,6 +15,7 @@
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/radiosity.h"
+#include "gi/render.h"
 #include "gi/sampling.h"
 #include "gi/scenes.h"
 #include "gi/specular.h"
@@ -559,6 +560,48 @@ TEST(PhotonMap, PointAndSpotLights) {
   for (const auto& p : ph) stored += p.power.g;
   const double power = 2 * M_PI * (1 - std::cos(glm::radians(20.0))) * I;
   EXPECT_NEAR(stored / power, 1.0, 1e-3);  // every photon of a 20-degree cone lands on the 4 x 4 plane
+}
+
+// A spot narrower than single precision resolves (0.01 degrees: its cosine
+// rounds to 1, so it emitted nothing and the run said "no point or spot
+// light") is refused naming spot_angle, by the photon map, the path tracer
+// and the eye pass; 0.1 degrees, the smallest allowed, lights the plane under
+// it with its power 2 pi (1 - cos a) I.
+TEST(PhotonMap, TooNarrowSpotIsRefusedNotDark) {
+  auto sf = scenes::openPlane(4.0, 8);
+  sf.scene.emission.assign(sf.scene.faceCount(), glm::vec3(0.f));
+  auto caster = makeEmbreeCaster(sf.scene);
+  PointLight L;
+  L.position = glm::vec3(glm::dvec3(0, 0, 1) - sf.scene.origin);
+  L.intensity = glm::vec3(1.f);
+  L.spotDirection = glm::vec3(0, 0, -1);
+  L.spotAngleDeg = 0.01f;
+  auto named = [](auto&& f) {
+    try {
+      f();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).find("spot_angle") != std::string::npos;
+    }
+    return false;
+  };
+  PhotonOptions o;
+  o.photons = 1000;
+  o.point = L;
+  EXPECT_TRUE(named([&] { computePhotonMap(sf.scene, *caster, o); }));
+  PathTraceOptions p;
+  p.samplesPerVertex = 4;
+  p.point = L;
+  EXPECT_TRUE(named([&] { pathTrace(sf.scene, *caster, p); }));
+  RenderOptions r;
+  r.camera = Camera::lookAt({0, 0, 3}, {0, 0, 0}, {0, 1, 0}, 40, 8, 8);
+  r.point = L;
+  EXPECT_TRUE(named([&] { render(sf.scene, *caster, r); }));
+  o.point.spotAngleDeg = 0.1f;
+  PhotonTraceStats st;
+  double stored = 0;
+  for (const auto& ph : tracePhotons(sf.scene, *caster, o, 0, 1000, Progress(nullptr), st)) stored += ph.power.g;
+  const double power = 2 * M_PI * (1 - double(std::cos(glm::radians(0.1f))));
+  EXPECT_NEAR(stored / power, 1.0, 1e-3);
 }
 
 // Caustic photons aimed at the glass and the mirror (projection) estimate the

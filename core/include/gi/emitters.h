@@ -45,6 +45,12 @@ struct PointLight {
   float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light
   bool on() const;
   float cosSpot() const;            // cosine of the half angle
+  // Throws std::invalid_argument when the light is on and its half angle is
+  // not an angle or is below kMinSpotAngleDeg: single precision holds no
+  // direction but the axis in such a cone (the cosine of 0.01 degrees
+  // rounds to 1), which then carried no power and read as no light at all.
+  void check() const;
+  static constexpr double kMinSpotAngleDeg = 0.1;
   bool shinesTowards(const glm::vec3& d) const { return glm::dot(d, spotDirection) >= cosSpot(); }
 };
 // Irradiance I cos / r^2 from the point light at x (unit normal n), 0 if the
