@@ -133,8 +133,8 @@ ShotData Camera::toShot() const {
 void Camera::setLens(double apertureRadius, double focusDistance) {
   if (!(apertureRadius >= 0.0) || !std::isfinite(apertureRadius))
     throw std::invalid_argument("the aperture radius must be a finite distance >= 0");
-  if (apertureRadius > 0.0 && !(focusDistance > 0.0 && std::isfinite(focusDistance)))
-    throw std::invalid_argument("the focus distance must be > 0 for a thin lens");
+  if (!(focusDistance >= 0.0 && std::isfinite(focusDistance)))
+    throw std::invalid_argument("the focus distance must be a finite distance >= 0 (0: the camera's own)");
   aperture_ = apertureRadius;
   if (focusDistance > 0.0) focus_ = focusDistance;
 }

@@ -79,7 +79,7 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .type = ParamType::Distance, .def = 0.0, .min = 0.0, .max = 1.0});
   s.push_back({.name = "focus_distance", .label = "Focus distance",
                .help = "Distance F from the lens of the plane that stays sharp; 0 = the distance to the target (look "
-                       "at) or to the scene's centre (framing).",
+                       "at) or to the scene's centre (framing), or 1 scene unit with the layer's camera.",
                .type = ParamType::Distance, .def = 0.0, .min = 0.0, .max = 1000.0});
   s.push_back({.name = "max_depth", .label = "Maximum bounces",
                .help = "Rays a path may spawn by reflection or refraction (mirror, glass, glossy, diffuse); 0 = the "

@@ -1,6 +1,8 @@
 // The camera (gi/camera.h) against its definition and against vcglib's
 // Shot/Camera conventions (MeshLab's view), and the image files (gi/image.h).
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <unistd.h>
 
 #include <cstdio>
@@ -148,9 +150,16 @@ TEST(Camera, RejectsDegenerateViews) {
   EXPECT_THROW(Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 40, 0, 10), std::invalid_argument);
   ShotData s;
   EXPECT_THROW(Camera::fromShot(s, 10, 10), std::invalid_argument);  // no intrinsics
-  Camera c = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 40, 10, 10);
+  Camera c = Camera::lookAt({0, 0, 0}, {0, 0, 3}, {0, 1, 0}, 40, 10, 10);
   EXPECT_THROW(c.setLens(-1, 1), std::invalid_argument);
-  EXPECT_THROW(c.setLens(0.1, 0), std::invalid_argument);
+  EXPECT_THROW(c.setLens(0.1, -1), std::invalid_argument);
+  EXPECT_THROW(c.setLens(0.1, std::nan("")), std::invalid_argument);
+  // Focus distance 0 (the table's default) keeps the target's distance: a
+  // lens with the default focus was refused until 3 December 2026.
+  c.setLens(0.1, 0);
+  EXPECT_EQ(c.focusDistance(), 3.0);
+  c.setLens(0.1, 2);
+  EXPECT_EQ(c.focusDistance(), 2.0);
 }
 
 // PFM keeps the linear floats bit for bit (negative, tiny, huge values too).

@@ -54,7 +54,9 @@ class Camera {
   // height()) gives this camera back, lens aside.
   ShotData toShot() const;
 
-  // Thin lens: aperture radius A and focus distance F (scene units, F > 0).
+  // Thin lens: aperture radius A and focus distance F (scene units; F = 0
+  // keeps the camera's own: the target's distance for lookAt and frame, 1
+  // for a layer's camera).
   // A = 0 is a pinhole (every depth sharp).
   void setLens(double apertureRadius, double focusDistance);
 
