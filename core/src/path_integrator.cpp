@@ -300,4 +300,14 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
   return L + trace(st, nullptr, smp, c, parts);
 }
 
+std::string unsampledLightPaths(const Scene& s, const LightSettings& lights) {
+  if (!lights.point.on()) return "";
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (isSpecular(s.faceMaterial(f)))
+      return "the point light's light reflected or refracted by mirrors or glass onto other surfaces (caustics, "
+             "L S+ D paths) is missing: no traced path can reach a point light through a perfect mirror or glass; "
+             "photon mapping computes it";
+  return "";
+}
+
 }  // namespace gi::paths

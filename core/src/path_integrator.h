@@ -24,6 +24,7 @@
 // the direct light), so 0 gives exactly the direct light at the first vertex.
 #pragma once
 #include <cstdint>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -102,6 +103,13 @@ struct LightSettings {
   float sunAngularRadiusDeg = 0.27f;
   PointLight point;
 };
+
+// Light paths these integrators cannot find, in one sentence, or "": a
+// point light's light reaching a diffuse surface by way of a mirror or glass
+// (L S+ D: a path from the surface meets the mirror in one direction and must
+// then hit a point exactly, which no sampled direction does; pbrt and every
+// unidirectional path tracer miss it too). Photon mapping finds it.
+std::string unsampledLightPaths(const Scene& s, const LightSettings& lights);
 
 struct PathRules {
   int maxDepth = 32;            // events that continue a path (see the top of this file)

@@ -286,6 +286,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
+  if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
   if (opt.tracedSelected)
     st.note("traced the " + std::to_string(std::count(part.subset->begin(), part.subset->end(), uint8_t(1))) +
             " selected of the " + std::to_string(nv) + " vertices; the others are 0, with ReferenceTraced 0");

@@ -263,6 +263,11 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   }
   st.note(std::string("mode ") + renderModeName(o.mode));
   if (o.mode == RenderMode::PathTraced && o.samplesPerPixel < 2) st.warn("one sample per pixel gives no error estimate");
+  if (o.mode == RenderMode::PathTraced) {
+    paths::LightSettings lights;
+    lights.point = o.point;
+    if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
+  }
   if (o.mode != RenderMode::PathTraced)
     st.note("error estimate from the spread of QMC pixel samples (an upper bound rather than an error bar)");
   if (o.mode == RenderMode::Whitted) {

@@ -10,7 +10,9 @@
 
 #include "gi/ambient.h"
 #include "gi/filters.h"
+#include "gi/pathtrace.h"
 #include "gi/photon.h"
+#include "gi/render.h"
 #include "gi/scene_setup.h"
 #include "gi/scenes.h"
 #include "mesh_io.h"
@@ -267,4 +269,36 @@ TEST(Warnings, ShippedMeshesWithDefaultsSayNothing) {
       }
     }
   }
+}
+
+// A point light's caustics (L S+ D) cannot be found by the path tracer: the
+// reference and the path-traced view say so where the scene has a point
+// light and a mirror or glass, and only there (the same scene lit by its
+// area light, or a point light without mirror or glass, says nothing).
+TEST(PathWarnings, PointLightCausticsMissingIsSaid) {
+  const Scene caustic = scenes::causticCornell(50.0, 20.0, 2, 1.5f);
+  const Scene plain = scenes::cornellBox(100.0).scene;
+  PointLight L;
+  L.position = glm::vec3(0.f);  // the scenes' centres, local units
+  L.intensity = glm::vec3(1e4f);
+  auto warnedAbout = [](const Scene& s, const PointLight& p) {
+    auto caster = makeEmbreeCaster(s);
+    PathTraceOptions o;
+    o.samplesPerVertex = 2;
+    o.minSamples = 2;
+    o.tracedVertices = 20;
+    o.point = p;
+    const bool ref = warned(pathTrace(s, *caster, o).stats, "point light's light reflected or refracted");
+    RenderOptions r;
+    r.mode = RenderMode::PathTraced;
+    r.samplesPerPixel = 2;
+    r.camera = Camera::lookAt({0, 0, -2000}, {0, 0, 0}, {0, 1, 0}, 40, 8, 8);
+    r.point = p;
+    const bool view = warned(render(s, *caster, r).stats, "point light's light reflected or refracted");
+    EXPECT_EQ(ref, view);
+    return ref;
+  };
+  EXPECT_TRUE(warnedAbout(caustic, L));
+  EXPECT_FALSE(warnedAbout(plain, L));
+  EXPECT_FALSE(warnedAbout(caustic, PointLight{}));
 }
