@@ -63,10 +63,20 @@ class PhotonMap {
     }
     r2 = std::max(r2, 1e-30f);
     const float r = std::sqrt(r2);
+    // When the k-th photon sets the radius it lies on the disk's edge, and
+    // counting it gives k / (pi r_k^2) photons per unit area, whose mean is
+    // k / (k - 1) times the density (pi r_k^2 times the density is Gamma(k)
+    // distributed for a Poisson process, and E[1 / Gamma(k)] = 1 / (k - 1)):
+    // 8% too high at k = 16, 1.6% at the default 64. The k - 1 photons inside
+    // give the density without that bias (the k-nearest-neighbour density
+    // estimate of Loftsgaarden and Quesenberry 1965). Found by an outside
+    // check: a closed box's reflected light 1.33 times too high at k = 4.
+    // k = 1 keeps its one photon (no estimate of that form has a mean).
+    const int counted = q.used == k && k >= 2 ? q.used - 1 : q.used;
     glm::dvec3 sum(0.0);
     glm::dvec3 sumPath[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
     double sumL2 = 0.0;
-    for (int m = 0; m < q.used; ++m) {
+    for (int m = 0; m < counted; ++m) {
       const float w = kernel == PhotonKernel::Cone ? std::max(0.f, 1.f - std::sqrt(q.d2[m]) / (kCone * r)) : 1.f;
       sum += double(w) * glm::dvec3(q.ph[m]->power);
       if (byPath) sumPath[q.ph[m]->path] += double(w) * glm::dvec3(q.ph[m]->power);

@@ -77,8 +77,11 @@ glm::vec3 CausticMap::irradiance(const glm::vec3& x, const glm::vec3& n, int k, 
   r2 = std::max(r2, 1e-30f);
   const float r = std::sqrt(r2);
   constexpr float c = 1.1f;
+  // The k-th photon on the disk's edge is left out, as in PhotonMap::irradiance
+  // (photon_map.h): k / (pi r_k^2) is k / (k - 1) times the density.
+  const int counted = used == k && k >= 2 ? used - 1 : used;
   glm::dvec3 sum(0.0);
-  for (int m = 0; m < used; ++m) sum += double(std::max(0.f, 1.f - std::sqrt(dd[m]) / (c * r))) * glm::dvec3(ph[m]->power);
+  for (int m = 0; m < counted; ++m) sum += double(std::max(0.f, 1.f - std::sqrt(dd[m]) / (c * r))) * glm::dvec3(ph[m]->power);
   const double area = M_PI * double(r2) * (1.0 - 2.0 / (3.0 * c));
   return glm::vec3(sum / area);
 }
