@@ -85,7 +85,11 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
         }
         case ParamType::Float: {
           double x = v.getFloat(s.name);
-          if (!std::isfinite(x) || x < s.min || x > s.max)
+          // Front ends hand values through single precision (MeshLab's
+          // RichFloat, the CLI's checks): a bound given as is must pass
+          // (1e-12 arrives as 9.99999996e-13).
+          const bool below = x < s.min && float(x) < float(s.min), above = x > s.max && float(x) > float(s.max);
+          if (!std::isfinite(x) || below || above)
             return "parameter '" + s.name + "' = " + num(x) + " is outside [" + num(s.min) + ", " + num(s.max) + "]";
           break;
         }

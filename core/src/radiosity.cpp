@@ -479,6 +479,15 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
 // reflected radiosity and indirect irradiance.
 RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                            const Progress& progress) {
+  // Refused before any work, not left out in silence: the hierarchy has no
+  // matrix to export and no sweeps of whole solutions to keep.
+  if (!opt.exportSystem.empty() || !opt.snapshotSteps.empty())
+    throw std::invalid_argument(std::string(!opt.exportSystem.empty() ? "export_system" : "snapshot_steps") +
+                                " needs a flat solver (Jacobi, Gauss-Seidel or Progressive refinement): the hierarchical "
+                                "solver has no form-factor matrix and no sweeps of whole solutions" +
+                                (opt.solver == RadiositySolver::Auto ? " (Auto chose it for " +
+                                                                           std::to_string(s.faceCount()) + " patches)"
+                                                                     : std::string()));
   Timer timer;
   const double budget = opt.memoryBudgetMB * 1048576.0;
   const size_t n = s.faceCount();

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "gi/color.h"
 #include "gi/direct.h"
@@ -351,4 +352,24 @@ TEST(HierarchicalRadiosity, LinkCapRefinesBestFirst) {
   }
   ASSERT_EQ(one.B.size(), cut.B.size());
   for (size_t f = 0; f < cut.B.size(); ++f) ASSERT_EQ(one.B[f], cut.B[f]) << "patch " << f;
+}
+
+// What the hierarchy cannot give is refused before any work, naming the
+// parameter: the linear system (there is no form-factor matrix) and
+// snapshots of whole solutions (there are no sweeps). Both used to be left
+// out without a word.
+TEST(HierarchicalRadiosity, RefusesExportAndSnapshots) {
+  const Scene s = scenes::cornellBox(100.0).scene;
+  auto caster = makeEmbreeCaster(s);
+  for (int k = 0; k < 2; ++k) {
+    RadiosityOptions o = patchOptions(RadiositySolver::Hierarchical);
+    if (k == 0) o.exportSystem = "unused";
+    else o.snapshotSteps = {1};
+    try {
+      solveRadiosity(s, *caster, o);
+      ADD_FAILURE() << "not refused";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(k == 0 ? "export_system" : "snapshot_steps"), std::string::npos) << e.what();
+    }
+  }
 }

@@ -187,6 +187,23 @@ void expectParseError(const std::string& name, const std::string& text) {
   }
 }
 
+// A float bound given as is passes after single precision (the table's
+// tolerance bound 1e-12 arrived as 9.99999996e-13 and was refused with
+// "1e-12 is outside [1e-12, 1]"); just past it is still refused.
+TEST(Params, FloatBoundsSurviveSinglePrecision) {
+  const std::vector<gi::ParamSpec> specs = {
+      {"tol", "Tolerance", "A small float.", gi::ParamType::Float, 1e-4, 1e-12, 0.3}};
+  gi::ParamValues v;
+  for (double x : {double(1e-12f), double(0.3f), 1e-12, 0.3}) {
+    v.set("tol", x);
+    EXPECT_FALSE(gi::validate(specs, v, kDiag).has_value()) << x;
+  }
+  for (double x : {0.9e-12, 0.31}) {
+    v.set("tol", x);
+    EXPECT_TRUE(gi::validate(specs, v, kDiag).has_value()) << x;
+  }
+}
+
 TEST(Params, ParseValueEveryType) {
   for (const char* t : {"1", "true", "on", "yes"}) EXPECT_EQ(std::get<bool>(parse("flag", t)), true) << t;
   for (const char* t : {"0", "false", "off", "no"}) EXPECT_EQ(std::get<bool>(parse("flag", t)), false) << t;
