@@ -15,6 +15,7 @@
 #include "gi/color.h"
 #include "gi/open_space.h"
 #include "gi/sampling.h"
+#include "gi/sky.h"
 
 namespace gi {
 namespace {
@@ -151,8 +152,9 @@ class AmbientKernel {
         for (int j = 0; j < m; ++j) w.add(occ[j] ? 0.0 : std::max(0.f, glm::dot(n, rays[j].d)));
       }
       sunRays = o_.sunRays;
-      sun = o_.sunColor * float(o_.sunIrradiance * w.mean());
-      sunErr = o_.sunIrradiance * w.stdError() * luminance(o_.sunColor);
+      const double scale = sunDiskScale(o_.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
+      sun = o_.sunColor * float(o_.sunIrradiance * scale * w.mean());
+      sunErr = o_.sunIrradiance * scale * w.stdError() * luminance(o_.sunColor);
     }
     const double skyErr = double(out.stdError) * o_.skyIrradiance * luminance(o_.skyRadiantColor);
     out.rgb = sky + sun;

@@ -52,7 +52,7 @@ Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& 
   sunCos_ = std::cos(glm::radians(L_.sunAngularRadiusDeg));
   const float omega = 2.f * float(M_PI) * (1.f - sunCos_);
   sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
-  sunL_ = sunDisk_ ? L_.sunIrradiance / omega : glm::vec3(0.f);
+  sunL_ = sunDisk_ ? L_.sunIrradiance * (sunDiskScale(L_.sunAngularRadiusDeg) / omega) : glm::vec3(0.f);  // E / (pi sin^2 a)
   hasPoint_ = L_.point.on();
 }
 

@@ -31,6 +31,7 @@
 #include "gi/emitters.h"
 #include "gi/glossy.h"
 #include "gi/light_paths.h"
+#include "gi/sky.h"
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
 #include "gi/scene.h"

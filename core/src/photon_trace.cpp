@@ -79,7 +79,10 @@ class PhotonLights {
       }
       const double disk = M_PI * double(radius_) * radius_;
       skyPower_ = o.outside.sky() ? 4.0 * M_PI * double(luminance(o.outside.skyRadiance)) * disk : 0.0;
-      sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk : 0.0;
+      sunScale_ = sunDiskScale(o.outside.sunAngularRadiusDeg);
+      // Through a disk facing each sampled direction: E_sun <n.w> = E_sun (1 + cos a) / 2 on a facing
+      // surface without the factor (gi/sky.h, sunDiskScale).
+      sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk * sunScale_ : 0.0;
     }
     o.point.check();
     cosSpot_ = o.point.cosSpot();
@@ -151,7 +154,7 @@ class PhotonLights {
     } else {
       w = Frame(o_.outside.sunDirection).toWorld(uniformCone(u1, o_.outside.sunCos()));
       // L_sun Omega = E_sun.
-      power = o_.outside.sunIrradiance * float(disk / (pOut * (1.0 - pSky) * count));
+      power = o_.outside.sunIrradiance * float(disk * sunScale_ / (pOut * (1.0 - pSky) * count));
     }
     const float ad = sky ? a / float(pSky) : (a - float(pSky)) / float(1.0 - pSky);
     const float r = radius_ * std::sqrt(std::clamp(ad, 0.f, 1.f)), phi = 2.f * float(M_PI) * b;
@@ -165,6 +168,7 @@ class PhotonLights {
   float radius_ = 0.f;
   double skyPower_ = 0.0, sunPower_ = 0.0, inner_ = 0.0;
   double pointPower_ = 0.0, total_ = 0.0, cosSpot_ = -1.0;
+  double sunScale_ = 1.0;
   glm::vec3 spotFrame_;
 };
 

@@ -67,7 +67,7 @@ glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3
     ray.d = sunFrame.toWorld(uniformCone(smp(k, skyDim + 1), sunCos));
     const float c = glm::dot(ray.d, n);
     ray.tfar = std::numeric_limits<float>::infinity();
-    if (c > 0.f && !caster.occluded(ray)) H += o.sunIrradiance * c;
+    if (c > 0.f && !caster.occluded(ray)) H += o.sunIrradiance * (c * sunDiskScale(o.sunAngularRadiusDeg));
   }
   return H;
 }

@@ -1,7 +1,9 @@
 // Light from outside the scene: a uniform sky of radiance L_sky over the
 // whole sphere (an unoccluded surface gets E_sky = pi L_sky) and a sun disk
-// of angular radius alpha whose radiance L_sun = E_sun / Omega_sun, with
-// Omega_sun = 2 pi (1 - cos alpha), gives a surface facing it E_sun. At a
+// of angular radius alpha whose radiance L_sun = E_sun / (pi sin^2 alpha)
+// gives a surface facing it E_sun (its cone's projected solid angle is
+// pi sin^2 alpha; over its solid angle Omega_sun = 2 pi (1 - cos alpha) the
+// mean of n.w is then (1 + cos alpha) / 2, which sunDiskScale undoes). At a
 // point x with normal n, the irradiance integral (Cohen and Wallace 1993,
 // "Radiosity and Realistic Image Synthesis", ch. 2):
 //   H_out(x) = L_sky ∫_{n.w > 0} V(x, w) (n.w) dw + L_sun ∫_{sun} V(x, w) max(0, n.w) dw
@@ -13,6 +15,7 @@
 // view see them along rays that leave the scene. One parameter table serves
 // them all (SkySun::specs).
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -25,6 +28,16 @@
 #include "gi/vertex_part.h"
 
 namespace gi {
+
+// The factor from E_sun <max(0, n.w)>, w uniform in the sun's cone, to the
+// irradiance: 2 / (1 + cos alpha) = 1 / cos^2(alpha / 2), so that a surface
+// facing the sun gets E_sun whatever its size (without it 0.854 E_sun at
+// alpha = 45 degrees; 1 - 5.6e-6 at the real sun's 0.27). The photons,
+// sent through a disk facing each sampled direction, take the same factor.
+inline float sunDiskScale(float angularRadiusDeg) {
+  const double c = std::cos(0.5 * double(angularRadiusDeg) * 3.14159265358979323846 / 180.0);
+  return float(1.0 / (c * c));
+}
 
 struct SkySun {
   glm::vec3 skyRadiance{0.f};    // uniform sky over the whole sphere, W/(m^2 sr) (linear RGB)
