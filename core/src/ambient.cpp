@@ -47,6 +47,7 @@ class AmbientKernel {
     tfar_ = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
     coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
+    sunScale_ = sunDiskScale(o.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
   }
 
   VertexOut run(uint32_t vi, const glm::vec3& org, const glm::vec3& n) const {
@@ -152,9 +153,8 @@ class AmbientKernel {
         for (int j = 0; j < m; ++j) w.add(occ[j] ? 0.0 : std::max(0.f, glm::dot(n, rays[j].d)));
       }
       sunRays = o_.sunRays;
-      const double scale = sunDiskScale(o_.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
-      sun = o_.sunColor * float(o_.sunIrradiance * scale * w.mean());
-      sunErr = o_.sunIrradiance * scale * w.stdError() * luminance(o_.sunColor);
+      sun = o_.sunColor * float(o_.sunIrradiance * sunScale_ * w.mean());
+      sunErr = o_.sunIrradiance * sunScale_ * w.stdError() * luminance(o_.sunColor);
     }
     const double skyErr = double(out.stdError) * o_.skyIrradiance * luminance(o_.skyRadiantColor);
     out.rgb = sky + sun;
@@ -166,7 +166,7 @@ class AmbientKernel {
 
   const RayCaster& caster_;
   const AmbientOptions& o_;
-  float tfar_, coneCos_, sunCos_;
+  float tfar_, coneCos_, sunCos_, sunScale_;
 };
 
 // The parameter table refuses all of these; a library caller filling

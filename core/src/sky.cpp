@@ -53,7 +53,7 @@ namespace {
 // With openings: the sky only where it is still sampled by cosine rays,
 // and only through no portal (the portals' light is the direct light's).
 glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3& x, const Frame& frame,
-                       const glm::vec3& n, const Frame& sunFrame, float sunCos, const PaddedSobol& smp, uint32_t k,
+                       const glm::vec3& n, const Frame& sunFrame, float sunCos, float sunScale, const PaddedSobol& smp, uint32_t k,
                        uint32_t skyDim, const SkyOpenings* op) {
   glm::vec3 H(0.f);
   Ray ray;
@@ -67,7 +67,7 @@ glm::vec3 skySunSample(const SkySun& o, const RayCaster& caster, const glm::vec3
     ray.d = sunFrame.toWorld(uniformCone(smp(k, skyDim + 1), sunCos));
     const float c = glm::dot(ray.d, n);
     ray.tfar = std::numeric_limits<float>::infinity();
-    if (c > 0.f && !caster.occluded(ray)) H += o.sunIrradiance * (c * sunDiskScale(o.sunAngularRadiusDeg));
+    if (c > 0.f && !caster.occluded(ray)) H += o.sunIrradiance * (c * sunScale);
   }
   return H;
 }
@@ -83,10 +83,10 @@ glm::vec3 skySunAt(const SkySun& o, const RayCaster& caster, const glm::vec3& x,
   if (!o.any() || rays < 1) return glm::vec3(0.f);
   const PaddedSobol smp(hash3(key, 0x5c1u, 0x5e2u));
   const Frame frame(n), sunFrame(o.sunDirection);
-  const float sunCos = o.sunCos();
+  const float sunCos = o.sunCos(), sunScale = sunDiskScale(o.sunAngularRadiusDeg);
   glm::dvec3 sum(0.0);
   for (int k = 0; k < rays; ++k)
-    sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 0, op));
+    sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, sunScale, smp, uint32_t(k), 0, op));
   return glm::vec3(sum / double(rays));
 }
 
@@ -106,7 +106,7 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
                                                    : std::vector<glm::vec3>(s.faceCount(), glm::vec3(0.f));
   if (!o.any() || rays < 1 || (openings && !openings->rest && !o.sun())) return H;
   const auto ok = usableFaceMask(s);
-  const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos();
+  const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos(), sunScale = sunDiskScale(o.sunAngularRadiusDeg);
   const Frame sunFrame(o.sunDirection);
   parallelBlocks(s.faceCount(), openings ? progress.sub(0.5, 1.0) : progress, "sky and sun", [&](size_t b, size_t e) {
     for (size_t f = b; f < e; ++f) {
@@ -121,7 +121,7 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
         const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
         const glm::vec3 x =
             w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
-        sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, smp, uint32_t(k), 1, openings));
+        sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, sunScale, smp, uint32_t(k), 1, openings));
       }
       H[f] += glm::vec3(sum / double(rays));
     }
