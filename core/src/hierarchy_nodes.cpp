@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "gi/form_factor_analytic.h"
+#include "gi/run.h"
+#include "gi/sampling.h"
 
 namespace gi::hierarchy {
 
@@ -239,6 +242,37 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
   } else {
     link.F = float(F * double(pass) / double(cast));
   }
+}
+
+std::vector<Closure> rowClosures(const Geometry& g, const RayCaster& caster, int rays, uint32_t seed, float eps,
+                                 uint64_t& cast) {
+  const size_t nf = g.s.faceCount();
+  std::vector<Closure> c(nf);
+  if (rays <= 0) return c;
+  parallelBlocks(nf, Progress(nullptr), "", [&](size_t b, size_t e) {
+    Ray ray;
+    for (size_t f = b; f < e; ++f) {
+      if (!(g.A[f] > 0)) continue;
+      const glm::uvec3 tri = g.s.triangles[f];
+      const glm::vec3 p0 = g.s.positions[tri.x], p1 = g.s.positions[tri.y], p2 = g.s.positions[tri.z];
+      const Frame frame(g.n[f]);
+      const PaddedSobol smp(hash3(uint32_t(f), seed, 0xc105u));
+      int hits = 0;
+      for (int k = 0; k < rays; ++k) {
+        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
+        ray.o = w.x * p0 + w.y * p1 + (1.f - w.x - w.y) * p2 + g.n[f] * eps;
+        ray.d = frame.toWorld(cosineHemisphere(smp(uint32_t(k), 1)));
+        ray.tnear = 0.f;
+        ray.tfar = std::numeric_limits<float>::infinity();
+        const Hit h = caster.intersect(ray);
+        hits += h.valid() && h.face != f && g.A[h.face] > 0 && glm::dot(ray.d, g.n[h.face]) < 0.f;
+      }
+      const double G = double(hits) / rays, sigma = std::sqrt(G * (1.0 - G) / rays);
+      c[f] = {float(G), float(std::max(0.0, G - 2.0 * sigma)), float(std::min(1.0, G + 2.0 * sigma))};
+    }
+  });
+  cast += uint64_t(rays) * uint64_t(std::count_if(g.A.begin(), g.A.end(), [](double a) { return a > 0; }));
+  return c;
 }
 
 }  // namespace gi::hierarchy

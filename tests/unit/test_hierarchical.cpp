@@ -106,14 +106,19 @@ TEST(HierarchicalRadiosity, AgreesWithFlatOnCornellBoxWithinFlatError) {
 // amplified by 1 / (1 - rho)); the energy
 // balance (emitted = absorbed in a closed box) within rho |delta| / (1 - rho)
 // + 2e-4 / (1 - rho); and at rho = 0.99, where the links to bright sources
-// are refined to triangles, B within 1% of 1 / (1 - rho).
+// are refined to triangles, B within 1% of 1 / (1 - rho). These are the
+// links' own bounds, asserted with the closure on (the default, which
+// brings delta to 1e-9 here: ClosureConservesEnergyInAClosedRoom) and off.
 TEST(HierarchicalRadiosity, FurnaceAndEnergyBalance) {
   auto sf = scenes::closedBox(1.0, 4, true);  // 192 triangles, all emitting: 6 luminaires, exact direct light
+  for (int closureRays : {64, 0})
   for (float rho : {0.5f, 0.9f, 0.99f}) {
+    SCOPED_TRACE("closure rays " + std::to_string(closureRays));
     scenes::setUniform(sf, glm::vec3(rho), glm::vec3(1.f));
     auto caster = makeEmbreeCaster(sf.scene);
     RadiosityOptions o = patchOptions(RadiositySolver::Hierarchical);
     o.tolerance = 1e-9;
+    o.closureRays = closureRays;
     const RadiosityResult r = solveRadiosity(sf.scene, *caster, o);
     if (rho == 0.5f) {
       EXPECT_GT(r.stats.get("links"), r.stats.get("links_patch_to_patch")) << "clusters linked";
@@ -137,6 +142,104 @@ TEST(HierarchicalRadiosity, FurnaceAndEnergyBalance) {
       EXPECT_NEAR(B / A * (1.0 - p), 1.0, 0.01);
     }
   }
+}
+
+// The closure (gi/hierarchical.h) in a closed room lit from a patch of its
+// ceiling (768 triangles, 8 x 8 patches a side; E = 10 on the 32 triangles
+// within 0.2 of the ceiling's centre), where light leaves nowhere: at
+// convergence every watt reflected is absorbed in the end, so sum A R =
+// rho / (1 - rho) sum A H_direct exactly, whatever the links. The links'
+// own row sums spread from 0.94 to 1.06 here: without the closure (rays 0)
+// the mean R is 10% high at rho 0.99 (measured 1.10) and the solve
+// diverges at 0.999 (a warning; 10.9 times the exact value after 3,000
+// sweeps, 2,367 times after 20,000). With it: the mean within 1e-5
+// (measured 6e-7 or less: the solve's tolerance), the energy balance within
+// 1e-5, and the patch values against the flat solution from Monte Carlo
+// rows of 16,384 rays (whose rows are closed too: every ray hits) within
+// 0.2% RMS, about ten times that reference's own noise (measured 0.018%
+// against 0.027% between two of its seeds; 10% without the closure).
+TEST(HierarchicalRadiosity, ClosureConservesEnergyInAClosedRoom) {
+  auto sf = scenes::closedBox(1.0, 8, true);
+  Scene& s = sf.scene;
+  s.emission.assign(s.faceCount(), glm::vec3(0.f));
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::vec3 c = (s.positions[s.triangles[f].x] + s.positions[s.triangles[f].y] + s.positions[s.triangles[f].z]) / 3.f;
+    if (c.y > 0.49f && std::fabs(c.x) < 0.2f && std::fabs(c.z) < 0.2f) s.emission[f] = glm::vec3(10.f);
+  }
+  for (float rho : {0.9f, 0.99f, 0.999f}) {
+    s.rho.assign(s.faceCount(), glm::vec3(rho));
+    auto caster = makeEmbreeCaster(s);
+    const std::vector<glm::vec3> Hd = patchDirectIrradiance(s, *caster, 64, 0);
+    double AHd = 0;
+    for (size_t f = 0; f < s.faceCount(); ++f) AHd += faceArea(s, f) * Hd[f].g;
+    const double exact = rho / (1.0 - rho) * AHd;
+    auto meanR = [&](const HierarchicalSolution& h) {
+      double AR = 0;
+      for (size_t f = 0; f < s.faceCount(); ++f) AR += faceArea(s, f) * h.R[f].g;
+      return AR / exact;
+    };
+    HierarchySettings hs;
+    const HierarchicalSolution closed = solveHierarchical(s, *caster, Hd, hs, -1, 1e-8, 0);
+    hs.closureRays = 0;
+    const HierarchicalSolution open = solveHierarchical(s, *caster, Hd, hs, -1, 1e-8, rho > 0.99f ? 3000 : 0);
+    std::printf("rho %.3f: mean R / exact: closure %.7f (balance %.2g, %g rows moved, RMS %.4f), without %.4f\n", rho,
+                meanR(closed), closed.stats.get("energy_balance_error"), closed.stats.get("rows_closed"),
+                closed.stats.get("row_closure_rms"), meanR(open));
+    EXPECT_NEAR(meanR(closed), 1.0, 1e-5) << "rho " << rho;
+    EXPECT_LT(closed.stats.get("energy_balance_error"), 1e-5) << "rho " << rho;
+    EXPECT_TRUE(closed.stats.warnings.empty()) << "rho " << rho;
+    if (rho == 0.99f) {
+      EXPECT_GT(meanR(open), 1.05) << "the links alone create light";
+      RadiosityOptions fo = patchOptions(RadiositySolver::GaussSeidel);
+      fo.formFactors.method = FormFactorMethod::MonteCarlo;
+      fo.formFactors.raysPerPatch = 16384;
+      fo.lightSamples = 64;
+      const RadiosityResult flat = solveRadiosity(s, *caster, fo);
+      std::vector<glm::vec3> B = closed.R;
+      for (size_t f = 0; f < B.size(); ++f) B[f] += s.emission[f];
+      const double e = rmsAll(B, flat.B);
+      std::printf("  patch values against the flat Monte Carlo rows: %.5f RMS\n", e);
+      EXPECT_LT(e, 0.002);
+    }
+    if (rho == 0.999f) {
+      EXPECT_GT(meanR(open), 2.0) << "diverges without the closure";
+      EXPECT_FALSE(open.stats.warnings.empty());
+    }
+  }
+}
+
+// Where the room has occluders only the rows are closed, and the links'
+// visibility rays can still create light; the energy balance, against the
+// closure rays' count of what escapes, says how much. The shadow-leak room
+// (a partition cutting through coarse patches, the light's back 2 cm below
+// the ceiling): the hierarchy absorbs 1.8% more than the flat solution
+// from Monte Carlo rows (whose balance is within 0.02%), and its balance
+// says 1.8% (1.5% above 1%: a warning); asserted within half a percent of
+// each other. The Cornell box balances within 1% (measured 0.46%): no
+// warning.
+TEST(HierarchicalRadiosity, EnergyBalanceSaysWhatTheLinksCreate) {
+  auto leak = scenes::shadowLeak();
+  auto caster = makeEmbreeCaster(leak.scene);
+  RadiosityOptions o = patchOptions(RadiositySolver::GaussSeidel);
+  o.tolerance = 1e-6;
+  o.formFactors.raysPerPatch = 16384;
+  const RadiosityResult flat = solveRadiosity(leak.scene, *caster, o);
+  o.solver = RadiositySolver::Hierarchical;
+  const RadiosityResult hier = solveRadiosity(leak.scene, *caster, o);
+  const double created = hier.stats.get("absorbed_power_W") / flat.stats.get("absorbed_power_W") - 1.0;
+  const double balance = hier.stats.get("energy_balance_error");
+  std::printf("shadow leak: absorbed %+.2f%% against the flat rows (balance %.2g), energy balance %.2f%%\n",
+              100 * created, flat.stats.get("energy_balance_error"), 100 * balance);
+  EXPECT_LT(flat.stats.get("energy_balance_error"), 1e-3);
+  EXPECT_NEAR(balance, std::fabs(created), 0.005);
+  bool warned = false;
+  for (const std::string& w : hier.stats.warnings) warned |= w.find("energy balance off by") != std::string::npos;
+  EXPECT_TRUE(warned);
+  auto box = scenes::cornellBox(50.0);
+  auto boxCaster = makeEmbreeCaster(box.scene);
+  const RadiosityResult cornell = solveRadiosity(box.scene, *boxCaster, o);
+  EXPECT_LT(cornell.stats.get("energy_balance_error"), 0.01);
+  for (const std::string& w : cornell.stats.warnings) EXPECT_EQ(w.find("energy balance"), std::string::npos) << w;
 }
 
 // Epsilon 0: every link joins two triangles, and the solution is the flat
@@ -271,7 +374,8 @@ TEST(HierarchicalRadiosity, AgreesWithFlatOnTenThousandPatchCornellBox) {
 // (every link joins two triangles, no cluster anywhere) is the reference;
 // the default links with sampled sources stay within 0.8% of it, the
 // area-mean rule (what link_rays above 31 falls back to: 32 rays) loses
-// more than twice as much.
+// more than twice as much. The rules are compared as the links give them,
+// without the closure's balance (closure_rays 0), which moves both.
 TEST(HierarchicalRadiosity, ClusterSourcesGatherWhatTheirRaysSee) {
   auto sf = scenes::cornellBox(50.0);
   const Scene& s = sf.scene;
@@ -281,6 +385,7 @@ TEST(HierarchicalRadiosity, ClusterSourcesGatherWhatTheirRaysSee) {
     RadiosityOptions x = o;
     x.hierarchyEpsilon = epsilon;
     x.linkRays = linkRays;
+    x.closureRays = 0;
     return solveRadiosity(s, *caster, x).stats.get("absorbed_power_W");
   };
   const double exact = absorbed(0.0, 4), sampled = absorbed(1e-4, 4), areaMean = absorbed(1e-4, 32);
@@ -340,7 +445,7 @@ TEST(HierarchicalRadiosity, LinkCapRefinesBestFirst) {
   const double e = rmsAll(cut.B, full.B);
   std::printf("links %g -> %g (cap %g): patch values %.4f RMS\n", links, cut.stats.get("links"), o.maxLinks, e);
   EXPECT_TRUE(noted);
-  EXPECT_TRUE(cut.stats.warnings.empty());
+  for (const std::string& w : cut.stats.warnings) EXPECT_EQ(w.find("memory budget"), std::string::npos) << w;
   EXPECT_LE(cut.stats.get("links"), o.maxLinks);
   EXPECT_LT(e, 0.006);
   // The refinement decides batches of candidates on all threads and applies

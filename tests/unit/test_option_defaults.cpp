@@ -131,6 +131,7 @@ TEST(OptionDefaults, Radiosity) {
   SAME(memoryBudgetMB);
   SAME(hierarchyEpsilon);
   SAME(linkRays);
+  SAME(closureRays);
   SAME(vertexOutput);
   SAME(gatherRays);
   SAME(refine);

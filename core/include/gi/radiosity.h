@@ -63,6 +63,7 @@ struct RadiosityOptions {
   double memoryBudgetMB = 1024;   // full sparse F while it fits; else progressive with rows on the fly
   double hierarchyEpsilon = 1e-4; // hierarchical: BF refinement threshold (fraction of the power leaving surfaces)
   int linkRays = 4;               // hierarchical: visibility rays per link
+  int closureRays = 64;           // hierarchical: rays per patch bounding its links' sum (0: off)
   double maxLinks = 0;            // hierarchical: links at most (refined best first where it binds); 0: no cap
   RadiosityVertexOutput vertexOutput = RadiosityVertexOutput::FinalGather;
   int gatherRays = 256;           // final-gather rays per vertex
