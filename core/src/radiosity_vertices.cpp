@@ -136,6 +136,27 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   if (gather) res.stats.add("final_gather_seconds", gt.seconds());
   for (size_t v = 0; v < s.vertexCount(); ++v)
     res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient) : glm::vec3(0.f);
+  // A vertex of a two-sided surface (each face with a reversed copy) has
+  // no normal, its faces' cancel (as has one whose normal in the file is
+  // zero): no side to evaluate the light on. It takes the patch average of
+  // its faces, both sides (what 'Patch average' writes everywhere), and
+  // the log says how many did.
+  std::vector<uint8_t> onDiffuse(s.vertexCount(), 0);
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f] && s.faceMaterial(f) == Material::Diffuse)
+      for (int k = 0; k < 3; ++k) onDiffuse[s.triangles[f][k]] = 1;
+  std::vector<glm::vec3> average;
+  size_t nTwoSided = 0;
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    if (mat.valid[v] || !onDiffuse[v] || !opt.vertices.contains(v, s.vertexCount())) continue;
+    if (average.empty()) average = faceToVertex(s, res.B);
+    res.Bvertex[v] = average[v];
+    ++nTwoSided;
+  }
+  if (nTwoSided)
+    res.stats.note(std::to_string(nTwoSided) + " vertices without a normal (on a two-sided surface their faces' " +
+                   "normals cancel): the patch average of their faces, both sides");
   res.stats.add("vertex_output_seconds", vt.seconds());
   res.stats.note(gather ? "vertices: direct light and a final gather of the patch solution at each vertex"
                         : "vertices: direct light at each vertex, indirect interpolated from the patches");

@@ -77,6 +77,9 @@ class Context : public paths::Integrator, private paths::StoredLight {
   glm::vec3 finalGather(const SurfacePoint& sp, Sampler& smp, Counts& c) const;
   // Whitted: direct irradiance at x, exact area-light factors with one shadow ray each.
   glm::vec3 whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const;
+  // Whitted: what reaches the end of a shadow ray: 0 past an opaque face,
+  // through glass the tint times 1 - F at each interface crossed.
+  glm::vec3 whittedTransmittance(Ray ray, Counts& c) const;
 
   struct AreaLight {
     std::vector<uint32_t> faces;

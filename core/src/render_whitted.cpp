@@ -14,6 +14,13 @@
 //     it is in view, and then the sum is its boundary's contour integral):
 //     hard shadows without noise;
 //   - the point or spot light and the sun's centre: one shadow ray each.
+// A shadow ray goes straight through glass, losing the Fresnel reflectance
+// F at each interface it crosses (and taking the glass's tint), as classical
+// ray tracers attenuate light through transparent objects without bending
+// it (Hall and Greenberg 1983): exact for glass of index 1 and for a pane
+// at normal incidence, short of a lens's focusing (the caustic map and the
+// path tracer have that). Beyond the critical angle (total internal
+// reflection) nothing passes.
 // The sky lights nothing here (it needs sampled rays: the distributed mode);
 // it is seen only along rays that leave the scene. Glossy faces have no
 // Whitted counterpart: they reflect one ray in the mirror direction weighted
@@ -82,16 +89,12 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
     w /= r;
     Ray ray = spawn(x, n, w);
     ray.tfar = r * (1.f - 1e-4f) - eps_;
-    ++c.shadow;
-    if (ray.tfar > 0.f && caster_.occluded(ray)) continue;
-    H += glm::vec3(Hl);
+    if (ray.tfar > 0.f) H += glm::vec3(Hl) * whittedTransmittance(ray, c);
+    else H += glm::vec3(Hl);
   }
   if (hasSun_) {
     const float cx = glm::dot(n, o_.sunDirection);
-    if (cx > 0.f) {
-      ++c.shadow;
-      if (!caster_.occluded(spawn(x, n, o_.sunDirection))) H += o_.sunIrradiance * cx;
-    }
+    if (cx > 0.f) H += o_.sunIrradiance * cx * whittedTransmittance(spawn(x, n, o_.sunDirection), c);
   }
   if (hasPoint_) {
     glm::vec3 w = o_.point.position - x;
@@ -103,12 +106,27 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
       if (cx > 0.f && o_.point.shinesTowards(-w)) {
         Ray ray = spawn(x, n, w);
         ray.tfar = r * (1.f - 1e-4f);
-        ++c.shadow;
-        if (!caster_.occluded(ray)) H += o_.point.intensity * (cx / r2);
+        H += o_.point.intensity * (cx / r2) * whittedTransmittance(ray, c);
       }
     }
   }
   return H;
+}
+
+glm::vec3 Context::whittedTransmittance(Ray ray, Counts& c) const {
+  glm::vec3 T(1.f);
+  for (int crossings = 0;; ++crossings) {
+    ++c.shadow;
+    const Hit h = caster_.intersect(ray);
+    if (!h.valid()) return T;
+    if (s_.faceMaterial(h.face) != Material::Glass || crossings >= 64) return glm::vec3(0.f);
+    const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
+    const float cosN = glm::dot(ray.d, faceN_[h.face]);
+    const float F = fresnelDielectric(std::min(1.f, std::fabs(cosN)), cosN < 0.f ? 1.f / ior : ior);
+    T *= s_.faceRho(h.face) * (1.f - F);
+    if (!(T.r > 0.f || T.g > 0.f || T.b > 0.f)) return T;
+    ray.tnear = h.t + eps_;  // on past the interface, the same line
+  }
 }
 
 glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, Counts& c) const {

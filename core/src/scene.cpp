@@ -203,8 +203,9 @@ void addCornerTerms(const Scene& s, const std::vector<uint8_t>& ok, std::vector<
 
 std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<uint8_t>* usable) {
   std::vector<glm::dvec3> acc(s.positions.size(), glm::dvec3(0.0));
+  std::vector<int> count(s.positions.size(), 0);
   std::vector<uint8_t> own;
-  addCornerTerms(s, usableFaces(s, usable, own), acc, nullptr, [&s](size_t f, CornerTerm* out) {
+  addCornerTerms(s, usableFaces(s, usable, own), acc, &count, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
     const glm::dvec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
@@ -218,8 +219,12 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<ui
   std::vector<glm::vec3> n(acc.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, acc.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
+      // Terms that cancel (a two-sided surface: each face with a reversed
+      // copy) leave a rounding residue in a random direction: no normal.
+      // A real vertex's sum is its faces' angles, radians, at least
+      // 1e-6 each.
       double l = glm::length(acc[i]);
-      n[i] = l > 0.0 ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
+      n[i] = l > 1e-6 * count[i] ? glm::vec3(acc[i] / l) : glm::vec3(0.f);
     }
   });
   return n;

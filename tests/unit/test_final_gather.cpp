@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "gi/ao_shared.h"
@@ -19,6 +20,7 @@
 #include "gi/pathtrace.h"
 #include "gi/radiosity.h"
 #include "gi/raycaster.h"
+#include "gi/scene_setup.h"
 #include "gi/scenes.h"
 
 using namespace gi;
@@ -144,4 +146,46 @@ TEST(FinalGather, SharingWithNeighboursCutsTheNoiseNotTheDetail) {
   EXPECT_GT(rough, 30);
   EXPECT_LT(rShared, rOwn);
   EXPECT_LT(worst, 0.1);
+}
+
+// A two-sided floor (every face with a reversed copy on the same vertices,
+// as some exporters write double-sided geometry) under a light: the
+// vertices' normals cancel, so there is no side to gather on. They wrote 0
+// (9 of 25 vertices in a reviewer's run); they now take the patch average
+// of their faces, both sides, in every vertex mode, and the log says how
+// many. Border vertices keep no normal either (their faces cancel too).
+TEST(FinalGather, TwoSidedSurfaceTakesThePatchAverage) {
+  auto floor = scenes::openPlane(2.0, 4);
+  std::vector<glm::dvec3> pts;
+  for (const auto& p : floor.scene.positions) pts.push_back(floor.scene.toWorld(p));
+  std::vector<glm::uvec3> tris = floor.scene.triangles;
+  const size_t nFloor = tris.size();
+  for (size_t f = 0; f < nFloor; ++f) tris.push_back({tris[f].x, tris[f].z, tris[f].y});
+  const uint32_t l = uint32_t(pts.size());  // a light 0.5 wide at height 1, facing down
+  for (glm::dvec3 p : {glm::dvec3(-0.25, -0.25, 1), glm::dvec3(0.25, -0.25, 1), glm::dvec3(0.25, 0.25, 1),
+                       glm::dvec3(-0.25, 0.25, 1)})
+    pts.push_back(p);
+  tris.push_back({l, l + 2, l + 1});
+  tris.push_back({l, l + 3, l + 2});
+  Scene s = Scene::fromAbsolute(pts, tris);
+  s.emission.assign(s.faceCount(), glm::vec3(0.f));
+  s.emission[s.faceCount() - 1] = s.emission[s.faceCount() - 2] = glm::vec3(10.f);
+  auto caster = makeEmbreeCaster(s);
+  for (auto mode : {RadiosityVertexOutput::FinalGather, RadiosityVertexOutput::InterpolatedIndirect}) {
+    RadiosityOptions o;
+    o.vertexOutput = mode;
+    o.gatherRays = 16;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    const std::vector<glm::vec3> average = faceToVertex(s, r.B);
+    size_t lit = 0;
+    for (uint32_t v = 0; v < l; ++v) {
+      EXPECT_GT(r.Bvertex[v].g, 0.f) << "vertex " << v;
+      EXPECT_EQ(r.Bvertex[v], average[v]) << "vertex " << v;
+      lit += r.Bvertex[v].g > 0.f;
+    }
+    EXPECT_EQ(lit, size_t(l));
+    bool noted = false;
+    for (const auto& n : r.stats.notes) noted |= n.find("25 vertices without a normal") != std::string::npos;
+    EXPECT_TRUE(noted) << r.stats.line("radiosity");
+  }
 }

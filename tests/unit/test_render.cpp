@@ -3,6 +3,7 @@
 // lens's circle of confusion, antialiasing of an edge, and its errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -125,6 +126,53 @@ TEST(Render, GlassSlabTransmittance) {
     const double samples = double(r.image.px.size()) * spp;
     const double mean = gi::test::meanLuminance(r.image) / luminance(glm::vec3(1.f));
     EXPECT_NEAR(mean, L, 4 * std::sqrt(T * (1 - T) / samples) * E.g / M_PI) << renderModeName(m);
+  }
+}
+
+// Whitted's shadow rays cross glass on a straight line, losing the Fresnel
+// reflectance at each interface: a pane between a point light (beside the
+// camera) and a backdrop covers half of it, and the camera sees that half
+// through the pane too. Each pixel against the same pixel without the pane
+// (the same samples): within 5e-4 for glass of index 1, which is no glass
+// at all (the pane's shadow was black); for 1.5, (1 - R)^2 on the eye ray
+// and again on the shadow ray, R = 0.04 at normal incidence (0.0401 at the
+// image's 10 degrees), plus the pane's internal reflections on the eye ray
+// (R^2 of it) and its sideways shift of the eye ray (0.03 at 10 degrees,
+// where the light changes by 0.1%): (1 - R)^4 = 0.8493 within 0.005. The
+// other half is untouched.
+TEST(Render, WhittedShadowsCrossGlass) {
+  const int W = 16, H = 16;
+  const Camera cam = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 20, W, H);
+  auto image = [&](bool pane, float n) {
+    SceneBuilder b;
+    frontQuad(b, 20, 10, glm::vec3(0.8f), glm::vec3(0.f), Material::Diffuse, 4);
+    if (pane) b.box({-20, -20, 6}, {0, 20, 6.5}, glm::vec3(1.f), glm::vec3(0.f), Material::Glass, false);
+    const Scene s = b.build(n);
+    RenderOptions o = opts(RenderMode::Whitted, cam, 1);
+    o.point.intensity = glm::vec3(100.f);
+    o.point.position = glm::vec3(glm::dvec3(0, 0, 0.5) - s.origin);
+    return run(s, o).image;
+  };
+  const Image bare = image(false, 1.5f);
+  const double R = std::pow((1.5 - 1.0) / 2.5, 2);
+  for (float n : {1.0f, 1.5f}) {
+    const Image glass = image(true, n);
+    size_t behind = 0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const double a = glass.at(x, y).g, c = bare.at(x, y).g;
+        ASSERT_GT(c, 0.0);
+        if (n == 1.0f || a == c) {  // (index 1: the eye ray lifted off each face it crosses: 1e-4 apart)
+          EXPECT_NEAR(a, c, 5e-4 * c) << "index " << n << ", pixel " << x << ", " << y;
+          continue;
+        }
+        ++behind;
+        if (x == W / 2 || x == W / 2 - 1) continue;  // the pane's edge
+        EXPECT_NEAR(a / c, std::pow(1.0 - R, 4), 0.005) << "index " << n << ", pixel " << x << ", " << y;
+      }
+    if (n == 1.5f) {
+      EXPECT_EQ(behind, size_t(W * H / 2));
+    }
   }
 }
 
