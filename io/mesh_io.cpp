@@ -171,6 +171,10 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   out.attrs.vertexColor = p.vertexColor;
   out.attrs.vertexSelected = p.vertexSelected;
   out.attributes = detail::vertexAttributes(p);
+  // Recorded layers hold only while they cover the faces, all triangles.
+  size_t layered = 0;
+  for (const auto& l : p.layers) layered += l.second;
+  if (p.layers.size() > 1 && layered == nf && out.triangleToFace.size() == nf) out.layers = p.layers;
   return out;
 }
 
@@ -222,6 +226,16 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   const bool hasFC = !attrs.faceColor.empty(), hasFQ = !attrs.faceQuality.empty();
   std::ostringstream h;
   h << "ply\nformat binary_little_endian 1.0\ncomment written by meshlab-gi\n";
+  size_t layered = 0;
+  for (const auto& l : extras.layers) layered += l.second;
+  if (extras.layers.size() > 1 && layered == nf)
+    for (const auto& [layerName, faces] : extras.layers) {
+      std::string clean = layerName.empty() ? std::string("layer") : layerName;  // one header line, one token start
+      for (char& c : clean)
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '_';
+      if (clean[0] == ' ' || clean[0] == '\t') clean[0] = '_';
+      h << "comment gi_layer " << faces << " " << clean << "\n";
+    }
   h << "element vertex " << nv << "\nproperty float x\nproperty float y\nproperty float z\n";
   if (hasN) h << "property float nx\nproperty float ny\nproperty float nz\n";
   if (hasC) h << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -267,7 +281,18 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   });
 }
 
+std::vector<LayerRange> meshLayers(const LoadedMesh& m, const std::string& fileName, size_t faceOffset) {
+  if (m.layers.empty()) return {{fileName, faceOffset, m.scene.faceCount()}};
+  std::vector<LayerRange> out;
+  for (const auto& [name, faces] : m.layers) {
+    out.push_back({name, faceOffset, faces});
+    faceOffset += faces;
+  }
+  return out;
+}
+
 void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
+  into.layers.clear();
   const size_t nf0 = into.scene.faceCount(), nv0 = into.scene.vertexCount();
   const size_t nf1 = other.scene.faceCount(), nv1 = other.scene.vertexCount();
   auto merge = [](auto& a, const auto& b, size_t n0, size_t n1, auto fill) {

@@ -4,6 +4,7 @@
 #pragma once
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "gi/filter_run.h"
@@ -19,6 +20,11 @@ struct LoadedMesh {
   // Per-vertex values an earlier filter left (PLY only: the vertex element's
   // other float properties; NAME_x, NAME_y, NAME_z as the vector NAME).
   std::vector<VertexAttribute> attributes;
+  // The layers this tool wrote into one PLY (writePly's `layers`), as names
+  // and triangle counts in face order; empty when the file records none, or
+  // records some that no longer match its faces (edited elsewhere, or
+  // polygons): then the file is one layer.
+  std::vector<std::pair<std::string, size_t>> layers;
 };
 
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure:
@@ -28,9 +34,14 @@ LoadedMesh loadMesh(const std::string& path);
 // names it in messages (an OBJ's material library is not followed).
 LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const std::string& name);
 
+// The layers of a loaded file as the scene's layers from `faceOffset` on:
+// those it records, else the whole file as one layer named `fileName`.
+std::vector<LayerRange> meshLayers(const LoadedMesh& m, const std::string& fileName, size_t faceOffset = 0);
+
 // Appends another mesh as a further part of one scene (colours and face
 // quality that only one of them has are filled with defaults: grey 188
-// colours, quality 0; per-vertex attributes that not both have are dropped).
+// colours, quality 0; per-vertex attributes that not both have are dropped;
+// the recorded layers are dropped: take meshLayers of each part first).
 void appendMesh(LoadedMesh& into, const LoadedMesh& other);
 
 // Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and
@@ -41,6 +52,10 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other);
 struct PlyExtras {
   std::vector<glm::vec3> normals;  // written as nx, ny, nz if not empty
   std::vector<VertexAttribute> attributes;
+  // Two or more layers of one scene written into this file (name, faces, in
+  // face order): recorded as "comment gi_layer COUNT NAME" header lines, so
+  // that loading the file gives the layers back (MeshLab ignores them).
+  std::vector<std::pair<std::string, size_t>> layers;
 };
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
               const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -26,6 +27,9 @@ struct Polygons {
   // value that is not finite in float is kept as NaN for its reader to judge.
   std::vector<std::string> vertexFloatNames;
   std::vector<std::vector<float>> vertexFloats;
+  // Layers this tool wrote into one PLY: "comment gi_layer COUNT NAME"
+  // header lines, in face order (PLY only; empty: none).
+  std::vector<std::pair<std::string, size_t>> layers;
 };
 
 // Throws std::runtime_error "cannot read NAME: WHY." (one line).

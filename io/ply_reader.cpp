@@ -77,6 +77,7 @@ struct Header {
   Format format = Format::Ascii;
   std::vector<Element> elements;
   size_t bodyStart = 0;
+  std::vector<std::pair<std::string, size_t>> layers;  // "comment gi_layer COUNT NAME"
 };
 
 std::vector<std::string_view> splitWords(std::string_view line) {
@@ -112,6 +113,12 @@ Header parseHeader(std::string_view b, const std::string& name) {
       if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f)
         failRead(name, at + " holds a control character: " + quoted(line));
     const auto w = splitWords(line);
+    long long layerFaces = -1;
+    if (w.size() >= 4 && w[0] == "comment" && w[1] == "gi_layer" && parseInt(w[2], layerFaces) && layerFaces >= 0) {
+      const size_t at3 = size_t(w[3].data() - line.data());  // the name: the rest of the line
+      h.layers.push_back({std::string(line.substr(at3)), size_t(layerFaces)});
+      continue;
+    }
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "format") {
       double version = 0;
@@ -436,6 +443,7 @@ Polygons readPly(std::string_view bytes, const std::string& name) {
     BinarySource src{bytes, h.bodyStart, h.format == Format::BinaryBE};
     readBody(h, src, out, name);
   }
+  out.layers = std::move(h.layers);
   return out;
 }
 

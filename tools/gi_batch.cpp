@@ -250,7 +250,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   in.values = defaultValues(specs, diag);
   for (const auto& [k, v] : params) in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
   if (auto err = validate(specs, in.values, diag)) throw std::invalid_argument(*err);
-  in.layers.push_back({fs::path(job.input).filename().string(), 0, mesh.scene.faceCount()});
+  in.layers = io::meshLayers(mesh, fs::path(job.input).filename().string());
   in.scene = std::move(mesh.scene);
   in.attrs = mesh.attrs;
   in.attributes = std::move(mesh.attributes);
@@ -258,7 +258,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   FilterResult r = runFilter(d.kind, in);
   // The layers first: a result PLY that exists has its layers beside it. Each file is written whole or not at all.
   const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
-  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r);
+  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers);
   json s;
   s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
   s["resolved"] = describe(specs, in.values);

@@ -204,12 +204,13 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   io::LoadedMesh mesh = io::loadMesh(a.input);
   // Layers as in MeshLab: named by file name, for the mirror/glass patterns.
   auto baseName = [](const std::string& p) { const size_t k = p.find_last_of('/'); return k == std::string::npos ? p : p.substr(k + 1); };
+  // A PLY this tool wrote from several layers records them: they come back.
   FilterInput in;
-  in.layers.push_back({baseName(a.input), 0, mesh.scene.faceCount()});
+  in.layers = io::meshLayers(mesh, baseName(a.input));
   for (const std::string& file : a.layers) {
-    const size_t off = mesh.scene.faceCount();
-    io::appendMesh(mesh, io::loadMesh(file));
-    in.layers.push_back({baseName(file), off, mesh.scene.faceCount() - off});
+    const io::LoadedMesh part = io::loadMesh(file);
+    for (const LayerRange& l : io::meshLayers(part, baseName(file), mesh.scene.faceCount())) in.layers.push_back(l);
+    io::appendMesh(mesh, part);
   }
   const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);  // written back unchanged
   mesh.scene.vertexNormals.clear();
@@ -260,7 +261,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
 
   std::vector<std::string> layerFiles;
   if (!a.output.empty()) {
-    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r);
+    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r, in.layers);
     layerFiles = writeLayerPlys(a.output, r);
   } else if (!r.layers.empty()) {
     r.stats.note("the new layers are written only beside an output (-o)");
@@ -388,7 +389,7 @@ int runCli(int argc, char** argv) {
   for (const FilterDesc& d : allFilters()) {
     CLI::App* sub = app.add_subcommand(d.cliName, "'" + d.meshlabName + "': " + d.summary);
     sub->add_option("input", a.input, "input mesh (PLY/OBJ/OFF/STL)")->required();
-    outputs.push_back({sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file); a filter's new layers (e.g. "
+    outputs.push_back({sub->add_option("-o,--output", a.output, "output PLY with vertex colour and quality (all layers in one file, which records their names and faces: a later run reads them as layers again); a filter's new layers (e.g. "
                                                   "photonmap --photon_layer) go beside it as OUT.NAME.ply (OUT.Photons.ply), "
                                                   "listed under \"layers\" in --json"),
                        &a.output});

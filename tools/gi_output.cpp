@@ -6,7 +6,8 @@
 namespace gi {
 
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
-                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r) {
+                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
+                    const std::vector<LayerRange>& layers) {
   const Scene& out = r.refined ? r.refined->scene : input;
   MeshAttributes attrs = r.refined ? refineAttributes(inputAttrs, *r.refined) : inputAttrs;
   if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
@@ -17,6 +18,8 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
   io::PlyExtras extras;
   extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
   extras.attributes = r.attributes;
+  if (!r.refined)
+    for (const LayerRange& l : layers) extras.layers.push_back({l.name, l.faceCount});
   io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);
 }
 

@@ -10,9 +10,12 @@ namespace gi {
 
 // The input mesh (or its refinement) with the result's properties: what the
 // result leaves alone keeps the input's values (colours, face quality and
-// the file's own normals, which the engine does not use).
+// the file's own normals, which the engine does not use); a scene of two or
+// more layers records them in the file (io::PlyExtras::layers), unless the
+// result refined the mesh.
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
-                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r);
+                    const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
+                    const std::vector<LayerRange>& layers = {});
 
 // Each new layer of the result (photon mapping's photons) as a PLY beside the
 // output, at gi::layerPath (out.ply -> out.Photons.ply): points, colour,

@@ -426,6 +426,49 @@ TEST(ScenesIo, PlyVertexAttributesRoundTrip) {
   EXPECT_EQ(both.attributes[0].values[9], 1.f);
 }
 
+// A scene of several layers written into one PLY records them ("comment
+// gi_layer COUNT NAME"), so that the next run (the CLI's two-pass view after
+// its photon mapping) finds the mirror and glass layers by name again. A
+// name's control characters become '_'; a file whose recorded layers no
+// longer cover its faces (edited elsewhere), or holding polygons, or naming
+// a single layer, is one layer named by its file.
+TEST(ScenesIo, PlyRecordsItsLayers) {
+  const SceneFile sf = gi::scenes::byName("cornell_box");
+  const auto& s = sf.scene;
+  const size_t nf = s.faceCount();
+  gi::io::PlyExtras extras;
+  extras.layers = {{"room.ply", nf - 12}, {"my glass\tball\n.ply", 10}, {"mirror.ply", 2}};
+  const std::string path = tempPath("layers.ply");
+  gi::io::writePly(path, s, sf.attrs, {}, {}, extras);
+  const gi::io::LoadedMesh m = gi::io::loadMesh(path);
+  ASSERT_EQ(m.layers.size(), 3u);
+  EXPECT_EQ(m.layers[1].first, "my glass_ball_.ply");
+  const std::vector<gi::LayerRange> layers = gi::io::meshLayers(m, "layers.ply", 5);
+  ASSERT_EQ(layers.size(), 3u);
+  EXPECT_EQ(layers[0].name, "room.ply");
+  EXPECT_EQ(layers[0].faceOffset, 5u);
+  EXPECT_EQ(layers[2].name, "mirror.ply");
+  EXPECT_EQ(layers[2].faceOffset, 5 + nf - 2);
+  EXPECT_EQ(layers[2].faceCount, 2u);
+  gi::io::LoadedMesh both = m;
+  gi::io::appendMesh(both, m);
+  EXPECT_TRUE(both.layers.empty()) << "stale after an append";
+  extras.layers[0].second -= 1;  // not covering the faces: ignored when written
+  gi::io::writePly(path, s, sf.attrs, {}, {}, extras);
+  EXPECT_TRUE(gi::io::loadMesh(path).layers.empty());
+  fs::remove(path);
+  const auto edited = gi::io::parseMesh(
+      "ply\nformat ascii 1.0\ncomment gi_layer 1 a.ply\ncomment gi_layer 1 b.ply\nelement vertex 3\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      "ply", "edited.ply");
+  EXPECT_TRUE(edited.layers.empty());
+  const auto one = gi::io::meshLayers(edited, "edited.ply");
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].name, "edited.ply");
+  EXPECT_EQ(one[0].faceCount, 1u);
+}
+
 TEST(ScenesIo, CommittedTestMeshesMatchTheGenerators) {
   for (const auto& name : gi::scenes::names())
   for (const auto& layer : gi::scenes::layersByName(name)) {
