@@ -172,9 +172,15 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   out.attrs.vertexSelected = p.vertexSelected;
   out.attributes = detail::vertexAttributes(p);
   // Recorded layers hold only while they cover the faces, all triangles.
+  // (Each count bounded first: counts a hostile header chose to wrap round
+  // to the face count would give ranges beyond the faces.)
   size_t layered = 0;
-  for (const auto& l : p.layers) layered += l.second;
-  if (p.layers.size() > 1 && layered == nf && out.triangleToFace.size() == nf) out.layers = p.layers;
+  bool fits = true;
+  for (const auto& l : p.layers) {
+    fits = fits && l.second <= nf - layered;
+    if (fits) layered += l.second;
+  }
+  if (p.layers.size() > 1 && fits && layered == nf && out.triangleToFace.size() == nf) out.layers = p.layers;
   return out;
 }
 

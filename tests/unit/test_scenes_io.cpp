@@ -463,6 +463,12 @@ TEST(ScenesIo, PlyRecordsItsLayers) {
       "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
       "ply", "edited.ply");
   EXPECT_TRUE(edited.layers.empty());
+  const auto wrapped = gi::io::parseMesh(  // 2^63 + 2^63 + 1 wraps round to the one face
+      "ply\nformat ascii 1.0\ncomment gi_layer 9223372036854775807 a\ncomment gi_layer 9223372036854775807 b\n"
+      "comment gi_layer 3 c\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      "ply", "wrapped.ply");
+  EXPECT_TRUE(wrapped.layers.empty());
   const auto one = gi::io::meshLayers(edited, "edited.ply");
   ASSERT_EQ(one.size(), 1u);
   EXPECT_EQ(one[0].name, "edited.ply");
