@@ -452,7 +452,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
                                                            : " vertices provably open (the whole scene below their "
                                                              "tangent plane)") + " got 1 without rays");
   if (duplicates) st.note(std::to_string(duplicates) + " duplicate vertices (same position and normal) computed once");
-  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
+  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
+                          "surface, each face with a reversed copy, the faces' normals cancel) got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)
     st.note(std::to_string(rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite) + " degenerate/invalid faces ignored");
   warnMeaningless(scene, usable, opt, res, st);

@@ -299,7 +299,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
             " vertices: all traced");
   if (valid < part.count(nv))
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
-            "glass or glossy faces only: no diffuse radiosity) got 0");
+            "glass or glossy faces only: no diffuse radiosity) or without a normal (on a two-sided surface the faces' "
+            "normals cancel: no side to trace from) got 0");
   return res;
 }
 

@@ -462,9 +462,9 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     st.note("caustic_projection not used: with a sky or a sun the global photons carry every caustic");
   if (opt.outside.any()) st.note("sky and sun photons enter from a disk covering the scene's bounding sphere");
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
-  if (specular && specOnly)
-    st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only (or unusable) have no diffuse "
-            "radiosity: 0");
+  if (specOnly)
+    st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only, unusable, or without a normal "
+            "(on a two-sided surface the faces' normals cancel) have no diffuse radiosity: 0");
   return out;
 }
 

@@ -17,10 +17,10 @@
 // A shadow ray goes straight through glass, losing the Fresnel reflectance
 // F at each interface it crosses (and taking the glass's tint), as classical
 // ray tracers attenuate light through transparent objects without bending
-// it (Hall and Greenberg 1983): exact for glass of index 1 and for a pane
-// at normal incidence, short of a lens's focusing (the caustic map and the
-// path tracer have that). Beyond the critical angle (total internal
-// reflection) nothing passes.
+// it (Hall and Greenberg 1983): exact for glass of index 1 and, but for the
+// pane's inner reflections, for a flat pane at any angle (F from the air
+// side at both faces); short of a lens's focusing (the caustic map and the
+// path tracer have that).
 // The sky lights nothing here (it needs sampled rays: the distributed mode);
 // it is seen only along rays that leave the scene. Glossy faces have no
 // Whitted counterpart: they reflect one ray in the mirror direction weighted
@@ -121,8 +121,13 @@ glm::vec3 Context::whittedTransmittance(Ray ray, Counts& c) const {
     if (!h.valid()) return T;
     if (s_.faceMaterial(h.face) != Material::Glass || crossings >= 64) return glm::vec3(0.f);
     const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
-    const float cosN = glm::dot(ray.d, faceN_[h.face]);
-    const float F = fresnelDielectric(std::min(1.f, std::fabs(cosN)), cosN < 0.f ? 1.f / ior : ior);
+    // F from the air side at either face: the straight line stands for the
+    // refracted ray, which leaves a pane at the angle it entered, losing
+    // the same F (Fresnel's F is the same both ways across an interface);
+    // evaluated inside at the unbent angle it would turn total beyond the
+    // critical angle and black out the pane's shadow.
+    const float cosN = std::min(1.f, std::fabs(glm::dot(ray.d, faceN_[h.face])));
+    const float F = fresnelDielectric(cosN, 1.f / ior);
     T *= s_.faceRho(h.face) * (1.f - F);
     if (!(T.r > 0.f || T.g > 0.f || T.b > 0.f)) return T;
     ray.tnear = h.t + eps_;  // on past the interface, the same line

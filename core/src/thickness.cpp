@@ -195,7 +195,8 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   st.add("rms_relative_error_estimate", counted ? std::sqrt(relVar / double(counted)) : 0.0);
   st.add("no_opposite_side", double(noHit));
   st.add("skipped_invalid", double(invalid));
-  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face or with NaN/Inf got 0");
+  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
+                          "surface, each face with a reversed copy, the faces' normals cancel) got 0");
   if (noHit) st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0");
   const size_t traced = nv - invalid;
   if (traced && (noHit + few) * 10 > traced)

@@ -174,6 +174,36 @@ TEST(Render, WhittedShadowsCrossGlass) {
       EXPECT_EQ(behind, size_t(W * H / 2));
     }
   }
+  // The sun 50 degrees off the pane's normal, past glass's critical angle
+  // (41.8): every shadow ray crosses the pane, those of the half the camera
+  // sees directly lose (1 - F(50))^2 = 0.888 exactly (Fresnel's equations
+  // written out here), where evaluating the second face inside at the unbent
+  // angle had turned it total and the shadow black.
+  const double ci = std::cos(50.0 * M_PI / 180.0), st = std::sin(50.0 * M_PI / 180.0) / 1.5;
+  const double ct = std::sqrt(1.0 - st * st);
+  const double rs = std::pow((ci - 1.5 * ct) / (ci + 1.5 * ct), 2), rp = std::pow((ct - 1.5 * ci) / (ct + 1.5 * ci), 2);
+  const double sunT = std::pow(1.0 - 0.5 * (rs + rp), 2);
+  auto sunImage = [&](bool pane) {
+    SceneBuilder b;
+    frontQuad(b, 20, 10, glm::vec3(0.8f), glm::vec3(0.f), Material::Diffuse, 4);
+    if (pane) b.box({-40, -20, 6}, {0, 20, 6.5}, glm::vec3(1.f), glm::vec3(0.f), Material::Glass, false);
+    const Scene s = b.build(1.5f);
+    RenderOptions o = opts(RenderMode::Whitted, cam, 1);
+    o.sunIrradiance = glm::vec3(10.f);
+    o.sunDirection = glm::vec3(-std::sin(50.0 * M_PI / 180.0), 0.0, -ci);
+    return run(s, o).image;
+  };
+  const Image sunBare = sunImage(false), sunGlass = sunImage(true);
+  size_t direct = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const double a = sunGlass.at(x, y).g, c = sunBare.at(x, y).g;
+      ASSERT_GT(c, 0.0);
+      if (a < 0.85 * c) continue;  // seen through the pane as well (0.92 of this)
+      ++direct;
+      EXPECT_NEAR(a / c, sunT, 1e-4) << "sun, pixel " << x << ", " << y;
+    }
+  EXPECT_GE(direct, size_t(W * H / 2 - W));
 }
 
 // A camera inside a glass cube (n = 1.5) looking at an emitter beyond its
