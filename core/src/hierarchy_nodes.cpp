@@ -244,10 +244,10 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
   }
 }
 
-std::vector<Closure> rowClosures(const Geometry& g, const RayCaster& caster, int rays, uint32_t seed, float eps,
-                                 uint64_t& cast) {
+std::vector<float> rowClosures(const Geometry& g, const RayCaster& caster, int rays, uint32_t seed, float eps,
+                               uint64_t& cast) {
   const size_t nf = g.s.faceCount();
-  std::vector<Closure> c(nf);
+  std::vector<float> c(nf, 0.f);
   if (rays <= 0) return c;
   parallelBlocks(nf, Progress(nullptr), "", [&](size_t b, size_t e) {
     Ray ray;
@@ -267,8 +267,7 @@ std::vector<Closure> rowClosures(const Geometry& g, const RayCaster& caster, int
         const Hit h = caster.intersect(ray);
         hits += h.valid() && h.face != f && g.A[h.face] > 0 && glm::dot(ray.d, g.n[h.face]) < 0.f;
       }
-      const double G = double(hits) / rays, sigma = std::sqrt(G * (1.0 - G) / rays);
-      c[f] = {float(G), float(std::max(0.0, G - 2.0 * sigma)), float(std::min(1.0, G + 2.0 * sigma))};
+      c[f] = hits == rays ? 1.f : float(double(hits) / rays);
     }
   });
   cast += uint64_t(rays) * uint64_t(std::count_if(g.A.begin(), g.A.end(), [](double a) { return a > 0; }));

@@ -108,18 +108,12 @@ class NodePointCache {
 void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, Link& link, int linkRays,
                     bool unoccluded, float eps, uint64_t& rays, NodePointCache& points);
 
-// What a triangle's row of form factors must sum to: the fraction G of its
-// cosine-weighted hemisphere that meets the front of a (usable) triangle,
-// counted with `rays` stratified rays from points on it (origins and
-// directions as the Monte Carlo form factors draw them), and the interval
-// that count allows for G: G +- 2 binomial standard errors (stratified
-// sampling errs less: the interval is wide). A triangle every ray of which
-// hits (a closed room) gets the interval [1, 1]. Unusable faces: [0, 0].
-struct Closure {
-  float G = 0.f, lo = 0.f, hi = 0.f;
-  double clamp(double sum) const { return sum < lo ? lo : sum > hi ? hi : sum; }
-};
-std::vector<Closure> rowClosures(const Geometry& g, const RayCaster& caster, int rays, uint32_t seed, float eps,
-                                 uint64_t& cast);
+// The fraction G of each triangle's cosine-weighted hemisphere that meets
+// the front of a (usable) triangle, counted with `rays` stratified rays
+// from points on it (origins and directions as the Monte Carlo form
+// factors draw them): what its row of form factors sums to. 1 exactly
+// where every ray hits; unusable faces: 0.
+std::vector<float> rowClosures(const Geometry& g, const RayCaster& caster, int rays, uint32_t seed, float eps,
+                               uint64_t& cast);
 
 }  // namespace gi::hierarchy

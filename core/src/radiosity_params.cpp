@@ -80,14 +80,14 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
       {.name = "closure_rays", .label = "Hierarchical: closure rays per patch",
        .help = "Hierarchical solver only. The links' form factors are quadratures, so the factors of one patch's "
-               "links sum only approximately to the part of its hemisphere that meets a surface (0.90 to 1.12 in a "
-               "closed box at the default link tolerance), and at high reflectance light is created or lost in "
-               "proportion to 1 / (1 - rho): a closed box at rho 0.991 read 11% high and at 0.999 diverged. This "
-               "many rays from each patch count that part, G; each patch's gathered light is then scaled so that "
-               "its links sum into the interval the rays allow for G (exactly 1 where every ray hits: a closed "
-               "room), and in a room with no occluders the light each patch sends too (Sinkhorn balancing), so "
-               "no light is created or lost. Cost: patches x rays. 0: the links' sums as they are (classical "
-               "hierarchical radiosity).",
+               "links sum only approximately to the part G of its hemisphere that meets a surface (0.94 to 1.06 "
+               "in a closed box at the default link tolerance), and at high reflectance light is created or lost "
+               "in proportion to 1 / (1 - rho): a closed box read 10% high at rho 0.99 and diverged at 0.999. "
+               "This many rays from each patch count G. In a closed room without occluders (every ray hits, no "
+               "link needs visibility rays) the links are then balanced so that every patch's links sum to 1, "
+               "both what it gathers and what it sends (Sinkhorn balancing): no light is created or lost. "
+               "Elsewhere the links stand, and the log's energy_balance_error (against the rays' count of what "
+               "escapes) says how much light they create or lose. Cost: patches x rays. 0: neither.",
        .type = ParamType::Int, .def = 64, .min = 0, .max = 65536},
       {.name = "max_links", .label = "Hierarchical: links at most",
        .help = "Hierarchical solver only. The links stop being refined at this many (as at the memory budget), "

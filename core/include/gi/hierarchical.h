@@ -33,19 +33,19 @@
 // hemisphere that meets the front of a surface (in a closed box of 768
 // triangles, 0.94 to 1.06 at epsilon 1e-4; 0.90 to 1.12 at 1,536), and at
 // high reflectance light is created or lost in proportion to 1 / (1 - rho):
-// a closed box at rho 0.991 read 11% high and diverged at 0.999. Each
-// triangle casts closureRays stratified rays to count G (exactly 1 where
-// every ray hits: a closed room) with an interval of two binomial standard
-// errors, and the links are balanced against it: row factors r_i on what a
-// triangle gathers and column factors c_j on what it sends, alternately
-// (Sinkhorn's iterative scaling of r F c, as in matrix balancing: Sinkhorn
-// 1964, "A relationship between arbitrary positive matrices and doubly
-// stochastic matrices"), each moving its sums into the interval. Rows: a
-// uniform R gives a uniform H (the furnace); columns: the power a triangle
-// sends arrives in full where the room is closed (energy). Columns are
-// balanced only where no link needs visibility rays; with occluders the
-// rows alone are, and the energy balance against the rays' count of what
-// escapes says how much light the links still create or lose.
+// a closed box lit from its ceiling read 10% high at rho 0.99 and diverged
+// at 0.999. Each triangle casts closureRays stratified rays to count G;
+// where every ray of every triangle hits (a closed room) and no link needs
+// visibility rays (no occluders), the links are balanced by row factors
+// r_i on what each triangle gathers and column factors c_j on what it
+// sends, alternately (Sinkhorn's iterative scaling of r F c, as in matrix
+// balancing: Sinkhorn 1964, "A relationship between arbitrary positive
+// matrices and doubly stochastic matrices"), so that every row (the
+// furnace: a uniform R gives a uniform H) and every column (energy: all
+// the power a triangle sends arrives) sums to 1. Elsewhere the links' sums
+// stand (every variant tried did worse somewhere: hierarchical.cpp), and
+// the energy balance against the rays' count of what escapes says how much
+// light the links create or lose.
 // Memory: O(n) nodes plus the links.
 #pragma once
 #include <cstdint>
@@ -66,7 +66,7 @@ struct HierarchySettings {
   double maxLinks = 1e18;     // and beyond this many links (refined best first, the strongest kept; a note)
   double enteringPower = 0;   // luminance power the sky and the sun bring onto the surfaces (gi/sky.h), local
                               // units; counts with the emitted power (Hd then holds their irradiance too)
-  int closureRays = 64;       // rays per triangle that bound its row sum (0: rows as the links give them)
+  int closureRays = 64;       // rays per triangle counting what its row sums to (0: no closure, no energy balance)
   uint32_t seed = 0;          // of those rays
 };
 
