@@ -364,8 +364,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // Energy account: emitted power = absorbed + escaped; absorbed from the
   // total irradiance (direct + indirect) of every triangle; escaped: the
   // emitted power the direct light does not bring onto a surface, and the
-  // reflected power outside each (closed) row. With reciprocal links the
-  // two balance exactly at convergence.
+  // share 1 - G of each triangle's reflected power that its closure rays
+  // saw escape. Links whose rows and columns sum to G balance the two
+  // exactly at convergence; the difference is what the links create or
+  // lose.
   double absorbed = 0, reflected = 0, escaped = P;
   for (size_t f = 0; f < nf; ++f) {
     if (!(g.A[f] > 0)) continue;
