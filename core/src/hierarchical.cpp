@@ -234,9 +234,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // 3,072 triangles lit from a patch of its ceiling, at rho 0.99: the rows
   // alone leave the mean R 1% low (the links are not reciprocal), rows and
   // columns 6e-5 (the direct light's own error).
-  // Elsewhere the links' sums are kept, and the energy balance says how
-  // far they are off: all that was tried did worse than the links alone
-  // somewhere.
+  // Elsewhere the links' sums are kept, and the energy balance indicates
+  // how far they are off: all that was tried did worse than the links
+  // alone somewhere.
   //  - Rows and columns into the interval of two binomial errors around G,
   //    in a room with a hole at rho 0.991: +0.8% absorbed at 64 rays, -9%
   //    at 256, +31% at 16 (+12% with the links alone); a triangle none of
@@ -248,6 +248,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   //    created 0.6% of the absorbed power; rows closed alone lost 1.5% to
   //    6% of it in rooms with a window, a lamp or a scan (the links alone:
   //    within 1.2%), rows only kept below 1 lost 2.5% to 25%.
+  //  - One factor on every row, the rays' mean G over the links' mean sum
+  //    (area-weighted): further from the flat solution's absorbed power
+  //    in all five rooms tried (a closed room with a lamp at rho 0.956:
+  //    -2.3% against +1.2%; a window: -1.6% against +0.2%).
   size_t rowsMoved = 0;
   double rowMoveRms = 0;
   bool closedRoom = false;

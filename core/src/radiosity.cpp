@@ -532,21 +532,6 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
                    std::to_string(kHierarchicalAutoPatches) + ")");
   res.stats.add("iterations", res.iterations);
   res.stats.add("residual", res.residual);
-  // The energy balance against the closure rays' count of what escapes:
-  // outside a closed room without occluders (which the closure balances)
-  // it measures the light the links create or lose (the shadow-leak room:
-  // 3.2%, the flat solution's absorbed power 3.2% below the hierarchy's).
-  const double balance = res.stats.get("energy_balance_error", 0.0);
-  if (opt.bounces < 0 && res.residual < opt.tolerance && balance > 0.01) {
-    char b[400];
-    std::snprintf(b, sizeof b,
-                  "energy balance off by %.1f%%: the links create or lose light (their factors' quadrature and "
-                  "few visibility rays, magnified at high reflectance; the closure balances closed rooms without "
-                  "occluders only): a flat solver on Monte Carlo rows conserves energy; a lower hierarchy_epsilon "
-                  "or more link_rays helps only where coarse links or their rays are the cause",
-                  100.0 * balance);
-    res.stats.warn(b);
-  }
   if (opt.hierarchyEpsilon == 0 && n > 20000)
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");

@@ -261,13 +261,15 @@ TEST(HierarchicalRadiosity, ClosureLeavesOtherScenesAlone) {
 
 // Where the room is open or has occluders the links' sums stand, and their
 // visibility rays and quadrature can create light; the energy balance,
-// against the closure rays' count of what escapes, says how much. The
+// against the closure rays' count of what escapes, indicates how much. The
 // shadow-leak room (a partition cutting through coarse patches, the
 // light's back 2 cm below the ceiling): the hierarchy absorbs 3.2% more
 // than the flat solution from Monte Carlo rows (whose balance is within
-// 0.02%), and its balance says 3.2% (above 1%: a warning); asserted within
-// half a percent of each other. The Cornell box balances within 1%
-// (measured 0.46%): no warning.
+// 0.02%), and its balance says 3.2%; asserted within half a percent of
+// each other. It is an indicator, not a measurement, so no warning: the
+// links are not reciprocal, and in a closed room with a lamp quad at rho
+// 0.956 it said 5.8% where the absorbed power was 1.2% off (a 20k scan
+// room: 0.39% for -0.37%). The Cornell box balances within 1%.
 TEST(HierarchicalRadiosity, EnergyBalanceSaysWhatTheLinksCreate) {
   auto leak = scenes::shadowLeak();
   auto caster = makeEmbreeCaster(leak.scene);
@@ -283,9 +285,6 @@ TEST(HierarchicalRadiosity, EnergyBalanceSaysWhatTheLinksCreate) {
               100 * created, flat.stats.get("energy_balance_error"), 100 * balance);
   EXPECT_LT(flat.stats.get("energy_balance_error"), 1e-3);
   EXPECT_NEAR(balance, std::fabs(created), 0.005);
-  bool warned = false;
-  for (const std::string& w : hier.stats.warnings) warned |= w.find("energy balance off by") != std::string::npos;
-  EXPECT_TRUE(warned);
   auto box = scenes::cornellBox(50.0);
   auto boxCaster = makeEmbreeCaster(box.scene);
   const RadiosityResult cornell = solveRadiosity(box.scene, *boxCaster, o);

@@ -44,8 +44,9 @@
 // furnace: a uniform R gives a uniform H) and every column (energy: all
 // the power a triangle sends arrives) sums to 1. Elsewhere the links' sums
 // stand (every variant tried did worse somewhere: hierarchical.cpp), and
-// the energy balance against the rays' count of what escapes says how much
-// light the links create or lose.
+// the energy balance against the rays' count of what escapes indicates how
+// much light the links create or lose (not exactly: they are not
+// reciprocal).
 // Memory: O(n) nodes plus the links.
 #pragma once
 #include <cstdint>
