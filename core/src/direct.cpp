@@ -39,8 +39,10 @@ VertexMaterial vertexMaterial(const Scene& s) {
   m.rho.resize(nv);
   m.E.resize(nv);
   m.valid.resize(nv);
+  m.diffuse.resize(nv);
   for (size_t i = 0; i < nv; ++i) {
-    m.valid[i] = w[i] > 0.0 && glm::dot(m.n[i], m.n[i]) > 0.5f;
+    m.diffuse[i] = w[i] > 0.0;
+    m.valid[i] = m.diffuse[i] && glm::dot(m.n[i], m.n[i]) > 0.5f;
     m.rho[i] = w[i] > 0.0 ? glm::vec3(rho[i] / w[i]) : glm::vec3(0.f);
     m.E[i] = w[i] > 0.0 ? glm::vec3(E[i] / w[i]) : glm::vec3(0.f);
   }

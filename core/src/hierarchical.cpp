@@ -95,7 +95,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // Each triangle's factor on what it gathers (its row) and on what it
   // sends (its column), balanced against the closure.
   std::vector<double> rowScale(nf, 1.0), colScale(nf, 1.0);
-  std::vector<glm::vec3> Rc(nf);  // R times colScale: what the links carry
+  std::vector<glm::vec3> Rc;  // R times colScale: what the links carry in a closed room
   std::vector<double> Rmax(nn, 0.0);
   std::vector<glm::dvec3> Rbar(nn, glm::dvec3(0.0)), Hg(nn, glm::dvec3(0.0)), Hacc(nn, glm::dvec3(0.0));
   uint64_t rays = 0, splits = 0;
@@ -196,9 +196,11 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     for (const Link& l : links) ++start[l.p + 1];
     for (size_t k = 0; k < nn; ++k) start[k + 1] += start[k];
   };
+  bool closedRoom = false;  // the links closed (below): rows and columns scaled
   auto sweep = [&](const std::vector<glm::vec3>& Rin, std::vector<glm::vec3>& H) {
-    for (size_t f = 0; f < nf; ++f) Rc[f] = glm::vec3(glm::dvec3(Rin[f]) * colScale[f]);
-    const std::vector<glm::vec3>& R = Rc;
+    if (closedRoom)
+      for (size_t f = 0; f < nf; ++f) Rc[f] = glm::vec3(glm::dvec3(Rin[f]) * colScale[f]);
+    const std::vector<glm::vec3>& R = closedRoom ? Rc : Rin;
     pull(R);
     parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
       for (size_t k = b; k < e; ++k) {
@@ -220,7 +222,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     for (size_t k = 0; k < nn; ++k) {  // preorder: parents first
       const Node& nd = t.nodes[k];
       Hacc[k] = Hg[k] + (k ? Hacc[nd.parent] : glm::dvec3(0.0));
-      if (nd.leaf()) H[t.order[nd.first]] = glm::vec3(Hacc[k] * rowScale[t.order[nd.first]]);
+      if (nd.leaf()) H[t.order[nd.first]] = glm::vec3(closedRoom ? Hacc[k] * rowScale[t.order[nd.first]] : Hacc[k]);
     }
   };
   // The links closed (gi/hierarchical.h) in a closed room without
@@ -254,7 +256,6 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   //    -2.3% against +1.2%; a window: -1.6% against +0.2%).
   size_t rowsMoved = 0;
   double rowMoveRms = 0;
-  bool closedRoom = false;
   auto columnSums = [&](std::vector<double>& col) {
     std::vector<double> W(nn), Y(nn, 0.0);
     for (size_t k = nn; k-- > 0;) {  // W: sum of A_i r_i under each node
@@ -279,6 +280,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     rowsMoved = 0;
     rowMoveRms = 0;
     if (!closedRoom) return;
+    Rc.resize(nf);
     index();
     const std::vector<glm::vec3> ones(nf, glm::vec3(1.f));
     std::vector<glm::vec3> sums(nf);

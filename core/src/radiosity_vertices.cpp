@@ -141,15 +141,10 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   // zero): no side to evaluate the light on. It takes the patch average of
   // its faces, both sides (what 'Patch average' writes everywhere), and
   // the log says how many did.
-  std::vector<uint8_t> onDiffuse(s.vertexCount(), 0);
-  const std::vector<uint8_t> ok = usableFaceMask(s);
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f] && s.faceMaterial(f) == Material::Diffuse)
-      for (int k = 0; k < 3; ++k) onDiffuse[s.triangles[f][k]] = 1;
   std::vector<glm::vec3> average;
   size_t nTwoSided = 0;
   for (size_t v = 0; v < s.vertexCount(); ++v) {
-    if (mat.valid[v] || !onDiffuse[v] || !opt.vertices.contains(v, s.vertexCount())) continue;
+    if (mat.valid[v] || !mat.diffuse[v] || !opt.vertices.contains(v, s.vertexCount())) continue;
     if (average.empty()) average = faceToVertex(s, res.B);
     res.Bvertex[v] = average[v];
     ++nTwoSided;

@@ -40,7 +40,8 @@ struct VertexRadiometry {
 // (area-weighted); a vertex with none (isolated, or on mirror/glass only) is not valid.
 struct VertexMaterial {
   std::vector<glm::vec3> rho, E, n;
-  std::vector<uint8_t> valid;
+  std::vector<uint8_t> valid;    // on a usable diffuse face, with a normal
+  std::vector<uint8_t> diffuse;  // on a usable diffuse face (valid, or without a normal: a two-sided surface)
 };
 VertexMaterial vertexMaterial(const Scene& s);
 
