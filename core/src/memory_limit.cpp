@@ -92,16 +92,16 @@ double cgroupRoom() {
   return room;
 }
 
+}  // namespace
+
 // "6.4 GB", "12 GB", "75 MB", "74 KB".
-std::string amount(double bytes) {
+std::string memoryAmount(double bytes) {
   char b[32];
   if (bytes >= 1e9) std::snprintf(b, sizeof b, bytes < 10e9 ? "%.1f GB" : "%.0f GB", bytes / 1e9);
   else if (bytes >= 1e6) std::snprintf(b, sizeof b, "%.0f MB", bytes / 1e6);
   else std::snprintf(b, sizeof b, "%.0f KB", bytes / 1e3);
   return b;
 }
-
-}  // namespace
 
 size_t availableMemoryBytes() {
   const long long kb = meminfoKB("MemAvailable");
@@ -115,7 +115,7 @@ size_t memoryLimitOrAvailable(size_t limit) { return limit != 0 ? limit : availa
 
 void requireMemory(double bytes, size_t limit, const std::string& what, const std::string& remedy) {
   if (limit == 0 || !(bytes > double(limit))) return;
-  throw std::invalid_argument(what + " needs about " + amount(bytes) + ", more than the " + amount(double(limit)) +
+  throw std::invalid_argument(what + " needs about " + memoryAmount(bytes) + ", more than the " + memoryAmount(double(limit)) +
                               " of memory available; " + remedy);
 }
 

@@ -184,7 +184,8 @@ constexpr double kStoredPhotonBytes = 56.0;
 // map of part of the photons would carry part of the power.
 class StoreBudget {
  public:
-  StoreBudget(size_t limitBytes, size_t paths) : limit_(memoryLimitOrAvailable(limitBytes)), paths_(paths) {}
+  StoreBudget(const PhotonOptions& o, size_t paths)
+      : limit_(memoryLimitOrAvailable(o.memoryLimitBytes)), paths_(paths), remedy_(o.memoryRemedy) {}
   bool full() const { return limit_ != 0 && double(stored_.load()) * kStoredPhotonBytes > double(limit_); }
   void add(size_t stored, size_t paths) {
     stored_ += stored;
@@ -193,11 +194,14 @@ class StoreBudget {
   void check(const std::string& what) const {
     if (!full()) return;
     const double need = double(stored_.load()) * kStoredPhotonBytes * double(paths_) / double(std::max<size_t>(traced_, 1));
-    requireMemory(need, limit_, what, "lower the photons (per pass when progressive: more passes take no more memory)");
+    requireMemory(need, limit_, what,
+                  remedy_.empty() ? "lower the photons (per pass when progressive: more passes take no more memory)"
+                                  : remedy_);
   }
 
  private:
   size_t limit_, paths_;
+  std::string remedy_;
   std::atomic<size_t> stored_{0}, traced_{0};
 };
 
@@ -232,7 +236,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   std::vector<std::vector<Photon>> blocks(nBlocks);
   std::vector<PhotonTraceStats> bstats(nBlocks);
 
-  StoreBudget budget(opt.memoryLimitBytes, count);
+  StoreBudget budget(opt, count);
   parallelBlocks(nBlocks, progress, "tracing photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;
@@ -405,7 +409,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   std::vector<std::vector<Photon>> blocks(nBlocks);
   std::vector<size_t> specular(nBlocks, 0), glossy(nBlocks, 0), missed(nBlocks, 0);
 
-  StoreBudget budget(opt.memoryLimitBytes, count);
+  StoreBudget budget(opt, count);
   parallelBlocks(nBlocks, progress, "tracing caustic photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;

@@ -203,9 +203,16 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
 
 RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions& o, const Progress& progress) {
   validate(o);
+  // One limit for the run. The image is checked first and the two-pass
+  // mode's caustic photons get what it leaves: each checked alone against
+  // the machine's figure, both could fit where together they do not (the
+  // image is allocated after the photons, so the kernel's figure would not
+  // count it yet).
+  const size_t limit = memoryLimitOrAvailable(o.memoryLimitBytes);
+  double imageBytes = 0;
   if (o.renderImage) {
-    const double pixels = double(o.camera.width()) * double(o.camera.height());
-    requireMemory(pixels * kRenderBytesPerPixel, memoryLimitOrAvailable(o.memoryLimitBytes),
+    imageBytes = double(o.camera.width()) * double(o.camera.height()) * kRenderBytesPerPixel;
+    requireMemory(imageBytes, limit,
                   "an image of " + std::to_string(o.camera.width()) + " x " + std::to_string(o.camera.height()) +
                       " pixels",
                   "lower width and height (about " + std::to_string(int(kRenderBytesPerPixel)) +
@@ -219,7 +226,10 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   RunStats& st = res.stats;
   const bool twoPass = o.mode == RenderMode::TwoPass;
   eye::TwoPassData tp;
-  if (twoPass) eye::prepareTwoPass(tp, s, caster, o, progress.sub(0.0, 0.2), st);
+  if (twoPass) {
+    const eye::PhotonMemory pm{limit == 0 ? 0 : size_t(std::max(1.0, double(limit) - imageBytes)), imageBytes};
+    eye::prepareTwoPass(tp, s, caster, o, pm, progress.sub(0.0, 0.2), st);
+  }
   const Context ctx(s, caster, o, twoPass ? &tp : nullptr);
   if (!ctx.anyLight() && !(twoPass && o.twoPass == TwoPassDiffuse::Map))
     throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality), "

@@ -54,8 +54,14 @@ struct TwoPassData {
   TwoPassData& operator=(const TwoPassData&) = delete;
   ~TwoPassData();
 };
+// The memory the caustic photons may take: what the image leaves of the
+// run's limit (0: unknown, nothing is checked).
+struct PhotonMemory {
+  size_t limitBytes = 0;
+  double imageBytes = 0;
+};
 void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, const RenderOptions& o,
-                    const Progress& progress, RunStats& stats);
+                    const PhotonMemory& memory, const Progress& progress, RunStats& stats);
 
 // The integrator as the eye pass drives it: its rules from the mode, the
 // two-pass mode's stored light, and Whitted's ray trees beside it.

@@ -24,6 +24,7 @@
 
 #include "gi/color.h"
 #include "gi/direct.h"
+#include "gi/memory_limit.h"
 #include "gi/specular.h"
 #include "render_internal.h"
 
@@ -58,7 +59,7 @@ bool anySpecularFace(const Scene& s) {
 }  // namespace
 
 void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, const RenderOptions& o,
-                    const Progress& progress, RunStats& stats) {
+                    const PhotonMemory& memory, const Progress& progress, RunStats& stats) {
   const size_t nv = s.vertexCount();
   if (o.firstPassB.empty())
     throw std::invalid_argument("the two-pass mode needs a first pass on these layers: run 'GI: Radiosity' or "
@@ -76,7 +77,10 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.causticK = o.causticK;
     po.point = o.point;
     po.seed = o.seed;
-    po.memoryLimitBytes = o.memoryLimitBytes;
+    po.memoryLimitBytes = memory.limitBytes;
+    po.memoryRemedy = "lower caustic_photons";
+    if (memory.imageBytes > 0)
+      po.memoryRemedy += ", or width and height (the image takes another " + memoryAmount(memory.imageBytes) + ")";
     PhotonTraceStats ts;
     std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
     const size_t stored = photons.size();

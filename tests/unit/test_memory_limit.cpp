@@ -7,6 +7,8 @@
 // at the tables' largest settings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -111,6 +113,41 @@ TEST(MemoryLimit, PhotonsRefusedOncePastTheLimit) {
   EXPECT_TRUE(has(m, "the caustic map of 200000 photons needs about")) << m;
   q.memoryLimitBytes = 64 << 20;
   EXPECT_FALSE(traceCausticPhotons(c, *cc, q, 0, 200000, Progress(nullptr), st).empty());
+}
+
+// The two-pass mode's caustic photons and its image share one limit: an
+// image and a map that each fit alone, but not together, are refused (each
+// was checked alone against the whole limit before, and the kernel's figure
+// does not count the image until it is allocated, after the photons); the
+// refusal names both remedies. Sizes from a first run: the image is made
+// as large as the photons, and the limit 1.5 times either.
+TEST(MemoryLimit, TwoPassImageAndCausticPhotonsShareTheLimit) {
+  const Scene c = scenes::causticCornell(50.0, 10.0, 3, 1.5f);
+  auto cc = makeEmbreeCaster(c);
+  RenderOptions o;
+  o.mode = RenderMode::TwoPass;
+  o.twoPass = TwoPassDiffuse::Caustics;
+  o.samplesPerPixel = 1;
+  o.causticPhotons = 20000;
+  o.firstPassB.assign(c.vertexCount(), glm::vec3(0.5f));
+  glm::dvec3 lo(1e30), hi(-1e30);
+  for (const auto& p : c.positions) {
+    lo = glm::min(lo, c.toWorld(p));
+    hi = glm::max(hi, c.toWorld(p));
+  }
+  o.camera = Camera::frame(lo, hi, {0, 0, 1}, {0, 1, 0}, 39.3, 8, 8);
+  const double photonBytes = render(c, *cc, o).stats.get("caustic_photons_stored") * 56.0;
+  ASSERT_GT(photonBytes, 100e3);
+  const int side = int(std::ceil(std::sqrt(photonBytes / 24.0)));
+  o.camera = Camera::frame(lo, hi, {0, 0, 1}, {0, 1, 0}, 39.3, side, side);
+  const double imageBytes = double(side) * side * 24.0;
+  o.memoryLimitBytes = size_t(1.5 * std::max(photonBytes, imageBytes));
+  ASSERT_LT(photonBytes + imageBytes, 2.2 * double(o.memoryLimitBytes) / 1.5);  // the two are alike
+  const std::string m = refusal([&] { render(c, *cc, o); });
+  EXPECT_TRUE(has(m, "the caustic map of 20000 photons needs about")) << m;
+  EXPECT_TRUE(has(m, "lower caustic_photons, or width and height (the image takes another")) << m;
+  o.memoryLimitBytes = size_t(1.1 * (photonBytes + imageBytes));
+  EXPECT_EQ(render(c, *cc, o).image.px.size(), size_t(side) * side);
 }
 
 // memory_budget_mb at the table's largest (10^7 MB) is more than any machine

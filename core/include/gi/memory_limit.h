@@ -27,4 +27,7 @@ size_t memoryLimitOrAvailable(size_t limit);
 // memory available; <remedy>" (MB or KB for smaller amounts).
 void requireMemory(double bytes, size_t limit, const std::string& what, const std::string& remedy);
 
+// "6.4 GB", "12 GB", "75 MB", "74 KB": the amount as the refusals write it.
+std::string memoryAmount(double bytes);
+
 }  // namespace gi

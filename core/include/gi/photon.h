@@ -67,6 +67,9 @@ struct PhotonOptions {
   // Memory the stored photons may take (gi/memory_limit.h); 0: what the
   // machine has available when the trace starts.
   size_t memoryLimitBytes = 0;
+  // What a refusal under that limit tells the user to do; "" for the
+  // photon filters' own advice (a run that shares the limit says how).
+  std::string memoryRemedy;
   static std::vector<ParamSpec> specs();
   static PhotonOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
