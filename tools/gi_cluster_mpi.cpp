@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "gi/memory_limit.h"
 #include "gi_cluster.h"
 
 namespace gi::cluster {
@@ -136,6 +137,14 @@ void start(int* argc, char*** argv) {
   g_started = true;
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  // The ranks on one machine start together and would each see all of its
+  // memory: each takes its share (gi/memory_limit.h).
+  MPI_Comm node;
+  int local = 1;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, g_rank, MPI_INFO_NULL, &node);
+  MPI_Comm_size(node, &local);
+  MPI_Comm_free(&node);
+  shareMemoryWith(local);
 }
 
 void stop() {

@@ -318,9 +318,11 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   const bool capped = availableMB > 0 && opt.memoryBudgetMB > availableMB;
   const double askedMB = opt.memoryBudgetMB;
   if (capped) opt.memoryBudgetMB = std::floor(availableMB);
+  const int share = memoryShare();
   const std::string lowered = "memory_budget_mb = " + std::to_string(int64_t(askedMB)) + " exceeds the " +
-                              std::to_string(int64_t(opt.memoryBudgetMB)) + " MB of memory available, so the budget was " +
-                              std::to_string(int64_t(opt.memoryBudgetMB)) + " MB";
+                              std::to_string(int64_t(opt.memoryBudgetMB)) + " MB of memory available" +
+                              (share > 1 ? " to each of the " + std::to_string(share) + " ranks on this machine" : "") +
+                              ", so the budget was " + std::to_string(int64_t(opt.memoryBudgetMB)) + " MB";
   RadiosityResult r;
   try {
     if (opt.refine) {

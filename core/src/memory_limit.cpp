@@ -2,6 +2,7 @@
 #include "gi/memory_limit.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -103,12 +104,19 @@ std::string memoryAmount(double bytes) {
   return b;
 }
 
+namespace {
+std::atomic<int> g_share{1};
+}  // namespace
+
+void shareMemoryWith(int processes) { g_share = std::max(processes, 1); }
+int memoryShare() { return g_share; }
+
 size_t availableMemoryBytes() {
   const long long kb = meminfoKB("MemAvailable");
   double avail = kb >= 0 ? double(kb) * 1024.0 : 0.0;
   const double room = cgroupRoom();
   if (room >= 0) avail = avail > 0 ? std::min(avail, room) : room;
-  return size_t(avail);
+  return size_t(avail / double(g_share.load()));
 }
 
 size_t memoryLimitOrAvailable(size_t limit) { return limit != 0 ? limit : availableMemoryBytes(); }

@@ -5,7 +5,8 @@ writes the same bytes as the plain run, for every filter that can be split
 gather), for 1, 2 and 4 ranks (oversubscribed on a small machine), both
 ways of splitting, and chunks smaller and larger than a rank's share. The
 JSON summary's "mpi" part must account for every vertex once. A parameter
-error under mpirun is one line; a filter that cannot be split says so.
+error under mpirun is one line; a filter that cannot be split says so; the
+ranks on one machine each take their share of its memory.
 
 usage: mpi_test.py --gi GI --mpirun MPIRUN --meshes TEST_MESHES_DIR
 """
@@ -99,6 +100,14 @@ def main():
         p = run(mpirun(a, 2) + [a.gi, "ao", cornell, "--rays_per_vertex", "0"])
         lines = [l for l in p.stderr.splitlines() if l.startswith("gi:")]
         check(p.returncode != 0 and len(lines) == 1, "a parameter error under mpirun: one line (%s)" % lines)
+        # The ranks on this machine share its memory: a radiosity budget
+        # beyond it is lowered to each rank's share, and the log says so.
+        p = run(mpirun(a, 4) + [a.gi, "radiosity", cornell, "--emitter_source", "1", "--rays_per_patch", "16",
+                                "--memory_budget_mb", "10000000", "-o", os.path.join(tmp, "share.ply"), "--json",
+                                "-q"])
+        warnings = json.loads(p.stdout).get("warnings", []) if p.returncode == 0 else [p.stderr[-500:]]
+        check(any("to each of the 4 ranks on this machine" in w for w in warnings),
+              "4 ranks share the machine's memory: %s" % warnings)
         p = run(mpirun(a, 2) + [a.gi, "photonmap", cornell, "--emitter_source", "1", "--photons", "1000"])
         lines = [l for l in p.stderr.splitlines() if l.startswith("gi:")]
         check(p.returncode != 0 and len(lines) == 1 and "split" in lines[0],

@@ -54,6 +54,29 @@ TEST(MemoryLimit, AvailableIsTheKernelsFigure) {
   EXPECT_EQ(memoryLimitOrAvailable(12345), 12345u);
 }
 
+// Ranks of one run on one machine (gi_cluster_mpi.cpp tells their count)
+// each see their share: a quarter for 4, within the kernel's figure moving
+// between the reads (5%); the radiosity budget lowered to it says so.
+TEST(MemoryLimit, RanksOnOneMachineShareIt) {
+  const double whole = double(availableMemoryBytes());
+  shareMemoryWith(4);
+  const double quarter = double(availableMemoryBytes());
+  shareMemoryWith(1);
+  EXPECT_NEAR(quarter * 4.0, whole, 0.05 * whole);
+  shareMemoryWith(0);  // not a count: one process
+  EXPECT_EQ(memoryShare(), 1);
+
+  const auto sf = scenes::cornellBox(100.0);
+  FilterInput huge = test::filterInput(FilterKind::Radiosity, sf);
+  huge.values.set("memory_budget_mb", 1e7);
+  shareMemoryWith(4);
+  const FilterResult r = runFilter(FilterKind::Radiosity, huge);
+  shareMemoryWith(1);
+  ASSERT_EQ(r.stats.warnings.size(), 1u);
+  EXPECT_TRUE(has(r.stats.warnings[0], " MB of memory available to each of the 4 ranks on this machine, so the budget"))
+      << r.stats.warnings[0];
+}
+
 TEST(MemoryLimit, RefusalIsOneSentence) {
   EXPECT_EQ(refusal([] { requireMemory(1e9, 2000000000, "x", "y"); }), "");
   EXPECT_EQ(refusal([] { requireMemory(1e18, 0, "x", "y"); }), "");  // limit unknown: no check

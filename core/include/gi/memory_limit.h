@@ -16,7 +16,14 @@
 namespace gi {
 
 // Bytes available to this process now; 0 if unknown (not Linux, no /proc).
+// Where several processes of one run share the machine (MPI ranks on one
+// node, which start together and would each see the whole figure), each
+// gets its share.
 size_t availableMemoryBytes();
+
+// The processes of this run on this machine, counting this one (default 1).
+void shareMemoryWith(int processes);
+int memoryShare();
 
 // The limit a run checks against: `limit` if nonzero (a caller's own
 // budget), else availableMemoryBytes() (0: unknown, nothing is checked).
