@@ -84,9 +84,11 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        .help = "Passes of 'Photons emitted' photons each (progressive mode).",
        .type = ParamType::Int, .def = 16, .min = 1, .max = 100000},
       {.name = "max_depth", .label = "Maximum bounces",
-       .help = "Paths end after this many bounces, diffuse or specular (Russian roulette ends most much earlier; the "
-               "power still carried by cut paths is logged).",
-       .type = ParamType::Int, .def = 32, .min = 1, .max = 1000},
+       .help = "Bounces a path may take, diffuse or specular, counted as the reference counts them: 0 = direct "
+               "light only, k = light that reflected at most k times before the vertex (with the final gather, its "
+               "rays are the last bounce). Russian roulette ends most paths much earlier; the power still carried by "
+               "cut paths is logged.",
+       .type = ParamType::Int, .def = 32, .min = 0, .max = 1000},
   };
   for (const ParamSpec& p : SkySun::specs()) out.push_back(p);
   for (const ParamSpec& p : pointLightSpecs()) out.push_back(p);

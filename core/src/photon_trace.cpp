@@ -212,6 +212,17 @@ class StoreBudget {
 // an independent randomisation, so no path repeats; the first 2^32 keep the
 // keys they always had. Until 3 December 2026 the index wrapped, and pass 43
 // on retraced the paths of the first passes.
+// The surface hits a photon path may reach, so that max_depth counts
+// bounces as the reference and the eye pass count them (0: direct light
+// only). A photon stored at a path's hit i brings light of i bounces, so
+// the map read at the vertices holds hits 0..max_depth; the final gather
+// adds one bounce where its rays land, so the map it reads holds one hit
+// fewer (max_depth 0: no photons, direct light only).
+int photonHits(const PhotonOptions& o) {
+  const bool gather = o.directLight && o.finalGather && !o.progressive;
+  return o.maxDepth + (gather ? 0 : 1);
+}
+
 struct PhotonKeys {
   uint32_t index, pos, dir, rng;
 };
@@ -237,6 +248,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   std::vector<PhotonTraceStats> bstats(nBlocks);
 
   StoreBudget budget(opt, count);
+  const int hits = photonHits(opt);
   parallelBlocks(nBlocks, progress, "tracing photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;
@@ -254,7 +266,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         int diffuse = 0;
         bool viaSpecular = false;
         int depth = 0;
-        for (; depth < opt.maxDepth; ++depth) {
+        for (; depth < hits; ++depth) {
           const Hit h = caster.intersect(ray);
           if (!h.valid()) { ++st.escaped; break; }
           const glm::vec3 x = ray.o + ray.d * h.t;
@@ -291,7 +303,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
         }
-        if (depth == opt.maxDepth) { ++st.lostAtMaxDepth; st.lostPower += luminance(power); }
+        if (depth == hits) { ++st.lostAtMaxDepth; st.lostPower += luminance(power); }
       }
       budget.add(out.size(), end - b * kBlock);
     }
@@ -440,7 +452,8 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
         ray.d = d;
         Rng rng(hash3(k.index, k.rng, 0xc5u));
         bool viaSpecular = false;
-        for (int depth = 0; depth < opt.maxDepth; ++depth) {
+        // Stored at the diffuse hit after at most max_depth specular bounces.
+        for (int depth = 0; depth <= opt.maxDepth; ++depth) {
           const Hit h = caster.intersect(ray);
           if (!h.valid()) break;
           const Material m = s.faceMaterial(h.face);
