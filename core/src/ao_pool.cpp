@@ -1,5 +1,5 @@
-// Pooling one vertex's neighbours (gi/ao_shared.h): the vertex graph,
-// poolVertex by a search of the rings, and poolMeans for the final gather.
+// Pooling one vertex's neighbours (gi/ao_shared.h): poolVertex by a search
+// of the rings, and poolMeans for the final gather.
 #include <atomic>
 #include <stdexcept>
 
@@ -13,57 +13,6 @@
 namespace gi {
 
 using namespace pooling;
-
-VertexGraph VertexGraph::build(const Scene& s, const std::vector<uint8_t>* usable) {
-  const size_t nv = s.vertexCount();
-  std::vector<uint8_t> own;
-  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
-  VertexGraph g;
-  // Every corner lists the face's other two corners, in parallel: the counts
-  // and the slots are taken atomically, so the order within a vertex's range
-  // varies from run to run, and the sort below makes it the same.
-  std::vector<std::atomic<uint32_t>> count(nv + 1);
-  const auto faces = tbb::blocked_range<size_t>(0, s.faceCount(), 1 << 14);
-  tbb::parallel_for(faces, [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t f = r.begin(); f < r.end(); ++f)
-      if (ok[f])
-        for (int k = 0; k < 3; ++k) count[s.triangles[f][k] + 1].fetch_add(2, std::memory_order_relaxed);
-  });
-  g.offset.assign(nv + 1, 0);
-  for (size_t v = 0; v < nv; ++v) g.offset[v + 1] = g.offset[v] + count[v + 1].load(std::memory_order_relaxed);
-  for (size_t v = 0; v < nv; ++v) count[v].store(g.offset[v], std::memory_order_relaxed);  // now each vertex's next slot
-  g.nbr.resize(g.offset[nv]);
-  tbb::parallel_for(faces, [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t f = r.begin(); f < r.end(); ++f) {
-      if (!ok[f]) continue;
-      const auto& t = s.triangles[f];
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t slot = count[t[k]].fetch_add(2, std::memory_order_relaxed);
-        g.nbr[slot] = t[(k + 1) % 3];
-        g.nbr[slot + 1] = t[(k + 2) % 3];
-      }
-    }
-  });
-  // Each neighbour once (a manifold vertex lists each twice): sorted and
-  // made unique within each vertex's range in parallel, then packed.
-  std::vector<uint32_t> unique(nv + 1, 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v < r.end(); ++v) {
-      const auto b = g.nbr.begin() + g.offset[v], e = g.nbr.begin() + g.offset[v + 1];
-      std::sort(b, e);
-      unique[v + 1] = uint32_t(std::unique(b, e) - b);
-    }
-  });
-  for (size_t v = 0; v < nv; ++v) unique[v + 1] += unique[v];
-  std::vector<uint32_t> packed(unique[nv]);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v < r.end(); ++v)
-      std::copy_n(g.nbr.begin() + g.offset[v], unique[v + 1] - unique[v], packed.begin() + unique[v]);
-  });
-  g.offset.swap(unique);
-  g.nbr.swap(packed);
-  return g;
-}
 
 Pooled poolVertex(uint32_t i, const VertexGraph& g, const std::vector<glm::vec3>& positions,
                   const std::vector<glm::vec3>& normals, const std::vector<VertexRays>& rays,

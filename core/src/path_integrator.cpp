@@ -216,8 +216,18 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
     const Material m = s_.faceMaterial(sp.face);
     if (isSpecular(m)) {
       if (st.lightOnly) break;
-      if (st.depth >= rules_.maxDepth) { ++c.cutAtMaxDepth; break; }
-      ++st.depth;
+      // At the limit a mirror or glass still shows the light straight behind
+      // it, as a diffuse vertex's last sampled direction may still find a
+      // light: max_depth k takes light of k reflections of any kind (the
+      // light seen in a mirror is one, as the light a wall reflects is; it
+      // took max_depth 2 until 4 December 2026).
+      if (st.depth >= rules_.maxDepth) {
+        ++c.cutAtMaxDepth;
+        if (!lightRays) break;
+        st.lightOnly = true;
+      } else {
+        ++st.depth;
+      }
       specularStep(sp, st, smp);
     } else {
       const float cosO = -glm::dot(sp.n, st.ray.d);

@@ -454,6 +454,58 @@ TEST(PathTracer, MirrorImageOfTheLight) {
   EXPECT_NEAR(compare(r.H, targets).meanRatio, 1.0, 0.05);
 }
 
+// Light that only rare paths find: the receiver sees the light only in the
+// mirror (F = 0.004: about 1 path in 250 finds it, and no shadow ray can
+// aim there). With 256 paths a third of the vertices find it never and
+// their own sample variance is 0: error bars of 0 under a missing light.
+// The error bars pool the irradiance's variance over the vertex's ring, so
+// they cover it: over the 40 target vertices, RMS of z = (H - exact) / error
+// below 1.5 (measured: see the test's output) and every |z| below 5, with
+// no error bar of 0. Adaptive to 10%: it stopped at the pilot before
+// wherever the pilot found no light (B 0, error 0, target met); now the
+// ring's variance keeps those vertices going, and the mean is within 5%
+// of the exact one, with the same z bounds.
+TEST(PathTracer, ErrorBarsCoverRareLight) {
+  Scene s = mirrorScene(10);
+  // A grey receiver, so that B = rho H has an error to meet (black, B = 0
+  // exactly), and one bounce: the mirror's (the receiver's own light seen
+  // in the mirror would be a second).
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (s.toWorld(s.positions[s.triangles[f].x]).y > 1.5) s.rho[f] = glm::vec3(0.5f);
+  auto caster = makeEmbreeCaster(s);
+  const auto targets = mirrorTargets(s);
+  ASSERT_EQ(targets.size(), 40u);
+  for (const bool adaptive : {false, true}) {
+    SCOPED_TRACE(adaptive ? "adaptive to 10%" : "256 paths");
+    PathTraceOptions o;
+    o.samplesPerVertex = 256;
+    o.maxDepth = 1;
+    if (adaptive) {
+      o.targetRelativeError = 0.1;
+      o.minSamples = 64;
+      o.maxSamples = 1 << 16;
+    }
+    const PathTraceResult r = pathTrace(s, *caster, o);
+    double z2 = 0, zMax = 0;
+    int missed = 0;
+    for (const auto& [i, ref] : targets) {
+      EXPECT_GT(r.stdErrorH[i], 0.f) << i;
+      const double z = (luminance(r.H[i]) - ref) / std::max(1e-12f, r.stdErrorH[i]);
+      z2 += z * z;
+      zMax = std::max(zMax, std::abs(z));
+      missed += r.H[i] == glm::vec3(0.f);
+    }
+    const double rmsZ = std::sqrt(z2 / double(targets.size()));
+    std::printf("%s: RMS z %.3f, max |z| %.2f, %d of 40 found no light, mean ratio %.4f, %.0f paths\n",
+                adaptive ? "adaptive" : "256 paths", rmsZ, zMax, missed, compare(r.H, targets).meanRatio,
+                r.stats.get("paths"));
+    EXPECT_LT(rmsZ, 1.5);
+    EXPECT_LT(zMax, 5.0);
+    if (!adaptive) EXPECT_GT(missed, 5);  // the light really is rare at 256 paths
+    if (adaptive) EXPECT_NEAR(compare(r.H, targets).meanRatio, 1.0, 0.05);
+  }
+}
+
 // The glass sphere focuses the light: the brightest floor vertex lies within
 // 40 mm (half the sphere's radius) of the line from the light's centre
 // through the sphere's centre, and its irradiance is over twice that of the

@@ -6,6 +6,8 @@
 // vertex flags as MeshLab saves it.
 #include <gtest/gtest.h>
 
+#include "gi/vertex_graph.h"
+
 #include <cmath>
 #include <string>
 
@@ -45,7 +47,8 @@ TEST(ReferenceSubset, RandomSubsetIsDeterministicAndUniform) {
 }
 
 // 40 of the Cornell box's vertices: bit-identical to the full run there, 0
-// elsewhere; 40 traced (every vertex of the box is on a diffuse face).
+// elsewhere; 40 traced (every vertex of the box is on a diffuse face); the
+// log says how many have error bars of their own paths alone.
 TEST(ReferenceSubset, TracedVerticesMatchTheFullRun) {
   const auto sf = scenes::cornellBox(150.0);
   const Scene& s = sf.scene;
@@ -57,13 +60,23 @@ TEST(ReferenceSubset, TracedVerticesMatchTheFullRun) {
   o.tracedVertexSeed = 3;
   const PathTraceResult part = pathTrace(s, *caster, o);
   const auto mask = randomVertexSubset(s.vertexCount(), 40, 3);
-  size_t traced = 0;
+  const VertexGraph graph = VertexGraph::build(s);
+  size_t traced = 0, isolated = 0;
   for (size_t v = 0; v < s.vertexCount(); ++v) {
     ASSERT_EQ(part.traced[v], (*mask)[v]) << v;
     traced += part.traced[v];
     if (part.traced[v]) {
       EXPECT_EQ(part.B[v], full.B[v]) << v;
-      EXPECT_EQ(part.stdError[v], full.stdError[v]) << v;
+      // Without a traced vertex within two rings its error bar is its own
+      // paths', at most the full run's (the larger of its own and its ring's).
+      bool alone = true;
+      for (uint32_t k = graph.offset[v]; k < graph.offset[v + 1]; ++k) {
+        const uint32_t j = graph.nbr[k];
+        alone = alone && !(*mask)[j];
+        for (uint32_t l = graph.offset[j]; l < graph.offset[j + 1]; ++l) alone = alone && (graph.nbr[l] == v || !(*mask)[graph.nbr[l]]);
+      }
+      if (alone) EXPECT_LE(part.stdError[v], full.stdError[v]) << v;
+      isolated += alone;
     } else {
       EXPECT_EQ(part.B[v], glm::vec3(0.f)) << v;
       EXPECT_EQ(part.samples[v], 0) << v;
@@ -71,6 +84,10 @@ TEST(ReferenceSubset, TracedVerticesMatchTheFullRun) {
   }
   EXPECT_EQ(traced, 40u);
   EXPECT_EQ(part.stats.get("traced_vertices"), 40.0);
+  EXPECT_GT(isolated, 0u);
+  EXPECT_NE(part.stats.line("reference").find(std::to_string(isolated) + " traced vertices have no traced vertex within"),
+            std::string::npos)
+      << part.stats.line("reference");
   EXPECT_EQ(full.stats.get("traced_vertices"), double(s.vertexCount()));
 }
 

@@ -68,17 +68,10 @@
 
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/vertex_graph.h"
 #include "gi/vertex_part.h"
 
 namespace gi {
-
-// Vertex adjacency from the usable faces (compressed rows, no duplicates).
-struct VertexGraph {
-  std::vector<uint32_t> offset;  // vertexCount + 1
-  std::vector<uint32_t> nbr;
-  static VertexGraph build(const Scene& s, const std::vector<uint8_t>* usable = nullptr);  // usable: usableFaceMask(s) if known
-  size_t degree(uint32_t v) const { return offset[v + 1] - offset[v]; }
-};
 
 // One vertex's own rays: how many, the sum of their values, the sum of the
 // unoccluded directions (bent normals).

@@ -16,7 +16,10 @@
 // disk and a point or spot light. Radiance is scaled by eta^2 across glass
 // (cancelling on paths that enter and leave). Random numbers are independent
 // per (vertex, sample, seed), so the reported standard error is an honest
-// Monte Carlo error bar and the result does not depend on threads. Vertices
+// Monte Carlo error bar and the result does not depend on threads; the
+// variance behind it is the larger of the vertex's own and its mesh ring's
+// (core/src/pathtrace.cpp: light that only rare paths find leaves a vertex's
+// own sample variance near 0 where its paths missed it). Vertices
 // with no diffuse face (only on mirror, glass or glossy faces) have no
 // diffuse radiosity: they get 0, and the log says how many.
 // On a large mesh the reference may trace a random sample of its vertices

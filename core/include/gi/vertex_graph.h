@@ -1,0 +1,19 @@
+// Which vertices share a face: the mesh rings that the shared ambient
+// occlusion estimator pools over and the reference's error bars read.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "gi/scene.h"
+
+namespace gi {
+
+// Vertex adjacency from the usable faces (compressed rows, no duplicates).
+struct VertexGraph {
+  std::vector<uint32_t> offset;  // vertexCount + 1
+  std::vector<uint32_t> nbr;
+  static VertexGraph build(const Scene& s, const std::vector<uint8_t>* usable = nullptr);  // usable: usableFaceMask(s) if known
+  size_t degree(uint32_t v) const { return offset[v + 1] - offset[v]; }
+};
+
+}  // namespace gi
