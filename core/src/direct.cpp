@@ -49,6 +49,61 @@ VertexMaterial vertexMaterial(const Scene& s) {
   return m;
 }
 
+VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m) {
+  const size_t nv = s.vertexCount();
+  VertexSides out;
+  out.slot.assign(nv, -1);
+  std::vector<uint32_t> candidates;
+  for (size_t v = 0; v < nv; ++v)
+    if (m.diffuse[v] && !m.valid[v]) {
+      out.slot[v] = int32_t(candidates.size());
+      candidates.push_back(uint32_t(v));
+    }
+  if (candidates.empty()) return out;
+  const size_t nc = candidates.size();
+  std::vector<glm::dvec3> ref(nc, glm::dvec3(0.0)), nsum[2], rho[2], E[2];
+  std::vector<double> area[2];
+  for (int k = 0; k < 2; ++k) {
+    nsum[k].assign(nc, glm::dvec3(0.0));
+    rho[k].assign(nc, glm::dvec3(0.0));
+    E[k].assign(nc, glm::dvec3(0.0));
+    area[k].assign(nc, 0.0);
+  }
+  const auto ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f] || s.faceMaterial(f) != Material::Diffuse) continue;
+    const auto& t = s.triangles[f];
+    const glm::dvec3 a(s.positions[t.x]), cr = glm::cross(glm::dvec3(s.positions[t.y]) - a, glm::dvec3(s.positions[t.z]) - a);
+    const double twiceArea = glm::length(cr);
+    if (!(twiceArea > 0)) continue;
+    for (int c = 0; c < 3; ++c) {
+      const int32_t k = out.slot[t[c]];
+      if (k < 0) continue;
+      if (ref[size_t(k)] == glm::dvec3(0.0)) ref[size_t(k)] = cr / twiceArea;  // the first face (by index) is side A
+      const int side = glm::dot(cr, ref[size_t(k)]) > 0 ? 0 : 1;
+      nsum[side][size_t(k)] += cr;
+      rho[side][size_t(k)] += 0.5 * twiceArea * glm::dvec3(s.faceRho(f));
+      E[side][size_t(k)] += 0.5 * twiceArea * glm::dvec3(s.faceEmission(f));
+      area[side][size_t(k)] += 0.5 * twiceArea;
+    }
+  }
+  out.slot.assign(nv, -1);
+  for (size_t k = 0; k < nc; ++k) {
+    const double l0 = glm::length(nsum[0][k]), l1 = glm::length(nsum[1][k]);
+    // Both sides must turn clearly one way (a fold or a fan of faces that
+    // cancel within one side has no side to trace from).
+    if (!(l0 > 1e-6 * 2 * area[0][k]) || !(l1 > 1e-6 * 2 * area[1][k])) continue;
+    out.slot[candidates[k]] = int32_t(out.vertex.size());
+    out.vertex.push_back(candidates[k]);
+    for (int sd = 0; sd < 2; ++sd) {
+      out.n[sd].push_back(glm::vec3(nsum[sd][k] / (sd ? l1 : l0)));
+      out.rho[sd].push_back(glm::vec3(rho[sd][k] / area[sd][k]));
+      out.E[sd].push_back(glm::vec3(E[sd][k] / area[sd][k]));
+    }
+  }
+  return out;
+}
+
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt, const Progress& progress) {
   if (opt.lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   Timer timer;

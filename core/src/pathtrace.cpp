@@ -199,6 +199,7 @@ RingVariance ringVariance(const VertexGraph& g, const std::vector<double>& var, 
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
   glm::dvec3 sumH{0.0};
+  glm::dvec3 sumRH{0.0};  // rho H, on a two-sided surface (its sides' reflectances differ)
   glm::dvec3 sumPart[kPathKinds] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};  // light_path_split
 };
 
@@ -229,11 +230,48 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   const SceneReport rep = analyzeScene(s);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const VertexMaterial mat = vertexMaterial(s);
-  const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, float(rep.rayEpsilon));
   const size_t nv = s.vertexCount();
+  // A vertex on a two-sided surface has no normal: it gets the mean of its
+  // two sides, each path traced from both (as radiosity's patch average
+  // there takes its faces on both sides).
+  const VertexSides sides = twoSidedVertices(s, mat);
+  std::vector<uint8_t> traceable = mat.valid;
+  std::vector<glm::vec3> rayNormal = mat.n;
+  for (size_t k = 0; k < sides.vertex.size(); ++k) {
+    traceable[sides.vertex[k]] = 1;
+    rayNormal[sides.vertex[k]] = sides.n[0][k];
+  }
+  const float eps = float(rep.rayEpsilon);
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, rayNormal, eps);
   std::vector<Accum> acc(nv);
   std::vector<paths::Counts> counts(nv);
+  auto traceTwoSided = [&](size_t i, int32_t slot, int count) {
+    Accum& a = acc[i];
+    const glm::vec3 o[2] = {origins[i], origins[i] + eps * (sides.n[1][size_t(slot)] - sides.n[0][size_t(slot)])};
+    for (int k = 0; k < count; ++k) {
+      paths::Sampler smp(hash3(uint32_t(i), opt.seed, 0x9a7eu), uint32_t(a.n), false);
+      glm::vec3 H(0.f), RH(0.f);
+      for (int sd = 0; sd < 2; ++sd) {
+        glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
+        const glm::vec3 h = float(M_PI) * tracer.traceFromSurface(o[sd], sides.n[sd][size_t(slot)], smp, counts[i],
+                                                                  opt.lightPathSplit ? parts : nullptr);
+        const glm::vec3 rho = sides.rho[sd][size_t(slot)];
+        for (int p = 0; p < kPathKinds; ++p) a.sumPart[p] += glm::dvec3(0.5f * float(M_PI) * rho * parts[p]);
+        H += 0.5f * h;
+        RH += 0.5f * rho * h;
+      }
+      const double l = luminance(RH), lh = luminance(H);
+      a.n += 1;
+      a.sumL += l;
+      a.sumL2 += l * l;
+      a.sumH += glm::dvec3(H);
+      a.sumRH += glm::dvec3(RH);
+      a.sumHL += lh;
+      a.sumHL2 += lh * lh;
+    }
+  };
   auto trace = [&](size_t i, int count) {
+    if (sides.slot[i] >= 0) return traceTwoSided(i, sides.slot[i], count);
     Accum& a = acc[i];
     for (int k = 0; k < count; ++k) {
       // Independent numbers keyed by (vertex, path, seed): honest error bars, any thread count.
@@ -310,24 +348,24 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.samplesPerVertex);
+        if (traceable[i] && part.contains(i, nv)) trace(i, opt.samplesPerVertex);
     });
   } else {
     // Pilot pass, then rounds for the vertices still above target.
     parallelBlocks(nv, progress.sub(0.0, 0.2), "tracing paths (pilot)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
-        if (mat.valid[i] && part.contains(i, nv)) trace(i, opt.minSamples);
+        if (traceable[i] && part.contains(i, nv)) trace(i, opt.minSamples);
     });
     // The pilot's mean B over all vertices, summed in vertex order: the same
     // bits in one process and in a split run (each part fills its vertices).
     std::vector<double> pilot(nv, 0.0);
     for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i] && part.contains(i, nv)) pilot[i] = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
+      if (traceable[i] && part.contains(i, nv)) pilot[i] = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
     if (!part.all()) part.sumOverParts(pilot);
     double meanB = 0;
     size_t valid = 0;
     for (size_t i = 0; i < nv; ++i)
-      if (mat.valid[i] && part.inSubset(i)) { meanB += pilot[i]; ++valid; }
+      if (traceable[i] && part.inSubset(i)) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
     const double floorB = 0.1 * meanB;
     // Rounds: every vertex whose error bar (its ring's pooled variance, as
@@ -346,7 +384,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       parallelBlocks(nv, progress.sub(0.2 + 0.8 * f0, 0.2 + 0.8 * f1), "tracing paths (adaptive)",
                      [&](size_t b, size_t e) {
                        for (size_t i = b; i < e; ++i) {
-                         if (!mat.valid[i] || !part.contains(i, nv) || acc[i].n >= opt.maxSamples) continue;
+                         if (!traceable[i] || !part.contains(i, nv) || acc[i].n >= opt.maxSamples) continue;
                          const double B = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
                          const double goal = opt.targetRelativeError * std::max(B, floorB);
                          if (var[i] <= goal * goal * acc[i].n) continue;
@@ -383,15 +421,18 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   for (size_t i = 0; i < nv; ++i) {
     totalRays += double(counts[i].rays());
     totalCut += double(counts[i].cutAtMaxDepth);
-    if (!mat.valid[i] || acc[i].n == 0) continue;
+    if (!traceable[i] || acc[i].n == 0) continue;
+    const bool twoSided = sides.slot[i] >= 0;
     res.H[i] = glm::vec3(acc[i].sumH / acc[i].n);
-    res.B[i] = mat.E[i] + mat.rho[i] * res.H[i];
+    res.B[i] = mat.E[i] + (twoSided ? glm::vec3(acc[i].sumRH / acc[i].n) : mat.rho[i] * res.H[i]);
     if (opt.lightPathSplit) {
-      // rho H_k per kind, from the same paths: they sum to B - E within float rounding.
+      // rho H_k per kind, from the same paths: they sum to B - E within float
+      // rounding (a two-sided vertex's parts carry their side's rho already).
+      const glm::vec3 rho = twoSided ? glm::vec3(1.f) : mat.rho[i];
       res.split.emitted[i] = mat.E[i];
-      res.split.direct[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathDirect] / acc[i].n);
-      res.split.caustic[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathCaustic] / acc[i].n);
-      res.split.indirect[i] = mat.rho[i] * glm::vec3(acc[i].sumPart[kPathIndirect] / acc[i].n);
+      res.split.direct[i] = rho * glm::vec3(acc[i].sumPart[kPathDirect] / acc[i].n);
+      res.split.caustic[i] = rho * glm::vec3(acc[i].sumPart[kPathCaustic] / acc[i].n);
+      res.split.indirect[i] = rho * glm::vec3(acc[i].sumPart[kPathIndirect] / acc[i].n);
     }
     res.stdError[i] = float(std::sqrt(var.B[i] / acc[i].n));
     res.stdErrorH[i] = float(std::sqrt(var.H[i] / acc[i].n));
@@ -432,10 +473,15 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   else if (opt.tracedVertices >= nv && opt.tracedVertices > 0)
     st.note("traced_vertices " + std::to_string(opt.tracedVertices) + " is not below the " + std::to_string(nv) +
             " vertices: all traced");
+  size_t twoSidedTraced = 0;
+  for (uint32_t v : sides.vertex) twoSidedTraced += part.contains(v, nv) && acc[v].n > 0;
+  if (twoSidedTraced)
+    st.note(std::to_string(twoSidedTraced) + " vertices on a two-sided surface (its faces' normals cancel) took the "
+            "mean of their two sides (each sample a path from either side)");
   if (valid < part.count(nv))
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
-            "glass or glossy faces only: no diffuse radiosity) or without a normal (on a two-sided surface the faces' "
-            "normals cancel: no side to trace from) got 0");
+            "glass or glossy faces only: no diffuse radiosity) or without a side to trace from (a fold whose faces' "
+            "normals cancel) got 0");
   return res;
 }
 

@@ -119,6 +119,43 @@ TEST(PathTracer, PointLightAndSun) {
   for (const auto& H : rs.H) EXPECT_NEAR(H.g, 1.5, 1e-5);
 }
 
+// A two-sided surface (every face with a reversed copy) has no vertex
+// normal: its vertices get the mean of their two sides, as radiosity's patch
+// average does there (they got 0 before 4 December 2026). A plane under a
+// sky of radiance 1 / pi (H = 1 on either side) and a sun of 2 straight
+// above: the top (rho 0.5) gets H = 3, the bottom (rho 0.2) H = 1, so B =
+// (0.5 x 3 + 0.2 x 1) / 2 = 0.85 and H = 2 at every vertex, borders
+// included (nothing is occluded: exact within float rounding); the light
+// path parts sum to B, and the log says how many vertices.
+TEST(PathTracer, TwoSidedSurfaceTakesTheMeanOfItsSides) {
+  auto sf = scenes::openPlane(2.0, 4);
+  std::vector<glm::dvec3> pts;
+  for (const auto& p : sf.scene.positions) pts.push_back(sf.scene.toWorld(p));
+  std::vector<glm::uvec3> tris = sf.scene.triangles;
+  const size_t n = tris.size();
+  for (size_t f = 0; f < n; ++f) tris.push_back({tris[f].x, tris[f].z, tris[f].y});
+  Scene s = Scene::fromAbsolute(pts, tris);
+  s.rho.assign(s.faceCount(), glm::vec3(0.2f));
+  for (size_t f = 0; f < n; ++f) s.rho[f] = glm::vec3(0.5f);  // the originals face up
+  s.emission.assign(s.faceCount(), glm::vec3(0.f));
+  PathTraceOptions o;
+  o.skyRadiance = glm::vec3(float(1.0 / M_PI));
+  o.sunIrradiance = glm::vec3(2.f);
+  o.sunAngularRadiusDeg = 0.f;
+  o.sunDirection = glm::vec3(0.f, 0.f, 1.f);
+  o.lightPathSplit = true;
+  const auto r = trace(s, 16, o);
+  for (size_t i = 0; i < s.vertexCount(); ++i) {
+    EXPECT_NEAR(r.B[i].g, 0.85, 1e-5) << i;
+    EXPECT_NEAR(r.H[i].g, 2.0, 1e-5) << i;
+    const glm::vec3 sum = r.split.emitted[i] + r.split.direct[i] + r.split.caustic[i] + r.split.indirect[i];
+    EXPECT_NEAR(sum.g, r.B[i].g, 1e-5) << i;
+  }
+  EXPECT_NE(r.stats.line("reference").find(std::to_string(s.vertexCount()) + " vertices on a two-sided surface"),
+            std::string::npos)
+      << r.stats.line("reference");
+}
+
 // The reported standard errors are honest: on the sky-lit floor with 256
 // paths, the true error is below 2 reported standard errors at about 95% of
 // the vertices (accepted: 88% to 99.5%) and below 3 at >= 97%. Vertices

@@ -45,6 +45,20 @@ struct VertexMaterial {
 };
 VertexMaterial vertexMaterial(const Scene& s);
 
+// The two sides of the vertices on a two-sided surface (each face with a
+// reversed copy: their normals cancel, so the vertex has none): the faces
+// that turn the way of the first incident diffuse face (by index) form side
+// A, the others side B; each side's normal is its faces' area-weighted
+// normal sum, normalised, and its reflectance and emission their area-
+// weighted means. A vertex whose two sums do not both give a normal is left
+// out. slot[v] is the vertex's index in the lists, or -1.
+struct VertexSides {
+  std::vector<int32_t> slot;
+  std::vector<uint32_t> vertex;
+  std::vector<glm::vec3> n[2], rho[2], E[2];
+};
+VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m);
+
 // Direct irradiance per face from the emitters: with up to
 // Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), the exact form
 // factor to each times its visibility, at up to P = max(1, lightSamples /
