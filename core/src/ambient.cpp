@@ -13,6 +13,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "gi/color.h"
+#include "gi/direct.h"
 #include "gi/open_space.h"
 #include "gi/sampling.h"
 #include "gi/sky.h"
@@ -285,7 +286,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const std::vector<glm::vec3> normals = vertexNormalsForRays(scene, &usable);
 
   // Which vertices need rays: valid ones, one per (position, normal) class, not provably open.
-  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart };
+  enum : uint8_t { kTrace, kInvalid, kDuplicate, kOpen, kOtherPart, kTwoSided };
   std::vector<uint8_t> status(nv, kTrace);
   std::vector<uint32_t> rep_of(nv);
   for (size_t i = 0; i < nv; ++i) {
@@ -296,6 +297,12 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
                     glm::dot(n, n) > 0.5f;
     if (!ok) status[i] = kInvalid;
   }
+  // A vertex of a two-sided surface (each face with a reversed copy) has no
+  // normal: it gets the mean of its two sides, each computed per vertex.
+  std::vector<uint8_t> noNormal(nv, 0);
+  for (size_t i = 0; i < nv; ++i) noNormal[i] = status[i] == kInvalid && finite3(scene.positions[i]);
+  const VertexSides sides = vertexSides(scene, noNormal, usable);
+  for (uint32_t v : sides.vertex) status[v] = kTwoSided;
   size_t duplicates = 0, open = 0, invalid = 0;
   if (opt.mergeDuplicates) {
     // Sorted by the bits of their six coordinates (+ 0 folds -0 into 0), in
@@ -374,6 +381,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     res.stats.note("the cone's ratio estimator is computed per vertex (not shared)");
   Timer traceTimer;
   SharedStats shareStats;
+  // The progress bar's share of the two-sided vertices (two casts each).
+  const double splitAt = 1.0 - 0.95 * double(2 * sides.vertex.size()) / double(nv + sides.vertex.size());
   if (shared) {
     // Pooling reads every vertex that casts rays in the whole run; this part casts its own.
     std::vector<uint8_t> poolable(nv, 0), mine(nv, 0);
@@ -386,9 +395,9 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       }
     }
     shareStats = computeSharedAmbient(scene, caster, opt, normals, origins, poolable, mine, usable, res,
-                                       progress.sub(0.05, 1.0));
+                                       progress.sub(0.05, splitAt));
   }
-  parallelBlocks(shared ? 0 : nv, progress.sub(0.05, 1.0), "casting rays", [&](size_t b, size_t e) {
+  parallelBlocks(shared ? 0 : nv, progress.sub(0.05, splitAt), "casting rays", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (status[i] == kOpen) {
         res.value[i] = 1.f;  // provably nothing within reach above the tangent plane
@@ -404,6 +413,26 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
       if (opt.bentNormals) res.bentNormal[i] = o.bent;
     }
   });
+  if (!sides.vertex.empty()) {
+    std::vector<glm::vec3> sideNormal = normals;
+    for (size_t k = 0; k < sides.vertex.size(); ++k) sideNormal[sides.vertex[k]] = sides.n[0][k];
+    const float eps = float(rep.rayEpsilon);
+    const std::vector<glm::vec3> sideOrigins = vertexRayOrigins(scene, sideNormal, eps, &usable);
+    parallelBlocks(sides.vertex.size(), progress.sub(splitAt, 1.0), "casting rays (two-sided)", [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        const uint32_t i = sides.vertex[k];
+        if (!part.contains(i, nv)) continue;
+        const glm::vec3 oA = sideOrigins[i], oB = oA + eps * (sides.n[1][k] - sides.n[0][k]);
+        // Side B's rays keyed apart from every vertex's own (indices below nv).
+        const uint32_t key = uint32_t(part.meshIndex(i));
+        const VertexOut a = kernel.run(key, oA, sides.n[0][k]), c = kernel.run(uint32_t(nv) + key, oB, sides.n[1][k]);
+        res.value[i] = 0.5f * (a.value + c.value);
+        res.stdError[i] = 0.5f * std::sqrt(a.stdError * a.stdError + c.stdError * c.stdError);
+        res.rays[i] = a.rays + c.rays;
+        if (opt.mode == AmbientMode::Sky) res.rgb[i] = 0.5f * (a.rgb + c.rgb);
+      }
+    });
+  }
   const double traceSeconds = traceTimer.seconds();
   for (size_t i = 0; i < nv; ++i) {
     if (status[i] == kDuplicate) {
@@ -452,8 +481,13 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
                                                            : " vertices provably open (the whole scene below their "
                                                              "tangent plane)") + " got 1 without rays");
   if (duplicates) st.note(std::to_string(duplicates) + " duplicate vertices (same position and normal) computed once");
-  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
-                          "surface, each face with a reversed copy, the faces' normals cancel) got 0");
+  size_t twoSided = 0;
+  for (uint32_t v : sides.vertex) twoSided += part.contains(v, nv);
+  if (twoSided)
+    st.note(std::to_string(twoSided) + " vertices on a two-sided surface (each face with a reversed copy: no normal) "
+            "took the mean of their two sides");
+  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a side to "
+                          "cast from (a fold whose faces' normals cancel) got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)
     st.note(std::to_string(rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite) + " degenerate/invalid faces ignored");
   warnMeaningless(scene, usable, opt, res, st);

@@ -50,12 +50,19 @@ VertexMaterial vertexMaterial(const Scene& s) {
 }
 
 VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m) {
+  std::vector<uint8_t> candidate(s.vertexCount(), 0), faces = usableFaceMask(s);
+  for (size_t v = 0; v < candidate.size(); ++v) candidate[v] = m.diffuse[v] && !m.valid[v];
+  for (size_t f = 0; f < faces.size(); ++f) faces[f] = faces[f] && s.faceMaterial(f) == Material::Diffuse;
+  return vertexSides(s, candidate, faces);
+}
+
+VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, const std::vector<uint8_t>& faces) {
   const size_t nv = s.vertexCount();
   VertexSides out;
   out.slot.assign(nv, -1);
   std::vector<uint32_t> candidates;
   for (size_t v = 0; v < nv; ++v)
-    if (m.diffuse[v] && !m.valid[v]) {
+    if (candidate[v]) {
       out.slot[v] = int32_t(candidates.size());
       candidates.push_back(uint32_t(v));
     }
@@ -69,9 +76,8 @@ VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m) {
     E[k].assign(nc, glm::dvec3(0.0));
     area[k].assign(nc, 0.0);
   }
-  const auto ok = usableFaceMask(s);
   for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f] || s.faceMaterial(f) != Material::Diffuse) continue;
+    if (!faces[f]) continue;
     const auto& t = s.triangles[f];
     const glm::dvec3 a(s.positions[t.x]), cr = glm::cross(glm::dvec3(s.positions[t.y]) - a, glm::dvec3(s.positions[t.z]) - a);
     const double twiceArea = glm::length(cr);
@@ -90,9 +96,12 @@ VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m) {
   out.slot.assign(nv, -1);
   for (size_t k = 0; k < nc; ++k) {
     const double l0 = glm::length(nsum[0][k]), l1 = glm::length(nsum[1][k]);
-    // Both sides must turn clearly one way (a fold or a fan of faces that
-    // cancel within one side has no side to trace from).
+    // Two-sided: both sides turn clearly one way, and cancel each other (a
+    // reversed copy's cross product is the exact negative). A vertex whose
+    // faces do not cancel (a cone's tip whose given normal is not finite)
+    // is no two-sided vertex.
     if (!(l0 > 1e-6 * 2 * area[0][k]) || !(l1 > 1e-6 * 2 * area[1][k])) continue;
+    if (!(glm::length(nsum[0][k] + nsum[1][k]) <= 1e-6 * (l0 + l1))) continue;
     out.slot[candidates[k]] = int32_t(out.vertex.size());
     out.vertex.push_back(candidates[k]);
     for (int sd = 0; sd < 2; ++sd) {

@@ -50,13 +50,17 @@ VertexMaterial vertexMaterial(const Scene& s);
 // that turn the way of the first incident diffuse face (by index) form side
 // A, the others side B; each side's normal is its faces' area-weighted
 // normal sum, normalised, and its reflectance and emission their area-
-// weighted means. A vertex whose two sums do not both give a normal is left
-// out. slot[v] is the vertex's index in the lists, or -1.
+// weighted means. A vertex whose two sums do not both give a normal, or do
+// not cancel (not two-sided), is left out. slot[v] is the vertex's index in
+// the lists, or -1.
 struct VertexSides {
   std::vector<int32_t> slot;
   std::vector<uint32_t> vertex;
   std::vector<glm::vec3> n[2], rho[2], E[2];
 };
+// The candidates' sides over the faces `faces` marks (usable ones only).
+VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, const std::vector<uint8_t>& faces);
+// Over the diffuse faces, for the vertices on one without a normal.
 VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m);
 
 // Direct irradiance per face from the emitters: with up to
