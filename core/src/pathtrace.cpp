@@ -1,12 +1,14 @@
 #include "gi/pathtrace.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "gi/color.h"
@@ -144,64 +146,112 @@ void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, do
 // The neighbours receive nearly the same light, so their mean variance is a
 // far better estimate of the vertex's; taking the larger keeps the vertex's
 // own where the light changes across the ring (a shadow edge). What is
-// pooled is the variance of the irradiance H, the light arriving, which does
-// not depend on the surface; a vertex's B takes it times the square of its
-// own reflectance's share of H (luminance(rho H) / luminance(H)), so a
+// pooled is the covariance of the irradiance H's three channels, the light
+// arriving, which does not depend on the surface; a vertex's B = E + rho H
+// takes the variance w^T C w of it, w the vertex's reflectance times the
+// luminance weights, so a red wall is not given a blue light's error, and a
 // black emitter's B = E keeps its error of 0 beside lit neighbours. The
-// ring is the vertex's neighbours, and theirs too while the first ring's
-// traced vertices hold fewer than kPooledPaths paths together (with the
-// vertex). Measured on the same scene (mean z^2, |z| > 4): 64 paths 0.89
+// ring is the vertex's neighbours, and theirs too while they hold fewer
+// than kPooledPaths paths together (with the vertex), and further rings (up
+// to 4) while it holds fewer than kPooledVertices traced vertices (a mesh's
+// border or corner). Measured on the same scene (mean z^2, |z| > 4): 64 paths 0.89
 // and 7 vertices, 256 paths 0.60 and 1, 1,024 paths 0.90 and 3 (one ring),
 // 2,048 paths 0.82 and 0; on the plain Cornell box at 256 paths 0.86 (1.07
 // with the own variance), the error bars 2% wider at the median vertex, 26%
 // at the 90th percentile.
 constexpr double kPooledPaths = 4096;
 
+constexpr int kPooledVertices = 10;  // at a border or a corner, rings grow (up to 4) until they hold this many
+
+// The covariance per path of H's three channels (rr, gg, bb, rg, rb, gb).
+using Cov = std::array<double, 6>;
+
 struct RingVariance {
-  std::vector<double> mean;          // mean variance over the traced vertices of the ring (the vertex's own included)
-  std::vector<uint32_t> vertices;    // how many (1: the vertex alone)
+  std::vector<Cov> mean;           // mean covariance over the traced vertices of the ring (the vertex's own included)
+  std::vector<uint32_t> vertices;  // how many (1: the vertex alone)
 };
 
-RingVariance ringVariance(const VertexGraph& g, const std::vector<double>& var, const std::vector<double>& paths) {
-  const size_t nv = var.size();
+RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, const std::vector<double>& paths) {
+  const size_t nv = cov.size();
   RingVariance out;
-  out.mean.assign(nv, 0.0);
+  out.mean.assign(nv, Cov{});
   out.vertices.assign(nv, 0);
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps([nv] { return std::vector<uint32_t>(nv, 0); });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<uint32_t> ring;
+    std::vector<uint32_t>& stamp = stamps.local();
+    std::vector<uint32_t> ring, next;
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (!(paths[i] >= 2)) continue;
+      const uint32_t mark = uint32_t(i) + 1;
+      stamp[i] = mark;
       ring.assign(1, uint32_t(i));
       double held = paths[i];
-      for (uint32_t k = g.offset[i]; k < g.offset[i + 1]; ++k) {
-        const uint32_t j = g.nbr[k];
-        ring.push_back(j);
-        if (paths[j] >= 2) held += paths[j];
+      uint32_t traced = 1;
+      size_t levelBegin = 0;
+      for (int level = 1; level <= 4; ++level) {
+        if (level == 2 && held >= kPooledPaths && traced >= kPooledVertices) break;
+        if (level > 2 && traced >= kPooledVertices) break;
+        next.clear();
+        for (size_t a = levelBegin; a < ring.size(); ++a)
+          for (uint32_t k = g.offset[ring[a]]; k < g.offset[ring[a] + 1]; ++k) {
+            const uint32_t j = g.nbr[k];
+            if (stamp[j] == mark) continue;
+            stamp[j] = mark;
+            next.push_back(j);
+            if (paths[j] >= 2) { held += paths[j]; ++traced; }
+          }
+        levelBegin = ring.size();
+        ring.insert(ring.end(), next.begin(), next.end());
+        if (next.empty()) break;
       }
-      if (held < kPooledPaths) {
-        const size_t first = ring.size();
-        for (size_t a = 1; a < first; ++a)
-          for (uint32_t k = g.offset[ring[a]]; k < g.offset[ring[a] + 1]; ++k) ring.push_back(g.nbr[k]);
-        std::sort(ring.begin(), ring.end());
-        ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-      }
-      double sum = 0;
+      std::sort(ring.begin(), ring.end());  // sums in vertex order: the same bits in any thread
+      Cov sum{};
       uint32_t n = 0;
       for (uint32_t j : ring)
-        if (paths[j] >= 2) { sum += var[j]; ++n; }
-      out.mean[i] = sum / double(n);  // n >= 1: the vertex itself
+        if (paths[j] >= 2) {
+          for (int c = 0; c < 6; ++c) sum[size_t(c)] += cov[j][size_t(c)];
+          ++n;
+        }
+      for (int c = 0; c < 6; ++c) out.mean[i][size_t(c)] = sum[size_t(c)] / double(n);  // n >= 1: the vertex itself
       out.vertices[i] = n;
     }
   });
   return out;
 }
 
+// w^T C w for the symmetric 3 x 3 matrix C: the variance of w . H.
+double quadratic(const Cov& C, const glm::dvec3& w) {
+  return w.x * w.x * C[0] + w.y * w.y * C[1] + w.z * w.z * C[2] +
+         2.0 * (w.x * w.y * C[3] + w.x * w.z * C[4] + w.y * w.z * C[5]);
+}
+
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
+  Cov sumHH{};  // H's channel products (as Cov)
   glm::dvec3 sumH{0.0};
   glm::dvec3 sumRH{0.0};  // rho H, on a two-sided surface (its sides' reflectances differ)
   glm::dvec3 sumPart[kPathKinds] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};  // light_path_split
 };
+
+void addProducts(Accum& a, const glm::vec3& H) {
+  const glm::dvec3 h(H);
+  a.sumHH[0] += h.x * h.x;
+  a.sumHH[1] += h.y * h.y;
+  a.sumHH[2] += h.z * h.z;
+  a.sumHH[3] += h.x * h.y;
+  a.sumHH[4] += h.x * h.z;
+  a.sumHH[5] += h.y * h.z;
+}
+
+// The sample covariance per path of H's channels.
+Cov sampleCov(const Accum& a) {
+  Cov c{};
+  if (a.n < 2) return c;
+  const glm::dvec3 m = a.sumH / a.n;
+  const double mm[6] = {m.x * m.x, m.y * m.y, m.z * m.z, m.x * m.y, m.x * m.z, m.y * m.z};
+  for (int k = 0; k < 6; ++k) c[size_t(k)] = (a.sumHH[size_t(k)] - a.n * mm[k]) / (a.n - 1);
+  return c;
+}
 
 }  // namespace
 
@@ -265,6 +315,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       a.sumL += l;
       a.sumL2 += l * l;
       a.sumH += glm::dvec3(H);
+      addProducts(a, H);
       a.sumRH += glm::dvec3(RH);
       a.sumHL += lh;
       a.sumHL2 += lh * lh;
@@ -285,6 +336,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       a.sumL += l;
       a.sumL2 += l * l;
       a.sumH += glm::dvec3(H);
+      addProducts(a, H);
       const double lh = luminance(H);
       a.sumHL += lh;
       a.sumHL2 += lh * lh;
@@ -320,25 +372,30 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     std::vector<uint32_t> vertices;
   };
   auto pooled = [&]() {
-    std::vector<double> all(3 * nv, 0.0);
+    // Only the covariances of H and the path counts are exchanged.
+    std::vector<double> all(7 * nv, 0.0);
     for (size_t i = 0; i < nv; ++i)
       if (acc[i].n >= 2 && part.contains(i, nv)) {
-        all[i] = sampleVar(acc[i], false);
-        all[nv + i] = sampleVar(acc[i], true);
-        all[2 * nv + i] = acc[i].n;
+        const Cov c = sampleCov(acc[i]);
+        for (int k = 0; k < 6; ++k) all[6 * i + size_t(k)] = c[size_t(k)];
+        all[6 * nv + i] = acc[i].n;
       }
     if (!part.all()) part.sumOverParts(all);
-    const std::vector<double> varH(all.begin() + nv, all.begin() + 2 * nv), paths(all.begin() + 2 * nv, all.end());
-    RingVariance ring = ringVariance(graph, varH, paths);
+    std::vector<Cov> cov(nv);
+    for (size_t i = 0; i < nv; ++i)
+      for (int k = 0; k < 6; ++k) cov[i][size_t(k)] = all[6 * i + size_t(k)];
+    const std::vector<double> paths(all.begin() + 6 * nv, all.end());
+    RingVariance ring = ringVariance(graph, cov, paths);
+    const glm::dvec3 lum(0.2126, 0.7152, 0.0722);
     Pooled p;
     p.B.assign(nv, 0.0);
     p.H.assign(nv, 0.0);
     for (size_t i = 0; i < nv; ++i) {
-      if (!(paths[i] >= 2)) continue;
-      // luminance(rho H) / luminance(H) from the vertex's own means.
-      const double h = acc[i].sumHL, share = h > 0 ? acc[i].sumL / h : luminance(mat.rho[i]);
-      p.H[i] = std::max(varH[i], ring.mean[i]);
-      p.B[i] = ring.vertices[i] > 1 ? std::max(all[i], share * share * ring.mean[i]) : all[i];
+      if (!(acc[i].n >= 2) || !part.contains(i, nv)) continue;
+      p.H[i] = std::max(sampleVar(acc[i], true), quadratic(ring.mean[i], lum));
+      // A two-sided vertex's B mixes its sides' reflectances: their mean weights the pool.
+      const double own = sampleVar(acc[i], false), pool = quadratic(ring.mean[i], glm::dvec3(mat.rho[i]) * lum);
+      p.B[i] = ring.vertices[i] > 1 ? std::max(own, pool) : own;
     }
     p.vertices = std::move(ring.vertices);
     return p;
@@ -412,8 +469,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.traced.assign(nv, 0);
   if (opt.lightPathSplit) res.split.assign(nv);
   const Pooled var = pooled();
-  // Traced vertices whose ring holds no other traced vertex (a sample of
-  // the vertices): their error bars are their own paths' alone.
+  // Traced vertices whose pool holds no other traced vertex within 4 rings
+  // (a sample of the vertices): their error bars are their own paths' alone.
   size_t isolated = 0;
   for (size_t i = 0; i < nv; ++i) isolated += part.contains(i, nv) && var.vertices[i] == 1;
   double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
@@ -466,13 +523,13 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     st.note("traced a random sample of " + std::to_string(opt.tracedVertices) + " of the " + std::to_string(nv) +
             " vertices (traced_vertex_seed " + std::to_string(opt.tracedVertexSeed) +
             "); the others are 0, with ReferenceTraced 0");
-  if (isolated)
-    st.note(std::to_string(isolated) + " traced vertices have no traced vertex within two rings: their error bars are "
-            "their own paths' alone, which can miss light that only rare paths find (a caustic, a light seen in a "
-            "mirror)");
   else if (opt.tracedVertices >= nv && opt.tracedVertices > 0)
     st.note("traced_vertices " + std::to_string(opt.tracedVertices) + " is not below the " + std::to_string(nv) +
             " vertices: all traced");
+  if (isolated)
+    st.note(std::to_string(isolated) + " traced vertices have no other traced vertex within 4 rings: their error "
+            "bars are their own paths' alone, which can miss light that only rare paths find (a caustic, a light "
+            "seen in a mirror)");
   size_t twoSidedTraced = 0;
   for (uint32_t v : sides.vertex) twoSidedTraced += part.contains(v, nv) && acc[v].n > 0;
   if (twoSidedTraced)
