@@ -86,8 +86,8 @@ std::vector<ParamSpec> PhotonOptions::specs() {
       {.name = "max_depth", .label = "Maximum bounces",
        .help = "Bounces a path may take, diffuse or specular, counted as the reference counts them: 0 = direct "
                "light only, k = light that reflected at most k times before the vertex (with the final gather, its "
-               "rays are the last bounce). Russian roulette ends most paths much earlier; the power still carried by "
-               "cut paths is logged.",
+               "rays are the last reflection; where they pass mirrors or glass on their way, those are not counted). "
+               "Russian roulette ends most paths much earlier; the power still carried by cut paths is logged.",
        .type = ParamType::Int, .def = 32, .min = 0, .max = 1000},
   };
   for (const ParamSpec& p : SkySun::specs()) out.push_back(p);
@@ -205,7 +205,7 @@ struct PhotonMaps {
 };
 
 PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, const std::vector<Photon>& causticPhotons,
-                     const GatherSurface& surface, const PhotonTraceStats& ts) {
+                     const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& lastHit) {
   PhotonMaps m;
   m.globalPaths = r.opt.directLight ? (1u << kIndirectPhoton) : 7u;
   const bool gather = r.opt.directLight && r.opt.finalGather;
@@ -224,7 +224,8 @@ PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, con
           m.caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
       },
       [&] {
-        if (gather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface);
+        // Without the photons of a path's last allowed hit: the gather's rays add that reflection.
+        if (gather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface, &lastHit);
       });
   m.bytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
   for (const auto* map : {m.global.get(), m.caustics.get(), m.all.get()})
@@ -297,22 +298,24 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
                                 PhotonMapContents* contents) {
   const PhotonOptions& opt = r.opt;
   Timer traceTimer;
-  std::vector<Photon> photons =
-      tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts);
+  const bool gather = opt.directLight && opt.finalGather;
+  std::vector<uint8_t> lastHit;
+  std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts,
+                                             gather ? &lastHit : nullptr);
   std::vector<Photon> causticPhotons;
   if (r.projection)
     causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
   const double traceSeconds = traceTimer.seconds();
   Timer buildTimer;
   const GatherSurface surface(r.s);
-  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts);
+  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts, lastHit);
   const double buildSeconds = buildTimer.seconds();
   if (contents) {
     // The same membership as the trees': `all` (final gather) or the global
     // paths, and the caustic map from the projection or the global trace.
     const unsigned globalMask = maps.all ? 7u : maps.global ? maps.globalPaths : 0u;
-    for (const Photon& p : photons)
-      if ((globalMask >> p.path) & 1u) contents->global.push_back(p);
+    for (size_t i = 0; i < photons.size(); ++i)
+      if (((globalMask >> photons[i].path) & 1u) && !(maps.all && lastHit[i])) contents->global.push_back(photons[i]);
     if (maps.caustics) {
       for (const Photon& p : r.projection && !causticPhotons.empty() ? causticPhotons : photons)
         if (p.path == kCausticPhoton) contents->caustic.push_back(p);

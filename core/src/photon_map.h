@@ -22,12 +22,14 @@ enum class PhotonKernel {
 
 class PhotonMap {
  public:
-  // Photons whose path kind has its bit set in `pathMask` (1 << PhotonPath).
+  // Photons whose path kind has its bit set in `pathMask` (1 << PhotonPath),
+  // but for those `exclude` (if given, one flag per photon) marks.
   // `surface` normalises the estimates (it must outlive the map).
-  PhotonMap(const std::vector<Photon>& all, unsigned pathMask, const GatherSurface& surface)
+  PhotonMap(const std::vector<Photon>& all, unsigned pathMask, const GatherSurface& surface,
+            const std::vector<uint8_t>* exclude = nullptr)
       : surface_(surface), cloud_{all, {}} {
     for (uint32_t i = 0; i < all.size(); ++i)
-      if (pathMask & (1u << all[i].path)) cloud_.idx.push_back(i);
+      if ((pathMask & (1u << all[i].path)) && !(exclude && (*exclude)[i])) cloud_.idx.push_back(i);
     // Positions copied together: the build reads them many times over.
     cloud_.pts.resize(cloud_.idx.size());
     for (size_t k = 0; k < cloud_.idx.size(); ++k) cloud_.pts[k] = all[cloud_.idx[k]].p;

@@ -212,17 +212,6 @@ class StoreBudget {
 // an independent randomisation, so no path repeats; the first 2^32 keep the
 // keys they always had. Until 3 December 2026 the index wrapped, and pass 43
 // on retraced the paths of the first passes.
-// The surface hits a photon path may reach, so that max_depth counts
-// bounces as the reference and the eye pass count them (0: direct light
-// only). A photon stored at a path's hit i brings light of i bounces, so
-// the map read at the vertices holds hits 0..max_depth; the final gather
-// adds one bounce where its rays land, so the map it reads holds one hit
-// fewer (max_depth 0: no photons, direct light only).
-int photonHits(const PhotonOptions& o) {
-  const bool gather = o.directLight && o.finalGather && !o.progressive;
-  return o.maxDepth + (gather ? 0 : 1);
-}
-
 struct PhotonKeys {
   uint32_t index, pos, dir, rng;
 };
@@ -234,7 +223,8 @@ PhotonKeys photonKeys(uint32_t seed, uint64_t g, uint32_t posSalt, uint32_t dirS
 }  // namespace
 
 std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
-                                 size_t count, const Progress& progress, PhotonTraceStats& stats) {
+                                 size_t count, const Progress& progress, PhotonTraceStats& stats,
+                                 std::vector<uint8_t>* lastHit) {
   const PhotonLights lights(s, opt);
   if (lights.empty())
     throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality), "
@@ -245,10 +235,13 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
   std::vector<std::vector<Photon>> blocks(nBlocks);
+  std::vector<std::vector<uint8_t>> lastBlocks(lastHit ? nBlocks : 0);
   std::vector<PhotonTraceStats> bstats(nBlocks);
 
   StoreBudget budget(opt, count);
-  const int hits = photonHits(opt);
+  // max_depth counts reflections as the reference and the eye pass do (0:
+  // direct light only): a path may reach hits 0 .. max_depth.
+  const int hits = opt.maxDepth + 1;
   parallelBlocks(nBlocks, progress, "tracing photons", [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;
@@ -290,6 +283,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           }
           const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
           out.push_back({x, power, packNormal(ng), path});
+          if (lastHit) lastBlocks[b].push_back(depth == opt.maxDepth);
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
           const glm::vec3 rho = s.faceRho(h.face);
@@ -314,9 +308,14 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   for (const auto& b : blocks) total += b.size();
   std::vector<Photon> all;
   all.reserve(total);
+  if (lastHit) {
+    lastHit->clear();
+    lastHit->reserve(total);
+  }
   for (size_t b = 0; b < nBlocks; ++b) {
     all.insert(all.end(), blocks[b].begin(), blocks[b].end());
     std::vector<Photon>().swap(blocks[b]);
+    if (lastHit) lastHit->insert(lastHit->end(), lastBlocks[b].begin(), lastBlocks[b].end());
     const auto& t = bstats[b];
     stats.caustic += t.caustic;
     stats.direct += t.direct;

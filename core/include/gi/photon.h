@@ -99,9 +99,14 @@ struct PhotonTraceStats {
 };
 
 // Traces photons `first` .. `first + count - 1` of the seed's sequence (each
-// carrying 1/count of the power); deterministic for any thread count.
+// carrying 1/count of the power); deterministic for any thread count. A
+// path stores photons at its hits 0 .. max_depth (a photon at hit i brings
+// light of i reflections). `lastHit`, if given, gets one flag per photon:
+// 1 where it was stored at hit max_depth (the final gather's map leaves
+// those out: its rays add the last reflection).
 std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
-                                 size_t count, const Progress& progress, PhotonTraceStats& stats);
+                                 size_t count, const Progress& progress, PhotonTraceStats& stats,
+                                 std::vector<uint8_t>* lastHit = nullptr);
 
 // Caustic photons by projection (Jensen 1996's projection maps): from points
 // on the lights, directions only towards the bounding spheres of the groups of
