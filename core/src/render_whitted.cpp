@@ -42,6 +42,7 @@ struct Branch {
   glm::vec3 w;   // product of reflectances and Fresnel factors: what the cut-off compares
   float scale;   // product of the eta^2 radiance factors (1 again once out of the glass)
   int depth;
+  bool lightOnly = false;  // past max_depth: it may only find a light (emission, sky, sun)
 };
 float maxChannel(const glm::vec3& v) { return std::max({v.r, v.g, v.b}); }
 }  // namespace
@@ -139,10 +140,13 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
   stack.clear();
   stack.push_back({primary, glm::vec3(1.f), 1.f, 0});
   glm::vec3 L(0.f);
+  // A branch past max_depth still shows a light straight behind the mirror
+  // or glass that spawned it, as the path-traced modes do at their limit: a
+  // light seen in a mirror is one reflection, as a wall's light is.
   auto push = [&](const Ray& r, const glm::vec3& w, float scale, int depth) {
     if (maxChannel(w) < o_.whittedMinWeight) { ++c.belowWeight; return; }
-    if (depth > o_.maxDepth) { ++c.cutAtMaxDepth; return; }
-    stack.push_back({r, w, scale, depth});
+    if (depth > o_.maxDepth) ++c.cutAtMaxDepth;
+    stack.push_back({r, w, scale, depth, depth > o_.maxDepth});
     ++c.specular;
   };
   while (!stack.empty()) {
@@ -161,6 +165,10 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
       continue;
     }
     const Material m = s_.faceMaterial(sp.face);
+    if (br.lightOnly) {
+      if (m == Material::Diffuse && -glm::dot(sp.n, d) > 0.f) L += br.w * br.scale * s_.faceEmission(sp.face) * kInvPi;
+      continue;
+    }
     const glm::vec3 tint = s_.faceRho(sp.face);
     if (m == Material::Mirror) {
       push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, sp.n))), br.w * tint, br.scale, br.depth + 1);
