@@ -77,6 +77,8 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.causticK = o.causticK;
     po.point = o.point;
     po.seed = o.seed;
+    // The eye pass's limit: a caustic through k mirrors or glass is k reflections.
+    po.maxDepth = std::min(o.maxDepth, 1000);
     po.memoryLimitBytes = memory.limitBytes;
     po.memoryRemedy = "lower caustic_photons";
     if (memory.imageBytes > 0)

@@ -69,9 +69,14 @@ TEST(MemoryLimit, RanksOnOneMachineShareIt) {
   const auto sf = scenes::cornellBox(100.0);
   FilterInput huge = test::filterInput(FilterKind::Radiosity, sf);
   huge.values.set("memory_budget_mb", 1e7);
-  shareMemoryWith(4);
-  const FilterResult r = runFilter(FilterKind::Radiosity, huge);
-  shareMemoryWith(1);
+  struct Share {
+    Share() { shareMemoryWith(4); }
+    ~Share() { shareMemoryWith(1); }  // also if the run throws
+  };
+  const FilterResult r = [&] {
+    Share four;
+    return runFilter(FilterKind::Radiosity, huge);
+  }();
   ASSERT_EQ(r.stats.warnings.size(), 1u);
   EXPECT_TRUE(has(r.stats.warnings[0], " MB of memory available to each of the 4 ranks on this machine, so the budget"))
       << r.stats.warnings[0];

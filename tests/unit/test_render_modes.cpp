@@ -501,3 +501,21 @@ TEST(RenderModes, MaxDepthZeroShowsTheLightInAMirrorInEveryMode) {
       EXPECT_NEAR(mean, ref, 0.02 * ref) << "mode " << int(m) << ", max_depth " << depth;
     }
 }
+
+// The two-pass view's caustic photons keep the eye pass's max_depth: none at
+// 0 (a caustic is a reflection), some at 1 (one through the sphere's two
+// faces is 2 reflections, one off the mirror 1).
+TEST(RenderModes, TwoPassCausticPhotonsKeepMaxDepth) {
+  const Scene s = scenes::causticCornell(50.0, 10.0, 3, 1.5f);
+  RenderOptions o;
+  o.mode = RenderMode::TwoPass;
+  o.twoPass = TwoPassDiffuse::Caustics;
+  o.samplesPerPixel = 1;
+  o.causticPhotons = 20000;
+  o.firstPassB.assign(s.vertexCount(), glm::vec3(0.5f));
+  o.camera = Camera::lookAt({278, 273, -800}, {278, 273, 0}, {0, 1, 0}, 40, 8, 8);
+  o.maxDepth = 0;
+  EXPECT_EQ(run(s, o).stats.get("caustic_photons_stored", -1), 0.0);
+  o.maxDepth = 1;
+  EXPECT_GT(run(s, o).stats.get("caustic_photons_stored", -1), 100.0);
+}
