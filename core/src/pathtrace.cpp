@@ -154,11 +154,11 @@ void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, do
 // ring is the vertex's neighbours, and theirs too while they hold fewer
 // than kPooledPaths paths together (with the vertex), and further rings (up
 // to 4) while it holds fewer than kPooledVertices traced vertices (a mesh's
-// border or corner). Measured on the same scene (mean z^2, |z| > 4): 64 paths 0.89
-// and 7 vertices, 256 paths 0.60 and 1, 1,024 paths 0.90 and 3 (one ring),
-// 2,048 paths 0.82 and 0; on the plain Cornell box at 256 paths 0.86 (1.07
-// with the own variance), the error bars 2% wider at the median vertex, 26%
-// at the 90th percentile.
+// border or corner). Measured on the same scene (mean z^2, |z| > 4): 64
+// paths 0.88 and 7 vertices, 256 paths 0.58 and 1, 2,048 paths 0.65 and 0,
+// adaptive to 5% 0.90 and 1 (2.2 times the paths); on the plain Cornell box
+// at 256 paths 0.83 (1.07 with the own variance), the error bars 3.5% wider
+// at the median vertex, 32% at the 90th percentile.
 constexpr double kPooledPaths = 4096;
 
 constexpr int kPooledVertices = 10;  // at a border or a corner, rings grow (up to 4) until they hold this many
