@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "gi/color.h"
@@ -176,14 +175,12 @@ RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, con
   RingVariance out;
   out.mean.assign(nv, Cov{});
   out.vertices.assign(nv, 0);
-  tbb::enumerable_thread_specific<std::vector<uint32_t>> stamps([nv] { return std::vector<uint32_t>(nv, 0); });
+  // Membership by a search of the ring itself: a few dozen vertices, where
+  // a stamp array per thread would take 4 bytes a vertex for each thread.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<uint32_t>& stamp = stamps.local();
     std::vector<uint32_t> ring, next;
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (!(paths[i] >= 2)) continue;
-      const uint32_t mark = uint32_t(i) + 1;
-      stamp[i] = mark;
       ring.assign(1, uint32_t(i));
       double held = paths[i];
       uint32_t traced = 1;
@@ -195,8 +192,9 @@ RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, con
         for (size_t a = levelBegin; a < ring.size(); ++a)
           for (uint32_t k = g.offset[ring[a]]; k < g.offset[ring[a] + 1]; ++k) {
             const uint32_t j = g.nbr[k];
-            if (stamp[j] == mark) continue;
-            stamp[j] = mark;
+            if (std::find(ring.begin(), ring.end(), j) != ring.end() ||
+                std::find(next.begin(), next.end(), j) != next.end())
+              continue;
             next.push_back(j);
             if (paths[j] >= 2) { held += paths[j]; ++traced; }
           }
