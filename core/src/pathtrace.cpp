@@ -150,17 +150,14 @@ void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, do
 // takes the variance w^T C w of it, w the vertex's reflectance times the
 // luminance weights, so a red wall is not given a blue light's error, and a
 // black emitter's B = E keeps its error of 0 beside lit neighbours. The
-// ring is the vertex's neighbours, and theirs too while they hold fewer
-// than kPooledPaths paths together (with the vertex), and further rings (up
-// to 4) while it holds fewer than kPooledVertices traced vertices (a mesh's
-// border or corner). Measured on the same scene (mean z^2, |z| > 4): 64
+// ring is two rings of neighbours, and further rings (up to 4) while it
+// holds fewer than kPooledVertices traced vertices (a mesh's border or
+// corner; an interior vertex of valence 6 has 19 within two). Measured on the same scene (mean z^2, |z| > 4): 64
 // paths 0.88 and 7 vertices, 256 paths 0.58 and 1, 2,048 paths 0.65 and 0,
 // adaptive to 5% 0.90 and 1 (2.2 times the paths); on the plain Cornell box
 // at 256 paths 0.83 (1.07 with the own variance), the error bars 3.5% wider
 // at the median vertex, 32% at the 90th percentile.
-constexpr double kPooledPaths = 4096;
-
-constexpr int kPooledVertices = 10;  // at a border or a corner, rings grow (up to 4) until they hold this many
+constexpr uint32_t kPooledVertices = 10;  // beyond two rings, rings grow (up to 4) until they hold this many
 
 // The covariance per path of H's three channels (rr, gg, bb, rg, rb, gb).
 using Cov = std::array<double, 6>;
@@ -175,34 +172,33 @@ RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, con
   RingVariance out;
   out.mean.assign(nv, Cov{});
   out.vertices.assign(nv, 0);
-  // Membership by a search of the ring itself: a few dozen vertices, where
-  // a stamp array per thread would take 4 bytes a vertex for each thread.
+  // Each level's new vertices: the frontier's neighbours, sorted and made
+  // unique, less those already in the ring (kept sorted: binary searches),
+  // so a vertex of high valence (a fan's hub) costs R log R, not R^2.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<uint32_t> ring, next;
+    std::vector<uint32_t> ring, frontier, next, merged;
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (!(paths[i] >= 2)) continue;
       ring.assign(1, uint32_t(i));
-      double held = paths[i];
+      frontier.assign(1, uint32_t(i));
       uint32_t traced = 1;
-      size_t levelBegin = 0;
-      for (int level = 1; level <= 4; ++level) {
-        if (level == 2 && held >= kPooledPaths && traced >= kPooledVertices) break;
+      for (int level = 1; level <= 4 && !frontier.empty(); ++level) {
         if (level > 2 && traced >= kPooledVertices) break;
         next.clear();
-        for (size_t a = levelBegin; a < ring.size(); ++a)
-          for (uint32_t k = g.offset[ring[a]]; k < g.offset[ring[a] + 1]; ++k) {
-            const uint32_t j = g.nbr[k];
-            if (std::find(ring.begin(), ring.end(), j) != ring.end() ||
-                std::find(next.begin(), next.end(), j) != next.end())
-              continue;
-            next.push_back(j);
-            if (paths[j] >= 2) { held += paths[j]; ++traced; }
-          }
-        levelBegin = ring.size();
-        ring.insert(ring.end(), next.begin(), next.end());
-        if (next.empty()) break;
+        for (uint32_t a : frontier)
+          for (uint32_t k = g.offset[a]; k < g.offset[a + 1]; ++k) next.push_back(g.nbr[k]);
+        std::sort(next.begin(), next.end());
+        next.erase(std::unique(next.begin(), next.end()), next.end());
+        next.erase(std::remove_if(next.begin(), next.end(),
+                                  [&](uint32_t j) { return std::binary_search(ring.begin(), ring.end(), j); }),
+                   next.end());
+        for (uint32_t j : next) traced += paths[j] >= 2;
+        merged.resize(ring.size() + next.size());
+        std::merge(ring.begin(), ring.end(), next.begin(), next.end(), merged.begin());
+        ring.swap(merged);
+        frontier.swap(next);
       }
-      std::sort(ring.begin(), ring.end());  // sums in vertex order: the same bits in any thread
+      // The ring is sorted: sums in vertex order, the same bits in any thread.
       Cov sum{};
       uint32_t n = 0;
       for (uint32_t j : ring)
@@ -391,8 +387,13 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     for (size_t i = 0; i < nv; ++i) {
       if (!(acc[i].n >= 2) || !part.contains(i, nv)) continue;
       p.H[i] = std::max(sampleVar(acc[i], true), quadratic(ring.mean[i], lum));
-      // A two-sided vertex's B mixes its sides' reflectances: their mean weights the pool.
-      const double own = sampleVar(acc[i], false), pool = quadratic(ring.mean[i], glm::dvec3(mat.rho[i]) * lum);
+      // A two-sided vertex's B mixes its sides' reflectances: the pool is
+      // weighted by their mix in its own estimate (rho H over H, per channel).
+      glm::dvec3 rho(mat.rho[i]);
+      if (sides.slot[i] >= 0)
+        for (int c = 0; c < 3; ++c)
+          if (acc[i].sumH[c] > 0) rho[c] = acc[i].sumRH[c] / acc[i].sumH[c];
+      const double own = sampleVar(acc[i], false), pool = quadratic(ring.mean[i], rho * lum);
       p.B[i] = ring.vertices[i] > 1 ? std::max(own, pool) : own;
     }
     p.vertices = std::move(ring.vertices);
@@ -491,9 +492,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     }
     res.stdError[i] = float(std::sqrt(var.B[i] / acc[i].n));
     res.stdErrorH[i] = float(std::sqrt(var.H[i] / acc[i].n));
-    res.samples[i] = int(acc[i].n);
+    res.samples[i] = int(acc[i].n) * (twoSided ? 2 : 1);
     res.traced[i] = 1;
-    samples += acc[i].n;
+    samples += acc[i].n * (twoSided ? 2.0 : 1.0);  // a two-sided sample is a path from either side
     const double b = luminance(res.B[i]);
     lum += b;
     err2 += double(res.stdError[i]) * res.stdError[i];
