@@ -485,7 +485,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   for (uint32_t v : sides.vertex) twoSided += part.contains(v, nv);
   if (twoSided)
     st.note(std::to_string(twoSided) + " vertices on a two-sided surface (each face with a reversed copy: no normal) "
-            "took the mean of their two sides");
+            "took the mean of their two sides" + std::string(opt.bentNormals ? " (their bent normals stay 0)" : ""));
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a side to "
                           "cast from (a fold whose faces' normals cancel) got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)

@@ -259,6 +259,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         int diffuse = 0;
         bool viaSpecular = false;
         int depth = 0;
+        bool flaggedLast = false;  // stored at the last hit, outside the gather's map: counted by the caller
         for (; depth < hits; ++depth) {
           const Hit h = caster.intersect(ray);
           if (!h.valid()) { ++st.escaped; break; }
@@ -283,7 +284,10 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           }
           const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
           out.push_back({x, power, packNormal(ng), path});
-          if (lastHit) lastBlocks[b].push_back(depth == opt.maxDepth);
+          if (lastHit) {
+            lastBlocks[b].push_back(depth == opt.maxDepth);
+            flaggedLast = depth == opt.maxDepth && path != kCausticPhoton;
+          }
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
           const glm::vec3 rho = s.faceRho(h.face);
@@ -297,7 +301,10 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
         }
-        if (depth == hits) { ++st.lostAtMaxDepth; st.lostPower += luminance(power); }
+        if (depth == hits) {
+          ++st.lostAtMaxDepth;
+          if (!flaggedLast) st.lostPower += luminance(power);
+        }
       }
       budget.add(out.size(), end - b * kBlock);
     }
