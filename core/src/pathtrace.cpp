@@ -167,8 +167,9 @@ struct RingVariance {
   std::vector<uint32_t> vertices;  // how many (1: the vertex alone)
 };
 
-RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, const std::vector<double>& paths) {
-  const size_t nv = cov.size();
+// cov: 6 numbers per vertex (as Cov); paths: nv counts.
+RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths) {
+  const size_t nv = paths.size();
   RingVariance out;
   out.mean.assign(nv, Cov{});
   out.vertices.assign(nv, 0);
@@ -203,7 +204,7 @@ RingVariance ringVariance(const VertexGraph& g, const std::vector<Cov>& cov, con
       uint32_t n = 0;
       for (uint32_t j : ring)
         if (paths[j] >= 2) {
-          for (int c = 0; c < 6; ++c) sum[size_t(c)] += cov[j][size_t(c)];
+          for (int c = 0; c < 6; ++c) sum[size_t(c)] += cov[6 * size_t(j) + size_t(c)];
           ++n;
         }
       for (int c = 0; c < 6; ++c) out.mean[i][size_t(c)] = sum[size_t(c)] / double(n);  // n >= 1: the vertex itself
@@ -375,11 +376,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
         all[6 * nv + i] = acc[i].n;
       }
     if (!part.all()) part.sumOverParts(all);
-    std::vector<Cov> cov(nv);
-    for (size_t i = 0; i < nv; ++i)
-      for (int k = 0; k < 6; ++k) cov[i][size_t(k)] = all[6 * i + size_t(k)];
     const std::vector<double> paths(all.begin() + 6 * nv, all.end());
-    RingVariance ring = ringVariance(graph, cov, paths);
+    RingVariance ring = ringVariance(graph, all.data(), paths);
     const glm::dvec3 lum(0.2126, 0.7152, 0.0722);
     Pooled p;
     p.B.assign(nv, 0.0);
