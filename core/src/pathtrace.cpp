@@ -18,6 +18,7 @@
 #include "gi/sky.h"
 #include "gi/specular.h"
 #include "gi/vertex_graph.h"
+#include "path_error_bars.h"
 #include "path_integrator.h"
 
 namespace gi {
@@ -98,6 +99,11 @@ PathTraceOptions PathTraceOptions::fromParams(const ParamValues& v, const glm::d
 
 namespace {
 
+using reference::Cov;
+using reference::quadratic;
+using reference::ringVariance;
+using reference::RingVariance;
+
 // max_depth -1: no fixed limit, but a path caught between perfect mirrors
 // (which Russian roulette never ends) stops here.
 constexpr int kDepthCap = 100000;
@@ -131,93 +137,6 @@ void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, do
                 "%.3g%%, and is not in the error bars (-1 = no limit, unbiased)",
                 opt.maxDepth, cut, paths, rhoMax, 100.0 * share, 100.0 * relErr);
   st.warn(b);
-}
-
-// The variance per path that a vertex's error bar uses: the larger of its
-// own sample variance and the mean of its neighbourhood's. Light that only
-// rare paths find (a caustic through glass, a light seen in a mirror: no
-// shadow ray aims there) gives a sample variance whose distribution is
-// heavily skewed: a vertex whose paths found that light once or never
-// reports a small error while the light is missing from its estimate. On
-// the Cornell box with a glass sphere and a mirror, 12% of the floor's
-// vertices at 64 paths (475 of 3,852) and 2.3% at 2,048 were more than 4
-// reported standard errors below a 32,768-path run (mean z^2 11 and 2.8).
-// The neighbours receive nearly the same light, so their mean variance is a
-// far better estimate of the vertex's; taking the larger keeps the vertex's
-// own where the light changes across the ring (a shadow edge). What is
-// pooled is the covariance of the irradiance H's three channels, the light
-// arriving, which does not depend on the surface; a vertex's B = E + rho H
-// takes the variance w^T C w of it, w the vertex's reflectance times the
-// luminance weights, so a red wall is not given a blue light's error, and a
-// black emitter's B = E keeps its error of 0 beside lit neighbours. The
-// ring is two rings of neighbours, and further rings (up to 4) while it
-// holds fewer than kPooledVertices traced vertices (a mesh's border or
-// corner; an interior vertex of valence 6 has 19 within two). Measured on the same scene (mean z^2, |z| > 4): 64
-// paths 0.88 and 7 vertices, 256 paths 0.58 and 1, 2,048 paths 0.65 and 0,
-// adaptive to 5% 0.90 and 1 (2.2 times the paths); on the plain Cornell box
-// at 256 paths 0.83 (1.07 with the own variance), the error bars 3.5% wider
-// at the median vertex, 32% at the 90th percentile.
-constexpr uint32_t kPooledVertices = 10;  // beyond two rings, rings grow (up to 4) until they hold this many
-
-// The covariance per path of H's three channels (rr, gg, bb, rg, rb, gb).
-using Cov = std::array<double, 6>;
-
-struct RingVariance {
-  std::vector<Cov> mean;           // mean covariance over the traced vertices of the ring (the vertex's own included)
-  std::vector<uint32_t> vertices;  // how many (1: the vertex alone)
-};
-
-// cov: 6 numbers per vertex (as Cov); paths: nv counts.
-RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths) {
-  const size_t nv = paths.size();
-  RingVariance out;
-  out.mean.assign(nv, Cov{});
-  out.vertices.assign(nv, 0);
-  // Each level's new vertices: the frontier's neighbours, sorted and made
-  // unique, less those already in the ring (kept sorted: binary searches),
-  // so a vertex of high valence (a fan's hub) costs R log R, not R^2.
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<uint32_t> ring, frontier, next, merged;
-    for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (!(paths[i] >= 2)) continue;
-      ring.assign(1, uint32_t(i));
-      frontier.assign(1, uint32_t(i));
-      uint32_t traced = 1;
-      for (int level = 1; level <= 4 && !frontier.empty(); ++level) {
-        if (level > 2 && traced >= kPooledVertices) break;
-        next.clear();
-        for (uint32_t a : frontier)
-          for (uint32_t k = g.offset[a]; k < g.offset[a + 1]; ++k) next.push_back(g.nbr[k]);
-        std::sort(next.begin(), next.end());
-        next.erase(std::unique(next.begin(), next.end()), next.end());
-        next.erase(std::remove_if(next.begin(), next.end(),
-                                  [&](uint32_t j) { return std::binary_search(ring.begin(), ring.end(), j); }),
-                   next.end());
-        for (uint32_t j : next) traced += paths[j] >= 2;
-        merged.resize(ring.size() + next.size());
-        std::merge(ring.begin(), ring.end(), next.begin(), next.end(), merged.begin());
-        ring.swap(merged);
-        frontier.swap(next);
-      }
-      // The ring is sorted: sums in vertex order, the same bits in any thread.
-      Cov sum{};
-      uint32_t n = 0;
-      for (uint32_t j : ring)
-        if (paths[j] >= 2) {
-          for (int c = 0; c < 6; ++c) sum[size_t(c)] += cov[6 * size_t(j) + size_t(c)];
-          ++n;
-        }
-      for (int c = 0; c < 6; ++c) out.mean[i][size_t(c)] = sum[size_t(c)] / double(n);  // n >= 1: the vertex itself
-      out.vertices[i] = n;
-    }
-  });
-  return out;
-}
-
-// w^T C w for the symmetric 3 x 3 matrix C: the variance of w . H.
-double quadratic(const Cov& C, const glm::dvec3& w) {
-  return w.x * w.x * C[0] + w.y * w.y * C[1] + w.z * w.z * C[2] +
-         2.0 * (w.x * w.y * C[3] + w.x * w.z * C[4] + w.y * w.z * C[5]);
 }
 
 struct Accum {
@@ -340,7 +259,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   // The sample variance per path of luminance(B) (of luminance(H) with `h`).
   auto sampleVar = [](const Accum& a, bool h = false) {
     if (a.n < 2) return 0.0;
-    const double s = h ? a.sumHL : a.sumL, s2 = h ? a.sumHL2 : a.sumL2, m = s / a.n;
+    const double s1 = h ? a.sumHL : a.sumL, s2 = h ? a.sumHL2 : a.sumL2, m = s1 / a.n;
     return std::max(0.0, (s2 - a.n * m * m) / (a.n - 1));
   };
   const bool adaptive = opt.targetRelativeError > 0;
@@ -362,7 +281,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   // The variances per path of every vertex's luminance(B) and luminance(H),
   // the other parts' included, and H's pooled over the vertex's ring
   // (ringVariance): the error bars' variances.
-  struct Pooled {
+  struct PooledVariance {
     std::vector<double> B, H;
     std::vector<uint32_t> vertices;
   };
@@ -379,7 +298,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     const std::vector<double> paths(all.begin() + 6 * nv, all.end());
     RingVariance ring = ringVariance(graph, all.data(), paths);
     const glm::dvec3 lum(0.2126, 0.7152, 0.0722);
-    Pooled p;
+    PooledVariance p;
     p.B.assign(nv, 0.0);
     p.H.assign(nv, 0.0);
     for (size_t i = 0; i < nv; ++i) {
@@ -465,7 +384,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   res.samples.assign(nv, 0);
   res.traced.assign(nv, 0);
   if (opt.lightPathSplit) res.split.assign(nv);
-  const Pooled var = pooled();
+  const PooledVariance var = pooled();
   // Traced vertices whose pool holds no other traced vertex within 4 rings
   // (a sample of the vertices): their error bars are their own paths' alone.
   size_t isolated = 0;
