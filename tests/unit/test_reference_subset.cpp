@@ -80,7 +80,9 @@ TEST(ReferenceSubset, TracedVerticesMatchTheFullRun) {
       }
       bool alone = true;
       for (uint32_t j : ring) alone = alone && (j == v || !(*mask)[j]);
-      if (alone) EXPECT_LE(part.stdError[v], full.stdError[v]) << v;
+      if (alone) {
+        EXPECT_LE(part.stdError[v], full.stdError[v]) << v;
+      }
       isolated += alone;
     } else {
       EXPECT_EQ(part.B[v], glm::vec3(0.f)) << v;
