@@ -22,6 +22,7 @@
 #include "gi/raycaster.h"
 #include "gi/scene_setup.h"
 #include "gi/scenes.h"
+#include "test_helpers.h"
 
 using namespace gi;
 
@@ -155,12 +156,7 @@ TEST(FinalGather, SharingWithNeighboursCutsTheNoiseNotTheDetail) {
 // of their faces, both sides, in every vertex mode, and the log says how
 // many. Border vertices keep no normal either (their faces cancel too).
 TEST(FinalGather, TwoSidedSurfaceTakesThePatchAverage) {
-  auto floor = scenes::openPlane(2.0, 4);
-  std::vector<glm::dvec3> pts;
-  for (const auto& p : floor.scene.positions) pts.push_back(floor.scene.toWorld(p));
-  std::vector<glm::uvec3> tris = floor.scene.triangles;
-  const size_t nFloor = tris.size();
-  for (size_t f = 0; f < nFloor; ++f) tris.push_back({tris[f].x, tris[f].z, tris[f].y});
+  auto [pts, tris] = test::twoSided(scenes::openPlane(2.0, 4).scene);
   const uint32_t l = uint32_t(pts.size());  // a light 0.5 wide at height 1, facing down
   for (glm::dvec3 p : {glm::dvec3(-0.25, -0.25, 1), glm::dvec3(0.25, -0.25, 1), glm::dvec3(0.25, 0.25, 1),
                        glm::dvec3(-0.25, 0.25, 1)})

@@ -78,4 +78,19 @@ inline std::map<std::string, std::array<double, 3>> wallSums(const Scene& s, con
   return groups;
 }
 
+// A scene's points (world units) and its triangles each followed, after
+// all of them, by a reversed copy: a two-sided surface, whose vertices have
+// no normal (the faces' normals cancel).
+struct TwoSidedMesh {
+  std::vector<glm::dvec3> pts;
+  std::vector<glm::uvec3> tris;  // the originals first, then their copies
+};
+inline TwoSidedMesh twoSided(const Scene& one) {
+  TwoSidedMesh m;
+  for (const auto& p : one.positions) m.pts.push_back(one.toWorld(p));
+  m.tris = one.triangles;
+  for (const glm::uvec3& t : one.triangles) m.tris.push_back({t.x, t.z, t.y});
+  return m;
+}
+
 }  // namespace gi::test

@@ -128,12 +128,8 @@ TEST(PathTracer, PointLightAndSun) {
 // included (nothing is occluded: exact within float rounding); the light
 // path parts sum to B, and the log says how many vertices.
 TEST(PathTracer, TwoSidedSurfaceTakesTheMeanOfItsSides) {
-  auto sf = scenes::openPlane(2.0, 4);
-  std::vector<glm::dvec3> pts;
-  for (const auto& p : sf.scene.positions) pts.push_back(sf.scene.toWorld(p));
-  std::vector<glm::uvec3> tris = sf.scene.triangles;
-  const size_t n = tris.size();
-  for (size_t f = 0; f < n; ++f) tris.push_back({tris[f].x, tris[f].z, tris[f].y});
+  const auto [pts, tris] = test::twoSided(scenes::openPlane(2.0, 4).scene);
+  const size_t n = tris.size() / 2;
   Scene s = Scene::fromAbsolute(pts, tris);
   s.rho.assign(s.faceCount(), glm::vec3(0.2f));
   for (size_t f = 0; f < n; ++f) s.rho[f] = glm::vec3(0.5f);  // the originals face up
