@@ -1,14 +1,10 @@
 #include "gi/pathtrace.h"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "gi/color.h"
 #include "gi/direct.h"
@@ -145,17 +141,25 @@ struct Accum {
   glm::dvec3 sumH{0.0};
   glm::dvec3 sumRH{0.0};  // rho H, on a two-sided surface (its sides' reflectances differ)
   glm::dvec3 sumPart[kPathKinds] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};  // light_path_split
-};
 
-void addProducts(Accum& a, const glm::vec3& H) {
-  const glm::dvec3 h(H);
-  a.sumHH[0] += h.x * h.x;
-  a.sumHH[1] += h.y * h.y;
-  a.sumHH[2] += h.z * h.z;
-  a.sumHH[3] += h.x * h.y;
-  a.sumHH[4] += h.x * h.z;
-  a.sumHH[5] += h.y * h.z;
-}
+  // One sample: l = luminance(rho H), and the irradiance H.
+  void add(double l, const glm::vec3& H) {
+    n += 1;
+    sumL += l;
+    sumL2 += l * l;
+    sumH += glm::dvec3(H);
+    const glm::dvec3 h(H);
+    sumHH[0] += h.x * h.x;
+    sumHH[1] += h.y * h.y;
+    sumHH[2] += h.z * h.z;
+    sumHH[3] += h.x * h.y;
+    sumHH[4] += h.x * h.z;
+    sumHH[5] += h.y * h.z;
+    const double lh = luminance(H);
+    sumHL += lh;
+    sumHL2 += lh * lh;
+  }
+};
 
 // The sample covariance per path of H's channels.
 Cov sampleCov(const Accum& a) {
@@ -224,15 +228,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
         H += 0.5f * h;
         RH += 0.5f * rho * h;
       }
-      const double l = luminance(RH), lh = luminance(H);
-      a.n += 1;
-      a.sumL += l;
-      a.sumL2 += l * l;
-      a.sumH += glm::dvec3(H);
-      addProducts(a, H);
+      a.add(luminance(RH), H);
       a.sumRH += glm::dvec3(RH);
-      a.sumHL += lh;
-      a.sumHL2 += lh * lh;
     }
   };
   auto trace = [&](size_t i, int count) {
@@ -245,15 +242,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(origins[i], mat.n[i], smp, counts[i],
                                                                 opt.lightPathSplit ? parts : nullptr);
       for (int p = 0; p < kPathKinds; ++p) a.sumPart[p] += glm::dvec3(float(M_PI) * parts[p]);
-      const double l = luminance(mat.rho[i] * H);
-      a.n += 1;
-      a.sumL += l;
-      a.sumL2 += l * l;
-      a.sumH += glm::dvec3(H);
-      addProducts(a, H);
-      const double lh = luminance(H);
-      a.sumHL += lh;
-      a.sumHL2 += lh * lh;
+      a.add(luminance(mat.rho[i] * H), H);
     }
   };
   // The sample variance per path of luminance(B) (of luminance(H) with `h`).
@@ -297,7 +286,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     if (!part.all()) part.sumOverParts(all);
     const std::vector<double> paths(all.begin() + 6 * nv, all.end());
     RingVariance ring = ringVariance(graph, all.data(), paths);
-    const glm::dvec3 lum(0.2126, 0.7152, 0.0722);
+    const glm::dvec3 lum(0.2126, 0.7152, 0.0722);  // luminance()'s weights (gi/color.h)
     PooledVariance p;
     p.B.assign(nv, 0.0);
     p.H.assign(nv, 0.0);

@@ -302,16 +302,6 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   std::vector<uint8_t> lastHit;
   std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts,
                                              gather ? &lastHit : nullptr);
-  if (gather) {
-    // The gather's map leaves out the photons of a path's last allowed hit:
-    // their light is missing as a cut path's is (but for caustics, which the
-    // caustic map keeps), so the log's lost power counts them (the trace
-    // left out the cut power of their paths, which is part of it).
-    double flagged = 0;
-    for (size_t i = 0; i < photons.size(); ++i)
-      if (lastHit[i] && photons[i].path != kCausticPhoton) flagged += luminance(photons[i].power);
-    ts.lostPower += flagged;
-  }
   std::vector<Photon> causticPhotons;
   if (r.projection)
     causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);

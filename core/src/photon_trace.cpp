@@ -259,7 +259,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         int diffuse = 0;
         bool viaSpecular = false;
         int depth = 0;
-        bool flaggedLast = false;  // stored at the last hit, outside the gather's map: counted by the caller
+        bool flaggedLast = false;  // stored at the last hit, outside the gather's map: counted as lost there
         for (; depth < hits; ++depth) {
           const Hit h = caster.intersect(ray);
           if (!h.valid()) { ++st.escaped; break; }
@@ -285,8 +285,12 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
           out.push_back({x, power, packNormal(ng), path});
           if (lastHit) {
+            // The gather's map leaves it out: its light is missing as a cut
+            // path's is (but for a caustic, which the caustic map keeps), and
+            // the path's own cut power below is part of it.
             lastBlocks[b].push_back(depth == opt.maxDepth);
             flaggedLast = depth == opt.maxDepth && path != kCausticPhoton;
+            if (flaggedLast) st.lostPower += luminance(power);
           }
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;

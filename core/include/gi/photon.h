@@ -95,7 +95,7 @@ struct PhotonTraceStats {
   size_t passes = 0;                             // calls of tracePhotons summed here
   double storedPower = 0.0;                      // luminance, W, summed over passes
   double emittedPower = 0.0;                     // luminance power of the lights, W
-  double lostPower = 0.0;                        // luminance still carried by paths cut at max depth
+  double lostPower = 0.0;  // luminance still carried by paths cut at max depth, and by the photons lastHit flags (caustics apart)
 };
 
 // Traces photons `first` .. `first + count - 1` of the seed's sequence (each
