@@ -113,6 +113,49 @@ VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, c
   return out;
 }
 
+Scene splitSides(const Scene& s, const VertexSides& sides) {
+  Scene out = s;
+  if (sides.vertex.empty()) return out;
+  const size_t nv = s.vertexCount();
+  for (uint32_t v : sides.vertex) out.positions.push_back(s.positions[v]);
+  if (out.vertexNormals.size() == nv) {
+    for (size_t k = 0; k < sides.vertex.size(); ++k) out.vertexNormals[sides.vertex[k]] = sides.n[0][k];
+    for (size_t k = 0; k < sides.vertex.size(); ++k) out.vertexNormals.push_back(sides.n[1][k]);
+  }
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    glm::uvec3& t = out.triangles[f];
+    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    for (int c = 0; c < 3; ++c) {
+      const int32_t k = sides.slot[t[c]];
+      if (k >= 0 && !(glm::dot(n, sides.n[0][size_t(k)]) > 0.f)) t[c] = uint32_t(nv + size_t(k));
+    }
+  }
+  return out;
+}
+
+void mergeSides(std::vector<glm::vec3>& value, const VertexSides& sides) {
+  if (value.empty() || sides.vertex.empty()) return;
+  const size_t nv = sides.slot.size();
+  for (size_t k = 0; k < sides.vertex.size(); ++k) {
+    glm::vec3& a = value[sides.vertex[k]];
+    a = 0.5f * (a + value[nv + k]);
+  }
+  value.resize(nv);
+}
+
+void mergeSideErrors(std::vector<float>& error, const VertexSides& sides) {
+  if (error.empty() || sides.vertex.empty()) return;
+  const size_t nv = sides.slot.size();
+  for (size_t k = 0; k < sides.vertex.size(); ++k) {
+    float& a = error[sides.vertex[k]];
+    const float b = error[nv + k];
+    a = 0.5f * std::sqrt(a * a + b * b);
+  }
+  error.resize(nv);
+}
+
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt, const Progress& progress) {
   if (opt.lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   Timer timer;

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -11,6 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/task_arena.h>
+
+#include "face_twins.h"
 #include "gi/raycaster.h"
 #include "gi/scene.h"
 
@@ -168,6 +172,7 @@ class EmbreeCaster final : public RayCaster {
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
       h.t = rh.ray.tfar; h.face = faceOf(rh.hit.primID); h.u = rh.hit.u; h.v = rh.hit.v;
       h.ng = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+      front(rh.hit.primID, r.d, h);
     }
     return h;
   }
@@ -205,11 +210,13 @@ class EmbreeCaster final : public RayCaster {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    auto hitOf = [&](unsigned geomID, unsigned primID, float t, float u, float v, float nx, float ny, float nz) {
+    auto hitOf = [&](const Ray& ray, unsigned geomID, unsigned primID, float t, float u, float v, float nx, float ny,
+                     float nz) {
       Hit h;
       if (geomID != RTC_INVALID_GEOMETRY_ID) {
         h.t = t; h.face = faceOf(primID); h.u = u; h.v = v;
         h.ng = {nx, ny, nz};
+        front(primID, ray.d, h);
       }
       return h;
     };
@@ -226,7 +233,7 @@ class EmbreeCaster final : public RayCaster {
         rtcIntersect1M(scene_.get(), &ctx, buf, unsigned(m), sizeof(RTCRayHit));
         for (size_t i = 0; i < m; ++i) {
           const RTCRayHit& r = buf[i];
-          hits[b + i] = hitOf(r.hit.geomID, r.hit.primID, r.ray.tfar, r.hit.u, r.hit.v, r.hit.Ng_x, r.hit.Ng_y, r.hit.Ng_z);
+          hits[b + i] = hitOf(rays[b + i], r.hit.geomID, r.hit.primID, r.ray.tfar, r.hit.u, r.hit.v, r.hit.Ng_x, r.hit.Ng_y, r.hit.Ng_z);
         }
       }
       return;
@@ -242,7 +249,7 @@ class EmbreeCaster final : public RayCaster {
       }
       rtcIntersect8(valid, scene_.get(), &ctx, &p);
       for (size_t i = 0; i < m; ++i)
-        hits[b + i] = hitOf(p.hit.geomID[i], p.hit.primID[i], p.ray.tfar[i], p.hit.u[i], p.hit.v[i], p.hit.Ng_x[i],
+        hits[b + i] = hitOf(rays[b + i], p.hit.geomID[i], p.hit.primID[i], p.ray.tfar[i], p.hit.u[i], p.hit.v[i], p.hit.Ng_x[i],
                             p.hit.Ng_y[i], p.hit.Ng_z[i]);
     }
   }
@@ -288,6 +295,22 @@ class EmbreeCaster final : public RayCaster {
   std::vector<uint32_t> primToFace_;
   bool identity_ = false;
   uint32_t faceOf(unsigned primID) const { return identity_ ? uint32_t(primID) : primToFace_[primID]; }
+  // A hit on a face's back that has a reversed copy: the copy's front
+  // (face_twins.h). The copies are found at the first hit from behind, so
+  // that the filters whose rays never meet a back (ambient occlusion's
+  // shadow rays) do not pay for the search.
+  void front(unsigned primID, const glm::vec3& d, Hit& h) const {
+    if (!(glm::dot(d, h.ng) > 0.f)) return;
+    std::call_once(twinsOnce_, [this] {
+      // Isolated: while it waits for its parallel sort, this thread must not
+      // take up another of the caller's rays (it would wait on itself here).
+      tbb::this_task_arena::isolate(
+          [this] { twins_ = std::make_unique<FaceTwins>(vertices_.data(), indices_.data(), primToFace_.size()); });
+    });
+    toFront(*twins_, uint32_t(primID), d, h, [this](uint32_t p) { return faceOf(p); });
+  }
+  mutable std::once_flag twinsOnce_;
+  mutable std::unique_ptr<FaceTwins> twins_;
 };
 
 }  // namespace

@@ -406,10 +406,10 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
   return {valid ? lum / double(valid) : 0.0, valid ? std::sqrt(err2 / double(valid)) : 0.0};
 }
 
-}  // namespace
-
-VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
-                                  const Progress& progress, PhotonMapContents* maps) {
+// The photon map at every vertex with a normal (computePhotonMap splits the
+// two-sided ones first).
+VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
+                                     const Progress& progress, PhotonMapContents* maps) {
   PhotonOptions opt = optWorld;  // distances and the point light in local units (Scene::unit)
   opt.maxRadius = optWorld.maxRadius / s.unit;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
@@ -470,7 +470,28 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
   if (specOnly)
     st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only, unusable, or without a normal "
-            "(on a two-sided surface the faces' normals cancel) have no diffuse radiosity: 0");
+            "have no diffuse radiosity: 0");
+  return out;
+}
+
+}  // namespace
+
+VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
+                                  const Progress& progress, PhotonMapContents* maps) {
+  // A vertex of a two-sided surface (each face with a reversed copy) has no
+  // normal: it is split into its two sides, each estimated as a vertex of
+  // its own (the same place, the side's normal, reflectance and emission;
+  // the same faces, so the caster still fits), and takes their mean, as the
+  // reference and ambient occlusion do there.
+  const VertexSides sides = twoSidedVertices(s, vertexMaterial(s));
+  if (sides.vertex.empty()) return photonMapAtVertices(s, caster, opt, progress, maps);
+  VertexRadiometry out = photonMapAtVertices(splitSides(s, sides), caster, opt, progress, maps);
+  for (auto* v : {&out.B, &out.Bdirect, &out.H, &out.split.emitted, &out.split.direct, &out.split.caustic,
+                  &out.split.indirect})
+    mergeSides(*v, sides);
+  mergeSideErrors(out.stdError, sides);
+  out.stats.note(std::to_string(sides.vertex.size()) + " vertices on a two-sided surface (its faces' normals cancel) "
+                 "took the mean of their two sides");
   return out;
 }
 

@@ -62,6 +62,18 @@ struct VertexSides {
 VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, const std::vector<uint8_t>& faces);
 // Over the diffuse faces, for the vertices on one without a normal.
 VertexSides twoSidedVertices(const Scene& s, const VertexMaterial& m);
+// The scene with each of those vertices split in two: the vertex keeps the
+// usable faces that turn its side A's way (n[0]), and a copy at the same
+// place, appended (index vertexCount() + slot), takes the others; given
+// vertex normals become the sides'. Each side then is an ordinary vertex
+// with a normal, for an estimator that has no two-sided case of its own
+// (the faces, and so any ray caster built on the scene, are unchanged).
+Scene splitSides(const Scene& s, const VertexSides& sides);
+// Results per vertex of splitSides's scene back to the scene's vertices: a
+// two-sided vertex takes the mean of its sides (the copies are removed).
+void mergeSides(std::vector<glm::vec3>& value, const VertexSides& sides);
+// Standard errors: of the mean of the two sides' independent estimates.
+void mergeSideErrors(std::vector<float>& error, const VertexSides& sides);
 
 // Direct irradiance per face from the emitters: with up to
 // Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), the exact form

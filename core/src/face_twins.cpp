@@ -1,0 +1,102 @@
+#include "face_twins.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+namespace gi {
+namespace {
+
+using Corner = std::array<float, 3>;
+
+struct Key {
+  uint64_t hash;
+  uint32_t prim;
+  bool operator<(const Key& o) const { return hash != o.hash ? hash < o.hash : prim < o.prim; }
+};
+
+// A face's corners in lexicographic order, and whether that order is a
+// rotation of the face's own (its turn) or a reflection of it.
+struct Sorted {
+  Corner c[3];
+  bool even;
+};
+
+Sorted sortedCorners(const float* xyz, const uint32_t* tri) {
+  Corner p[3];
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) p[k][a] = xyz[3 * size_t(tri[k]) + a] + 0.f;  // -0 and +0 as one
+  int o[3] = {0, 1, 2};
+  std::sort(o, o + 3, [&](int a, int b) { return p[a] < p[b]; });
+  Sorted s;
+  for (int k = 0; k < 3; ++k) s.c[k] = p[o[k]];
+  // (0 1 2), (1 2 0) and (2 0 1) keep the turn.
+  s.even = (o[1] == (o[0] + 1) % 3);
+  return s;
+}
+
+uint64_t hashOf(const Sorted& s) {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the nine coordinates' bits
+  for (const Corner& c : s.c)
+    for (float f : c) {
+      uint32_t b;
+      std::memcpy(&b, &f, sizeof b);
+      for (int k = 0; k < 4; ++k) {
+        h ^= (b >> (8 * k)) & 0xffu;
+        h *= 1099511628211ull;
+      }
+    }
+  return h;
+}
+
+}  // namespace
+
+FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
+  std::vector<Key> keys(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p < r.end(); ++p) keys[p] = {hashOf(sortedCorners(xyz, idx + 3 * p)), uint32_t(p)};
+  });
+  tbb::parallel_sort(keys.begin(), keys.end());
+  auto corner = [&](uint32_t p, int k) {
+    Corner c;
+    for (int a = 0; a < 3; ++a) c[a] = xyz[3 * size_t(idx[3 * size_t(p) + k]) + a] + 0.f;
+    return c;
+  };
+  for (size_t b = 0; b < n;) {
+    size_t e = b + 1;
+    while (e < n && keys[e].hash == keys[b].hash) ++e;
+    // A run of faces on the same corners (or a hash collision): each takes
+    // the first face of the opposite turn on exactly the same corners.
+    for (size_t i = b; e - b > 1 && i < e; ++i) {
+      const uint32_t p = keys[i].prim;
+      const Sorted sp = sortedCorners(xyz, idx + 3 * size_t(p));
+      for (size_t j = b; j < e; ++j) {
+        const uint32_t q = keys[j].prim;
+        const Sorted sq = sortedCorners(xyz, idx + 3 * size_t(q));
+        if (sq.even == sp.even || !std::equal(sp.c, sp.c + 3, sq.c)) continue;
+        if (!any_) {
+          twin_.assign(n, kNoHit);
+          corner_.assign(n, 0);
+          any_ = true;
+        }
+        twin_[p] = q;
+        const Corner pc[3] = {corner(p, 0), corner(p, 1), corner(p, 2)};
+        uint8_t m = 0;
+        for (int k = 1; k <= 2; ++k) {
+          const Corner qc = corner(q, k);
+          const int c = qc == pc[0] ? 0 : qc == pc[1] ? 1 : 2;
+          m |= uint8_t(c << (2 * (k - 1)));
+        }
+        corner_[p] = m;
+        break;
+      }
+    }
+    b = e;
+  }
+}
+
+}  // namespace gi
