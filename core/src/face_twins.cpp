@@ -39,26 +39,40 @@ Sorted sortedCorners(const float* xyz, const uint32_t* tri) {
   return s;
 }
 
-uint64_t hashOf(const Sorted& s) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a over the nine coordinates' bits
-  for (const Corner& c : s.c)
-    for (float f : c) {
-      uint32_t b;
-      std::memcpy(&b, &f, sizeof b);
-      for (int k = 0; k < 4; ++k) {
-        h ^= (b >> (8 * k)) & 0xffu;
-        h *= 1099511628211ull;
-      }
-    }
+// A well-mixed 64-bit hash of a position (splitmix64's finaliser over its
+// coordinates' bits); a face's key is the sum over its corners, the same in
+// any order, so the corners need no sorting to be compared.
+uint64_t mix(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+uint64_t hashOf(const float* p) {
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (int a = 0; a < 3; ++a) {
+    const float f = p[a] + 0.f;  // -0 and +0 as one
+    uint32_t b;
+    std::memcpy(&b, &f, sizeof b);
+    h = mix(h + b);
+  }
   return h;
 }
 
 }  // namespace
 
 FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
+  uint32_t nv = 0;
+  for (size_t k = 0; k < 3 * n; ++k) nv = std::max(nv, idx[k] + 1);
+  std::vector<uint64_t> vh(nv);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v < r.end(); ++v) vh[v] = hashOf(xyz + 3 * v);
+  });
   std::vector<Key> keys(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t p = r.begin(); p < r.end(); ++p) keys[p] = {hashOf(sortedCorners(xyz, idx + 3 * p)), uint32_t(p)};
+    for (size_t p = r.begin(); p < r.end(); ++p) {
+      const uint32_t* t = idx + 3 * p;
+      keys[p] = {vh[t[0]] + vh[t[1]] + vh[t[2]], uint32_t(p)};
+    }
   });
   tbb::parallel_sort(keys.begin(), keys.end());
   auto corner = [&](uint32_t p, int k) {

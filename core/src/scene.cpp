@@ -294,16 +294,26 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
     std::vector<uint32_t> id(nv, 0);
     for (size_t k = 0; k < order.size(); ++k)
       id[order[k]] = k > 0 && !less(order[k - 1], order[k]) ? id[order[k - 1]] : uint32_t(k);
-    std::vector<std::array<uint32_t, 3>> keys;
+    // The sorted ids and the turn: 0 where the sorted order is a rotation
+    // of the face's own, 1 where it is reversed.
+    std::vector<std::array<uint32_t, 4>> keys;
     keys.reserve(r.faces);
     for (size_t f = 0; f < r.faces; ++f) {
       if (!ok[f]) continue;
-      std::array<uint32_t, 3> c = {id[s.triangles[f].x], id[s.triangles[f].y], id[s.triangles[f].z]};
+      const std::array<uint32_t, 3> turn = {id[s.triangles[f].x], id[s.triangles[f].y], id[s.triangles[f].z]};
+      std::array<uint32_t, 3> c = turn;
       std::sort(c.begin(), c.end());
-      keys.push_back(c);
+      const int first = int(std::find(turn.begin(), turn.end(), c[0]) - turn.begin());
+      keys.push_back({c[0], c[1], c[2], turn[size_t((first + 1) % 3)] == c[1] ? 0u : 1u});
     }
     std::sort(keys.begin(), keys.end());
-    for (size_t k = 1; k < keys.size(); ++k) r.duplicateFaces += keys[k] == keys[k - 1] ? 1 : 0;
+    // A face turned as an earlier one on the same corners is a duplicate; a
+    // group on the same corners with both turns is a two-sided pair.
+    for (size_t k = 1; k < keys.size(); ++k) {
+      const bool sameCorners = std::equal(keys[k].begin(), keys[k].begin() + 3, keys[k - 1].begin());
+      if (sameCorners && keys[k][3] == keys[k - 1][3]) ++r.duplicateFaces;
+      else if (sameCorners) ++r.twoSidedPairs;
+    }
   }
   if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; }
   const SceneScale sc = sceneScale(s);
@@ -337,10 +347,13 @@ std::string SceneReport::summary() const {
                 "%zu NaN/Inf vertices, %zu isolated vertices; %zu emitter faces; bbox diagonal %.6g",
                 vertices, faces, usableFaces(), degenerateFaces, invalidFaces, facesOnNonFinite, nonFiniteVertices,
                 isolatedVertices, emitterFaces, diagonal);
+  std::string line = buf;
   if (duplicateFaces)
-    return std::string(buf) + "; " + std::to_string(duplicateFaces) +
-           " duplicated faces (coplanar copies shadow each other at random: remove them for exact results)";
-  return buf;
+    line += "; " + std::to_string(duplicateFaces) +
+            " duplicated faces (coplanar copies shadow each other at random: remove them for exact results)";
+  if (twoSidedPairs)
+    line += "; " + std::to_string(twoSidedPairs) + " faces with a reversed copy (a two-sided surface: lit on both sides)";
+  return line;
 }
 
 }  // namespace gi

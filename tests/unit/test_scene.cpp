@@ -189,9 +189,11 @@ TEST(Scene, AppendKeepsPerFaceArraysAligned) {
   EXPECT_EQ(p.triangles[1], glm::uvec3(3, 4, 5));
 }
 
-// Duplicated faces are the same three corner positions in any order, whether
-// the copy reuses the vertices or has its own (a triangle soup); sharing two
-// corners, or a corner that differs in the last bit, is not a duplicate.
+// Duplicated faces are the same three corner positions in the same turn,
+// whether the copy reuses the vertices or has its own (a triangle soup);
+// sharing two corners, or a corner that differs in the last bit, is not a
+// duplicate. A copy in the other turn makes a two-sided pair, counted apart
+// (the ray casters meet such a surface on the side facing the ray).
 TEST(Scene, DuplicateFacesByPositionNotIndex) {
   const float nudged = std::nextafter(1.f, 2.f);
   const gi::Scene s = gi::Scene::fromAbsolute(
@@ -200,15 +202,18 @@ TEST(Scene, DuplicateFacesByPositionNotIndex) {
        {0, 0, 0}, {1, 0, 0}, {0, double(nudged), 0},      // 7-9: 0, 1 and a corner one ulp off 2
        {-0.0, 0, 0}, {1, 0, 0}, {0, 1, 0}},               // 10-12: a third copy, its own vertices
       {{0, 1, 2}, {1, 3, 2},
-       {2, 1, 0},     // same vertices, other order: duplicate
+       {2, 1, 0},     // same vertices, reversed: a two-sided pair with face 0
        {4, 5, 6},     // own vertices, rotated: duplicate
        {7, 8, 9},     // one corner differs: not
        {0, 1, 3},     // shares two corners: not
-       {10, 11, 12}}  // duplicate
+       {10, 11, 12},  // duplicate
+       {1, 2, 3}}     // face 1 reversed (its vertices rotated): a two-sided pair
   );
   const gi::SceneReport r = gi::analyzeScene(s);
-  EXPECT_EQ(r.duplicateFaces, 3u);
-  EXPECT_EQ(r.usableFaces(), 7u);
+  EXPECT_EQ(r.duplicateFaces, 2u);
+  EXPECT_EQ(r.twoSidedPairs, 2u);
+  EXPECT_NE(r.summary().find("2 faces with a reversed copy"), std::string::npos) << r.summary();
+  EXPECT_EQ(r.usableFaces(), 8u);
   EXPECT_NEAR(gi::sceneDiagonal(s), r.diagonal, 1e-12);
 }
 

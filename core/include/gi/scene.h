@@ -89,7 +89,8 @@ struct SceneReport {
   size_t facesOnNonFinite = 0;     // faces touching a non-finite vertex
   size_t isolatedVertices = 0;     // referenced by no usable face
   size_t emitterFaces = 0;
-  size_t duplicateFaces = 0;       // usable faces repeating an earlier face's corners
+  size_t duplicateFaces = 0;       // usable faces repeating an earlier face's corners, in its turn
+  size_t twoSidedPairs = 0;        // corners with faces of both turns (a two-sided surface's faces)
   double emittedPower = 0.0;       // luminance-weighted, W
   glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
   double diagonal = 0.0;           // bbox diagonal (world units)
