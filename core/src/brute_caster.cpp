@@ -14,22 +14,8 @@ namespace {
 
 class BruteForceCaster final : public RayCaster {
  public:
-  explicit BruteForceCaster(const Scene& s) : s_(s), ok_(usableFaceMask(s)) {
-    // The faces with a reversed copy, as the Embree caster finds them.
-    std::vector<float> xyz;
-    for (const glm::vec3& p : s.positions) xyz.insert(xyz.end(), {p.x, p.y, p.z});
-    std::vector<uint32_t> idx;
-    for (size_t f = 0; f < ok_.size(); ++f)
-      if (ok_[f]) {
-        idx.insert(idx.end(), {s.triangles[f].x, s.triangles[f].y, s.triangles[f].z});
-        primOf_.push_back(uint32_t(f));
-      }
-    twins_ = std::make_unique<FaceTwins>(xyz.data(), idx.data(), primOf_.size());
-    if (twins_->any()) {
-      primOfFace_.assign(ok_.size(), kNoHit);
-      for (size_t k = 0; k < primOf_.size(); ++k) primOfFace_[primOf_[k]] = uint32_t(k);
-    }
-  }
+  // The faces with a reversed copy, as the Embree caster finds them.
+  explicit BruteForceCaster(const Scene& s) : s_(s), ok_(usableFaceMask(s)), twins_(sceneFaceTwins(s)) {}
   Hit intersect(const Ray& r) const override {
     Hit best;
     best.t = r.tfar;
@@ -55,7 +41,7 @@ class BruteForceCaster final : public RayCaster {
       }
     }
     if (!best.valid()) best.t = std::numeric_limits<float>::infinity();
-    else if (twins_->any()) toFront(*twins_, primOfFace_[best.face], r.d, best, [this](uint32_t p) { return primOf_[p]; });
+    else toFront(*twins_.twins, twins_.primOf[best.face], r.d, best, [this](uint32_t p) { return twins_.faceOf[p]; });
     return best;
   }
   bool occluded(const Ray& r) const override { return intersect(r).valid(); }
@@ -63,8 +49,7 @@ class BruteForceCaster final : public RayCaster {
  private:
   const Scene& s_;
   std::vector<uint8_t> ok_;
-  std::vector<uint32_t> primOf_, primOfFace_;  // usable faces in order, and back
-  std::unique_ptr<FaceTwins> twins_;
+  SceneFaceTwins twins_;
 };
 
 }  // namespace

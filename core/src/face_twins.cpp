@@ -113,4 +113,22 @@ FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
   }
 }
 
+SceneFaceTwins sceneFaceTwins(const Scene& s) {
+  SceneFaceTwins out;
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  std::vector<float> xyz;
+  xyz.reserve(3 * s.positions.size());
+  for (const glm::vec3& p : s.positions) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+  std::vector<uint32_t> idx;
+  out.primOf.assign(ok.size(), kNoHit);
+  for (size_t f = 0; f < ok.size(); ++f)
+    if (ok[f]) {
+      idx.insert(idx.end(), {s.triangles[f].x, s.triangles[f].y, s.triangles[f].z});
+      out.primOf[f] = uint32_t(out.faceOf.size());
+      out.faceOf.push_back(uint32_t(f));
+    }
+  out.twins = std::make_unique<FaceTwins>(xyz.data(), idx.data(), out.faceOf.size());
+  return out;
+}
+
 }  // namespace gi

@@ -13,9 +13,11 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "gi/raycaster.h"
+#include "gi/scene.h"
 
 namespace gi {
 
@@ -41,6 +43,14 @@ class FaceTwins {
   std::vector<uint32_t> twin_;
   std::vector<uint8_t> corner_;  // which of p's corners the twin's corners 1 and 2 are (2 bits each)
 };
+
+// The twins of a scene's usable faces (primitive k is face faceOf[k]).
+struct SceneFaceTwins {
+  std::vector<uint32_t> faceOf, primOf;  // primitives to faces, faces to primitives (kNoHit: unusable)
+  std::unique_ptr<FaceTwins> twins;
+  bool hasTwin(size_t face) const { return primOf[face] != kNoHit && twins->twin(primOf[face]) != kNoHit; }
+};
+SceneFaceTwins sceneFaceTwins(const Scene& s);
 
 // A hit h of a ray along d on primitive `prim` (face faceOf(prim)), met from
 // behind (d . ng > 0) on a face with a reversed copy: becomes the hit on the

@@ -177,14 +177,19 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
     for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(g.s.positions[tri[k]]);
   };
   // From points x (normals n) of a cluster to a triangle: the exact
-  // point-to-triangle factor, 0 where the triangle turns its back on x.
+  // point-to-triangle factor, 0 where the triangle turns its back on x or
+  // x lies in its plane (up to the ray offset, as for the analytic form
+  // factors: a point of a two-sided surface's reversed copy lies inside the
+  // triangle, where the factor's contour integral gives 1, not 0: the
+  // sheet of a furnace gathered 15% too much).
   auto toTriangle = [&](const glm::dvec3 x[kPoints], const glm::vec3 n[kPoints], const Node& tri) {
     glm::dvec3 v[3];
     corners(tri, v);
     const glm::dvec3 tn(g.n[t.order[tri.first]]);
     double sum = 0;
     for (int k = 0; k < kPoints; ++k)
-      if (glm::dot(tn, x[k] - v[0]) > 0) sum += pointToTriangleFormFactor(x[k], glm::dvec3(n[k]), v[0], v[1], v[2]);
+      if (glm::dot(tn, x[k] - v[0]) > double(eps))
+        sum += pointToTriangleFormFactor(x[k], glm::dvec3(n[k]), v[0], v[1], v[2]);
     return sum / kPoints;
   };
   double F = 0;
@@ -192,7 +197,15 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
     glm::dvec3 a[3], b[3];
     corners(np, a);
     corners(nq, b);
-    F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
+    // Either triangle wholly behind or in the other's plane, up to the ray
+    // offset (as the analytic form factors): 0. Without it a two-sided
+    // surface's reversed copy, its corners rounded a hair in front of the
+    // face, filled the face's whole hemisphere (F about 1).
+    const glm::dvec3 na(g.n[t.order[np.first]]), nb(g.n[t.order[nq.first]]);
+    auto ahead = [&](const glm::dvec3& n, const glm::dvec3& o, const glm::dvec3 v[3]) {
+      return std::max({glm::dot(n, v[0] - o), glm::dot(n, v[1] - o), glm::dot(n, v[2] - o)}) > double(eps);
+    };
+    if (ahead(na, a[0], b) && ahead(nb, b[0], a)) F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
   } else if (nq.leaf()) {
     F = toTriangle(xp, npn, nq);  // exact over the source triangle, 16 points of the receiving cluster
   } else if (np.leaf()) {
@@ -204,7 +217,10 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
         const double r2 = glm::dot(d, d);
         if (!(r2 > 0)) continue;
         const double ci = glm::dot(glm::dvec3(npn[i]), d), cj = -glm::dot(glm::dvec3(nqn[j]), d);
-        if (ci <= 0 || cj <= 0) continue;
+        // Each point off the other's plane by more than the ray offset (as
+        // above): two points of a two-sided surface's sides, a rounding
+        // apart, would otherwise give ci cj / r^4 of any size.
+        if (ci <= double(eps) || cj <= double(eps)) continue;
         F += ci * cj / (M_PI * r2 * r2);
       }
     F *= nq.A / double(kPoints * kPoints);
