@@ -80,33 +80,50 @@ FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
     for (int a = 0; a < 3; ++a) c[a] = xyz[3 * size_t(idx[3 * size_t(p) + k]) + a] + 0.f;
     return c;
   };
+  auto link = [&](uint32_t p, uint32_t q) {  // q is p's reversed copy
+    if (!any_) {
+      twin_.assign(n, kNoHit);
+      corner_.assign(n, 0);
+      any_ = true;
+    }
+    twin_[p] = q;
+    const Corner pc[3] = {corner(p, 0), corner(p, 1), corner(p, 2)};
+    uint8_t m = 0;
+    for (int k = 1; k <= 2; ++k) {
+      const Corner qc = corner(q, k);
+      const int c = qc == pc[0] ? 0 : qc == pc[1] ? 1 : 2;
+      m |= uint8_t(c << (2 * (k - 1)));
+    }
+    corner_[p] = m;
+  };
+  struct Entry {
+    Sorted s;
+    uint32_t prim;
+  };
+  std::vector<Entry> run;
   for (size_t b = 0; b < n;) {
     size_t e = b + 1;
     while (e < n && keys[e].hash == keys[b].hash) ++e;
-    // A run of faces on the same corners (or a hash collision): each takes
-    // the first face of the opposite turn on exactly the same corners.
-    for (size_t i = b; e - b > 1 && i < e; ++i) {
-      const uint32_t p = keys[i].prim;
-      const Sorted sp = sortedCorners(xyz, idx + 3 * size_t(p));
-      for (size_t j = b; j < e; ++j) {
-        const uint32_t q = keys[j].prim;
-        const Sorted sq = sortedCorners(xyz, idx + 3 * size_t(q));
-        if (sq.even == sp.even || !std::equal(sp.c, sp.c + 3, sq.c)) continue;
-        if (!any_) {
-          twin_.assign(n, kNoHit);
-          corner_.assign(n, 0);
-          any_ = true;
-        }
-        twin_[p] = q;
-        const Corner pc[3] = {corner(p, 0), corner(p, 1), corner(p, 2)};
-        uint8_t m = 0;
-        for (int k = 1; k <= 2; ++k) {
-          const Corner qc = corner(q, k);
-          const int c = qc == pc[0] ? 0 : qc == pc[1] ? 1 : 2;
-          m |= uint8_t(c << (2 * (k - 1)));
-        }
-        corner_[p] = m;
-        break;
+    if (e - b > 1) {
+      // A run of faces on the same corners (or a hash collision), sorted by
+      // their exact corners and turn (n log n however many copies a hostile
+      // mesh stacks on one triangle): each takes the first face of the
+      // opposite turn on exactly the same corners.
+      run.clear();
+      for (size_t i = b; i < e; ++i) run.push_back({sortedCorners(xyz, idx + 3 * size_t(keys[i].prim)), keys[i].prim});
+      std::sort(run.begin(), run.end(), [](const Entry& x, const Entry& y) {
+        if (!std::equal(x.s.c, x.s.c + 3, y.s.c)) return std::lexicographical_compare(x.s.c, x.s.c + 3, y.s.c, y.s.c + 3);
+        return x.s.even != y.s.even ? x.s.even : x.prim < y.prim;
+      });
+      for (size_t g = 0; g < run.size();) {
+        size_t h = g + 1;
+        while (h < run.size() && std::equal(run[g].s.c, run[g].s.c + 3, run[h].s.c)) ++h;
+        // [g, h): one set of corners, the even turn first.
+        size_t odd = g;
+        while (odd < h && run[odd].s.even) ++odd;
+        if (odd > g && odd < h)
+          for (size_t i = g; i < h; ++i) link(run[i].prim, run[i < odd ? odd : g].prim);
+        g = h;
       }
     }
     b = e;

@@ -572,6 +572,27 @@ TEST(RayCaster, TwoSidedSurfaceIsMetOnTheFrontFacingTheRay) {
   }
 }
 
+// A hostile mesh: 100,000 copies of one triangle, half of them reversed.
+// Finding the copies sorts each set of equal corners once (it compared every
+// pair: 10^10 comparisons here), and the hit is still the front facing the ray.
+TEST(RayCaster, ManyCopiesOfOneTriangle) {
+  gi::Scene s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (int k = 0; k < 100000; ++k) s.triangles.push_back(k % 2 ? glm::uvec3(0, 2, 1) : glm::uvec3(0, 1, 2));
+  const auto embree = gi::makeEmbreeCaster(s);
+  const auto brute = gi::makeBruteForceCaster(s);
+  for (const gi::RayCaster* c : {embree.get(), brute.get()})
+    for (float dz : {-1.f, 1.f}) {
+      gi::Ray r;
+      r.o = {0.25f, 0.25f, -2.f * dz};
+      r.d = {0.f, 0.f, dz};
+      const gi::Hit h = c->intersect(r);
+      ASSERT_TRUE(h.valid());
+      EXPECT_LT(glm::dot(r.d, h.ng), 0.f);
+      EXPECT_EQ(h.face % 2, dz > 0 ? 1u : 0u);  // from below, a reversed copy (facing down)
+    }
+}
+
 }  // namespace
 
 // A scene filled directly with world coordinates (not through
