@@ -44,6 +44,31 @@ EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
   return smp;
 }
 
+std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, int rays) {
+  const EmitterSampler lights(s);
+  if (lights.empty() || rays < 1) return std::nullopt;
+  const float eps = float(sceneScale(s).rayEpsilon);
+  int front = 0, back = 0, escaped = 0;
+  Rng rng(0x11e7u);
+  for (int k = 0; k < rays; ++k) {
+    const EmitterSampler::Sample smp = lights.sample({rng.next(), rng.next()});
+    Ray r;
+    r.o = smp.p + smp.n * eps;
+    r.d = Frame(smp.n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
+    const Hit h = caster.intersect(r);
+    if (!h.valid()) ++escaped;
+    else if (glm::dot(r.d, h.ng) < 0.f) ++front;
+    else ++back;
+  }
+  if (100 * front >= rays) return std::nullopt;
+  return "the lights face no surface: of " + std::to_string(rays) + " rays cast from their fronts, " +
+         std::to_string(escaped) + " left the scene and " + std::to_string(back) + " met the back of a face (" +
+         std::to_string(front) + " a front), so their light is lost and the result stays dark. If the scene is a "
+         "room, its faces point out of it (a box built as a solid has outward normals): invert the faces' "
+         "orientation (MeshLab: Filters > Normals, Curvatures and Orientation > Invert Faces Orientation), or only "
+         "the lights' if they alone face away";
+}
+
 bool PointLight::on() const { return luminance(intensity) > 0.f; }
 float PointLight::cosSpot() const { return std::cos(glm::radians(std::clamp(spotAngleDeg, 0.f, 180.f))); }
 

@@ -444,6 +444,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) or without a side to trace from (a fold whose faces' "
             "normals cancel) got 0");
+  if (const auto w = emitterOrientationWarning(s, caster)) st.warn(*w);
   return res;
 }
 

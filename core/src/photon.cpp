@@ -484,8 +484,10 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   // the same faces, so the caster still fits), and takes their mean, as the
   // reference and ambient occlusion do there.
   const VertexSides sides = twoSidedVertices(s, vertexMaterial(s));
-  if (sides.vertex.empty()) return photonMapAtVertices(s, caster, opt, progress, maps);
-  VertexRadiometry out = photonMapAtVertices(splitSides(s, sides), caster, opt, progress, maps);
+  const Scene split = sides.vertex.empty() ? Scene() : splitSides(s, sides);
+  VertexRadiometry out = photonMapAtVertices(sides.vertex.empty() ? s : split, caster, opt, progress, maps);
+  if (const auto w = emitterOrientationWarning(s, caster)) out.stats.warn(*w);
+  if (sides.vertex.empty()) return out;
   for (auto* v : {&out.B, &out.Bdirect, &out.H, &out.split.emitted, &out.split.direct, &out.split.caustic,
                   &out.split.indirect})
     mergeSides(*v, sides);

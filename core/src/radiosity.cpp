@@ -590,7 +590,11 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const FormFactors::Settings& ffs = opt.formFactors;
   if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   checkRadiosityMemory(s.faceCount(), opt);  // either solver: before any work
-  if (usesHierarchy(s.faceCount(), opt)) return solveHierarchicalRadiosity(s, caster, opt, progress);
+  if (usesHierarchy(s.faceCount(), opt)) {
+    RadiosityResult res = solveHierarchicalRadiosity(s, caster, opt, progress);
+    if (const auto w = emitterOrientationWarning(s, caster)) res.stats.warn(*w);
+    return res;
+  }
   Timer timer;
   const FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
@@ -615,6 +619,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   res.stats.add("memory_estimate_MB", (mem.rest + (mem.fits ? mem.matrix : 0.0)) / 1048576.0);
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());
+  if (const auto w = emitterOrientationWarning(s, caster)) res.stats.warn(*w);
   return res;
 }
 

@@ -14,6 +14,7 @@
 #include <tbb/task_arena.h>
 
 #include "gi/color.h"
+#include "gi/emitters.h"
 #include "gi/memory_limit.h"
 #include "render_internal.h"
 
@@ -292,6 +293,7 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   if (c.cutAtMaxDepth)
     st.note(std::to_string(c.cutAtMaxDepth) + " paths cut at max_depth " + std::to_string(o.maxDepth));
   if (tally.nonFinite) st.warn(std::to_string(tally.nonFinite) + " samples with a non-finite radiance dropped");
+  if (const auto w = emitterOrientationWarning(s, caster)) st.warn(*w);
   return res;
 }
 

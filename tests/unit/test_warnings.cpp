@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gi/ambient.h"
+#include "gi/emitters.h"
 #include "gi/filters.h"
 #include "gi/pathtrace.h"
 #include "gi/photon.h"
@@ -331,4 +332,53 @@ TEST(RadiosityWarnings, EnergyBalanceOff) {
   const RadiosityResult m = solveRadiosity(s, *caster, o);
   EXPECT_LT(m.stats.get("energy_balance_error"), 0.01);
   EXPECT_FALSE(warned(m.stats, "energy balance off by")) << all(m.stats);
+}
+
+// A room whose faces point out of it (a box built as a solid) turns its
+// lights towards the outside too: their light leaves the scene or meets the
+// backs of faces, and every lighting filter's result stays dark. Each says
+// so, with the remedy, and the room as built says nothing. The light alone
+// turned away says so too.
+TEST(LightWarnings, LightsFacingNoSurface) {
+  const Scene room = scenes::cornellBox(100.0).scene;
+  Scene inverted = room;
+  for (glm::uvec3& t : inverted.triangles) std::swap(t.y, t.z);
+  Scene lightAway = room;
+  for (size_t f = 0; f < lightAway.faceCount(); ++f)
+    if (lightAway.faceEmission(f) != glm::vec3(0.f)) std::swap(lightAway.triangles[f].y, lightAway.triangles[f].z);
+  const std::string what = "the lights face no surface";
+  auto warnings = [&](const Scene& s) {
+    auto caster = makeEmbreeCaster(s);
+    std::vector<RunStats> out;
+    RadiosityOptions ro;
+    ro.formFactors.raysPerPatch = 64;
+    out.push_back(solveRadiosity(s, *caster, ro).stats);
+    PhotonOptions po;
+    po.photons = 20000;
+    po.lightSamples = 16;
+    out.push_back(computePhotonMap(s, *caster, po).stats);
+    PathTraceOptions pt;
+    pt.samplesPerVertex = 2;
+    pt.minSamples = 2;
+    pt.tracedVertices = 20;
+    out.push_back(pathTrace(s, *caster, pt).stats);
+    RenderOptions r;
+    r.mode = RenderMode::PathTraced;
+    r.samplesPerPixel = 2;
+    r.camera = Camera::lookAt({0, 0, -2000}, {0, 0, 0}, {0, 1, 0}, 40, 8, 8);  // local units: the box centred
+    out.push_back(render(s, *caster, r).stats);
+    return out;
+  };
+  for (const RunStats& st : warnings(room)) EXPECT_FALSE(warned(st, what)) << all(st);
+  for (const Scene* s : {&inverted, &lightAway})
+    for (const RunStats& st : warnings(*s)) {
+      EXPECT_TRUE(warned(st, what)) << all(st);
+      EXPECT_TRUE(warned(st, "Invert Faces Orientation")) << all(st);
+    }
+  // The counts: the inverted room's light faces the ceiling's back or the
+  // outside; none of its 1024 rays meets a front.
+  auto caster = makeEmbreeCaster(inverted);
+  const auto w = emitterOrientationWarning(inverted, *caster);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find("(0 a front)"), std::string::npos) << *w;
 }

@@ -1,6 +1,8 @@
 // Sampling points on area emitters in proportion to their emitted power,
 // shared by direct lighting and photon emission.
 #pragma once
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -36,6 +38,15 @@ class EmitterSampler {
 };
 
 class RayCaster;
+
+// Whether the emitters' light can reach a surface: `rays` cosine-distributed
+// rays from points on the emitters' fronts (in proportion to power), each
+// ending where it meets a face's front, a face's back, or nothing. Where
+// fewer than 1% meet a front, the light is lost and the result is dark: a
+// room whose faces point out of it (a box built as a solid), or lights
+// turned away from everything. Returns the warning, naming the counts and
+// the remedy, or nothing (no emitters, or their light reaches a surface).
+std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, int rays = 1024);
 
 // An optional point or spot light (photon mapping and the reference).
 struct PointLight {
