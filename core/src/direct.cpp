@@ -104,6 +104,7 @@ VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, c
     if (!(glm::length(nsum[0][k] + nsum[1][k]) <= 1e-6 * (l0 + l1))) continue;
     out.slot[candidates[k]] = int32_t(out.vertex.size());
     out.vertex.push_back(candidates[k]);
+    out.ref.push_back(ref[k]);
     for (int sd = 0; sd < 2; ++sd) {
       out.n[sd].push_back(glm::vec3(nsum[sd][k] / (sd ? l1 : l0)));
       out.rho[sd].push_back(glm::vec3(rho[sd][k] / area[sd][k]));
@@ -126,10 +127,12 @@ Scene splitSides(const Scene& s, const VertexSides& sides) {
   for (size_t f = 0; f < s.faceCount(); ++f) {
     if (!ok[f]) continue;
     glm::uvec3& t = out.triangles[f];
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
+    // The side by vertexSides's own rule (the sides' normals, reflectances
+    // and emissions were summed by it).
+    const glm::dvec3 a(s.positions[t.x]), cr = glm::cross(glm::dvec3(s.positions[t.y]) - a, glm::dvec3(s.positions[t.z]) - a);
     for (int c = 0; c < 3; ++c) {
       const int32_t k = sides.slot[t[c]];
-      if (k >= 0 && !(glm::dot(n, sides.n[0][size_t(k)]) > 0.f)) t[c] = uint32_t(nv + size_t(k));
+      if (k >= 0 && !(glm::dot(cr, sides.ref[size_t(k)]) > 0)) t[c] = uint32_t(nv + size_t(k));
     }
   }
   return out;

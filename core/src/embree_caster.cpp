@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include "face_twins.h"
 #include "gi/raycaster.h"
@@ -108,6 +109,7 @@ class EmbreeCaster final : public RayCaster {
     // With every face usable, a primitive is its face: no lookup (a cache
     // miss per hit on a large mesh).
     identity_ = primToFace_.size() == s.faceCount();
+    faceCount_ = s.faceCount();
     if (!primToFace_.empty()) {
       // The buffers are ours (std::vector: large ones go to huge pages in
       // the tool, gi/huge_pages.h), shared with Embree for the scene's
@@ -301,16 +303,40 @@ class EmbreeCaster final : public RayCaster {
   // shadow rays) do not pay for the search.
   void front(unsigned primID, const glm::vec3& d, Hit& h) const {
     if (!(glm::dot(d, h.ng) > 0.f)) return;
+    toFront(twins(), uint32_t(primID), d, h, [this](uint32_t p) { return faceOf(p); });
+  }
+  const FaceTwins& twins() const {
     std::call_once(twinsOnce_, [this] {
       // Isolated: while it waits for its parallel sort, this thread must not
       // take up another of the caller's rays (it would wait on itself here).
-      tbb::this_task_arena::isolate(
-          [this] { twins_ = std::make_unique<FaceTwins>(vertices_.data(), indices_.data(), primToFace_.size()); });
+      tbb::this_task_arena::isolate([this] {
+        auto t = std::make_unique<FaceTwins>(vertices_.data(), indices_.data(), primToFace_.size());
+        // A search cut short by the caller's cancellation (an exception in
+        // another ray's task) would miss copies for the caster's life: not
+        // kept (call_once tries again at the next call).
+        if (tbb::is_current_task_group_canceling()) throw std::runtime_error("the computation was cancelled");
+        if (!identity_ && t->any()) {
+          primOfFace_.assign(faceCount_, kNoHit);
+          for (size_t k = 0; k < primToFace_.size(); ++k) primOfFace_[primToFace_[k]] = uint32_t(k);
+        }
+        twins_ = std::move(t);
+      });
     });
-    toFront(*twins_, uint32_t(primID), d, h, [this](uint32_t p) { return faceOf(p); });
+    return *twins_;
   }
   mutable std::once_flag twinsOnce_;
   mutable std::unique_ptr<FaceTwins> twins_;
+  mutable std::vector<uint32_t> primOfFace_;  // faces to primitives, where they differ and copies exist
+  size_t faceCount_ = 0;
+
+ public:
+  uint32_t reversedCopy(uint32_t face) const override {
+    const FaceTwins& t = twins();
+    if (!t.any() || face >= faceCount_) return kNoHit;
+    const uint32_t prim = identity_ ? face : primOfFace_[face];
+    const uint32_t copy = prim == kNoHit ? kNoHit : t.twin(prim);
+    return copy == kNoHit ? kNoHit : faceOf(copy);
+  }
 };
 
 }  // namespace

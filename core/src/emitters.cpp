@@ -44,7 +44,8 @@ EmitterSampler::Sample EmitterSampler::sample(glm::vec2 u) const {
   return smp;
 }
 
-std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, int rays) {
+std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, bool otherLights,
+                                                     int rays) {
   const EmitterSampler lights(s);
   if (lights.empty() || rays < 1) return std::nullopt;
   const float eps = float(sceneScale(s).rayEpsilon);
@@ -57,10 +58,10 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
     r.d = Frame(smp.n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
     const Hit h = caster.intersect(r);
     if (!h.valid()) ++escaped;
-    else if (glm::dot(r.d, h.ng) < 0.f) ++front;
+    else if (glm::dot(r.d, h.ng) < 0.f || s.faceMaterial(h.face) == Material::Glass) ++front;
     else ++back;
   }
-  if (100 * front >= rays) return std::nullopt;
+  if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;
   return "the lights face no surface: of " + std::to_string(rays) + " rays cast from their fronts, " +
          std::to_string(escaped) + " left the scene and " + std::to_string(back) + " met the back of a face (" +
          std::to_string(front) + " a front), so their light is lost and the result stays dark. If the scene is a "

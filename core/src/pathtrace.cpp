@@ -444,7 +444,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) or without a side to trace from (a fold whose faces' "
             "normals cancel) got 0");
-  if (const auto w = emitterOrientationWarning(s, caster)) st.warn(*w);
+  const bool otherLights = opt.point.on() || luminance(opt.skyRadiance) > 0.f || luminance(opt.sunIrradiance) > 0.f;
+  if (const auto w = emitterOrientationWarning(s, caster, otherLights)) st.warn(*w);
   return res;
 }
 

@@ -483,17 +483,29 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   // its own (the same place, the side's normal, reflectance and emission;
   // the same faces, so the caster still fits), and takes their mean, as the
   // reference and ambient occlusion do there.
-  const VertexSides sides = twoSidedVertices(s, vertexMaterial(s));
+  const VertexMaterial mat = vertexMaterial(s);
+  const VertexSides sides = twoSidedVertices(s, mat);
   const Scene split = sides.vertex.empty() ? Scene() : splitSides(s, sides);
   VertexRadiometry out = photonMapAtVertices(sides.vertex.empty() ? s : split, caster, opt, progress, maps);
-  if (const auto w = emitterOrientationWarning(s, caster)) out.stats.warn(*w);
+  if (const auto w = emitterOrientationWarning(s, caster, opt.point.on() || opt.outside.any())) out.stats.warn(*w);
   if (sides.vertex.empty()) return out;
   for (auto* v : {&out.B, &out.Bdirect, &out.H, &out.split.emitted, &out.split.direct, &out.split.caustic,
                   &out.split.indirect})
     mergeSides(*v, sides);
   mergeSideErrors(out.stdError, sides);
+  // The run's means over the scene's vertices (the split scene counted each side).
+  double lum = 0, err2 = 0;
+  size_t valid = 0;
+  for (size_t i = 0; i < s.vertexCount(); ++i) {
+    if (!mat.valid[i] && sides.slot[i] < 0) continue;
+    lum += luminance(out.B[i]);
+    err2 += double(out.stdError[i]) * out.stdError[i];
+    ++valid;
+  }
+  out.stats.set("mean_luminance_B", valid ? lum / double(valid) : 0.0);
+  out.stats.set("photon_noise_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   out.stats.note(std::to_string(sides.vertex.size()) + " vertices on a two-sided surface (its faces' normals cancel) "
-                 "took the mean of their two sides");
+                 "took the mean of their two sides (the counts of estimates above count each side)");
   return out;
 }
 

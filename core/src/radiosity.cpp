@@ -592,7 +592,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   checkRadiosityMemory(s.faceCount(), opt);  // either solver: before any work
   if (usesHierarchy(s.faceCount(), opt)) {
     RadiosityResult res = solveHierarchicalRadiosity(s, caster, opt, progress);
-    if (const auto w = emitterOrientationWarning(s, caster)) res.stats.warn(*w);
+    if (const auto w = emitterOrientationWarning(s, caster, opt.outside.any())) res.stats.warn(*w);
     return res;
   }
   Timer timer;
@@ -619,7 +619,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   res.stats.add("memory_estimate_MB", (mem.rest + (mem.fits ? mem.matrix : 0.0)) / 1048576.0);
   res.stats.add("rays", double(ff.raysCast()));
   res.stats.add("seconds", timer.seconds());
-  if (const auto w = emitterOrientationWarning(s, caster)) res.stats.warn(*w);
+  if (const auto w = emitterOrientationWarning(s, caster, opt.outside.any())) res.stats.warn(*w);
   return res;
 }
 

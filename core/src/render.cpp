@@ -293,7 +293,8 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   if (c.cutAtMaxDepth)
     st.note(std::to_string(c.cutAtMaxDepth) + " paths cut at max_depth " + std::to_string(o.maxDepth));
   if (tally.nonFinite) st.warn(std::to_string(tally.nonFinite) + " samples with a non-finite radiance dropped");
-  if (const auto w = emitterOrientationWarning(s, caster)) st.warn(*w);
+  const bool otherLights = o.point.on() || luminance(o.skyRadiance) > 0.f || luminance(o.sunIrradiance) > 0.f;
+  if (const auto w = emitterOrientationWarning(s, caster, otherLights)) st.warn(*w);
   return res;
 }
 

@@ -9,6 +9,15 @@
 
 namespace gi {
 
+void RunStats::set(const std::string& key, double v) {
+  for (auto& kv : numbers)
+    if (kv.first == key) {
+      kv.second = v;
+      return;
+    }
+  add(key, v);
+}
+
 double RunStats::get(const std::string& key, double fallback) const {
   for (const auto& kv : numbers)
     if (kv.first == key) return kv.second;

@@ -352,7 +352,8 @@ std::string SceneReport::summary() const {
     line += "; " + std::to_string(duplicateFaces) +
             " duplicated faces (coplanar copies shadow each other at random: remove them for exact results)";
   if (twoSidedPairs)
-    line += "; " + std::to_string(twoSidedPairs) + " faces with a reversed copy (a two-sided surface: lit on both sides)";
+    line += "; " + std::to_string(twoSidedPairs) +
+            " two-sided pairs (faces with a reversed copy on the same corners: lit on both sides)";
   return line;
 }
 

@@ -65,8 +65,11 @@ class ThicknessKernel {
       }
       caster_.intersectBatch(rays, size_t(m), hits);
       for (int j = 0; j < m; ++j) {
-        // Leaving the object: the face met faces along the ray (its back is seen).
-        if (!hits[j].valid() || glm::dot(hits[j].ng, rays[j].d) <= 0.f) continue;
+        // Leaving the object: the face met faces along the ray (its back is
+        // seen), or, where two solids touch, a face whose reversed copy (the
+        // other solid's) the caster reported instead of its back.
+        if (!hits[j].valid()) continue;
+        if (!(glm::dot(hits[j].ng, rays[j].d) > 0.f) && caster_.reversedCopy(hits[j].face) == kNoHit) continue;
         const glm::vec3 q = rays[j].o + hits[j].t * rays[j].d;
         lengths.push_back(glm::length(q - p));  // from the vertex itself, not the lifted origin
       }

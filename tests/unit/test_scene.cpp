@@ -212,7 +212,7 @@ TEST(Scene, DuplicateFacesByPositionNotIndex) {
   const gi::SceneReport r = gi::analyzeScene(s);
   EXPECT_EQ(r.duplicateFaces, 2u);
   EXPECT_EQ(r.twoSidedPairs, 2u);
-  EXPECT_NE(r.summary().find("2 faces with a reversed copy"), std::string::npos) << r.summary();
+  EXPECT_NE(r.summary().find("2 two-sided pairs"), std::string::npos) << r.summary();
   EXPECT_EQ(r.usableFaces(), 8u);
   EXPECT_NEAR(gi::sceneDiagonal(s), r.diagonal, 1e-12);
 }

@@ -352,3 +352,42 @@ TEST(Thickness, ScaleInvariant) {
       EXPECT_NEAR(b.value[i] / 1e-12, a.value[i], 5.0 * std::hypot(a.stdError[i], b.stdError[i] / 1e-12)) << i;
   }
 }
+
+// Two solids touching: a second slab stacked on the first shares its top as
+// a reversed copy (the same corners, facing down). The caster reports the
+// copy's front where a ray meets the first slab's top from inside; thickness
+// still takes it as the ray leaving the first slab (it lost those rays, and
+// the bottom's vertices their thickness, when the casters began to report
+// fronts on 4 December 2026). The first slab's bottom vertices, whose rays
+// leave through the shared face, get the values they get alone (to the ray
+// offset, which grows with the scene's diagonal).
+TEST(Thickness, TouchingSolidsKeepTheirThickness) {
+  const double t = 0.1;
+  const Scene alone = slab(4.0, t, 40);
+  // The copy in the same local coordinates, its bottom exactly on the top
+  // (every vertex of the slab lies on its bottom or its top).
+  float lo = HUGE_VALF, hi = -HUGE_VALF;
+  for (const glm::vec3& p : alone.positions) {
+    lo = std::min(lo, p.z);
+    hi = std::max(hi, p.z);
+  }
+  Scene stacked = alone;
+  const uint32_t off = uint32_t(alone.vertexCount());
+  for (const glm::vec3& p : alone.positions) stacked.positions.push_back({p.x, p.y, p.z == lo ? hi : hi + (hi - lo)});
+  for (const glm::uvec3& tri : alone.triangles) stacked.triangles.push_back(tri + glm::uvec3(off));
+  ASSERT_EQ(analyzeScene(stacked).twoSidedPairs, 2u * 40u * 40u);  // the shared face, reversed
+  const auto n = computeVertexNormals(alone);
+  std::vector<size_t> bottom;
+  for (size_t i = 0; i < alone.vertexCount(); ++i) {
+    const glm::dvec3 p = alone.toWorld(alone.positions[i]);
+    if (std::fabs(p.z) < 1e-9 && std::fabs(p.x) < 1.0 && std::fabs(p.y) < 1.0 && n[i].z < -0.9999f) bottom.push_back(i);
+  }
+  ASSERT_GT(bottom.size(), 300u);
+  const ThicknessResult a = runThickness(alone, 64, 60.0, false), b = runThickness(stacked, 64, 60.0, false);
+  double mean = 0;
+  for (size_t i : bottom) {
+    EXPECT_NEAR(b.value[i], a.value[i], 1e-5 * a.value[i]) << i;  // the ray offset follows the scene's size
+    mean += b.value[i];
+  }
+  EXPECT_NEAR(mean / double(bottom.size()), slabMean(t, kPi / 3), 0.02 * t);
+}

@@ -378,7 +378,44 @@ TEST(LightWarnings, LightsFacingNoSurface) {
   // The counts: the inverted room's light faces the ceiling's back or the
   // outside; none of its 1024 rays meets a front.
   auto caster = makeEmbreeCaster(inverted);
-  const auto w = emitterOrientationWarning(inverted, *caster);
+  const auto w = emitterOrientationWarning(inverted, *caster, false);
   ASSERT_TRUE(w.has_value());
   EXPECT_NE(w->find("(0 a front)"), std::string::npos) << *w;
+}
+
+// Where other lights light the scene, emitters facing open space may be
+// meant (lit windows on a façade): said only where half the rays or more
+// meet backs. Glass passes light from either side: a lamp inside a glass
+// globe, whose faces point out, is not turned the wrong way.
+TEST(LightWarnings, OpenSkyAndGlassAreNotMistakenForInvertedFaces) {
+  // A ground plane and, above it, a small emitter facing the sky.
+  Scene s = scenes::openPlane(10.0, 4).scene;
+  Scene lamp;
+  lamp.positions = {{-0.5f, -0.5f, 2.f}, {0.5f, -0.5f, 2.f}, {0.5f, 0.5f, 2.f}, {-0.5f, 0.5f, 2.f}};
+  lamp.triangles = {{0, 1, 2}, {0, 2, 3}};  // facing +z, away from the ground
+  s.append(lamp);
+  s.emission.assign(s.faceCount(), glm::vec3(0.f));
+  s.emission[s.faceCount() - 1] = s.emission[s.faceCount() - 2] = glm::vec3(10.f);
+  auto caster = makeEmbreeCaster(s);
+  EXPECT_TRUE(emitterOrientationWarning(s, *caster, false).has_value());  // its light is all lost
+  EXPECT_FALSE(emitterOrientationWarning(s, *caster, true).has_value());  // a sun or sky lights the ground
+  // The Cornell box's light inside a closed glass globe (outward faces):
+  // the light's first hits are the globe's backs.
+  Scene room = scenes::cornellBox(100.0).scene;
+  const auto globe = scenes::sphere(100.0, 2, false).scene;  // around the whole light (its corners 84 from the centre)
+  const glm::dvec3 lightCentre(278.0, 548.0, 279.5);
+  std::vector<glm::dvec3> pts;
+  for (const glm::vec3& p : globe.positions) pts.push_back(globe.toWorld(p) + lightCentre);
+  const Scene g = Scene::fromAbsolute(pts, globe.triangles);
+  const size_t first = room.faceCount();
+  room.append(g);
+  room.rho.resize(room.faceCount(), glm::vec3(0.9f));
+  room.emission.resize(room.faceCount(), glm::vec3(0.f));
+  room.material.assign(room.faceCount(), Material::Diffuse);
+  for (size_t f = first; f < room.faceCount(); ++f) room.material[f] = Material::Glass;
+  auto roomCaster = makeEmbreeCaster(room);
+  EXPECT_FALSE(emitterOrientationWarning(room, *roomCaster, false).has_value());
+  for (size_t f = first; f < room.faceCount(); ++f) room.material[f] = Material::Diffuse;  // an opaque globe
+  auto opaque = makeEmbreeCaster(room);
+  EXPECT_TRUE(emitterOrientationWarning(room, *opaque, false).has_value());
 }

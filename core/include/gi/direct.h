@@ -57,6 +57,7 @@ struct VertexSides {
   std::vector<int32_t> slot;
   std::vector<uint32_t> vertex;
   std::vector<glm::vec3> n[2], rho[2], E[2];
+  std::vector<glm::dvec3> ref;  // the first face's unit normal: a face turned its way (dot > 0) is on side A
 };
 // The candidates' sides over the faces `faces` marks (usable ones only).
 VertexSides vertexSides(const Scene& s, const std::vector<uint8_t>& candidate, const std::vector<uint8_t>& faces);

@@ -41,12 +41,16 @@ class RayCaster;
 
 // Whether the emitters' light can reach a surface: `rays` cosine-distributed
 // rays from points on the emitters' fronts (in proportion to power), each
-// ending where it meets a face's front, a face's back, or nothing. Where
-// fewer than 1% meet a front, the light is lost and the result is dark: a
-// room whose faces point out of it (a box built as a solid), or lights
-// turned away from everything. Returns the warning, naming the counts and
-// the remedy, or nothing (no emitters, or their light reaches a surface).
-std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, int rays = 1024);
+// ending where it meets a face's front (or glass, from either side: light
+// passes it), a face's back, or nothing. Where fewer than 1% meet a front,
+// the light is lost: a room whose faces point out of it (a box built as a
+// solid), or lights turned away from everything. With `otherLights` (a
+// point light, the sky or the sun light the scene anyway) emitters facing
+// open space may be meant (lit windows on a façade): then only where half
+// the rays or more meet backs, the sign of faces turned the wrong way.
+// Returns the warning, naming the counts and the remedy, or nothing.
+std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCaster& caster, bool otherLights,
+                                                     int rays = 1024);
 
 // An optional point or spot light (photon mapping and the reference).
 struct PointLight {

@@ -48,6 +48,15 @@ class RayCaster {
   virtual void intersectBatch(const Ray* rays, size_t n, Hit* hits) const {
     for (size_t i = 0; i < n; ++i) hits[i] = intersect(rays[i]);
   }
+  // The reversed copy of a face (the same three corners in the other turn:
+  // a two-sided surface, or two solids touching), or kNoHit. Where a ray
+  // meets such a face's back, the hits above report the copy's front (the
+  // same point); a caller that wants the back it crossed (thickness: where a
+  // ray leaves a solid) asks here.
+  virtual uint32_t reversedCopy(uint32_t face) const {
+    (void)face;
+    return kNoHit;
+  }
 };
 
 struct Rng;

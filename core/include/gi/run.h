@@ -26,6 +26,7 @@ struct RunStats {
   // line as "WARNING: ..." and listed apart in the CLI's JSON.
   std::vector<std::string> warnings;
   void add(const std::string& key, double v) { numbers.emplace_back(key, v); }
+  void set(const std::string& key, double v);  // replaces key's value (or adds it)
   void note(const std::string& s) { notes.push_back(s); }
   void warn(const std::string& s) { warnings.push_back(s); }
   double get(const std::string& key, double fallback = 0.0) const;
