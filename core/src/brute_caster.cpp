@@ -45,11 +45,7 @@ class BruteForceCaster final : public RayCaster {
     return best;
   }
   bool occluded(const Ray& r) const override { return intersect(r).valid(); }
-  uint32_t reversedCopy(uint32_t face) const override {
-    if (face >= twins_.primOf.size() || twins_.primOf[face] == kNoHit) return kNoHit;
-    const uint32_t copy = twins_.twins->twin(twins_.primOf[face]);
-    return copy == kNoHit ? kNoHit : twins_.faceOf[copy];
-  }
+  uint32_t reversedCopy(uint32_t face) const override { return twins_.copyOf(face); }
 
  private:
   const Scene& s_;

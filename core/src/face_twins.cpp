@@ -26,10 +26,14 @@ struct Sorted {
   bool even;
 };
 
+Corner cornerOf(const float* xyz, uint32_t v) {
+  Corner c;
+  for (int a = 0; a < 3; ++a) c[a] = xyz[3 * size_t(v) + a] + 0.f;  // -0 and +0 as one
+  return c;
+}
+
 Sorted sortedCorners(const float* xyz, const uint32_t* tri) {
-  Corner p[3];
-  for (int k = 0; k < 3; ++k)
-    for (int a = 0; a < 3; ++a) p[k][a] = xyz[3 * size_t(tri[k]) + a] + 0.f;  // -0 and +0 as one
+  const Corner p[3] = {cornerOf(xyz, tri[0]), cornerOf(xyz, tri[1]), cornerOf(xyz, tri[2])};
   int o[3] = {0, 1, 2};
   std::sort(o, o + 3, [&](int a, int b) { return p[a] < p[b]; });
   Sorted s;
@@ -47,12 +51,11 @@ uint64_t mix(uint64_t z) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
 }
-uint64_t hashOf(const float* p) {
+uint64_t hashOf(const Corner& p) {
   uint64_t h = 0x9e3779b97f4a7c15ull;
   for (int a = 0; a < 3; ++a) {
-    const float f = p[a] + 0.f;  // -0 and +0 as one
     uint32_t b;
-    std::memcpy(&b, &f, sizeof b);
+    std::memcpy(&b, &p[size_t(a)], sizeof b);
     h = mix(h + b);
   }
   return h;
@@ -65,7 +68,7 @@ FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
   for (size_t k = 0; k < 3 * n; ++k) nv = std::max(nv, idx[k] + 1);
   std::vector<uint64_t> vh(nv);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v < r.end(); ++v) vh[v] = hashOf(xyz + 3 * v);
+    for (size_t v = r.begin(); v < r.end(); ++v) vh[v] = hashOf(cornerOf(xyz, uint32_t(v)));
   });
   std::vector<Key> keys(n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
@@ -75,11 +78,7 @@ FaceTwins::FaceTwins(const float* xyz, const uint32_t* idx, size_t n) {
     }
   });
   tbb::parallel_sort(keys.begin(), keys.end());
-  auto corner = [&](uint32_t p, int k) {
-    Corner c;
-    for (int a = 0; a < 3; ++a) c[a] = xyz[3 * size_t(idx[3 * size_t(p) + k]) + a] + 0.f;
-    return c;
-  };
+  auto corner = [&](uint32_t p, int k) { return cornerOf(xyz, idx[3 * size_t(p) + size_t(k)]); };
   auto link = [&](uint32_t p, uint32_t q) {  // q is p's reversed copy
     if (!any_) {
       twin_.assign(n, kNoHit);

@@ -48,7 +48,11 @@ class FaceTwins {
 struct SceneFaceTwins {
   std::vector<uint32_t> faceOf, primOf;  // primitives to faces, faces to primitives (kNoHit: unusable)
   std::unique_ptr<FaceTwins> twins;
-  bool hasTwin(size_t face) const { return primOf[face] != kNoHit && twins->twin(primOf[face]) != kNoHit; }
+  uint32_t copyOf(size_t face) const {  // the face's reversed copy, or kNoHit
+    const uint32_t p = face < primOf.size() ? primOf[face] : kNoHit;
+    const uint32_t t = p == kNoHit ? kNoHit : twins->twin(p);
+    return t == kNoHit ? kNoHit : faceOf[t];
+  }
 };
 SceneFaceTwins sceneFaceTwins(const Scene& s);
 

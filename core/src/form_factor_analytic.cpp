@@ -159,9 +159,9 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     // surface, see them; otherwise the rounding gives such a pair F of about
     // 0.5 and refines it to the last level (measured).
     const double inPlane = double(eps_);
-    if (std::max({glm::dot(n, pa - src.a), glm::dot(n, pb - src.a), glm::dot(n, pc - src.a)}) <= inPlane) continue;
+    if (heightAbovePlane(n, src.a, pa, pb, pc) <= inPlane) continue;
     const glm::dvec3 nj(normal_[j]);
-    if (std::max({glm::dot(nj, src.a - pa), glm::dot(nj, src.b - pa), glm::dot(nj, src.c - pa)}) <= inPlane) continue;
+    if (heightAbovePlane(nj, pa, src.a, src.b, src.c) <= inPlane) continue;
     auto g = [&](const glm::dvec3& x) {
       return glm::dot(nj, x - pa) > 0 ? pointToTriangleFormFactor(x, n, pa, pb, pc) : 0.0;  // 0 where j faces away
     };

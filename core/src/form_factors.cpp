@@ -6,7 +6,6 @@
 #include <cmath>
 #include <limits>
 
-#include "face_twins.h"
 #include "gi/form_factor_analytic.h"
 #include "gi/run.h"
 #include "gi/sampling.h"
@@ -34,14 +33,6 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
       centroid_[f] = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
       for (int k = 0; k < 3; ++k) radius_[f] = std::max(radius_[f], glm::length(glm::dvec3(s.positions[t[k]]) - centroid_[f]));
     }
-  }
-  if (set_.method == FormFactorMethod::Hemicube) {
-    // A two-sided surface's faces and their reversed copies lie in one
-    // plane: the hemicube draws only the one facing its eye (the other, at
-    // the same depth, would win some cells as a back: light lost).
-    const SceneFaceTwins twins = sceneFaceTwins(s);
-    reversedCopy_.assign(s.faceCount(), 0);
-    for (size_t f = 0; f < s.faceCount(); ++f) reversedCopy_[f] = twins.hasTwin(f);
   }
   if (set_.method == FormFactorMethod::Auto) {
     // Exact-per-point factors are affordable for small scenes (n^2 work);

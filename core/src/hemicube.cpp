@@ -185,7 +185,10 @@ double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::v
       }
       if (m < 3) continue;
       const bool back = glm::dot(normal_[j], s_.positions[t.x] - c) >= 0.f;  // c is behind patch j
-      if (back && !reversedCopy_.empty() && reversedCopy_[j]) continue;  // its copy, in the same place, faces c
+      // A two-sided surface's face and its reversed copy lie in one plane:
+      // only the one facing c is drawn (the other, at the same depth, would
+      // win some cells as a back: light lost).
+      if (back && caster_.reversedCopy(j) != kNoHit) continue;
       V2 q[4];
       for (int k = 0; k < m; ++k) q[k] = {poly[k].x / poly[k].z, poly[k].y / poly[k].z, 1.f / poly[k].z};
       for (int k = 1; k + 1 < m; ++k) face.drawTriangle(q[0], q[k], q[k + 1], j, back);

@@ -179,9 +179,8 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
   // From points x (normals n) of a cluster to a triangle: the exact
   // point-to-triangle factor, 0 where the triangle turns its back on x or
   // x lies in its plane (up to the ray offset, as for the analytic form
-  // factors: a point of a two-sided surface's reversed copy lies inside the
-  // triangle, where the factor's contour integral gives 1, not 0: the
-  // sheet of a furnace gathered 15% too much).
+  // factors: a point of a two-sided surface's reversed copy may lie inside
+  // the triangle, where the factor's contour integral gives 1, not 0).
   auto toTriangle = [&](const glm::dvec3 x[kPoints], const glm::vec3 n[kPoints], const Node& tri) {
     glm::dvec3 v[3];
     corners(tri, v);
@@ -202,10 +201,8 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
     // surface's reversed copy, its corners rounded a hair in front of the
     // face, filled the face's whole hemisphere (F about 1).
     const glm::dvec3 na(g.n[t.order[np.first]]), nb(g.n[t.order[nq.first]]);
-    auto ahead = [&](const glm::dvec3& n, const glm::dvec3& o, const glm::dvec3 v[3]) {
-      return std::max({glm::dot(n, v[0] - o), glm::dot(n, v[1] - o), glm::dot(n, v[2] - o)}) > double(eps);
-    };
-    if (ahead(na, a[0], b) && ahead(nb, b[0], a)) F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
+    if (heightAbovePlane(na, a[0], b[0], b[1], b[2]) > double(eps) && heightAbovePlane(nb, b[0], a[0], a[1], a[2]) > double(eps))
+      F = triangleToTriangleFormFactor(a, b, 1, 1e-2, 3);
   } else if (nq.leaf()) {
     F = toTriangle(xp, npn, nq);  // exact over the source triangle, 16 points of the receiving cluster
   } else if (np.leaf()) {

@@ -286,7 +286,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     if (!part.all()) part.sumOverParts(all);
     const std::vector<double> paths(all.begin() + 6 * nv, all.end());
     RingVariance ring = ringVariance(graph, all.data(), paths);
-    const glm::dvec3 lum(0.2126, 0.7152, 0.0722);  // luminance()'s weights (gi/color.h)
+    const glm::dvec3& lum = kLuminanceWeights;
     PooledVariance p;
     p.B.assign(nv, 0.0);
     p.H.assign(nv, 0.0);

@@ -376,6 +376,19 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
 struct Totals {
   double meanLuminance = 0, rmsNoise = 0;
 };
+// Over the vertices `counted` marks.
+Totals totalsOver(const std::vector<glm::vec3>& B, const std::vector<float>& stdError,
+                  const std::vector<uint8_t>& counted) {
+  double lum = 0, err2 = 0;
+  size_t n = 0;
+  for (size_t i = 0; i < counted.size(); ++i) {
+    if (!counted[i]) continue;
+    lum += luminance(B[i]);
+    err2 += double(stdError[i]) * stdError[i];
+    ++n;
+  }
+  return {n ? lum / double(n) : 0.0, n ? std::sqrt(err2 / double(n)) : 0.0};
+}
 Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const PhotonEstimate& e, bool directApart,
                VertexRadiometry& out) {
   const size_t nv = Hd.size();
@@ -383,8 +396,6 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
   if (directApart) out.Bdirect.assign(nv, glm::vec3(0.f));
   out.H.assign(nv, glm::vec3(0.f));
   out.stdError.assign(nv, 0.f);
-  double lum = 0, err2 = 0;
-  size_t valid = 0;
   for (size_t i = 0; i < nv; ++i) {
     if (!mat.valid[i]) continue;
     out.H[i] = Hd[i] + e.H[i];
@@ -399,11 +410,8 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
       out.split.indirect[i] = mat.rho[i] * part(kPathIndirect);
     }
     out.stdError[i] = float(luminance(mat.rho[i]) * e.noise[i]);
-    lum += luminance(out.B[i]);
-    err2 += double(out.stdError[i]) * out.stdError[i];
-    ++valid;
   }
-  return {valid ? lum / double(valid) : 0.0, valid ? std::sqrt(err2 / double(valid)) : 0.0};
+  return totalsOver(out.B, out.stdError, mat.valid);
 }
 
 // The photon map at every vertex with a normal (computePhotonMap splits the
@@ -494,16 +502,11 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
     mergeSides(*v, sides);
   mergeSideErrors(out.stdError, sides);
   // The run's means over the scene's vertices (the split scene counted each side).
-  double lum = 0, err2 = 0;
-  size_t valid = 0;
-  for (size_t i = 0; i < s.vertexCount(); ++i) {
-    if (!mat.valid[i] && sides.slot[i] < 0) continue;
-    lum += luminance(out.B[i]);
-    err2 += double(out.stdError[i]) * out.stdError[i];
-    ++valid;
-  }
-  out.stats.set("mean_luminance_B", valid ? lum / double(valid) : 0.0);
-  out.stats.set("photon_noise_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
+  std::vector<uint8_t> counted = mat.valid;
+  for (uint32_t v : sides.vertex) counted[v] = 1;
+  const Totals totals = totalsOver(out.B, out.stdError, counted);
+  out.stats.set("mean_luminance_B", totals.meanLuminance);
+  out.stats.set("photon_noise_estimate", totals.rmsNoise);
   out.stats.note(std::to_string(sides.vertex.size()) + " vertices on a two-sided surface (its faces' normals cancel) "
                  "took the mean of their two sides (the counts of estimates above count each side)");
   return out;

@@ -290,12 +290,11 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
   // read, follow each change): a patch receives a small gain from every
   // shot, hundreds of thousands of them at high reflectance, and float
   // sums rounded them away (a closed box at rho 0.999 stalled 0.16% low).
-  const glm::dvec3 kLuminance(0.2126, 0.7152, 0.0722);  // luminance() in double
   std::vector<glm::vec3> dB = S;
   std::vector<glm::dvec3> Rd(R.begin(), R.end()), dBd(S.begin(), S.end());
   std::vector<double> unshot(u.n);
   double U = 0;
-  for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * glm::dot(dBd[i], kLuminance); U += unshot[i]; }
+  for (size_t i = 0; i < u.n; ++i) { unshot[i] = u.A[i] * glm::dot(dBd[i], kLuminanceWeights); U += unshot[i]; }
   const long maxShots = long(stop.maxIter) * long(std::max<size_t>(u.n, 1));
   long shots = 0;
   if (stop.observe) stop.observe(0, R, &dB);
@@ -304,7 +303,7 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
     dBd[j] += d;
     R[j] = glm::vec3(Rd[j]);
     dB[j] = glm::vec3(dBd[j]);
-    const double nu = u.A[j] * glm::dot(dBd[j], kLuminance);
+    const double nu = u.A[j] * glm::dot(dBd[j], kLuminanceWeights);
     U += nu - unshot[j];
     unshot[j] = nu;
   };

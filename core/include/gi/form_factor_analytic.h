@@ -9,6 +9,8 @@
 // (midpoint subdivision), and where a sub-triangle's one-point value and its
 // four quarters' differ by more than a tolerance, the quarters are split again.
 #pragma once
+#include <algorithm>
+
 #include <glm/glm.hpp>
 
 namespace gi {
@@ -18,6 +20,14 @@ namespace gi {
 double lambertEdgeTerm(const glm::dvec3& v0, const glm::dvec3& v1, const glm::dvec3& n);
 
 // Triangle (a, b, c), seen from either side; 0 if it lies behind x's tangent plane.
+// How far the farthest of a, b, c lies in front of the plane through o with
+// unit normal n (negative: wholly behind it). Up to the scene's ray offset a
+// triangle counts as in the plane: it exchanges nothing with a surface there.
+inline double heightAbovePlane(const glm::dvec3& n, const glm::dvec3& o, const glm::dvec3& a, const glm::dvec3& b,
+                               const glm::dvec3& c) {
+  return std::max({glm::dot(n, a - o), glm::dot(n, b - o), glm::dot(n, c - o)});
+}
+
 double pointToTriangleFormFactor(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3& a, const glm::dvec3& b,
                                  const glm::dvec3& c);
 

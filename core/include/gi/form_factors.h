@@ -120,7 +120,6 @@ class FormFactors {
   std::vector<double> area_;
   std::vector<glm::vec3> normal_;
   std::vector<uint8_t> ok_;
-  std::vector<uint8_t> reversedCopy_;  // the hemicube method's (else empty): the face has a reversed copy
   mutable std::vector<uint64_t> rays_;        // per patch, for the statistics
   mutable std::vector<uint64_t> farSkipped_;  // per patch, for the statistics
   std::vector<glm::dvec3> centroid_;
