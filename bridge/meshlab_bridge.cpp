@@ -210,12 +210,15 @@ ProgressFn progressFrom(vcg::CallBackPos* cb) {
   // meshlabserver prints every call's message: pass on only new stages and
   // steps of 5%, which is also all a progress bar needs.
   auto last = std::make_shared<std::pair<int, std::string>>(-100, "");
+  auto timeLeft = std::make_shared<TimeLeft>();
   // meshlabserver prints each label as it comes, without a separator.
   const bool server = QCoreApplication::applicationFilePath().endsWith("meshlabserver");
-  return [cb, last, server](int pct, const std::string& stage) {
+  return [cb, last, server, timeLeft](int pct, const std::string& stage) {
     if (stage == last->second && pct < last->first + 5 && pct < 100) return true;
     *last = {pct, stage};
-    const std::string label = server ? stage + " " + std::to_string(pct) + "%\n" : stage;
+    const std::string left = timeLeft->text(pct);
+    const std::string shown = left.empty() ? stage : stage + ", " + left;
+    const std::string label = server ? shown + " " + std::to_string(pct) + "%\n" : shown;
     cb(pct, label.c_str());
     return true;
   };

@@ -50,14 +50,17 @@ ProgressFn stderrProgress(bool quiet) {
   const bool tty = isatty(fileno(stderr));
   auto last = std::make_shared<int>(-1);
   auto lastStage = std::make_shared<std::string>();
-  return [tty, last, lastStage](int pct, const std::string& stage) {
+  auto timeLeft = std::make_shared<TimeLeft>();
+  return [tty, last, lastStage, timeLeft](int pct, const std::string& stage) {
     if (pct == *last && stage == *lastStage) return true;
+    const std::string left = timeLeft->text(pct);
     if (tty) {
       const int w = 30, fill = pct * w / 100;
-      std::fprintf(stderr, "\r[%.*s%*s] %3d%% %-28s", fill, "##############################", w - fill, "", pct, stage.c_str());
+      std::fprintf(stderr, "\r[%.*s%*s] %3d%% %-28s %-22s", fill, "##############################", w - fill, "", pct,
+                   stage.c_str(), left.c_str());
       if (pct >= 100) std::fputc('\n', stderr);
     } else if (pct / 10 != *last / 10 || stage != *lastStage) {
-      std::fprintf(stderr, "%3d%% %s\n", pct, stage.c_str());
+      std::fprintf(stderr, "%3d%% %s%s\n", pct, stage.c_str(), left.empty() ? "" : (" (" + left + ")").c_str());
     }
     *last = pct;
     *lastStage = stage;

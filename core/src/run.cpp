@@ -1,8 +1,10 @@
 #include "gi/run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -70,6 +72,30 @@ void parallelBlocks(size_t n, const Progress& progress, const std::string& stage
 Timer::Timer() : t0_(std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count()) {}
 double Timer::seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count() - t0_;
+}
+
+TimeLeft::TimeLeft(std::function<double()> clock) : clock_(std::move(clock)) {
+  if (!clock_) {
+    auto t = std::make_shared<Timer>();
+    clock_ = [t] { return t->seconds(); };
+  }
+  t0_ = clock_();
+}
+
+std::string TimeLeft::text(int percent) const {
+  constexpr double kQuietSeconds = 5.0;
+  const double t = clock_() - t0_;
+  if (percent < 1 || percent >= 100 || !(t >= kQuietSeconds)) return "";
+  return "about " + roughDuration(t * double(100 - percent) / double(percent)) + " left";
+}
+
+std::string roughDuration(double seconds) {
+  if (!(seconds < 1e9)) return "a very long time";
+  if (seconds < 57.5) return std::to_string(std::max(1L, std::lround(seconds / 5.0)) * 5) + " s";
+  if (seconds < 3600 - 30) return std::to_string(std::max(1L, std::lround(seconds / 60.0))) + " min";
+  const long minutes = std::lround(seconds / 300.0) * 5;
+  const long h = minutes / 60, m = minutes % 60;
+  return std::to_string(h) + " h" + (m ? " " + std::to_string(m) + " min" : "");
 }
 
 }  // namespace gi

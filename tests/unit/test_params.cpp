@@ -431,6 +431,36 @@ TEST(RunStats, LineShowsWarningsBeforeNotes) {
   EXPECT_EQ(st.line("T"), "T: rays=10; WARNING: not converged; skipped nothing");
 }
 
+// The time left is the elapsed time scaled by the share still to do, said
+// only after the first seconds and the first percent, and rounded as a
+// person reads it.
+TEST(TimeLeft, ExtrapolatesTheProgressAndStaysQuietAtFirst) {
+  double now = 100.0;
+  const gi::TimeLeft left([&now] { return now; });
+  EXPECT_EQ(left.text(50), "");  // no time has passed
+  now = 103.0;
+  EXPECT_EQ(left.text(60), "");  // under 5 s
+  now = 110.0;
+  EXPECT_EQ(left.text(0), "");    // nothing done yet
+  EXPECT_EQ(left.text(100), "");  // finished
+  EXPECT_EQ(left.text(25), "about 30 s left");    // 10 s for 25%: 30 s for 75%
+  EXPECT_EQ(left.text(1), "about 17 min left");   // 10 s x 99 = 990 s
+  now = 700.0;
+  EXPECT_EQ(left.text(10), "about 1 h 30 min left");  // 600 s x 9
+  EXPECT_EQ(left.text(99), "about 5 s left");         // 6.06 s
+}
+
+TEST(TimeLeft, RoughDurations) {
+  EXPECT_EQ(gi::roughDuration(0.2), "5 s");
+  EXPECT_EQ(gi::roughDuration(44), "45 s");
+  EXPECT_EQ(gi::roughDuration(58), "1 min");
+  EXPECT_EQ(gi::roughDuration(3569), "59 min");
+  EXPECT_EQ(gi::roughDuration(3600), "1 h");
+  EXPECT_EQ(gi::roughDuration(3 * 3600 + 7 * 60), "3 h 5 min");
+  EXPECT_EQ(gi::roughDuration(1e300), "a very long time");
+  EXPECT_EQ(gi::roughDuration(std::nan("")), "a very long time");
+}
+
 // An enumeration's table gives its dialog choices, log names and values by
 // one list: index <-> value both ways, out-of-range choices refused.
 TEST(EnumTable, ChoicesLogNamesAndValuesFromOneList) {

@@ -59,4 +59,25 @@ class Timer {
   double t0_;
 };
 
+// The time a run still needs, extrapolated from its overall progress: the
+// elapsed time t times (100 - p) / p at p percent. Stages of unequal cost
+// per percent make it a rough guide, so it is rounded (roughDuration) and
+// said only once the run has taken a few seconds and done 1% of its work.
+// The front ends append it to the stage they show.
+class TimeLeft {
+ public:
+  // clock: seconds from any origin (tests pass their own); default: wall clock.
+  explicit TimeLeft(std::function<double()> clock = {});
+  // "about 3 min left", or "" while no estimate is worth showing.
+  std::string text(int percent) const;
+
+ private:
+  std::function<double()> clock_;
+  double t0_;
+};
+
+// A duration as a person reads it: "45 s" (to 5 s), "12 min", "2 h 5 min"
+// (to 5 min beyond an hour).
+std::string roughDuration(double seconds);
+
 }  // namespace gi
