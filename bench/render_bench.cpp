@@ -110,7 +110,7 @@ std::vector<uint8_t> lightFreeMask(const Scene& s, const RayCaster& c, const Cam
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x)
       for (int k = 0; k < 16 && !sees[size_t(y) * size_t(W) + size_t(x)]; ++k)
-        if (reaches(cam.ray({x + (k % 4 + 0.5f) / 4.f, y + (k / 4 + 0.5f) / 4.f}, {0.5f, 0.5f}, s.origin)))
+        if (reaches(cam.ray({x + (k % 4 + 0.5f) / 4.f, y + (k / 4 + 0.5f) / 4.f}, {0.5f, 0.5f}, s.origin, s.unit)))
           sees[size_t(y) * size_t(W) + size_t(x)] = 1;
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x)
@@ -136,7 +136,7 @@ Image surfaceClasses(const Scene& s, const RayCaster& c, const Camera& cam) {
   Image out(cam.width(), cam.height());
   for (int y = 0; y < cam.height(); ++y)
     for (int x = 0; x < cam.width(); ++x) {
-      const Ray ray = cam.ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, s.origin);
+      const Ray ray = cam.ray({x + 0.5f, y + 0.5f}, {0.5f, 0.5f}, s.origin, s.unit);
       const Hit h = c.intersect(ray);
       glm::vec3& px = out.at(x, y);
       if (!h.valid()) { px = {10.f, 0.f, 0.f}; continue; }
@@ -333,7 +333,7 @@ int throughput(int w, int h, int spp, int repeats) {
         for (int y = ty; y < std::min(h, ty + 16); ++y)
           for (int x = tx; x < std::min(w, tx + 16); ++x) {
             const float jx = float((k * 7 + 3) % 16) / 16.f, jy = float((k * 11 + 5) % 16) / 16.f;
-            primary.push_back(base.camera.ray({x + jx, y + jy}, {0.5f, 0.5f}, s.origin));
+            primary.push_back(base.camera.ray({x + jx, y + jy}, {0.5f, 0.5f}, s.origin, s.unit));
           }
   const size_t tileRays = 256;  // one batch: a full tile's sample
   const size_t batches = (primary.size() + tileRays - 1) / tileRays;

@@ -139,7 +139,7 @@ void Camera::setLens(double apertureRadius, double focusDistance) {
   if (focusDistance > 0.0) focus_ = focusDistance;
 }
 
-Ray Camera::ray(glm::vec2 film, glm::vec2 lens, const glm::dvec3& origin) const {
+Ray Camera::ray(glm::vec2 film, glm::vec2 lens, const glm::dvec3& origin, double unit) const {
   const double px = (film.x - cx_) / pixelsPerTan_, py = (cy_ - film.y) / pixelsPerTan_;
   glm::dvec3 o = eye_, d;
   if (ortho_) {
@@ -155,7 +155,7 @@ Ray Camera::ray(glm::vec2 film, glm::vec2 lens, const glm::dvec3& origin) const 
     }
   }
   Ray r;
-  r.o = glm::vec3(o - origin);
+  r.o = glm::vec3((o - origin) / unit);
   r.d = glm::vec3(glm::normalize(d));
   return r;
 }

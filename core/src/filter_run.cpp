@@ -56,6 +56,11 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   const double diagonal = sceneDiagonal(in.scene);
   if (auto err = validate(specs, in.values, diagonal)) throw std::invalid_argument(*err);
   const ParamValues& v = in.values;
+  // Vertex colours that display the light an earlier lighting filter left
+  // (radiosity, photon mapping, the reference, sky lighting, a view's vertex
+  // radiance) are not the surfaces' colours.
+  for (const char* shown : {"Radiosity", "Irradiance", "Radiance", "Reference"})
+    if (in.attrs.vertexColorShows.empty() && in.attribute(shown)) in.attrs.vertexColorShows = shown;
   if (v.has("reflectance_source"))
     if (auto err = applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog))
       throw std::invalid_argument(*err);
@@ -344,6 +349,8 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   // from a run on a machine with more memory.
   if (capped) res.stats.warn(lowered + " (the solve's memory plan follows it)");
   res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
+  // Its direct part, for a two-pass view (as photon mapping leaves it).
+  if (r.Bdirect.size() == r.Bvertex.size()) res.attributes.push_back(vectorAttribute("RadiosityDirect", r.Bdirect));
   if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
   // Course outputs: snapshots as attributes, the residual per step in the log and a CSV.
   for (const RadiosityResult::Snapshot& sn : r.snapshots)
@@ -414,7 +421,7 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
       out[i] = {a->values[3 * i], a->values[3 * i + 1], a->values[3 * i + 2]};
   };
   perVertex("Radiosity", opt.firstPassB);
-  perVertex("RadiosityDirect", opt.firstPassBdirect);  // photon mapping's direct part, if it left one
+  perVertex("RadiosityDirect", opt.firstPassBdirect);  // the first pass's direct part, if it left one
   const auto caster = makeEmbreeCaster(in.scene);
   RenderResult r = render(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);

@@ -134,8 +134,15 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   const std::vector<glm::vec3> Hi =
       gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect);
   if (gather) res.stats.add("final_gather_seconds", gt.seconds());
-  for (size_t v = 0; v < s.vertexCount(); ++v)
-    res.Bvertex[v] = mat.valid[v] ? mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient) : glm::vec3(0.f);
+  res.Bdirect.assign(s.vertexCount(), glm::vec3(0.f));
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    if (!mat.valid[v]) {
+      res.Bvertex[v] = glm::vec3(0.f);
+      continue;
+    }
+    res.Bdirect[v] = mat.E[v] + mat.rho[v] * Hd[v];
+    res.Bvertex[v] = mat.E[v] + mat.rho[v] * (Hd[v] + Hi[v] + res.ambient);
+  }
   // A vertex of a two-sided surface (each face with a reversed copy) has
   // no normal, its faces' cancel (as has one whose normal in the file is
   // zero): no side to evaluate the light on. It takes the patch average of

@@ -16,6 +16,7 @@
 #include "gi/color.h"
 #include "gi/emitters.h"
 #include "gi/memory_limit.h"
+#include "gi/scene_setup.h"
 #include "render_internal.h"
 
 namespace gi {
@@ -96,7 +97,7 @@ void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o
           const uint32_t pixel = uint32_t(y) * uint32_t(W) + uint32_t(x);
           smp.emplace_back(hash3(pixel, o.seed, salt), uint32_t(k), qmc);
           const glm::vec2 u = smp[i].next2D(), lens = smp[i].next2D();
-          rays[i] = cam.ray({float(x) + u.x, float(y) + u.y}, lens, s.origin);
+          rays[i] = cam.ray({float(x) + u.x, float(y) + u.y}, lens, s.origin, s.unit);
         }
       caster.intersectBatch(rays.data(), n, hits.data());
       tl.counts.primary += n;
@@ -202,7 +203,12 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
 
 }  // namespace
 
-RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions& o, const Progress& progress) {
+RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions& optWorld, const Progress& progress) {
+  // Lengths and the point light in the scene's local units (Scene::unit); the
+  // camera stays in world coordinates and maps its rays itself.
+  RenderOptions o = optWorld;
+  o.point = pointLightInLocalUnits(optWorld.point, s);
+  o.causticMaxRadius = optWorld.causticMaxRadius / s.unit;
   validate(o);
   // One limit for the run. The image is checked first and the two-pass
   // mode's caustic photons get what it leaves: each checked alone against

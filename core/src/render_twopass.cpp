@@ -25,6 +25,7 @@
 #include "gi/color.h"
 #include "gi/direct.h"
 #include "gi/memory_limit.h"
+#include "gi/sky.h"
 #include "gi/specular.h"
 #include "render_internal.h"
 
@@ -115,10 +116,21 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
       }
     }
     if (Bd.empty()) {
-      // Estimated here, from the lights a first pass knows: the emitting faces and the point light.
+      // Estimated here, from this view's lights, taken to be the first
+      // pass's: the emitting faces, the sky and the sun, the point light.
       Timer t;
       std::vector<glm::vec3> Hd =
-          vertexDirectIrradiance(s, caster, kVertexDirectSamples, o.seed ^ 0x2b0du, progress.sub(0.5, 1.0));
+          vertexDirectIrradiance(s, caster, kVertexDirectSamples, o.seed ^ 0x2b0du, progress.sub(0.5, 0.75));
+      SkySun outside;
+      outside.skyRadiance = o.skyRadiance;
+      outside.sunDirection = o.sunDirection;
+      outside.sunIrradiance = o.sunIrradiance;
+      outside.sunAngularRadiusDeg = o.sunAngularRadiusDeg;
+      if (outside.any()) {
+        const std::vector<glm::vec3> Hout = vertexSkySunIrradiance(s, caster, outside, kVertexDirectSamples,
+                                                                   o.seed ^ 0x5c1du, VertexPart(), progress.sub(0.75, 1.0));
+        for (size_t i = 0; i < nv; ++i) Hd[i] += Hout[i];
+      }
       if (o.point.on()) {
         const float eps = float(sceneScale(s).rayEpsilon);
         const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);

@@ -20,8 +20,9 @@ std::vector<ParamSpec> geometrySceneSpecs() {
                .choices = kSceneExtents.choices(), .meshlabOnly = true});
   s.push_back({.name = "reflectance_source", .label = "Reflectance from",
                .help = "Where the diffuse reflectance (albedo) rho of each face comes from. 'Auto': face colour if "
-                       "the mesh has face colours, else the mean of its vertex colours, else the constant below. "
-                       "Colours are sRGB and are converted to linear reflectance. Every channel must stay below 1 "
+                       "the mesh has face colours, else the mean of its vertex colours, else the constant below. Vertex "
+                       "colours that show the light a lighting filter of this suite computed (its result's display) "
+                       "are no reflectance: 'Auto' then takes the constant. Colours are sRGB and are converted to linear reflectance. Every channel must stay below 1 "
                        "(energy conservation).",
                .type = ParamType::Enum, .def = kReflectanceSources.index(ReflectanceSource::Auto),
                .choices = kReflectanceSources.choices()});
@@ -217,7 +218,12 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
   const glm::vec3 constantLin(srgbToLinear(constant.r), srgbToLinear(constant.g), srgbToLinear(constant.b));
   const bool hasFace = a.faceColor.size() == nf && nf > 0;
   const bool hasVert = a.vertexColor.size() == s.vertexCount() && s.vertexCount() > 0;
-  if (src == ReflectanceSource::Auto) src = hasFace ? ReflectanceSource::FaceColor : hasVert ? ReflectanceSource::VertexColor : ReflectanceSource::Constant;
+  const bool auto_ = src == ReflectanceSource::Auto;
+  const bool resultColors = auto_ && !hasFace && hasVert && !a.vertexColorShows.empty();
+  if (auto_)
+    src = hasFace                    ? ReflectanceSource::FaceColor
+          : hasVert && !resultColors ? ReflectanceSource::VertexColor
+                                     : ReflectanceSource::Constant;
   if (src == ReflectanceSource::FaceColor && !hasFace) return std::string("reflectance from face colour was asked for, but the mesh has no face colours");
   if (src == ReflectanceSource::VertexColor && !hasVert) return std::string("reflectance from vertex colour was asked for, but the mesh has no vertex colours");
   s.rho.assign(nf, constantLin);
@@ -242,6 +248,9 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
     for (int k = 0; k < 3; ++k)
       if (r[k] > 0.999f) { r[k] = 0.999f; ++clamped; }
   *msg = std::string("reflectance from ") + kReflectanceSources.logName(src);
+  if (resultColors)
+    *msg += " (the vertex colours display an earlier filter's result, " + a.vertexColorShows +
+            ", not a reflectance: choose 'Vertex color' to use them anyway)";
   if (clamped) *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
   return std::nullopt;
 }

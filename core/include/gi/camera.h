@@ -63,8 +63,9 @@ class Camera {
   // The eye ray through film position (x, y) in pixels (0,0 = top-left corner
   // of the image, x right, y down; pixel (i, j) covers [i, i+1) x [j, j+1))
   // and lens sample u in [0,1)^2, in the local coordinates of a scene whose
-  // origin is `sceneOrigin`. The direction is unit length.
-  Ray ray(glm::vec2 film, glm::vec2 lens, const glm::dvec3& sceneOrigin) const;
+  // origin is `sceneOrigin` and whose local unit is `sceneUnit` world lengths
+  // (Scene::origin, Scene::unit). The direction is unit length.
+  Ray ray(glm::vec2 film, glm::vec2 lens, const glm::dvec3& sceneOrigin, double sceneUnit = 1.0) const;
   // Film position (pixels) where a world point appears through the pinhole
   // (the lens centre); nothing for points behind the camera.
   std::optional<glm::dvec2> project(const glm::dvec3& world) const;

@@ -23,6 +23,10 @@ struct MeshAttributes {
   std::vector<float> faceQuality;
   std::vector<uint8_t> faceSelected;
   std::vector<uint8_t> vertexSelected;   // 1: selected (MeshLab's vertex selection, PLY vertex flags bit 0x20)
+  // Not empty where the vertex colours display a result an earlier filter
+  // left (its attribute's name, e.g. "Radiosity"): they are no reflectance,
+  // and the reflectance source 'Auto' passes them over.
+  std::string vertexColorShows;
 };
 
 enum class EmitterSource { SelectedFaces, QualityAbove, None, Auto };

@@ -1,0 +1,143 @@
+// The ray-traced view where the scene is kept in a local unit (Scene::unit:
+// scenes below 2^-10 or above 2^20 across), and the chain from a first pass
+// to the view through the filters as the front ends run them: the first
+// pass's direct part, and the vertex colours it leaves behind.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "gi/filter_run.h"
+#include "gi/render.h"
+#include "render_test_helpers.h"
+
+using namespace gi;
+using gi::test::SceneBuilder;
+
+namespace {
+
+// A floor of reflectance 0.5 (2 x 2, 4 x 4 cells) with a small lamp above it
+// facing down and a point light beside it, all scaled by s.
+Scene litFloor(double s) {
+  SceneBuilder b;
+  b.quad({-s, -s, 0}, {s, -s, 0}, {s, s, 0}, {-s, s, 0}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, 4);
+  const double a = 0.1 * s, h = 0.8 * s;
+  b.quad({-a, -a, h}, {-a, a, h}, {a, a, h}, {a, -a, h}, glm::vec3(0.f), glm::vec3(3.f));
+  return b.build();
+}
+
+RenderOptions viewOf(double s, RenderMode mode) {
+  RenderOptions o;
+  o.mode = mode;
+  o.samplesPerPixel = 4;
+  o.camera = Camera::lookAt(glm::dvec3(0.3, -2.0, 1.5) * s, glm::dvec3(0.0), {0, 0, 1}, 40.0, 24, 24);
+  o.point.position = glm::vec3(glm::dvec3(0.5, 0.2, 0.6) * s);  // relative to the scene origin, in world lengths
+  o.point.intensity = glm::vec3(float(0.4 * s * s));             // I cos / r^2: the same radiance at every scale
+  return o;
+}
+
+}  // namespace
+
+// The camera and the point light are given in world coordinates; the
+// scene 1e-5 and 1e7 across is traced in its own unit (2^-17 and 2^23), so
+// the image must be the scale-1 image (up to float rounding of the
+// positions). Before the camera's rays and the point light were mapped to
+// the local unit, the small scene showed nothing and the large one the
+// floor's corner.
+TEST(RenderUnits, SmallAndLargeScenesGiveTheScaleOneImage) {
+  for (const RenderMode mode : {RenderMode::Whitted, RenderMode::Distributed}) {
+    const Scene s1 = litFloor(1.0);
+    ASSERT_EQ(s1.unit, 1.0);
+    const auto c1 = makeEmbreeCaster(s1);
+    const Image ref = render(s1, *c1, viewOf(1.0, mode), Progress(nullptr)).image;
+    ASSERT_GT(gi::test::meanLuminance(ref), 0.01);  // 0.023: the floor fills a third of the view
+    for (const double s : {1e-5, 1e7}) {
+      const Scene sc = litFloor(s);
+      ASSERT_NE(sc.unit, 1.0) << s;
+      const auto c = makeEmbreeCaster(sc);
+      const Image img = render(sc, *c, viewOf(s, mode), Progress(nullptr)).image;
+      ASSERT_EQ(img.px.size(), ref.px.size());
+      double worst = 0;
+      for (size_t p = 0; p < ref.px.size(); ++p)
+        worst = std::max(worst, double(glm::length(img.px[p] - ref.px[p])) / (glm::length(ref.px[p]) + 1e-3));
+      EXPECT_LT(worst, 1e-3) << "scale " << s << ", mode " << renderModeName(mode);
+    }
+  }
+}
+
+namespace {
+
+// A floor (4 x 4 cells of 1 x 1) under a uniform sky of irradiance pi:
+// B = rho E = 0.5029 pi, radiance rho E / pi = rho everywhere (sRGB 188).
+FilterInput skyFloor(FilterKind kind) {
+  SceneBuilder b;
+  b.quad({-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}, glm::vec3(0.f), glm::vec3(0.f), Material::Diffuse, 4);
+  FilterInput in;
+  in.scene = b.build();
+  in.values = defaultValues(filterSpecs(kind), 4.0 * std::sqrt(2.0));
+  in.values.set("sky_irradiance", M_PI);
+  in.values.set("emitter_source", kEmitterSources.index(EmitterSource::None));
+  return in;
+}
+
+double floorRadianceInTwoPass(const std::vector<VertexAttribute>& firstPass, TwoPassDiffuse diffuse) {
+  FilterInput in = skyFloor(FilterKind::RayTracedView);
+  in.attributes = firstPass;
+  in.values.set("mode", kRenderModes.index(RenderMode::TwoPass));
+  in.values.set("two_pass_diffuse", kTwoPassDiffuse.index(diffuse));
+  in.values.set("camera", 1);  // Look at
+  in.values.set("eye", glm::vec3(0.f, 0.f, 3.f));
+  in.values.set("target", glm::vec3(0.f));
+  in.values.set("width", 16);
+  in.values.set("height", 16);
+  in.values.set("samples_per_pixel", 4);
+  const FilterResult r = runFilter(FilterKind::RayTracedView, in);
+  EXPECT_EQ(r.images.size(), 1u);
+  return r.images.empty() ? 0.0 : gi::test::meanLuminance(r.images[0].image);
+}
+
+}  // namespace
+
+// A first pass by radiosity under a sky, then the two-pass view under the
+// same sky: its direct light is ray-traced again, so the first pass's own
+// direct part must come out of the stored light, whether radiosity left it
+// (RadiosityDirect) or the view estimates it (the sky and sun included).
+// Before, the sky's direct light was counted twice (radiance 2 rho).
+TEST(RenderUnits, TwoPassAfterRadiosityUnderASkyCountsItOnce) {
+  FilterInput first = skyFloor(FilterKind::Radiosity);
+  const FilterResult r = runFilter(FilterKind::Radiosity, first);
+  ASSERT_NE(r.attribute("RadiosityDirect"), nullptr);
+  const double rho = srgbToLinear(188.f / 255.f);
+  for (const TwoPassDiffuse d : {TwoPassDiffuse::DirectIndirect, TwoPassDiffuse::Caustics}) {
+    EXPECT_NEAR(floorRadianceInTwoPass(r.attributes, d), rho, 0.002 * rho) << "with RadiosityDirect";
+    std::vector<VertexAttribute> withoutDirect;
+    for (const VertexAttribute& a : r.attributes)
+      if (a.name != "RadiosityDirect") withoutDirect.push_back(a);
+    EXPECT_NEAR(floorRadianceInTwoPass(withoutDirect, d), rho, 0.002 * rho) << "estimated by the view";
+  }
+}
+
+// The vertex colours a lighting filter writes display its result: the
+// reflectance source 'Auto' passes them over (the constant, sRGB 188), where
+// before a second run took the display's white as a reflectance of 0.999.
+TEST(RenderUnits, AutoReflectancePassesOverAResultsColours) {
+  FilterInput first = skyFloor(FilterKind::Radiosity);
+  const FilterResult r = runFilter(FilterKind::Radiosity, first);
+  ASSERT_EQ(r.vertexColor.size(), first.scene.vertexCount());
+  for (const bool withResult : {true, false}) {
+    FilterInput again = skyFloor(FilterKind::Radiosity);
+    again.attrs.vertexColor.clear();
+    for (const Rgb8& c : r.vertexColor) again.attrs.vertexColor.push_back({c.r, c.g, c.b});
+    if (withResult) again.attributes = r.attributes;
+    const FilterResult r2 = runFilter(FilterKind::Radiosity, again);
+    EXPECT_NE(r2.setupLog.find(withResult ? "reflectance from constant" : "reflectance from vertex colour"),
+              std::string::npos)
+        << r2.setupLog;
+    const VertexAttribute* B = r2.attribute("Radiosity");
+    ASSERT_NE(B, nullptr);
+    const double rho = srgbToLinear(188.f / 255.f);
+    if (withResult) {
+      EXPECT_NEAR(B->values[0], rho * M_PI, 0.01 * rho * M_PI);
+    }
+  }
+}
