@@ -15,6 +15,7 @@
 
 #include "atomic_file.h"
 #include "mesh_parts.h"
+#include "output_files.h"
 #include "vertex_file.h"
 
 namespace gi::io {
@@ -79,8 +80,16 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
     const std::string folder = path.substr(0, path.rfind('/') + 1);
     for (const std::string& lib : declared.materialFiles) {
       const std::string file = folder + lib;
-      std::ifstream f(file, std::ios::binary);
-      if (f) detail::checkMaterial(std::string{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()}, file);
+      std::error_code ec;
+      if (!std::filesystem::exists(file, ec)) continue;  // OpenMesh reads the mesh without it
+      std::string material;
+      try {
+        // A pipe or a device would block OpenMesh or never end; 64 MB is far beyond any material library.
+        material = files::readTextFile(file, "material library", size_t(64) << 20);
+      } catch (const std::invalid_argument& e) {
+        failRead(name, e.what());
+      }
+      detail::checkMaterial(material, file);
     }
   } else {
     for (size_t at : declared.materialLines) text[at] = '#';  // from memory: no library is opened

@@ -6,6 +6,8 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <stdexcept>
 
@@ -58,6 +60,22 @@ void checkWritable(const Named& out, std::map<std::string, std::string>& folders
 }
 
 }  // namespace
+
+std::string readTextFile(const std::string& path, const std::string& what, size_t maxBytes) {
+  const std::string name = "the " + what + " " + (path.empty() ? std::string("''") : path);
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (path.empty() || !fs::exists(st)) throw std::invalid_argument(name + " does not exist");
+  if (fs::is_directory(st)) throw std::invalid_argument(name + " is a folder, not a file");
+  if (!fs::is_regular_file(st)) throw std::invalid_argument(name + " is not a regular file (a pipe or a device)");
+  const uintmax_t size = fs::file_size(path, ec);
+  if (ec || size > maxBytes)
+    throw std::invalid_argument(name + (ec ? " cannot be read" : " is larger than " + std::to_string(maxBytes >> 20) + " MB"));
+  std::ifstream f(path, std::ios::binary);
+  std::string text{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  if (!f.good() && !f.eof()) throw std::invalid_argument(name + " cannot be read (" + std::strerror(errno) + ")");
+  return text;
+}
 
 void checkWritable(const Named& out) {
   std::map<std::string, std::string> folders;

@@ -30,6 +30,13 @@ void checkWritable(const Named& out);
 // readers.
 void check(const std::vector<Named>& inputs, const std::vector<Named>& outputs);
 
+// The whole text of a file the run reads besides its meshes (a manifest, a
+// parameter file, a cached result, an OBJ's material library). Throws
+// std::invalid_argument "the WHAT PATH ...: WHY" (one sentence) where it is
+// missing, a folder, not a regular file (a pipe or a device would block or
+// never end) or larger than maxBytes.
+std::string readTextFile(const std::string& path, const std::string& what, size_t maxBytes = size_t(1) << 30);
+
 // The writer of gi::writeOutputFiles that writes each file whole or not at all.
 FileWriter atomicWriter();
 

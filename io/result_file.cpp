@@ -1,5 +1,7 @@
 #include "result_file.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -7,6 +9,7 @@
 
 #include "atomic_file.h"
 #include "json_text.h"
+#include "output_files.h"
 
 namespace gi::io {
 
@@ -74,10 +77,14 @@ void writeResultFile(const std::string& path, const ResultKey& key, const Filter
 }
 
 ResultKey readResultFile(const std::string& path, FilterResult& r) {
-  std::ifstream f(path);
-  if (!f) throw std::runtime_error("cannot read " + path + ": no such file");
+  std::string text;
   try {
-    const json j = json::parse(f);
+    text = files::readTextFile(path, "cached result");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
+  }
+  try {
+    const json j = json::parse(text);
     if (j.at("format") != "gi-result" || j.at("version") != 1) throw std::runtime_error("not a gi result file (version 1)");
     ResultKey key{j.at("filter"), j.at("file"), std::stoull(j.at("scene_hash").get<std::string>(), nullptr, 16),
                   j.at("parameters")};
@@ -98,6 +105,13 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
     }
     if (r.vertexQuality.size() != nv || (!r.vertexColor.empty() && r.vertexColor.size() != nv))
       throw std::runtime_error("array sizes do not match the vertex count");
+    // JSON numbers beyond float range become infinities: no result holds one.
+    auto finite = [](const std::vector<float>& v) {
+      return std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); });
+    };
+    bool allFinite = finite(r.vertexQuality) && finite(r.faceQuality) && finite(n);
+    for (const VertexAttribute& a : r.attributes) allFinite = allFinite && finite(a.values);
+    if (!allFinite) throw std::runtime_error("it holds a value that is not a finite number in float range");
     r.files.clear();
     if (j.contains("files"))
       for (const auto& x : j.at("files")) r.files.push_back({x.at("path"), x.at("text")});

@@ -96,11 +96,10 @@ Texts parameterPairs(const std::vector<std::string>& w, size_t from, const std::
 // A parameter file: {"filter": "ao" or its MeshLab name, "parameters": {name: value}};
 // values as the CLI takes them ("10%", "255,255,255"), or JSON numbers, booleans and [x, y, z].
 std::pair<std::string, Texts> readParamsFile(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw std::invalid_argument("cannot read the parameter file " + path);
+  const std::string text = files::readTextFile(path, "parameter file", size_t(64) << 20);
   json j;
   try {
-    j = json::parse(f);
+    j = json::parse(text);
   } catch (const std::exception& e) {
     throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
   }
@@ -128,8 +127,9 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw std::invalid_argument("the manifest " + path + " is a folder: give a file listing the meshes, or --dir for a folder of meshes");
-  std::ifstream f(path);
-  if (!f) throw std::invalid_argument("cannot read the manifest " + path);
+  std::string text = files::readTextFile(path, "manifest", size_t(256) << 20);
+  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark is no part of a name
+  std::istringstream f(text);
   const fs::path base = fs::path(path).parent_path();
   std::vector<Job> jobs;
   std::string line;
@@ -215,11 +215,9 @@ std::string jobHash(const std::string& filter, const Texts& params, const std::s
 }
 
 json readJson(const fs::path& p) {
-  std::ifstream f(p);
-  if (!f) return nullptr;
   try {
-    return json::parse(f);
-  } catch (const std::exception&) {
+    return json::parse(files::readTextFile(p.string(), "summary"));
+  } catch (const std::exception&) {  // missing, not a regular file, not JSON: no summary
     return nullptr;
   }
 }
@@ -378,7 +376,14 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   if (!fs::is_directory(a.outDir)) throw std::invalid_argument("cannot create the output folder " + a.outDir);
   checkFiles(a, d, common, jobs, shard, shards, explicitShard);
   int threads = a.threads;
-  if (threads == 0 && std::getenv("SLURM_CPUS_PER_TASK")) threads = std::max(1, std::atoi(std::getenv("SLURM_CPUS_PER_TASK")));
+  if (const char* slurm = std::getenv("SLURM_CPUS_PER_TASK"); threads == 0 && slurm) {
+    // As --threads: 1 to 4096 (a larger figure is no machine's and a text is none).
+    char* end = nullptr;
+    const long n = std::strtol(slurm, &end, 10);
+    if (end == slurm || *end != '\0' || n < 1 || n > 4096)
+      throw std::invalid_argument(std::string("SLURM_CPUS_PER_TASK = '") + slurm + "' is not a thread count in [1, 4096]");
+    threads = int(n);
+  }
   std::unique_ptr<tbb::global_control> cap;
   if (threads > 0) cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(threads));
 
@@ -470,6 +475,10 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     std::cerr << b << "\n";
     for (const json& f : failures) std::cerr << "  FAILED " << f["input"].get<std::string>() << ": " << f["error"].get<std::string>() << "\n";
     std::cerr << "wrote " << (fs::path(a.outDir) / name).string() << "\n";
+  } else if (failed || missing) {  // quiet, but a failed run still says why it exits 1
+    std::cerr << "gi: error: " << failed << " of " << meshes << " meshes failed"
+              << (missing ? ", " + std::to_string(missing) + " missing" : std::string()) << " (see "
+              << (fs::path(a.outDir) / name).string() << ")\n";
   }
   return failed || missing ? 1 : 0;
 }

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -233,11 +235,18 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   const io::ResultKey key{desc.cliName, a.input, sceneHash(in.scene), describe(specs, in.values)};
   const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
   bool reused = false;
-  if (!cached.empty() && std::ifstream(cached)) {
+  std::error_code noFile;
+  if (!cached.empty() && std::filesystem::exists(cached, noFile)) {
     FilterResult stored = r;
     const io::ResultKey k = io::readResultFile(cached, stored);
+    // The text files a result rewrites are those its parameters name, and
+    // no others (a cache file is not trusted to choose where to write).
+    const FilterFiles plan = filterFiles(kind, in.values);
+    const bool filesNamed = std::all_of(stored.files.begin(), stored.files.end(), [&](const FilterFile& f) {
+      return std::any_of(plan.writes.begin(), plan.writes.end(), [&](const NamedFile& w) { return w.path == f.path; });
+    });
     reused = k.filter == key.filter && k.sceneHash == key.sceneHash && k.parameters == key.parameters &&
-             stored.vertexQuality.size() == in.scene.vertexCount();
+             stored.vertexQuality.size() == in.scene.vertexCount() && filesNamed;
     if (reused) {
       r = std::move(stored);
       r.stats.note("reused the cached result " + cached);

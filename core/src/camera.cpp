@@ -58,8 +58,11 @@ Camera Camera::frame(const glm::dvec3& lo, const glm::dvec3& hi, const glm::dvec
   const double vl = glm::length(viewDir);
   if (!(vl > 0.0) || !std::isfinite(vl)) throw std::invalid_argument("the view direction must be a non-zero vector");
   const glm::dvec3 fwd = viewDir / vl, c = (lo + hi) * 0.5;
-  // Orientation first (at unit distance), then the distance that fits the box.
-  const Camera probe = lookAt(c - fwd, c, up, fovYDeg, width, height);
+  // Orientation first (at a distance the box's coordinates can resolve: a
+  // unit step vanishes beside coordinates of 1e17), then the distance that
+  // fits the box.
+  const double reach = std::max({1.0, glm::length(c), glm::length(hi - lo)});
+  const Camera probe = lookAt(c - fwd * reach, c, up, fovYDeg, width, height);
   const double tanY = height / (2.0 * probe.pixelsPerTan_), tanX = tanY * width / double(height);
   double dist = 0.0, nearest = 0.0;
   for (int k = 0; k < 8; ++k) {

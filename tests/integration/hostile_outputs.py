@@ -11,6 +11,7 @@ Each check returns a list of failures (empty: passed); hostile_input.py
 prints them with its own cases.
 """
 import json
+import math
 import os
 import resource
 import signal
@@ -33,14 +34,14 @@ def fast(args):
     return args + extra
 
 
-def run(cmd, limit=None, timeout=120, cwd=None):
+def run(cmd, limit=None, timeout=120, cwd=None, env=None):
     """(exit status, stdout bytes, stderr lines); limit: RLIMIT_FSIZE in bytes (writes beyond it fail with EFBIG)."""
     def small_files():
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
     try:
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=timeout, cwd=cwd,
-                           preexec_fn=small_files if limit else None)
+                           preexec_fn=small_files if limit else None, env=dict(os.environ, **env) if env else None)
     except subprocess.TimeoutExpired:
         return None, b"", ["timeout"]
     return p.returncode, p.stdout, [l for l in p.stderr.decode("utf-8", "replace").splitlines() if l.strip()]
@@ -262,8 +263,77 @@ def check_numbers_and_batches(gi, tmp):
     return failures
 
 
+def check_side_files(gi, tmp):
+    """Files a run reads besides its meshes (an OBJ's material library, a manifest, a parameter file, a cached
+    result) that are pipes, devices or folders, or a cache file altered by hand: one line, never a hang or an
+    endless read, never a value beyond float range written, never a file the parameters do not name."""
+    failures = []
+    d = os.path.join(tmp, "side")
+    os.makedirs(d)
+    cornell(d)
+    os.mkfifo(os.path.join(d, "pipe"))
+    tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    up = "../" * 40
+    for name, lib in (("fifo.obj", "pipe"), ("zero.obj", up + "dev/zero"), ("dir.obj", ".")):
+        with open(os.path.join(d, name), "w") as f:
+            f.write("mtllib %s\n%s" % (lib, tri))
+    with open(os.path.join(d, "missing.txt"), "w") as f:
+        f.write("no_such_mesh.ply\n")
+    cases = [  # (what, arguments, fragment, environment)
+        ("an OBJ whose material library is a pipe", ["ao", "fifo.obj", "-o", "o.ply", "-q"], "not a regular file", None),
+        ("an OBJ whose material library is /dev/zero", ["ao", "zero.obj", "-o", "o.ply", "-q"], "not a regular file", None),
+        ("an OBJ whose material library is its folder", ["ao", "dir.obj", "-o", "o.ply", "-q"], "is a folder", None),
+        ("a pipe as the manifest", ["batch", "ao", "--manifest", "pipe", "-o", "bout"], "not a regular file", None),
+        ("a pipe as the parameter file", ["batch", "ao", "--params", "pipe", "--manifest", "missing.txt", "-o", "bout"],
+         "not a regular file", None),
+        ("a failed mesh in a quiet batch", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout"],
+         "1 of 1 meshes failed", None),
+        ("SLURM_CPUS_PER_TASK beyond int", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout"],
+         "SLURM_CPUS_PER_TASK", {"SLURM_CPUS_PER_TASK": "99999999999"}),
+    ]
+    for what, args, fragment, env in cases:
+        rc, _, lines = run([gi] + args, cwd=d, timeout=60, env=env)
+        report(failures, what, one_error(rc, lines, fragment), rc, lines)
+    # A cached result altered by hand: a value beyond float range, a file the parameters do not name, a pipe.
+    cache = os.path.join(d, "cache")
+    os.makedirs(cache)
+    args = fast(["ao", "in.ply", "-o", "o.ply", "-q", "--cache", cache])
+    rc, _, lines = run([gi] + args, cwd=d)
+    stored = [os.path.join(cache, n) for n in os.listdir(cache)]
+    if rc != 0 or len(stored) != 1:
+        report(failures, "a first cached run", "expected exit 0 and one cache file", rc, lines)
+        return failures
+    with open(stored[0]) as f:
+        original = json.load(f)
+    beyond = dict(original, vertex_quality=[3.5e38] * len(original["vertex_quality"]))
+    evil = os.path.join(d, "written_by_the_cache.txt")
+    elsewhere = dict(original, files=[{"path": evil, "text": "x"}])
+    for what, content in (("a cached value beyond float range", beyond), ("a cached file no parameter names", elsewhere)):
+        with open(stored[0], "w") as f:
+            json.dump(content, f)
+        rc, _, lines = run([gi] + args, cwd=d)
+        out = read_quality(os.path.join(d, "o.ply")) if rc == 0 else []
+        if content is beyond:
+            why = one_error(rc, lines, "not a finite number")
+        else:
+            why = None if rc == 0 and not os.path.exists(evil) and out and all(math.isfinite(q) for q in out) else \
+                "expected a fresh run (exit 0) that writes no %s" % evil
+        report(failures, what, why, rc, lines)
+    os.remove(stored[0])
+    os.mkfifo(stored[0])
+    rc, _, lines = run([gi] + args, cwd=d, timeout=60)
+    report(failures, "a pipe as the cache file", one_error(rc, lines, "not a regular file"), rc, lines)
+    return failures
+
+
+def read_quality(path):
+    from plyread import read_ply
+    return [v["quality"] for v in read_ply(path)["vertex"]]
+
+
 def check_all(gi, tmp):
     failures = []
-    for check in (check_overwrite, check_failed_writes, check_early, check_latin1_names, check_numbers_and_batches):
+    for check in (check_overwrite, check_failed_writes, check_early, check_latin1_names, check_numbers_and_batches,
+                  check_side_files):
         failures += check(gi, tmp)
     return failures

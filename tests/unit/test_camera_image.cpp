@@ -69,9 +69,14 @@ TEST(Camera, ShotRoundTrip) {
 
 // Framing: every corner of the box is inside the image, and the box touches
 // the border (within the 2% margin): no wasted pixels.
+// Also for a box 1e30 across (framing took its orientation from a point one
+// unit in front of the centre, which coordinates of 1e30 cannot tell from
+// the centre: "the camera's eye and target must differ") and one far from
+// the origin.
 TEST(Camera, FrameFitsTheBox) {
-  const glm::dvec3 lo(-3, 0, 10), hi(5, 2, 13);
+  for (const double s : {1.0, 1e30, 1e-20})
   for (const glm::dvec3 dir : {glm::dvec3(0, 0, 1), glm::dvec3(1, -0.5, 0.3)}) {
+    const glm::dvec3 lo = glm::dvec3(-3, 0, 10) * s, hi = glm::dvec3(5, 2, 13) * s;
     const Camera c = Camera::frame(lo, hi, dir, {0, 1, 0}, 40.0, 300, 200);
     double margin = 1e9;
     for (int k = 0; k < 8; ++k) {
