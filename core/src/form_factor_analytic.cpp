@@ -42,6 +42,11 @@ namespace {
 struct Tri {
   glm::dvec3 a, b, c;
   glm::dvec3 centroid() const { return (a + b + c) / 3.0; }
+  // Distance from the centroid to the farthest corner.
+  double radius() const {
+    const glm::dvec3 m = centroid();
+    return std::sqrt(std::max({glm::dot(a - m, a - m), glm::dot(b - m, b - m), glm::dot(c - m, c - m)}));
+  }
   // Midpoint subdivision: three corner quarters and the middle one, all similar to this.
   std::array<Tri, 4> quarters() const {
     const glm::dvec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
@@ -61,6 +66,55 @@ std::vector<Tri> baseTriangles(const Tri& t, int level) {
   return out;
 }
 
+double distanceToSegment(const glm::dvec3& x, const glm::dvec3& p, const glm::dvec3& q) {
+  const glm::dvec3 d = q - p;
+  const double dd = glm::dot(d, d);
+  const double u = dd > 0 ? std::clamp(glm::dot(x - p, d) / dd, 0.0, 1.0) : 0.0;
+  return glm::length(x - (p + u * d));
+}
+
+// Where the midpoint rule cannot see its error: g changes across the
+// target's edges within a band as wide as the height h above the target's
+// plane, and across a target narrower than a sub-triangle, and a
+// sub-triangle whose sample points all miss such a band passes the
+// comparison (two plates 0.01 apart read F = 1.009 for 0.980; a strip 0.001
+// high at a common edge, -62%). So a sub-triangle within twice its radius r
+// of one of the target's edges is split whatever its points say where r
+// exceeds 3 h at its centroid (a band narrower than itself; faces meeting at
+// a common edge at more than about 20 degrees are left to the comparison,
+// which handles them) or the target's smallest altitude, unless even all of
+// g there stays below the tolerance: F <= A / (pi d^2) from any point at
+// least d from a target of area A (d bounded below by h less r).
+struct TargetEdges {
+  glm::dvec3 p[3];
+  glm::dvec3 unitNormal;
+  double area = 0, narrowest = 0;
+  TargetEdges(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) : p{a, b, c} {
+    const glm::dvec3 cr = glm::cross(b - a, c - a);
+    area = 0.5 * glm::length(cr);
+    unitNormal = area > 0 ? cr / (2.0 * area) : glm::dvec3(0.0);
+    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    narrowest = longest > 0 ? area / longest : 0.0;  // half the smallest altitude
+  }
+  bool mustSplit(const Tri& t, double tolPerShare) const {
+    const glm::dvec3 m = t.centroid();
+    const double r = t.radius();
+    const double h = std::fabs(glm::dot(unitNormal, m - p[0]));
+    // The band: only where the whole sub-triangle is on one side of the
+    // target's plane (one that crosses it has g going to 0 along the
+    // crossing, which the comparison follows, as at a common edge).
+    auto side = [&](const glm::dvec3& x) { return glm::dot(unitNormal, x - p[0]); };
+    const double ha = side(t.a), hb = side(t.b), hc = side(t.c);
+    const bool oneSide = (ha > 0 && hb > 0 && hc > 0) || (ha < 0 && hb < 0 && hc < 0);
+    if ((!oneSide || r <= 3.0 * h) && r <= narrowest) return false;
+    const double edge = std::min({distanceToSegment(m, p[0], p[1]), distanceToSegment(m, p[1], p[2]),
+                                  distanceToSegment(m, p[2], p[0])});
+    if (edge >= 2.0 * r) return false;
+    const double d = h - r;
+    return d <= 0 || area / (M_PI * d * d) > tolPerShare;
+  }
+};
+
 // w x (mean of g over t), given the one-point estimate wg = w g(centroid):
 // the quarters' estimate is accepted where it differs from the one-point one
 // by at most tolPerShare x w (the midpoint rule's error falls by about 4 per
@@ -70,15 +124,21 @@ std::vector<Tri> baseTriangles(const Tri& t, int level) {
 // refined in turn. The integrand is continuous (the point-to-triangle factor
 // goes to 0 where x reaches either plane) but its slope is unbounded along a
 // common edge, which is where the splitting concentrates.
+constexpr int kEdgeLevels = 6;
+
 template <class G>
-double refine(const Tri& t, double w, double wg, const G& g, int levelsLeft, double tolPerShare) {
+double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges& target, int levelsLeft,
+              double tolPerShare) {
   const auto q = t.quarters();
   // The middle quarter's centroid is t's own: its value is known.
   double wq[4] = {0.25 * w * g(q[0].centroid()), 0.25 * w * g(q[1].centroid()), 0.25 * w * g(q[2].centroid()), 0.25 * wg};
   double sum = wq[0] + wq[1] + wq[2] + wq[3];
-  if (levelsLeft <= 1 || std::fabs(sum - wg) <= tolPerShare * w) return sum;
+  // The comparison splits for up to levelsLeft levels, the target's edges
+  // for kEdgeLevels more (a strip 0.001 high at a common edge needs 11).
+  const bool compared = levelsLeft > kEdgeLevels && std::fabs(sum - wg) > tolPerShare * w;
+  if (levelsLeft <= 1 || (!compared && !target.mustSplit(t, tolPerShare))) return sum;
   sum = 0;
-  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, levelsLeft - 1, tolPerShare);
+  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, levelsLeft - 1, tolPerShare);
   return sum;
 }
 
@@ -120,8 +180,10 @@ double triangleToTriangleFormFactor(const glm::dvec3 s[3], const glm::dvec3 t[3]
   double Fbase = 0;
   for (size_t k = 0; k < base.size(); ++k) Fbase += (wg[k] = w * g(base[k].centroid()));
   const double tolPerShare = relTol * std::max(Fbase, FormFactors::kNegligibleF);
+  const TargetEdges target(t[0], t[1], t[2]);
   double F = 0;
-  for (size_t k = 0; k < base.size(); ++k) F += refine(base[k], w, wg[k], g, maxRefine, tolPerShare);
+  for (size_t k = 0; k < base.size(); ++k)
+    F += refine(base[k], w, wg[k], g, target, maxRefine + kEdgeLevels, tolPerShare);
   return F;
 }
 
@@ -169,9 +231,10 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     for (size_t k = 0; k < base.size(); ++k) Fbase += (wg[k] = w * g(xs[k]));
     const bool near = d < kNear * rBase;
     const double tolPerShare = kRelTol * std::max(Fbase, kFloorF);
+    const TargetEdges target(pa, pb, pc);
     double F = 0;
     for (size_t k = 0; k < base.size(); ++k) {
-      const double f = near ? refine(base[k], w, wg[k], g, kMaxRefine, tolPerShare) : wg[k];
+      const double f = near ? refine(base[k], w, wg[k], g, target, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
       if (f <= 0) continue;
       // Visibility: one ray per base point to a random point of j, for all of
       // that base sub-triangle's refined quarters (as many rays as before refinement).
