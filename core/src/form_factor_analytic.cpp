@@ -126,8 +126,10 @@ struct TargetEdges {
 // common edge, which is where the splitting concentrates.
 constexpr int kEdgeLevels = 6;
 
+// target: null for the comparison alone (levelsLeft levels); else its edges
+// split for kEdgeLevels levels beyond the comparison's levelsLeft - kEdgeLevels.
 template <class G>
-double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges& target, int levelsLeft,
+double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* target, int levelsLeft,
               double tolPerShare) {
   const auto q = t.quarters();
   // The middle quarter's centroid is t's own: its value is known.
@@ -135,8 +137,8 @@ double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges& 
   double sum = wq[0] + wq[1] + wq[2] + wq[3];
   // The comparison splits for up to levelsLeft levels, the target's edges
   // for kEdgeLevels more (a strip 0.001 high at a common edge needs 11).
-  const bool compared = levelsLeft > kEdgeLevels && std::fabs(sum - wg) > tolPerShare * w;
-  if (levelsLeft <= 1 || (!compared && !target.mustSplit(t, tolPerShare))) return sum;
+  const bool compared = levelsLeft > (target ? kEdgeLevels : 0) && std::fabs(sum - wg) > tolPerShare * w;
+  if (levelsLeft <= 1 || (!compared && !(target && target->mustSplit(t, tolPerShare)))) return sum;
   sum = 0;
   for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, levelsLeft - 1, tolPerShare);
   return sum;
@@ -180,10 +182,10 @@ double triangleToTriangleFormFactor(const glm::dvec3 s[3], const glm::dvec3 t[3]
   double Fbase = 0;
   for (size_t k = 0; k < base.size(); ++k) Fbase += (wg[k] = w * g(base[k].centroid()));
   const double tolPerShare = relTol * std::max(Fbase, FormFactors::kNegligibleF);
-  const TargetEdges target(t[0], t[1], t[2]);
+  // The comparison alone: the hierarchy splits its links itself (and its
+  // furnace and closure were measured with this rule).
   double F = 0;
-  for (size_t k = 0; k < base.size(); ++k)
-    F += refine(base[k], w, wg[k], g, target, maxRefine + kEdgeLevels, tolPerShare);
+  for (size_t k = 0; k < base.size(); ++k) F += refine(base[k], w, wg[k], g, nullptr, maxRefine, tolPerShare);
   return F;
 }
 
@@ -234,7 +236,7 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     const TargetEdges target(pa, pb, pc);
     double F = 0;
     for (size_t k = 0; k < base.size(); ++k) {
-      const double f = near ? refine(base[k], w, wg[k], g, target, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
+      const double f = near ? refine(base[k], w, wg[k], g, &target, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
       if (f <= 0) continue;
       // Visibility: one ray per base point to a random point of j, for all of
       // that base sub-triangle's refined quarters (as many rays as before refinement).
