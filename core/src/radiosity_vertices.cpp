@@ -34,14 +34,21 @@ namespace {
 // One ray per level is enough, as a vertex averages its many near hits; the
 // direct light keeps 4 light samples per point (with 1, a closed furnace
 // box gathered with 64 rays per vertex is 1% off at its corners).
-// Only for the converged solution: with a fixed bounce count the patch
-// values are what the count asks for.
+// For the converged solution; and for one bounce, where the light a near
+// hit reflects is its direct light alone (exact: no patch value needed).
+// With 2 or more bounces the patch values a near hit would need (its own
+// indirect light one bounce short) are not kept, so near hits read the
+// patch: an outside check (4 December 2026) found the ceiling's edge
+// vertices of a sealed room 25% bright with one bounce (fixed here) and
+// 6.6% with two (README, Limitations).
 constexpr int kNearLevels = 2;
 
 std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
                                       const RadiosityOptions& opt, RadiosityResult& res, const Progress& progress) {
   const uint32_t seed = opt.formFactors.seed;
-  const bool refineNear = opt.bounces < 0;
+  const bool refineNear = opt.bounces < 0 || opt.bounces == 1;
+  const bool nearIndirect = opt.bounces < 0;  // one bounce: a near hit reflects its direct light only
+  const int nearLevels = nearIndirect ? kNearLevels : 0;
   const DirectLightAt directAt(s, caster, 4);
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
@@ -63,7 +70,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     if (!refineNear || t > faceRead[f].nearT) return faceRead[f].R;
     nearHits.fetch_add(1, std::memory_order_relaxed);
     const glm::vec3 n = faceN[f], o = y + n * eps;
-    glm::vec3 Hi = res.Hindirect[f];
+    glm::vec3 Hi = nearIndirect ? res.Hindirect[f] : glm::vec3(0.f);
     if (levels > 0) {
       Ray r;
       r.o = o;
@@ -90,7 +97,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     std::memcpy(bits, &g.point, sizeof bits);
     const glm::vec2 u = PaddedSobol(hash3(g.vertex, seed, 0xfbu))(g.ray, 1);
     return reflectedAt(reflectedAt, g.face, g.point, g.t, u, hash3(bits[0] ^ seed, bits[1], bits[2] ^ g.face),
-                       kNearLevels);
+                       nearLevels);
   };
   // The rays' luminance statistics only where the vertices pool them.
   const bool share = opt.gatherShareRings > 0;
