@@ -6,16 +6,18 @@
 #include <stdexcept>
 
 #include "gi/error_map.h"
+#include "gi/render.h"
 
 namespace gi {
 
-namespace {
-
-// "dir/name.png" -> "dir/name"; a name without an extension stays whole.
-std::string stemOf(const std::string& path) {
+std::string imageStem(const std::string& path) {
   const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
   return dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(0, dot) : path;
 }
+
+std::string stdErrorImagePath(const std::string& imagePath) { return imageStem(imagePath) + "_stderr.png"; }
+
+namespace {
 
 void image(FilterFiles& f, const std::string& png, const std::string& parameter) {
   f.writes.push_back({png, parameter});
@@ -24,20 +26,23 @@ void image(FilterFiles& f, const std::string& png, const std::string& parameter)
 
 }  // namespace
 
-std::string pfmPath(const std::string& imagePath) { return stemOf(imagePath) + ".pfm"; }
+std::string pfmPath(const std::string& imagePath) { return imageStem(imagePath) + ".pfm"; }
 
 FilterFiles filterFiles(FilterKind kind, const ParamValues& v) {
   FilterFiles f;
   switch (kind) {
     case FilterKind::RayTracedView:
-      if (const std::string& p = v.getString("image_path"); !p.empty()) image(f, p, "image_path");
+      if (const std::string& p = v.getString("image_path"); !p.empty()) {
+        image(f, p, "image_path");
+        if (kRenderModes.get(v, "mode") == RenderMode::PathTraced) image(f, stdErrorImagePath(p), "image_path");
+      }
       break;
     case FilterKind::HemicubeOfFace:
       // runHemicube's three pictures: the cells at the path, NAME_dff and NAME_nusselt beside it.
       if (const std::string& p = v.getString("image_path"); !p.empty()) {
         image(f, p, "image_path");
-        image(f, stemOf(p) + "_dff.png", "image_path");
-        image(f, stemOf(p) + "_nusselt.png", "image_path");
+        image(f, imageStem(p) + "_dff.png", "image_path");
+        image(f, imageStem(p) + "_nusselt.png", "image_path");
       }
       break;
     case FilterKind::Radiosity:

@@ -233,9 +233,7 @@ void runHemicube(FilterInput& in, FilterResult& res) {
   for (size_t j = 0; j < F3.size(); ++j) F3[j] = glm::vec3(res.faceQuality[j]);
   for (const glm::vec3& x : faceToVertex(s, F3)) res.vertexQuality.push_back(x.x);
   const std::string path = v.getString("image_path");
-  const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
-  const std::string stem =
-      dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(0, dot) : path;
+  const std::string stem = imageStem(path);
   auto add = [&](const char* name, Image&& img, const std::string& p, double fovDeg) {
     FilterImage fi;
     fi.name = name;
@@ -439,6 +437,20 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
       res.vertexColor.push_back(displayMap(L, img.exposure));
     }
     res.attributes.push_back(vectorAttribute("Radiance", r.vertexRadiance));
+  }
+  if (opt.mode == RenderMode::PathTraced && r.stdError.size() == img.image.px.size()) {
+    // Its error bars as a picture of their own, at the image's exposure: the
+    // standard error of each pixel's luminance (grey).
+    FilterImage err;
+    err.name = "Path traced view, standard error per pixel";
+    err.image = Image(img.image.width, img.image.height);
+    for (size_t p = 0; p < r.stdError.size(); ++p) err.image.px[p] = glm::vec3(r.stdError[p]);
+    err.exposure = img.exposure;
+    err.camera = img.camera;
+    err.path = img.path.empty() ? "" : stdErrorImagePath(img.path);
+    res.images.push_back(std::move(img));
+    res.images.push_back(std::move(err));
+    return;
   }
   res.images.push_back(std::move(img));
 }

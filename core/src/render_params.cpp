@@ -143,8 +143,9 @@ std::vector<ParamSpec> RenderOptions::specs() {
   s.push_back(seedSpec("pixel samples, lights and photons"));
   s.push_back({.name = "image_path", .label = "Image file",
                .help = "Where to write the image: a PNG (sRGB at the exposure below) and, beside it, the linear "
-                       "radiance as a PFM (same name, .pfm) for numerical comparison. Empty: MeshLab shows the image "
-                       "as a raster layer only, and the command-line tool writes no image.",
+                       "radiance as a PFM (same name, .pfm) for numerical comparison; path traced, also each pixel's "
+                       "standard error as NAME_stderr.png and .pfm. Empty: MeshLab shows the images as raster layers "
+                       "only, and the command-line tool writes no image.",
                .type = ParamType::String});
   return s;
 }

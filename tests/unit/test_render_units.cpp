@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "gi/filter_files.h"
 #include "gi/filter_run.h"
 #include "gi/render.h"
 #include "render_test_helpers.h"
@@ -140,4 +141,42 @@ TEST(RenderUnits, AutoReflectancePassesOverAResultsColours) {
       EXPECT_NEAR(B->values[0], rho * M_PI, 0.01 * rho * M_PI);
     }
   }
+}
+
+// The path-traced view's error bars per pixel as a picture of their own
+// (raster layer in MeshLab, NAME_stderr.png and .pfm beside the image): the
+// standard error of each pixel's luminance, whose RMS is the log's
+// rms_std_error; the other modes give one picture, and the file plan names
+// the two error files only for path tracing.
+TEST(RenderUnits, PathTracedViewGivesItsErrorBarsPerPixel) {
+  FilterInput in = skyFloor(FilterKind::RayTracedView);
+  in.values.set("camera", 1);  // Look at
+  in.values.set("eye", glm::vec3(0.5f, -3.f, 2.f));
+  in.values.set("target", glm::vec3(0.f));
+  in.values.set("width", 16);
+  in.values.set("height", 12);
+  in.values.set("samples_per_pixel", 8);
+  in.values.set("image_path", std::string("dir/view.png"));
+  in.values.set("mode", kRenderModes.index(RenderMode::PathTraced));
+  FilterResult r = runFilter(FilterKind::RayTracedView, in);
+  ASSERT_EQ(r.images.size(), 2u);
+  EXPECT_EQ(r.images[1].path, "dir/view_stderr.png");
+  double sum2 = 0;
+  for (const glm::vec3& p : r.images[1].image.px) sum2 += double(p.r) * p.r;
+  const double rms = std::sqrt(sum2 / double(r.images[1].image.px.size()));
+  EXPECT_GT(rms, 0.0);
+  EXPECT_NEAR(rms, r.stats.get("rms_std_error"), 1e-6 * rms);
+  const FilterFiles plan = filterFiles(FilterKind::RayTracedView, in.values);
+  auto planned = [&](const std::string& path) {
+    for (const NamedFile& w : plan.writes)
+      if (w.path == path) return true;
+    return false;
+  };
+  EXPECT_TRUE(planned("dir/view_stderr.png") && planned("dir/view_stderr.pfm"));
+  in = skyFloor(FilterKind::RayTracedView);
+  in.values.set("width", 16);
+  in.values.set("height", 12);
+  in.values.set("image_path", std::string("dir/view.png"));
+  EXPECT_EQ(runFilter(FilterKind::RayTracedView, in).images.size(), 1u);  // distributed
+  EXPECT_EQ(filterFiles(FilterKind::RayTracedView, in.values).writes.size(), 2u);  // the PNG and the PFM
 }

@@ -34,6 +34,11 @@ FilterFiles filterFiles(FilterKind kind, const ParamValues& v);
 
 // Where an image's linear values go: beside its PNG, the same name with .pfm.
 std::string pfmPath(const std::string& imagePath);
+// "dir/name.png" -> "dir/name" (a name without an extension stays whole):
+// the stem the pictures beside an image are named from.
+std::string imageStem(const std::string& imagePath);
+// A path-traced view's standard error per pixel goes beside its image.
+std::string stdErrorImagePath(const std::string& imagePath);
 
 // Writes the file `path` by calling `write` with the path to write to; a
 // front end's writer may hand it a temporary and move that into place.
