@@ -44,6 +44,46 @@ std::vector<uint8_t> roomEdgeVertices(const Scene& s) {
   return edge;
 }
 
+// d = (B - ref) / ref over the edge vertices the reference traced: its
+// mean, the mean's standard error (from the spread of d) and its RMS.
+struct EdgeError {
+  int n = 0;
+  double mean = 0, sem = 0, rms = 0;
+};
+
+EdgeError edgeError(const std::vector<uint8_t>& edge, const PathTraceResult& ref, const std::vector<glm::vec3>& B) {
+  double sum = 0, sum2 = 0;
+  EdgeError e;
+  for (size_t v = 0; v < edge.size(); ++v) {
+    const double q = luminance(ref.B[v]);
+    if (!edge[v] || !(q > 0)) continue;
+    const double d = luminance(B[v]) / q - 1.0;
+    sum += d, sum2 += d * d, ++e.n;
+  }
+  e.mean = sum / e.n;
+  e.rms = std::sqrt(sum2 / e.n);
+  e.sem = std::sqrt((sum2 / e.n - e.mean * e.mean) / (e.n - 1));
+  return e;
+}
+
+// The reference at the edge vertices alone: 16,384 paths each.
+PathTraceResult edgeReference(const Scene& s, const RayCaster& caster, std::shared_ptr<std::vector<uint8_t>> edge,
+                              int maxDepth) {
+  PathTraceOptions po;
+  po.samplesPerVertex = 16384;
+  po.maxDepth = maxDepth;
+  po.tracedSelected = true;
+  po.selectedVertices = std::move(edge);
+  return pathTrace(s, caster, po);
+}
+
+void expectWithinTheReference(const EdgeError& e) {
+  EXPECT_GT(e.n, 150);
+  EXPECT_LT(std::fabs(e.mean), 4 * e.sem);
+  EXPECT_LT(std::fabs(e.mean), 0.01);
+  EXPECT_LT(e.rms, 0.025);
+}
+
 }  // namespace
 
 // The Cornell box (1.5k patches) at its 165 edge vertices: the flat solver
@@ -61,31 +101,15 @@ TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
   const Scene& s = sf.scene;
   auto caster = makeEmbreeCaster(s);
   auto edge = std::make_shared<std::vector<uint8_t>>(roomEdgeVertices(s));
-  PathTraceOptions po;
-  po.samplesPerVertex = 16384;
-  po.tracedSelected = true;
-  po.selectedVertices = edge;
-  const PathTraceResult ref = pathTrace(s, *caster, po);
+  const PathTraceResult ref = edgeReference(s, *caster, edge, -1);
   for (RadiositySolver solver : {RadiositySolver::GaussSeidel, RadiositySolver::Hierarchical}) {
     RadiosityOptions o;
     o.solver = solver;
     o.gatherRays = 2048;
-    const RadiosityResult r = solveRadiosity(s, *caster, o);
-    double sum = 0, sum2 = 0;
-    int n = 0;
-    for (size_t v = 0; v < s.vertexCount(); ++v) {
-      const double q = luminance(ref.B[v]);
-      if (!(*edge)[v] || !(q > 0)) continue;
-      const double d = luminance(r.Bvertex[v]) / q - 1.0;
-      sum += d, sum2 += d * d, ++n;
-    }
-    const double mean = sum / n, rms = std::sqrt(sum2 / n), sem = std::sqrt((sum2 / n - mean * mean) / (n - 1));
+    const EdgeError e = edgeError(*edge, ref, solveRadiosity(s, *caster, o).Bvertex);
     std::printf("%s: %d edge vertices, mean %+.4f (standard error %.4f), RMS %.4f\n",
-                solver == RadiositySolver::GaussSeidel ? "flat" : "hierarchical", n, mean, sem, rms);
-    EXPECT_GT(n, 150);
-    EXPECT_LT(std::fabs(mean), 4 * sem);
-    EXPECT_LT(std::fabs(mean), 0.01);
-    EXPECT_LT(rms, 0.025);
+                solver == RadiositySolver::GaussSeidel ? "flat" : "hierarchical", e.n, e.mean, e.sem, e.rms);
+    expectWithinTheReference(e);
   }
 }
 
@@ -100,31 +124,14 @@ TEST(FinalGather, RoomEdgeVerticesMatchTheReferenceAtOneBounce) {
   const Scene& s = sf.scene;
   auto caster = makeEmbreeCaster(s);
   auto edge = std::make_shared<std::vector<uint8_t>>(roomEdgeVertices(s));
-  PathTraceOptions po;
-  po.samplesPerVertex = 16384;
-  po.maxDepth = 1;
-  po.tracedSelected = true;
-  po.selectedVertices = edge;
-  const PathTraceResult ref = pathTrace(s, *caster, po);
+  const PathTraceResult ref = edgeReference(s, *caster, edge, 1);
   RadiosityOptions o;
   o.solver = RadiositySolver::GaussSeidel;
   o.bounces = 1;
   o.gatherRays = 2048;
-  const RadiosityResult r = solveRadiosity(s, *caster, o);
-  double sum = 0, sum2 = 0;
-  int n = 0;
-  for (size_t v = 0; v < s.vertexCount(); ++v) {
-    const double q = luminance(ref.B[v]);
-    if (!(*edge)[v] || !(q > 0)) continue;
-    const double d = luminance(r.Bvertex[v]) / q - 1.0;
-    sum += d, sum2 += d * d, ++n;
-  }
-  const double mean = sum / n, rms = std::sqrt(sum2 / n), sem = std::sqrt((sum2 / n - mean * mean) / (n - 1));
-  std::printf("one bounce: %d edge vertices, mean %+.4f (standard error %.4f), RMS %.4f\n", n, mean, sem, rms);
-  EXPECT_GT(n, 150);
-  EXPECT_LT(std::fabs(mean), 4 * sem);
-  EXPECT_LT(std::fabs(mean), 0.01);
-  EXPECT_LT(rms, 0.025);
+  const EdgeError e = edgeError(*edge, ref, solveRadiosity(s, *caster, o).Bvertex);
+  std::printf("one bounce: %d edge vertices, mean %+.4f (standard error %.4f), RMS %.4f\n", e.n, e.mean, e.sem, e.rms);
+  expectWithinTheReference(e);
 }
 
 // Sharing the gather between neighbours (gather_share_rings) on the Cornell
