@@ -15,7 +15,6 @@
 #include "gi/error_map.h"
 #include "gi/filter_files.h"
 #include "gi/form_factors.h"
-#include "gi/hemicube_view.h"
 #include "gi/memory_limit.h"
 #include "gi/output.h"
 #include "gi/pathtrace.h"
@@ -24,19 +23,14 @@
 #include "gi/render.h"
 #include "gi/thickness.h"
 #include "gi/vertex_order.h"
+#include "filter_views.h"
 
 namespace gi {
 
 namespace {
 
-VertexAttribute scalarAttribute(const std::string& name, const std::vector<float>& v) { return {name, 1, v}; }
-
-VertexAttribute vectorAttribute(const std::string& name, const std::vector<glm::vec3>& v) {
-  VertexAttribute a{name, 3, {}};
-  a.values.reserve(v.size() * 3);
-  for (const glm::vec3& x : v) a.values.insert(a.values.end(), {x.x, x.y, x.z});
-  return a;
-}
+using detail::scalarAttribute;
+using detail::vectorAttribute;
 
 // Validation, the scene conventions and the scene report: steps 1 and 2.
 void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
@@ -188,84 +182,6 @@ void runThickness(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
 }
 
-void runFormFactors(FilterInput& in, FilterResult& res) {
-  const Scene& s = in.scene;
-  const uint32_t face = chosenFace(in.values.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
-  const auto caster = makeEmbreeCaster(s);
-  const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(in.values), face);
-  FormFactorOutput out = formFactorOutput(s, rep, face);
-  res.vertexQuality = std::move(out.vertexF);
-  res.faceQuality = std::move(out.faceF);
-  res.faceColor = std::move(out.faceColor);
-  res.stats.add("face", double(face));
-  res.stats.add("row_sum", rep.rowSum);
-  res.stats.add("lost", rep.escaped);
-  res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
-  res.stats.add("seconds", rep.seconds);
-  res.stats.note(out.summary);
-}
-
-// The hemicube of the chosen face as pictures; the faces take the pictures'
-// colours and the hemicube's F_ij (gi/hemicube_view.h).
-void runHemicube(FilterInput& in, FilterResult& res) {
-  const Scene& s = in.scene;
-  const ParamValues& v = in.values;
-  const uint32_t face = chosenFace(v.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
-  if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(face) + " is degenerate");
-  const Timer timer;
-  const auto caster = makeEmbreeCaster(s);
-  HemicubeView hv = hemicubeView(s, *caster, face, v.getInt("hemicube_resolution"), v.getInt("nusselt_resolution"));
-  const HemicubeCells& c = hv.cells;
-  res.faceQuality.assign(s.faceCount(), 0.f);
-  res.faceColor.resize(s.faceCount());
-  double rowSum = 0, nusseltSum = 0, maxDiff = 0;
-  size_t seen = 0;
-  for (size_t j = 0; j < s.faceCount(); ++j) {
-    res.faceQuality[j] = float(c.F[j]);  // as the form-factor row stores it
-    res.faceColor[j] = j == face ? Rgb8{255, 255, 255} : patchColor(uint32_t(j));
-    rowSum += c.F[j];
-    nusseltSum += hv.nusseltF[j];
-    maxDiff = std::max(maxDiff, std::fabs(hv.nusseltF[j] - c.F[j]));
-    seen += c.F[j] > 0;
-  }
-  // Per vertex, the area-weighted mean of the incident faces' F (as the form-factor filter writes it).
-  std::vector<glm::vec3> F3(s.faceCount());
-  for (size_t j = 0; j < F3.size(); ++j) F3[j] = glm::vec3(res.faceQuality[j]);
-  for (const glm::vec3& x : faceToVertex(s, F3)) res.vertexQuality.push_back(x.x);
-  const std::string path = v.getString("image_path");
-  const std::string stem = imageStem(path);
-  auto add = [&](const char* name, Image&& img, const std::string& p, double fovDeg) {
-    FilterImage fi;
-    fi.name = name;
-    fi.image = std::move(img);
-    fi.exposure = 1.f;  // the colours are the pictures' own
-    fi.camera = Camera::lookAt(glm::dvec3(c.eye), glm::dvec3(c.eye + c.n), glm::dvec3(c.b), fovDeg, fi.image.width,
-                               fi.image.height);
-    fi.path = path.empty() ? "" : p;
-    res.images.push_back(std::move(fi));
-  };
-  const double crossFov = 2.0 * std::atan(2.0) * 180.0 / M_PI;  // the cross spans +-2 in the top face's plane
-  add("Hemicube cells by patch", std::move(hv.byPatch), path, crossFov);
-  add("Hemicube delta form factors", std::move(hv.deltaF), stem + "_dff.png", crossFov);
-  add("Nusselt disk", std::move(hv.nusselt), stem + "_nusselt.png", 90.0);
-  res.stats.add("face", double(face));
-  res.stats.add("row_sum", rowSum);
-  res.stats.add("lost", c.lost);
-  res.stats.add("cells_dF_sum", c.total);
-  res.stats.add("nusselt_sum", nusseltSum);
-  res.stats.add("nusselt_lost", hv.nusseltLost);
-  res.stats.add("max_hemicube_nusselt_difference", maxDiff);
-  res.stats.add("seconds", timer.seconds());
-  char b[400];
-  std::snprintf(b, sizeof b,
-                "GI: Hemicube of Selected Face: face %u, %d cells across, %zu patches seen; hemicube row sum %.6f "
-                "(cells' dF sum %.6f before normalising), Nusselt disk %d pixels across: covered area / pi %.6f, "
-                "largest |F_hemicube - F_Nusselt| %.4g",
-                face, c.resolution, seen, rowSum, c.total, hv.nusseltResolution, nusseltSum, maxDiff);
-  res.stats.note(b);
-}
-
-// The light-path split (light_paths.h) as four RGB attributes, when asked for.
 void addLightPathAttributes(const LightPathSplit& split, FilterResult& res) {
   if (split.empty()) return;
   res.attributes.push_back(vectorAttribute("Radiosity_emitted", split.emitted));
@@ -408,53 +324,6 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   addLightPathAttributes(r.split, res);
 }
 
-void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
-  const ParamValues& v = in.values;
-  RenderOptions opt = RenderOptions::fromParams(v, in.scene, in.layerCamera ? &*in.layerCamera : nullptr);
-  auto perVertex = [&](const char* name, std::vector<glm::vec3>& out) {
-    const VertexAttribute* a = in.attribute(name);
-    if (!a || a->components != 3 || opt.mode != RenderMode::TwoPass) return;
-    out.resize(in.scene.vertexCount());
-    for (size_t i = 0; i < out.size() && 3 * i + 2 < a->values.size(); ++i)
-      out[i] = {a->values[3 * i], a->values[3 * i + 1], a->values[3 * i + 2]};
-  };
-  perVertex("Radiosity", opt.firstPassB);
-  perVertex("RadiosityDirect", opt.firstPassBdirect);  // the first pass's direct part, if it left one
-  const auto caster = makeEmbreeCaster(in.scene);
-  RenderResult r = render(in.scene, *caster, opt, progress);
-  res.stats = std::move(r.stats);
-  FilterImage img;
-  img.name = std::string(renderModeName(opt.mode)) + " view";
-  img.exposure = imageExposure(r.image, v.getFloat("exposure"), r.seesEmitter);
-  img.image = std::move(r.image);
-  img.camera = opt.camera;
-  img.path = v.getString("image_path");
-  res.stats.add("exposure", img.exposure);
-  if (opt.vertexRadiance) {
-    // What each vertex shows the camera, at the image's exposure.
-    for (const glm::vec3& L : r.vertexRadiance) {
-      res.vertexQuality.push_back(luminance(L));
-      res.vertexColor.push_back(displayMap(L, img.exposure));
-    }
-    res.attributes.push_back(vectorAttribute("Radiance", r.vertexRadiance));
-  }
-  if (opt.mode == RenderMode::PathTraced && r.stdError.size() == img.image.px.size()) {
-    // Its error bars as a picture of their own, at the image's exposure: the
-    // standard error of each pixel's luminance (grey).
-    FilterImage err;
-    err.name = "Path traced view, standard error per pixel";
-    err.image = Image(img.image.width, img.image.height);
-    for (size_t p = 0; p < r.stdError.size(); ++p) err.image.px[p] = glm::vec3(r.stdError[p]);
-    err.exposure = img.exposure;
-    err.camera = img.camera;
-    err.path = img.path.empty() ? "" : stdErrorImagePath(img.path);
-    res.images.push_back(std::move(img));
-    res.images.push_back(std::move(err));
-    return;
-  }
-  res.images.push_back(std::move(img));
-}
-
 // Step 4: every array has the output scene's size and nothing non-finite
 // leaves the engine (a NaN in MeshLab's quality breaks its colour ramps).
 void finish(FilterResult& res, const Scene& out) {
@@ -576,12 +445,12 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
     case FilterKind::AmbientObscurance:
     case FilterKind::SkyLighting: runAmbient(kind, in, res, progress); break;
     case FilterKind::Thickness: runThickness(in, res, progress); break;
-    case FilterKind::FormFactorsOfFace: runFormFactors(in, res); break;
+    case FilterKind::FormFactorsOfFace: detail::runFormFactors(in, res); break;
     case FilterKind::PathTracedReference: runReference(in, res, progress); break;
     case FilterKind::Radiosity: runRadiosity(in, res, progress); break;
     case FilterKind::PhotonMapping: runPhotonMap(in, res, progress); break;
-    case FilterKind::RayTracedView: runRender(in, res, progress); break;
-    case FilterKind::HemicubeOfFace: runHemicube(in, res); break;
+    case FilterKind::RayTracedView: detail::runRender(in, res, progress); break;
+    case FilterKind::HemicubeOfFace: detail::runHemicube(in, res); break;
     case FilterKind::ErrorMap: computeErrorMap(in, res); break;
   }
 }
