@@ -340,7 +340,6 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
   if (shots >= maxShots)
     warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "shots per patch", res.stats);
   res.ambient = ambientTerm(u, dB);
-  res.stats.add("ambient_term", luminance(res.ambient));
 }
 
 // After any solver: the energy account, what vertices gather from (the
@@ -404,6 +403,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
     res.stats.warn(std::string("ambient_term applies to progressive refinement only: ignored with the solver ") +
                    kRadiositySolvers.logName(solver) + (stop.fixed ? " (a bounce count is set)" : ""));
   if (!opt.ambientTerm || solver != RadiositySolver::Progressive) res.ambient = glm::vec3(0.f);
+  else res.stats.add("ambient_term", luminance(res.ambient));
   snap.finish(R, res.ambient);
   finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, stop.fixed, res);
   if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");

@@ -2,7 +2,8 @@
 // refinement (Cohen et al. 1988, "A progressive refinement approach to fast
 // radiosity image generation"):
 //   A = 1 / (1 - rho_avg) * sum_j A_j dB_j / sum_j A_j,   B_i,display = B_i + rho_i A
-// (rho_avg the area-weighted mean reflectance, dB_j the unshot radiosity),
+// (per colour channel: rho_avg the area-weighted mean reflectance, dB_j the
+// unshot radiosity),
 // and snapshots of B after chosen steps. Internal to gi_core.
 #pragma once
 #include <vector>
