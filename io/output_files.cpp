@@ -65,15 +65,18 @@ std::string readTextFile(const std::string& path, const std::string& what, size_
   const std::string name = "the " + what + " " + (path.empty() ? std::string("''") : path);
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
-  if (path.empty() || !fs::exists(st)) throw std::invalid_argument(name + " does not exist");
+  if (path.empty() || st.type() == fs::file_type::not_found) throw std::invalid_argument(name + " does not exist");
+  if (ec) throw std::invalid_argument(name + " cannot be read (" + ec.message() + ")");
   if (fs::is_directory(st)) throw std::invalid_argument(name + " is a folder, not a file");
   if (!fs::is_regular_file(st)) throw std::invalid_argument(name + " is not a regular file (a pipe or a device)");
   const uintmax_t size = fs::file_size(path, ec);
-  if (ec || size > maxBytes)
-    throw std::invalid_argument(name + (ec ? " cannot be read" : " is larger than " + std::to_string(maxBytes >> 20) + " MB"));
+  if (ec) throw std::invalid_argument(name + " cannot be read (" + ec.message() + ")");
+  if (size > maxBytes) throw std::invalid_argument(name + " is larger than " + std::to_string(maxBytes >> 20) + " MB");
   std::ifstream f(path, std::ios::binary);
-  std::string text{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-  if (!f.good() && !f.eof()) throw std::invalid_argument(name + " cannot be read (" + std::strerror(errno) + ")");
+  std::string text(size_t(size), '\0');
+  if (!f || !f.read(text.data(), std::streamsize(size)) || f.peek() != std::char_traits<char>::eof())
+    throw std::invalid_argument(name + " cannot be read" + (errno ? " (" + std::string(std::strerror(errno)) + ")" : std::string()) +
+                                " or changed while it was read");
   return text;
 }
 

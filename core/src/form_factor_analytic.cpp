@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "gi/form_factors.h"
@@ -78,13 +79,18 @@ double distanceToSegment(const glm::dvec3& x, const glm::dvec3& p, const glm::dv
 // plane, and across a target narrower than a sub-triangle, and a
 // sub-triangle whose sample points all miss such a band passes the
 // comparison (two plates 0.01 apart read F = 1.009 for 0.980; a strip 0.001
-// high at a common edge, -62%). So a sub-triangle within twice its radius r
-// of one of the target's edges is split whatever its points say where r
-// exceeds 3 h at its centroid (a band narrower than itself; faces meeting at
-// a common edge at more than about 20 degrees are left to the comparison,
-// which handles them) or the target's smallest altitude, unless even all of
-// g there stays below the tolerance: F <= A / (pi d^2) from any point at
-// least d from a target of area A (d bounded below by h less r).
+// high at a common edge, -62%). So a sub-triangle is split whatever its
+// points say where its extent w across the nearest of the target's edges
+// (in its own plane, perpendicular to that edge) exceeds 3 h at its
+// centroid (a band narrower than itself; faces meeting at a common edge at
+// more than about 20 degrees are left to the comparison, which handles
+// them) or the target's smallest altitude, and that edge passes within 2 w
+// of its centroid, unless even all of g there stays below the tolerance:
+// F <= A / (pi d^2) from any point at least d from a target of area A (d
+// bounded below by h less the sub-triangle's radius). The extent across
+// the edge, not the radius: a sliver along an edge keeps its shape under
+// midpoint subdivision, and measured by its length it was split to the
+// last level everywhere (a 192-patch tube took 355 s).
 struct TargetEdges {
   glm::dvec3 p[3];
   glm::dvec3 unitNormal;
@@ -98,7 +104,20 @@ struct TargetEdges {
   }
   bool mustSplit(const Tri& t, double tolPerShare) const {
     const glm::dvec3 m = t.centroid();
-    const double r = t.radius();
+    int k = 0;
+    double edge = std::numeric_limits<double>::infinity();
+    for (int e = 0; e < 3; ++e)
+      if (const double d = distanceToSegment(m, p[e], p[(e + 1) % 3]); d < edge) edge = d, k = e;
+    const glm::dvec3 along = p[(k + 1) % 3] - p[k];
+    glm::dvec3 across = glm::cross(glm::cross(t.b - t.a, t.c - t.a), along);  // in t's plane, perpendicular to the edge
+    const double l = glm::length(across);
+    double w = 2.0 * t.radius();  // t's plane perpendicular to the edge: every direction in it is across
+    if (l > 0) {
+      across /= l;
+      const double xa = glm::dot(t.a, across), xb = glm::dot(t.b, across), xc = glm::dot(t.c, across);
+      w = std::max({xa, xb, xc}) - std::min({xa, xb, xc});
+    }
+    if (edge >= 2.0 * w) return false;
     const double h = std::fabs(glm::dot(unitNormal, m - p[0]));
     // The band: only where the whole sub-triangle is on one side of the
     // target's plane (one that crosses it has g going to 0 along the
@@ -106,11 +125,8 @@ struct TargetEdges {
     auto side = [&](const glm::dvec3& x) { return glm::dot(unitNormal, x - p[0]); };
     const double ha = side(t.a), hb = side(t.b), hc = side(t.c);
     const bool oneSide = (ha > 0 && hb > 0 && hc > 0) || (ha < 0 && hb < 0 && hc < 0);
-    if ((!oneSide || r <= 3.0 * h) && r <= narrowest) return false;
-    const double edge = std::min({distanceToSegment(m, p[0], p[1]), distanceToSegment(m, p[1], p[2]),
-                                  distanceToSegment(m, p[2], p[0])});
-    if (edge >= 2.0 * r) return false;
-    const double d = h - r;
+    if ((!oneSide || w <= 3.0 * h) && w <= narrowest) return false;
+    const double d = h - t.radius();
     return d <= 0 || area / (M_PI * d * d) > tolPerShare;
   }
 };
@@ -126,21 +142,33 @@ struct TargetEdges {
 // common edge, which is where the splitting concentrates.
 constexpr int kEdgeLevels = 6;
 
-// target: null for the comparison alone (levelsLeft levels); else its edges
-// split for kEdgeLevels levels beyond the comparison's levelsLeft - kEdgeLevels.
+// At most this many sub-triangles a pair splits for the target's edges
+// alone (3 evaluations each): a bound on the cost of any configuration the
+// rule above misjudges (the catalogue's hardest case, plates 0.01 apart,
+// takes about 9,000 per triangle pair).
+constexpr long kEdgeSplitBudget = 16384;
+
+// target: null for the comparison alone (levelsLeft levels: it splits while
+// levelsLeft > 1); else the comparison splits while levelsLeft > kEdgeLevels
+// + 1 (as many levels as without a target) and the target's edges for
+// kEdgeLevels more, while *edgeBudget lasts.
 template <class G>
-double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* target, int levelsLeft,
-              double tolPerShare) {
+double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* target, long* edgeBudget,
+              int levelsLeft, double tolPerShare) {
   const auto q = t.quarters();
   // The middle quarter's centroid is t's own: its value is known.
   double wq[4] = {0.25 * w * g(q[0].centroid()), 0.25 * w * g(q[1].centroid()), 0.25 * w * g(q[2].centroid()), 0.25 * wg};
   double sum = wq[0] + wq[1] + wq[2] + wq[3];
   // The comparison splits for up to levelsLeft levels, the target's edges
   // for kEdgeLevels more (a strip 0.001 high at a common edge needs 11).
-  const bool compared = levelsLeft > (target ? kEdgeLevels : 0) && std::fabs(sum - wg) > tolPerShare * w;
-  if (levelsLeft <= 1 || (!compared && !(target && target->mustSplit(t, tolPerShare)))) return sum;
+  const bool compared = levelsLeft > (target ? kEdgeLevels + 1 : 1) && std::fabs(sum - wg) > tolPerShare * w;
+  if (levelsLeft <= 1) return sum;
+  if (!compared) {
+    if (!target || *edgeBudget <= 0 || !target->mustSplit(t, tolPerShare)) return sum;
+    --*edgeBudget;
+  }
   sum = 0;
-  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, levelsLeft - 1, tolPerShare);
+  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, edgeBudget, levelsLeft - 1, tolPerShare);
   return sum;
 }
 
@@ -185,7 +213,7 @@ double triangleToTriangleFormFactor(const glm::dvec3 s[3], const glm::dvec3 t[3]
   // The comparison alone: the hierarchy splits its links itself (and its
   // furnace and closure were measured with this rule).
   double F = 0;
-  for (size_t k = 0; k < base.size(); ++k) F += refine(base[k], w, wg[k], g, nullptr, maxRefine, tolPerShare);
+  for (size_t k = 0; k < base.size(); ++k) F += refine(base[k], w, wg[k], g, nullptr, nullptr, maxRefine, tolPerShare);
   return F;
 }
 
@@ -234,9 +262,11 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     const bool near = d < kNear * rBase;
     const double tolPerShare = kRelTol * std::max(Fbase, kFloorF);
     const TargetEdges target(pa, pb, pc);
+    long edgeBudget = kEdgeSplitBudget;
     double F = 0;
     for (size_t k = 0; k < base.size(); ++k) {
-      const double f = near ? refine(base[k], w, wg[k], g, &target, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
+      const double f =
+          near ? refine(base[k], w, wg[k], g, &target, &edgeBudget, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
       if (f <= 0) continue;
       // Visibility: one ray per base point to a random point of j, for all of
       // that base sub-triangle's refined quarters (as many rays as before refinement).

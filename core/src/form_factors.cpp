@@ -125,9 +125,9 @@ std::vector<ParamSpec> formFactorSpecs() {
                "4 part radii the parts are split further, up to 8 more levels, where a split changes the estimate by "
                "more than 1% of the pair's factor (large patches at a common edge, where the factor varies fastest, "
                "come out within 0.2% too), and, up to 6 levels more, where an edge of the other patch passes "
-               "closer than a part's size and the factor may change there unseen by the points (plates 0.01 "
-               "apart, a strip 0.001 high at a common edge: within 0.5%). One visibility ray per base point and "
-               "pair.",
+               "closer than a part's width across it and the factor may change there unseen by the points "
+               "(plates 0.01 apart, a strip 0.001 high at a common edge: within 0.5%; a sliver patch as the "
+               "source stays within about 1%). One visibility ray per base point and pair.",
        .type = ParamType::Int, .def = 4, .min = 1, .max = 4096},
       {.name = "hemicube_resolution", .label = "Hemicube resolution",
        .help = "Cells across the hemicube's top face (the sides have half as many rows). A patch seen across few "

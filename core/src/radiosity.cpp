@@ -43,6 +43,17 @@ struct Setup {
   double unit2 = 1;  // world area of one local unit of area (Scene::unit^2)
 };
 
+// With patch-average vertex values, the vertices' direct part is their
+// faces' (E + rho H_direct, sky and sun included, averaged as B is): a
+// two-pass view then takes the same indirect part the vertices show, and a
+// direct part an earlier run left on the mesh is replaced, never reused.
+std::vector<glm::vec3> patchAverageDirect(const Scene& s, const std::vector<glm::vec3>& E,
+                                          const std::vector<glm::vec3>& rho, const std::vector<glm::vec3>& Hd) {
+  std::vector<glm::vec3> Bd(E.size());
+  for (size_t i = 0; i < E.size(); ++i) Bd[i] = E[i] + rho[i] * Hd[i];
+  return faceToVertex(s, Bd);
+}
+
 // Hd: the direct irradiance from the emitters; Hout: from the sky and the sun
 // (gi/sky.h; empty: none). Both are direct light: the solve starts from
 // rho (Hd + Hout), and the power entering from outside counts as emitted.
@@ -535,6 +546,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
   if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &direct.openings);
+  else res.Bdirect = patchAverageDirect(s, u.E, u.rho, u.Hd);
   direct.report(opt, res.stats);
   res.stats.add("patches", double(u.n));
   res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
@@ -607,6 +619,8 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
                                  : solveOnTheFly(s, u, ff, mem, solver, opt, progress);
   if (opt.vertexOutput != RadiosityVertexOutput::PatchAverage)
     radiosityVertexValues(s, caster, opt, res, Progress(nullptr), &direct.openings);
+  else
+    res.Bdirect = patchAverageDirect(s, u.E, u.rho, u.Hd);
   direct.report(opt, res.stats);
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +

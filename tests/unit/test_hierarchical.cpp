@@ -267,8 +267,8 @@ TEST(HierarchicalRadiosity, ClosureLeavesOtherScenesAlone) {
 // light's back 2 cm below the ceiling): the hierarchy absorbs 3.2% more
 // than the flat solution from Monte Carlo rows (whose balance is within
 // 0.02%), and its balance says 3.2%; asserted within half a percent of
-// each other. It is an indicator, not a measurement, so no warning: the
-// links are not reciprocal, and in a closed room with a lamp quad at rho
+// each other. It is an indicator, not a measurement (the links are not
+// reciprocal), and in a closed room with a lamp quad at rho
 // 0.956 it said 5.8% where the absorbed power was 1.2% off (a 20k scan
 // room: 0.39% for -0.37%). The Cornell box balances within 1%. Above 5% it
 // warns: a sealed room parted by a floating block (gaps of 0.05 all round),

@@ -88,9 +88,9 @@ struct RadiosityResult {
   std::vector<glm::vec3> B;         // per face
   std::vector<glm::vec3> Bvertex;   // per vertex (see RadiosityOptions::vertexOutput)
   // Per vertex, its direct part E + rho H_direct (luminaires, point light,
-  // sky and sun, at the vertex), where the vertex values computed it apart
-  // (every vertex output but the patch average; else empty): a two-pass view
-  // replaces it by ray-traced direct light.
+  // sky and sun): at the vertex where the vertex values compute it there,
+  // the patch average of the faces' with patch-average values. A two-pass
+  // view replaces it by ray-traced direct light.
   std::vector<glm::vec3> Bdirect;
   std::vector<glm::vec3> Rgather;   // per face: reflected radiosity the vertices gather from
   std::vector<glm::vec3> Hindirect; // per face: irradiance from Rgather
