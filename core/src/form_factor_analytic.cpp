@@ -118,11 +118,11 @@ struct TargetEdges {
       w = std::max({xa, xb, xc}) - std::min({xa, xb, xc});
     }
     if (edge >= 2.0 * w) return false;
-    const double h = std::fabs(glm::dot(unitNormal, m - p[0]));
     // The band: only where the whole sub-triangle is on one side of the
     // target's plane (one that crosses it has g going to 0 along the
     // crossing, which the comparison follows, as at a common edge).
     auto side = [&](const glm::dvec3& x) { return glm::dot(unitNormal, x - p[0]); };
+    const double h = std::fabs(side(m));
     const double ha = side(t.a), hb = side(t.b), hc = side(t.c);
     const bool oneSide = (ha > 0 && hb > 0 && hc > 0) || (ha < 0 && hb < 0 && hc < 0);
     if ((!oneSide || w <= 3.0 * h) && w <= narrowest) return false;

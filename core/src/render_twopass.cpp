@@ -121,11 +121,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
       Timer t;
       std::vector<glm::vec3> Hd =
           vertexDirectIrradiance(s, caster, kVertexDirectSamples, o.seed ^ 0x2b0du, progress.sub(0.5, 0.75));
-      SkySun outside;
-      outside.skyRadiance = o.skyRadiance;
-      outside.sunDirection = o.sunDirection;
-      outside.sunIrradiance = o.sunIrradiance;
-      outside.sunAngularRadiusDeg = o.sunAngularRadiusDeg;
+      const SkySun outside = o.outside();
       if (outside.any()) {
         const std::vector<glm::vec3> Hout = vertexSkySunIrradiance(s, caster, outside, kVertexDirectSamples,
                                                                    o.seed ^ 0x5c1du, VertexPart(), progress.sub(0.75, 1.0));

@@ -46,6 +46,7 @@
 #include "gi/raycaster.h"
 #include "gi/run.h"
 #include "gi/scene.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -96,6 +97,15 @@ struct RenderOptions {
   glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length
   glm::vec3 sunIrradiance{0.f};
   float sunAngularRadiusDeg = 0.27f;
+  // The sky and the sun above as gi/sky.h's settings (fromParams reads them so).
+  SkySun outside() const {
+    SkySun o;
+    o.skyRadiance = skyRadiance;
+    o.sunDirection = sunDirection;
+    o.sunIrradiance = sunIrradiance;
+    o.sunAngularRadiusDeg = sunAngularRadiusDeg;
+    return o;
+  }
   PointLight point;
   uint32_t seed = 0;
   // Memory the image and the caustic photons may take (gi/memory_limit.h);
