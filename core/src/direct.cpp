@@ -238,6 +238,7 @@ class DirectLight {
         double r = 0;
         for (const glm::dvec3& p : l.corners) r = std::max(r, glm::length(p - l.origin));
         lumRadius_.push_back(r);
+        targets_.push_back(lums_.target(L));
       }
     }
   }
@@ -270,15 +271,24 @@ class DirectLight {
   // point on a patch). With luminaires: `budget` shadow rays at most per
   // luminaire, keyed by `key`; light from the luminaire of face `skip` is left out.
   LuminaireEstimate estimate(const glm::vec3& x, const glm::vec3& n, const PaddedSobol& smp, uint32_t k, int budget,
-                             uint32_t key, uint32_t skip) const {
+                             uint32_t key, uint32_t skip, LuminaireSums* sums = nullptr) const {
     if (!exact_) {
       LuminaireEstimate e;
       e.H = sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, smp(k, 1), smp(k, 2), eps_);
       e.rays = 1;
       return e;
     }
-    const uint32_t skipL = skip < lumOfFace_.size() ? lumOfFace_[skip] : kNoHit;
-    return luminaireIrradiance(lums_, caster_, x, n, budget, key, eps_, unoccluded_, skipL);
+    return luminaireIrradiance(lums_, caster_, x, n, budget, key, eps_, unoccluded_, luminaireOf(skip), sums);
+  }
+  // With luminaires: the one face f belongs to (kNoHit: none).
+  uint32_t luminaireOf(uint32_t f) const { return f < lumOfFace_.size() ? lumOfFace_[f] : kNoHit; }
+  size_t luminaires() const { return lums_.count(); }
+  glm::vec3 emission(size_t L) const { return lums_.list()[L].E; }
+  // With luminaires: the unoccluded F from the patch (corners p, unit normal
+  // n) to luminaire L, averaged over the patch; *best: the patch's base
+  // point of largest F.
+  double patchFormFactor(size_t L, const glm::dvec3 p[3], const glm::dvec3& n, glm::dvec3* best) const {
+    return meanOverTriangle(p, [&](const glm::dvec3& x) { return lums_.formFactor(L, x, n); }, targets_[L], best);
   }
 
   // The log: luminaires found and the method used, and the shadow rays cast.
@@ -315,6 +325,7 @@ class DirectLight {
   float eps_;
   std::vector<uint32_t> lumOfFace_;
   std::vector<double> lumRadius_;
+  std::vector<FormFactorTarget> targets_;
   bool portals_ = false;
   bool exact_ = true, unoccluded_ = false;  // unoccluded: an empty convex room needs no shadow rays
 };
@@ -334,6 +345,47 @@ glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint
   return sum / float(samples_);
 }
 
+namespace {
+
+// A patch's mean direct irradiance from the luminaires, given its points'
+// sums: sum_L E_L Fbar_L V_L, with Fbar_L the unoccluded factor to L
+// averaged over the patch (meanOverTriangle: no noise where F varies
+// steeply, as next to an edge the patch shares with L) and V_L the points'
+// F-weighted visibility of L, sum_k F_L(x_k) V_L(x_k) / sum_k F_L(x_k)
+// (the ratio estimator of Heitz, Hill and McGuire 2018, "Combining
+// Analytic Direct Illumination and Stochastic Shadows": exact where nothing
+// is hidden). Where no point sees L but part of the patch does (it
+// straddles L's plane or horizon), V_L comes from the base point of largest
+// F, with its own rays (counted in *rays).
+glm::vec3 patchMean(const detail::DirectLight& direct, const Scene& s, size_t i, const glm::vec3& n,
+                    const LuminaireSums& sums, int budget, uint32_t seed, uint64_t& rays) {
+  const auto& t = s.triangles[i];
+  const glm::dvec3 p[3] = {glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]), glm::dvec3(s.positions[t.z])};
+  const uint32_t own = direct.luminaireOf(uint32_t(i));
+  glm::dvec3 H(0.0);
+  for (size_t L = 0; L < direct.luminaires(); ++L) {
+    if (L == own) continue;
+    glm::dvec3 best(0.0);
+    const double F = direct.patchFormFactor(L, p, glm::dvec3(n), &best);
+    if (!(F > 0.0)) continue;
+    double V = 0.0;
+    if (sums.F[L] > 0.0) {
+      V = sums.FV[L] / sums.F[L];
+    } else {
+      LuminaireSums one(direct.luminaires());
+      const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd4u));
+      const LuminaireEstimate e = direct.estimate(glm::vec3(best) + n * direct.eps(), n, smp, 0, budget,
+                                                  hash3(uint32_t(i), seed, 0xd9u), uint32_t(i), &one);
+      rays += e.rays;
+      if (one.F[L] > 0.0) V = one.FV[L] / one.F[L];
+    }
+    H += F * V * glm::dvec3(direct.emission(L));
+  }
+  return glm::vec3(H);
+}
+
+}  // namespace
+
 std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                              const Progress& progress, RunStats* stats, const SkyOpenings* portals) {
   if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
@@ -346,6 +398,7 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
   std::atomic<uint64_t> rays{0}, penumbra{0}, allPoints{0};
   parallelBlocks(s.faceCount(), progress, "direct light", [&](size_t b, size_t e) {
     uint64_t r = 0, pen = 0, pts = 0;
+    LuminaireSums sums;
     for (size_t i = b; i < e; ++i) {
       if (!ok[i]) continue;
       const int points = direct.points(lightSamples, i);
@@ -356,17 +409,19 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       // and 2) from one padded sequence: independent of each other.
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd3u));
       glm::dvec3 sum(0.0);
+      if (direct.exact()) sums.F.assign(direct.luminaires(), 0.0), sums.FV.assign(direct.luminaires(), 0.0);
       for (int k = 0; k < points; ++k) {
         const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
         const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] +
                             n * direct.eps();
-        const LuminaireEstimate est =
-            direct.estimate(x, n, smp, uint32_t(k), budget, hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i));
+        const LuminaireEstimate est = direct.estimate(x, n, smp, uint32_t(k), budget,
+                                                      hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i), &sums);
         sum += glm::dvec3(est.H);
         r += est.rays;
         pen += est.penumbra;
       }
-      H[i] = glm::vec3(sum / double(points));
+      H[i] = direct.exact() ? patchMean(direct, s, i, n, sums, budget, seed, r)
+                            : glm::vec3(sum / double(points));
     }
     rays += r;
     penumbra += pen;

@@ -312,8 +312,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   auto solveSweeps = [&](int sweeps, const Progress& pr) {
     Timer st;
     index();
+    if (fixed) sol.Rbounces.assign(size_t(std::max(0, sweeps)), {});
     for (int it = 0; it < sweeps; ++it) {
       sol.Rprev = sol.R;
+      if (fixed && keptBounce(it + 1, sweeps)) sol.Rbounces[size_t(it)] = sol.R;  // R^(it + 1)
       sweep(sol.R, H);
       double change = 0;
       for (size_t f = 0; f < nf; ++f) {

@@ -245,6 +245,28 @@ double Luminaires::formFactor(size_t i, const glm::dvec3& x, const glm::dvec3& n
   return F;
 }
 
+FormFactorTarget Luminaires::target(size_t i) const {
+  const Luminaire& L = lum_[i];
+  FormFactorTarget t;
+  t.edges = L.boundary;
+  t.normal = L.normal;
+  t.origin = L.origin;
+  t.area = L.area;
+  auto narrowest = [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    const double half = longest > 0 ? 0.5 * glm::length(glm::cross(b - a, c - a)) / longest : 0.0;
+    t.narrowest = t.narrowest > 0 ? std::min(t.narrowest, half) : half;
+  };
+  for (uint32_t f : L.faces) {
+    const auto& tri = s_.triangles[f];
+    narrowest(glm::dvec3(s_.positions[tri.x]), glm::dvec3(s_.positions[tri.y]), glm::dvec3(s_.positions[tri.z]));
+  }
+  for (const auto& tri : L.tris) narrowest(tri[0], tri[1], tri[2]);
+  for (const glm::dvec3& p : L.corners) t.centre += p / double(L.corners.size());
+  for (const glm::dvec3& p : L.corners) t.radius = std::max(t.radius, glm::length(p - t.centre));
+  return t;
+}
+
 bool Luminaires::point(size_t i, glm::vec2 u, glm::vec3* y) const {
   const Luminaire& L = lum_[i];
   if (L.rect) {
@@ -339,7 +361,7 @@ void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const g
 
 LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& caster, const glm::vec3& x,
                                       const glm::vec3& n, int budget, uint32_t key, float eps, bool unoccluded,
-                                      uint32_t skip) {
+                                      uint32_t skip, LuminaireSums* sums) {
   LuminaireEstimate out;
   const int first = Luminaires::kFirstRays, total = std::max(first, budget);
   double var = 0;
@@ -348,7 +370,11 @@ LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& c
     const double F = lums.formFactor(L, glm::dvec3(x), glm::dvec3(n));
     if (!(F > 0.0)) continue;
     const glm::vec3 E = lums.list()[L].E;
-    if (unoccluded) { out.H += float(F) * E; continue; }
+    if (unoccluded) {
+      out.H += float(F) * E;
+      if (sums) sums->F[L] += F, sums->FV[L] += F;
+      continue;
+    }
     SobolOwenStream seq(hash3(key, uint32_t(L), 0x1ea5u));
     auto stratified = [&](glm::vec3* y) { return lums.point(L, seq.next(), y); };
     VisibilitySums v;
@@ -369,6 +395,7 @@ LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& c
     }
     out.rays += v.rays;
     out.H += float(F * v.V()) * E;
+    if (sums) sums->F[L] += F, sums->FV[L] += F * v.V();
     const double se = F * double(luminance(E)) * v.stdError();
     var += se * se;
   }

@@ -106,14 +106,14 @@ struct DirectSetup {
     const bool skyRays = opt.outside.sky() && (!openings.any() || openings.rest);  // the cosine rays still cast
     st.add("shadow_rays", double(u.n) * opt.lightSamples * (1 + int(skyRays) + int(opt.outside.sun())));
     // No surface can receive more direct light than the lights and the sky
-    // send. The patches' direct light comes from a few points each (one per
-    // 64 shadow rays), and next to an edge a patch shares with a light
-    // those can overstate it: a closed tube of 16 sliver facets received
-    // 26% more than its lamp emits at the default 256 samples (an outside
-    // review; 1,024: 1.1%, 4,096: within 0.5%), or 11% less with the faces
-    // in another order (other seeds): a noisy estimate, whose excess is
-    // what can be told. The energy balance does not see it (what escapes
-    // is the remainder).
+    // send. With luminaires each patch takes the exact factor averaged over
+    // it (gi/direct.h), and its visibility from a few points, which cannot
+    // exceed 1; with more than Luminaires::kMaxLuminaires, power-sampled
+    // light points, one per shadow ray, whose estimate is noisy next to an
+    // edge a patch shares with a light (a closed tube of 300 sliver facets,
+    // its lamp a cone of 300 facets, received up to 3.8% more than the lamp
+    // emits at 16 shadow rays). The energy balance does not see it (what
+    // escapes is the remainder); the excess is what can be told.
     double received = 0;
     for (size_t i = 0; i < u.n; ++i) received += u.A[i] * luminance(u.Hd[i]);
     st.add("direct_received_power_W", received * u.unit2);
@@ -121,9 +121,8 @@ struct DirectSetup {
       char b[400];
       std::snprintf(b, sizeof b,
                     "the patches receive %.1f%% more direct light than the lights and the sky send: their direct "
-                    "light, from one point per 64 shadow rays, overstates it next to edges they share with a light "
-                    "(slivers, nearly coplanar faces); raise light_samples (the vertex values compute it at each "
-                    "vertex)",
+                    "light, sampled on the lights (more than 256 luminaires), overstates it next to edges they "
+                    "share with a light; raise light_samples (the vertex values compute it at each vertex)",
                     100.0 * (received / u.P - 1.0));
       st.warn(b);
     }
@@ -256,14 +255,17 @@ bool endSweep(const Setup& u, const Stopping& stop, int it, double change, const
 
 // Jacobi: R <- S + rho F R for all patches from the last iterate (sweep k
 // adds bounce k). With a fixed bounce count, *prevR gets the iterate before
-// the last sweep (zero for no sweep at all: no indirect light at vertices).
+// the last sweep (zero for no sweep at all: no indirect light at vertices)
+// and res.Rbounces the iterates the final gather reads (keptBounce).
 void jacobi(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& S, const Stopping& stop,
             const Progress& progress, std::vector<glm::vec3>& R, std::vector<glm::vec3>* prevR, RadiosityResult& res) {
   const int sweeps = stop.fixed ? stop.bounces : stop.maxIter;
   std::vector<glm::vec3> Rn = R;
   if (prevR) prevR->assign(u.n, glm::vec3(0.f));
+  if (prevR) res.Rbounces.assign(size_t(std::max(0, sweeps)), {});
   for (int it = 0; it < sweeps; ++it) {
     if (prevR) *prevR = R;
+    if (prevR && keptBounce(it + 1, sweeps)) res.Rbounces[size_t(it)] = R;  // R^(it + 1)
     parallelBlocks(u.n, Progress(nullptr), "", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         Rn[i] = (u.A[i] > 0 && u.rho[i] != glm::vec3(0.f)) ? S[i] + u.rho[i] * gather(row(uint32_t(i)), R) : S[i];
@@ -553,6 +555,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   res.residual = h.residual;
   res.residualHistory = std::move(h.residualHistory);
   res.Rgather = std::move(h.Rprev);
+  res.Rbounces = std::move(h.Rbounces);
   res.Hindirect = std::move(h.H);
   res.B = h.R;
   for (size_t i = 0; i < n; ++i) res.B[i] += u.E[i];

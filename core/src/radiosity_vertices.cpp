@@ -34,21 +34,38 @@ namespace {
 // One ray per level is enough, as a vertex averages its many near hits; the
 // direct light keeps 4 light samples per point (with 1, a closed furnace
 // box gathered with 64 rays per vertex is 1% off at its corners).
-// For the converged solution; and for one bounce, where the light a near
-// hit reflects is its direct light alone (exact: no patch value needed).
-// With 2 or more bounces the patch values a near hit would need (its own
-// indirect light one bounce short) are not kept, so near hits read the
-// patch: an outside check (4 December 2026) found the ceiling's edge
-// vertices of a sealed room 25% bright with one bounce (fixed here) and
-// 6.6% with two (README, Limitations).
-constexpr int kNearLevels = 2;
+// The same for a fixed bounce count K: the vertex gathers R^(K), the
+// reflected radiosity after K bounces; a near hit is relit as R^(m)(y) =
+// rho (H_direct(y) + H^(m-1)(y)) with m = K, its indirect part gathered
+// again from the values of one bounce fewer (R^(m-1): a far hit reads the
+// patch's, a near one is relit the same way), and with no levels left the
+// patch's own, rho F R^(m-1) = R^(m) - R^(1). With one bounce a near hit
+// reflects its direct light alone (exact: no patch value needed). Reading
+// the patch instead, an outside check (4 December 2026) found the
+// ceiling's edge vertices of a sealed room 25% bright with one bounce and
+// 6.6% with two.
+constexpr int kNearLevels = kGatherNearLevels;
 
 std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
                                       const RadiosityOptions& opt, RadiosityResult& res, const Progress& progress) {
   const uint32_t seed = opt.formFactors.seed;
-  const bool refineNear = opt.bounces < 0 || opt.bounces == 1;
-  const bool nearIndirect = opt.bounces < 0;  // one bounce: a near hit reflects its direct light only
-  const int nearLevels = nearIndirect ? kNearLevels : 0;
+  // K fixed bounces (K < 0: the converged solution): the patch values R^(m)
+  // the near hits read, where the solver kept them (res.Rbounces).
+  const int K = opt.bounces;
+  const bool haveBounces = K > 0 && res.Rbounces.size() == size_t(K);
+  const bool refineNear = K < 0 || haveBounces;
+  const int nearLevels = K == 1 ? 0 : kNearLevels;
+  // R^(m) of face f (m < 0: converged, m = 0: nothing reflected yet).
+  const auto patchR = [&](uint32_t f, int m) -> glm::vec3 {
+    return m < 0 ? res.Rgather[f] : m == 0 ? glm::vec3(0.f) : res.Rbounces[size_t(m - 1)][f];
+  };
+  // Face f's own indirect irradiance in R^(m): F R^(m-1) = (R^(m) - R^(1)) / rho.
+  const auto patchH = [&](uint32_t f, int m) -> glm::vec3 {
+    if (m < 0) return res.Hindirect[f];
+    if (m <= 1) return glm::vec3(0.f);
+    const glm::vec3 rho = s.faceRho(f), d = res.Rbounces[size_t(m - 1)][f] - res.Rbounces[0][f];
+    return {rho.r > 0 ? d.r / rho.r : 0.f, rho.g > 0 ? d.g / rho.g : 0.f, rho.b > 0 ? d.b / rho.b : 0.f};
+  };
   const DirectLightAt directAt(s, caster, 4);
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
@@ -63,15 +80,16 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   for (size_t f = 0; f < s.faceCount(); ++f)
     faceRead[f] = {res.Rgather[f], float(2.0 * std::sqrt(2.0 * faceArea(s, f)))};
   std::atomic<uint64_t> nearHits{0};
-  // The light reflected at y on face f, seen from t away; u: a 2D sample
-  // for its own gather ray.
+  // R^(m) at y on face f, seen from t away (m = K at the vertex's own
+  // hits); u: a 2D sample for its own gather ray.
   const auto reflectedAt = [&](const auto& self, uint32_t f, const glm::vec3& y, float t, glm::vec2 u, uint32_t key,
-                               int levels) -> glm::vec3 {
-    if (!refineNear || t > faceRead[f].nearT) return faceRead[f].R;
+                               int levels, int m) -> glm::vec3 {
+    if (m == 0) return glm::vec3(0.f);
+    if (t > faceRead[f].nearT) return patchR(f, m);
     nearHits.fetch_add(1, std::memory_order_relaxed);
     const glm::vec3 n = faceN[f], o = y + n * eps;
-    glm::vec3 Hi = nearIndirect ? res.Hindirect[f] : glm::vec3(0.f);
-    if (levels > 0) {
+    glm::vec3 Hi = patchH(f, m);
+    if (levels > 0 && m != 1) {
       Ray r;
       r.o = o;
       r.d = Frame(n).toWorld(cosineHemisphere(u));
@@ -81,7 +99,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
       if (h.valid() && glm::dot(r.d, faceN[h.face]) < 0.f) {
         const uint32_t next = hash3(key, h.face, 0x53u);
         Hi = self(self, h.face, r.o + r.d * h.t, h.t, glm::vec2(toUnitFloat(next), toUnitFloat(hash32(next))), next,
-                  levels - 1);
+                  levels - 1, m < 0 ? m : m - 1);
       }
     }
     const glm::vec3 Hout = skySunIrradianceAt(opt.outside, caster, o, n, 4, key);
@@ -97,7 +115,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
     std::memcpy(bits, &g.point, sizeof bits);
     const glm::vec2 u = PaddedSobol(hash3(g.vertex, seed, 0xfbu))(g.ray, 1);
     return reflectedAt(reflectedAt, g.face, g.point, g.t, u, hash3(bits[0] ^ seed, bits[1], bits[2] ^ g.face),
-                       nearLevels);
+                       nearLevels, K);
   };
   // The rays' luminance statistics only where the vertices pool them.
   const bool share = opt.gatherShareRings > 0;

@@ -77,11 +77,16 @@ void mergeSides(std::vector<glm::vec3>& value, const VertexSides& sides);
 void mergeSideErrors(std::vector<float>& error, const VertexSides& sides);
 
 // Direct irradiance per face from the emitters: with up to
-// Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), the exact form
-// factor to each times its visibility, at up to P = max(1, lightSamples /
-// 64) points of the patch (fewer where the patch is small against its
-// distance to the luminaires), each with up to lightSamples / P shadow rays
-// per luminaire in penumbra (16 and the corners elsewhere); with more, lightSamples
+// Luminaires::kMaxLuminaires luminaires (gi/luminaires.h), per luminaire L,
+//   H_i = E_L Fbar_iL V_iL,  V_iL = sum_k F_L(x_k) V_L(x_k) / sum_k F_L(x_k),
+// Fbar_iL the exact unoccluded factor averaged over the patch
+// (meanOverTriangle, gi/form_factor_analytic.h) and V_iL the visibility
+// found at up to P = max(1, lightSamples / 64) points x_k of the patch
+// (fewer where the patch is small against its distance to the luminaires),
+// each with up to lightSamples / P shadow rays per luminaire in penumbra
+// (16 and the corners elsewhere): the ratio estimator of Heitz, Hill and
+// McGuire 2018, "Combining Analytic Direct Illumination and Stochastic
+// Shadows", exact wherever the points agree; with more, lightSamples
 // power-proportional light samples with MIS. *stats (if given) gets the
 // luminaires found, the method and the shadow rays. With `portals`
 // (findSkyOpenings), the light of the sky through its portals instead, the

@@ -75,6 +75,7 @@ struct HierarchicalSolution {
   std::vector<glm::vec3> R;     // per face: reflected radiosity (converged, or after the fixed sweeps)
   std::vector<glm::vec3> Rprev; // fixed bounces: the iterate before the last sweep (what vertices gather from)
   std::vector<glm::vec3> H;     // per face: indirect irradiance sum_j F_ij R_j (from Rprev when bounces are fixed)
+  std::vector<std::vector<glm::vec3>> Rbounces;  // fixed bounces: as RadiosityResult::Rbounces
   int iterations = 0;
   double residual = 0;
   std::vector<double> residualHistory;

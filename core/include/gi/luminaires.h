@@ -56,6 +56,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/form_factor_analytic.h"
 #include "gi/scene.h"
 
 namespace gi {
@@ -126,6 +127,8 @@ class Luminaires {
 
   // Unoccluded F from the point x (unit normal n) to luminaire L; 0 behind L's plane.
   double formFactor(size_t L, const glm::dvec3& x, const glm::dvec3& n) const;
+  // L as the target of a mean of formFactor over a patch (meanOverTriangle).
+  FormFactorTarget target(size_t L) const;
   // A point of L for u in [0,1)^2, uniform over its area; false where u
   // falls outside the polygon in its bounding rectangle (Luminaire::rect).
   bool point(size_t L, glm::vec2 u, glm::vec3* y) const;
@@ -147,13 +150,22 @@ struct LuminaireEstimate {
   bool penumbra = false; // some luminaire's rays disagreed
 };
 
+// Per luminaire, the sums over a patch's points of F(x -> L) and of
+// F(x -> L) V(x, L): their ratio is L's visibility from the patch, weighted
+// as its light arrives (patchDirectIrradiance).
+struct LuminaireSums {
+  std::vector<double> F, FV;
+  explicit LuminaireSums(size_t count = 0) : F(count, 0.0), FV(count, 0.0) {}
+};
+
 // H(x) = sum_L E_L F(x -> L) V(x, L) at x (lifted off its surface, unit
 // normal n): kFirstRays rays per luminaire, continued to `budget` rays (at
 // least kFirstRays) for a luminaire in penumbra; no rays when `unoccluded`
 // (nothing in the scene can block). Random numbers keyed by key. Luminaire
-// `skip` (the one x lies on, if any) is left out.
+// `skip` (the one x lies on, if any) is left out. sums (optional): F and
+// F V of each luminaire added.
 LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& caster, const glm::vec3& x,
                                       const glm::vec3& n, int budget, uint32_t key, float eps, bool unoccluded,
-                                      uint32_t skip = 0xffffffffu);
+                                      uint32_t skip = 0xffffffffu, LuminaireSums* sums = nullptr);
 
 }  // namespace gi

@@ -94,6 +94,11 @@ struct RadiosityResult {
   std::vector<glm::vec3> Bdirect;
   std::vector<glm::vec3> Rgather;   // per face: reflected radiosity the vertices gather from
   std::vector<glm::vec3> Hindirect; // per face: irradiance from Rgather
+  // A fixed bounce count K: per face, the reflected radiosity after m
+  // bounces, R^(m) = rho H_direct + rho F R^(m-1) (R^(1) = rho H_direct,
+  // sky and sun included), at index m - 1 for the m that the final gather's
+  // near hits read (keptBounce), the others empty.
+  std::vector<std::vector<glm::vec3>> Rbounces;
   int iterations = 0;
   double residual = 0.0;            // relative, at the end
   std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
@@ -113,13 +118,21 @@ struct RadiosityResult {
   RunStats stats;
 };
 
+// The final gather relights a near hit and gathers again from it, down to
+// kGatherNearLevels levels (radiosity_vertices.cpp): with K fixed bounces it
+// reads R^(K), R^(K-1) and R^(K-2) there, and R^(1) (to take a patch's own
+// indirect part, R^(m) - R^(1) = rho F R^(m-1)).
+constexpr int kGatherNearLevels = 2;
+inline bool keptBounce(int m, int K) { return m >= 1 && m <= K && (m == 1 || m >= K - kGatherNearLevels); }
+
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt,
                                const Progress& progress = Progress(nullptr));
 
 // The memory memory_budget_mb must cover besides the form-factor matrix, in
 // bytes: per patch, the scene's face arrays, the ray-casting structure and
 // the solver's vectors and vertex output (kSolverBytesPerPatch; measured 330
-// at peak on a box of 1.08 million patches, the matrix apart), and per
+// at peak on a box of 1.08 million patches, the matrix apart; a fixed bounce
+// count keeps up to 4 more vectors for the final gather, 48), and per
 // worker thread the scratch of one form-factor row (a dense row of n values;
 // a hemicube's buffers, 144 MB at resolution 4096).
 inline constexpr double kSolverBytesPerPatch = 400;
