@@ -492,7 +492,11 @@ RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors&
   if (!opt.exportSystem.empty()) {
     std::vector<double> area(u.A);
     for (double& a : area) a *= u.unit2;
-    res.exports = linearSystemFiles(rows, area, u.E, u.rho, u.Hd, res.B);
+    // The solution of the system, without the display's ambient term (an
+    // early stop of progressive refinement adds rho x ambient to B).
+    std::vector<glm::vec3> B = res.B;
+    for (size_t i = 0; i < B.size(); ++i) B[i] -= u.rho[i] * res.ambient;
+    res.exports = linearSystemFiles(rows, area, u.E, u.rho, u.Hd, B);
   }
   res.stats.add("form_factor_seconds", ffSeconds);
   res.stats.add("form_factor_entries", double(entries));

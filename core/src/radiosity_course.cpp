@@ -39,7 +39,8 @@ std::vector<ParamSpec> radiosityCourseSpecs() {
        .help = "If not empty, a path prefix: the system solved is written as Matrix Market files (1-based) so that "
                "B = E + rho F B can be solved elsewhere: PREFIX_F.mtx (form factors, sparse), PREFIX_E.mtx, "
                "PREFIX_rho.mtx, PREFIX_Esys.mtx (E + rho (H_direct - F E): with it the system has the filter's "
-               "exact direct light), PREFIX_B.mtx (the filter's patch radiosity, to check against) and "
+               "exact direct light), PREFIX_B.mtx (the filter's patch radiosity, to check against; without the "
+               "ambient term, which only the display adds) and "
                "PREFIX_area.mtx. Needs the form-factor matrix in memory (memory budget).",
        .type = ParamType::String, .defText = ""},
   };
