@@ -1,5 +1,7 @@
 #include "gi_output.h"
 
+#include <algorithm>
+
 #include "gi/refine.h"
 #include "mesh_io.h"
 
@@ -16,11 +18,41 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
     for (const Rgb8& c : r.faceColor) attrs.faceColor.push_back({c.r, c.g, c.b});
   }
   io::PlyExtras extras;
-  extras.normals = !r.vertexNormal.empty() ? r.vertexNormal : r.refined ? std::vector<glm::vec3>() : fileNormals;
+  extras.normals = !r.vertexNormal.empty() ? r.vertexNormal
+                   : r.refined             ? refineVertexNormals(fileNormals, *r.refined)
+                                           : fileNormals;
   extras.attributes = r.attributes;
-  if (!r.refined)
+  if (!r.refined || layers.size() < 2) {
     for (const LayerRange& l : layers) extras.layers.push_back({l.name, l.faceCount});
-  io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);
+    io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);
+    return;
+  }
+  // Refined with layers: the faces grouped by the layer of their input face
+  // (refinement appends new faces at the end), so that the file still
+  // records each layer's faces and a later run reads them as layers again.
+  std::vector<uint32_t> layerOf(input.faceCount(), 0);
+  for (uint32_t L = 0; L < layers.size(); ++L)
+    for (size_t f = layers[L].faceOffset; f < layers[L].faceOffset + layers[L].faceCount && f < layerOf.size(); ++f)
+      layerOf[f] = L;
+  const RefinedMesh& m = *r.refined;
+  std::vector<uint32_t> order(m.sourceFace.size());
+  for (uint32_t f = 0; f < order.size(); ++f) order[f] = f;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return layerOf[m.sourceFace[a]] < layerOf[m.sourceFace[b]]; });
+  std::vector<size_t> count(layers.size(), 0);
+  for (uint32_t f : order) ++count[layerOf[m.sourceFace[f]]];
+  for (size_t L = 0; L < layers.size(); ++L) extras.layers.push_back({layers[L].name, count[L]});
+  Scene grouped = out;
+  auto permute = [&](auto& v) {
+    if (v.size() != order.size()) return;
+    auto copy = v;
+    for (size_t k = 0; k < order.size(); ++k) v[k] = copy[order[k]];
+  };
+  permute(grouped.triangles);
+  permute(attrs.faceColor);
+  permute(attrs.faceQuality);
+  permute(attrs.faceSelected);
+  io::writePly(path, grouped, attrs, r.vertexQuality, r.vertexColor, extras);
 }
 
 std::vector<std::string> writeLayerPlys(const std::string& outputPly, const FilterResult& r) {

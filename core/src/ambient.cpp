@@ -46,6 +46,10 @@ class AmbientKernel {
  public:
   AmbientKernel(const RayCaster& c, const AmbientOptions& o) : caster_(c), o_(o) {
     tfar_ = o.maxDistance > 0.0 ? float(o.maxDistance) : std::numeric_limits<float>::infinity();
+    // Sky lighting: the target is the sky's light's standard error in W/m^2,
+    // the sky fraction's times the sky's irradiance (no sky: nothing to refine).
+    const double sky = o.mode == AmbientMode::Sky ? double(o.skyIrradiance) * luminance(o.skyRadiantColor) : 1.0;
+    target_ = sky > 0.0 ? o.targetError / sky : std::numeric_limits<double>::infinity();
     coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
     sunScale_ = sunDiskScale(o.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
@@ -100,7 +104,7 @@ class AmbientKernel {
       }
       done += m;
       if (!adaptive || done < o_.minRays) continue;
-      if (stdError(w, done, num, den, numSq, denSq, numDen) <= o_.targetError) break;
+      if (stdError(w, done, num, den, numSq, denSq, numDen) <= target_) break;
     }
     out.rays = done;
     if (o_.useCone) out.value = den > 0 ? float(num / den) : 0.f;
@@ -148,7 +152,7 @@ class AmbientKernel {
         const int m = std::min(kRound, o_.sunRays - done);
         for (int j = 0; j < m; ++j) {
           rays[j].o = org; rays[j].d = sf.toWorld(uniformCone(seq.next(), sunCos_));
-          rays[j].tnear = 0.f; rays[j].tfar = std::numeric_limits<float>::infinity();
+          rays[j].tnear = 0.f; rays[j].tfar = tfar_;  // max_distance: farther geometry does not occlude
         }
         caster_.occludedBatch(rays, size_t(m), occ);
         for (int j = 0; j < m; ++j) w.add(occ[j] ? 0.0 : std::max(0.f, glm::dot(n, rays[j].d)));
@@ -168,6 +172,7 @@ class AmbientKernel {
   const RayCaster& caster_;
   const AmbientOptions& o_;
   float tfar_, coneCos_, sunCos_, sunScale_;
+  double target_;  // the adaptive stop, in the units of the per-ray values
 };
 
 // The parameter table refuses all of these; a library caller filling
@@ -252,13 +257,20 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
     if (o.sunIrradiance > 0.f && !(o.sunAngularRadiusDeg > 0.f) && o.sunRays > 1)
       st.warn("sun_angular_radius 0 is a point sun: all " + std::to_string(o.sunRays) +
               " sun rays per vertex follow one direction (hard shadows; one ray gives the same)");
-  } else if (o.targetError > 0.0) {
+  }
+  if (o.targetError > 0.0) {
+    // Sky lighting: a vertex's rays are its sky rays and, facing the sun, its
+    // fixed sun rays; its error holds the sun's part too.
+    const bool sky = o.mode == AmbientMode::Sky;
+    auto atMax = [&](int rays) {
+      return sky ? rays == o.maxRays || rays == o.maxRays + o.sunRays : rays >= o.maxRays;
+    };
     size_t unmet = 0, traced = 0;
     float worst = 0.f;
     for (size_t i = 0; i < res.rays.size(); ++i) {
       if (res.rays[i] == 0) continue;
       ++traced;
-      if (res.rays[i] >= o.maxRays && res.stdError[i] > o.targetError) {
+      if (atMax(res.rays[i]) && res.stdError[i] > o.targetError) {
         ++unmet;
         worst = std::max(worst, res.stdError[i]);
       }

@@ -14,10 +14,15 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                        "are best.",
                .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20});
   s.push_back({.name = "target_error", .label = "Target standard error",
-               .help = "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until its own estimated "
-                       "standard error is below this value (between the minimum and maximum ray counts). 0 = fixed "
-                       "ray count.",
-               .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 0.5});
+               .help = mode == AmbientMode::Sky
+                           ? "Adaptive sampling: if > 0, each vertex casts sky rays in rounds of 32 until the "
+                             "estimated standard error of its sky light (W/m^2) is below this value (between the "
+                             "minimum and maximum ray counts); the sun's shadow rays are a fixed count (sun_rays). "
+                             "0 = fixed ray count."
+                           : "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until its own "
+                             "estimated standard error is below this value (between the minimum and maximum ray "
+                             "counts). 0 = fixed ray count.",
+               .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = mode == AmbientMode::Sky ? 1e9 : 0.5});
   s.push_back({.name = "min_rays", .label = "Minimum rays (adaptive)",
                .help = "Adaptive sampling never stops before this many rays.",
                .type = ParamType::Int, .def = 32, .min = 1, .max = 1 << 20});
@@ -74,10 +79,12 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  .help = "Direction towards the sun.",
                  .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)});
     s.push_back({.name = "sun_color", .label = "Sun colour",
-                 .help = "Colour of the sun (sRGB).",
-                 .type = ParamType::Color, .defVec = glm::vec3(1.f, 244.f / 255.f, 214.f / 255.f)});
+                 .help = "Colour of the sun (sRGB): scales each channel of its irradiance (linear colour). White "
+                         "(the default, as in the other filters) gives the irradiance below in every channel.",
+                 .type = ParamType::Color, .defVec = glm::vec3(1.f)});
     s.push_back({.name = "sun_irradiance", .label = "Sun irradiance (W/m^2)",
-                 .help = "Irradiance of the sun on a surface facing it; 0 = sky only.",
+                 .help = "Irradiance of a white sun on a surface facing it (times the linear sun colour per "
+                         "channel); 0 = sky only.",
                  .type = ParamType::Float, .def = 3.0, .min = 0.0, .max = 1e9});
     s.push_back({.name = "sun_angular_radius", .label = "Sun angular radius (deg)",
                  .help = "Soft shadows: shadow rays go to points spread over the sun's disk of this angular radius "

@@ -161,6 +161,9 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
   }
   for (const auto& l : log) res.stats.note(l);
   res.stats.note("refinement stopped: " + why);
+  if (size_t(ro.maxPatches) < s.faceCount())
+    res.stats.warn("refine_max_patches " + std::to_string(ro.maxPatches) + " is below the mesh's " +
+                   std::to_string(s.faceCount()) + " patches: nothing can be refined (the mesh is never coarsened)");
   res.stats.add("refine_levels", double(log.size()));
   res.stats.add("input_patches", double(s.faceCount()));
   res.stats.add("refined_patches", double(sc.faceCount()));

@@ -377,6 +377,13 @@ MeshAttributes refineAttributes(const MeshAttributes& a, const RefinedMesh& m) {
   byFace(o.faceColor, a.faceColor);
   byFace(o.faceQuality, a.faceQuality);
   byFace(o.faceSelected, a.faceSelected);
+  if (!a.vertexSelected.empty()) {  // a midpoint is selected where both ends are
+    o.vertexSelected.resize(m.vertexParents.size());
+    for (size_t v = 0; v < m.vertexParents.size(); ++v)
+      o.vertexSelected[v] = v < m.inputVertices ? a.vertexSelected[v]
+                                                : uint8_t(o.vertexSelected[m.vertexParents[v].x] &&
+                                                          o.vertexSelected[m.vertexParents[v].y]);
+  }
   if (!a.vertexColor.empty()) {
     // Parents come before their midpoints: one pass in vertex order.
     std::vector<glm::vec3> lin(m.vertexParents.size());
@@ -392,6 +399,21 @@ MeshAttributes refineAttributes(const MeshAttributes& a, const RefinedMesh& m) {
       const Rgb8 c = displayMap(lin[v], 1.f);
       o.vertexColor[v] = glm::u8vec3(c.r, c.g, c.b);
     }
+  }
+  return o;
+}
+
+std::vector<glm::vec3> refineVertexNormals(const std::vector<glm::vec3>& n, const RefinedMesh& m) {
+  if (n.empty()) return {};
+  std::vector<glm::vec3> o(m.vertexParents.size());
+  for (size_t v = 0; v < m.vertexParents.size(); ++v) {  // parents come before their midpoints
+    if (v < m.inputVertices) {
+      o[v] = n[v];
+      continue;
+    }
+    const glm::vec3 sum = o[m.vertexParents[v].x] + o[m.vertexParents[v].y];
+    const float l = glm::length(sum);
+    o[v] = l > 0.f ? sum / l : o[m.vertexParents[v].x];
   }
   return o;
 }

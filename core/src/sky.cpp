@@ -25,10 +25,11 @@ std::vector<ParamSpec> SkySun::specs() {
        .help = "Direction towards the sun.",
        .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)},
       {.name = "sun_color", .label = "Sun colour",
-       .help = "Colour of the sun (sRGB).",
+       .help = "Colour of the sun (sRGB): scales each channel of its irradiance (linear colour).",
        .type = ParamType::Color, .defVec = glm::vec3(1.f)},
       {.name = "sun_irradiance", .label = "Sun irradiance (W/m^2)",
-       .help = "Irradiance of the sun on a surface facing it; 0 = no sun.",
+       .help = "Irradiance of a white sun on a surface facing it (times the linear sun colour per channel); 0 = no "
+               "sun.",
        .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
       {.name = "sun_angular_radius", .label = "Sun angular radius (deg)",
        .help = "0 gives a sharp directional light.",

@@ -288,6 +288,69 @@ TEST(SkyLighting, SunOnOpenPlane) {
   for (float v : r.value) EXPECT_NEAR(v, 1.0, 2e-3);
 }
 
+// max_distance: geometry farther than it does not occlude, for the sun's
+// shadow rays as for the sky's (an outside audit found the sun still
+// shadowed by a wall 1.13 away at max_distance 0.3: 0 for 0.707). A sharp
+// sun at 45 degrees behind the wall (floor x in [0, 2], wall at x = 0, 1
+// high): a floor vertex at x = 0.75 is in the wall's shadow (its sun ray
+// meets the wall 1.06 away), and lit with E_sun cos 45 when max_distance is
+// 0.3.
+TEST(SkyLighting, MaxDistanceLimitsTheSunsShadowsToo) {
+  auto sf = scenes::floorWithWall(2.0, 1.0, 8);
+  auto caster = makeEmbreeCaster(sf.scene);
+  AmbientOptions o;
+  o.mode = AmbientMode::Sky;
+  o.raysPerVertex = 32;
+  o.skyIrradiance = 0.f;
+  o.sunIrradiance = 1.f;
+  o.sunColor = glm::vec3(1.f);
+  o.sunAngularRadiusDeg = 0.f;
+  o.sunRays = 1;
+  o.sunDirection = glm::normalize(glm::vec3(-1.f, 0.f, 1.f));
+  const auto n = computeVertexNormals(sf.scene);
+  const size_t v = test::nearestVertex(sf.scene, {0.75, 0, 0}, [&](size_t i) { return n[i].z > 0.99f; });
+  EXPECT_EQ(computeAmbient(sf.scene, *caster, o).value[v], 0.f);
+  o.maxDistance = 0.3;
+  EXPECT_NEAR(computeAmbient(sf.scene, *caster, o).value[v], std::sqrt(0.5), 1e-4);
+}
+
+// Adaptive sky lighting: target_error is the standard error of the sky's
+// light in W/m^2 (it was of the sky fraction: at a sky of 100 W/m^2 a target
+// of 0.01 gave errors of 0.97 W/m^2). At 100 times the sky, 100 times the
+// target stops every vertex where the plain one did; the plain target there
+// needs 10,000 times the rays, which max_rays (4,096) cuts short: every
+// vertex still stops either below the target or at max_rays, and the log
+// says the target is not met (it said nothing, as an audit found).
+TEST(SkyLighting, TargetErrorIsInWattsPerSquareMetre) {
+  auto sf = scenes::floorWithWall(2.0, 1.0, 8);
+  auto caster = makeEmbreeCaster(sf.scene);
+  AmbientOptions o;
+  o.mode = AmbientMode::Sky;
+  o.sunIrradiance = 0.f;
+  o.minRays = 32;
+  o.maxRays = 4096;
+  auto run = [&](float sky, double target) {
+    o.skyIrradiance = sky;
+    o.targetError = target;
+    return computeAmbient(sf.scene, *caster, o);
+  };
+  const AmbientResult one = run(1.f, 0.02), hundred = run(100.f, 2.0), strict = run(100.f, 0.02);
+  double rays1 = 0, raysStrict = 0;
+  for (size_t i = 0; i < one.value.size(); ++i) {
+    if (one.rays[i] == 0) continue;
+    EXPECT_EQ(one.rays[i], hundred.rays[i]) << "vertex " << i;
+    if (hundred.rays[i] < o.maxRays) EXPECT_LE(hundred.stdError[i], 2.f) << "vertex " << i;
+    if (strict.rays[i] < o.maxRays) EXPECT_LE(strict.stdError[i], 0.02f) << "vertex " << i;
+    rays1 += one.rays[i], raysStrict += strict.rays[i];
+  }
+  std::printf("sky rays: %.0f at 0.02 of a sky of 1 W/m^2, %.0f at 0.02 of 100 W/m^2\n", rays1, raysStrict);
+  EXPECT_GT(raysStrict, 5 * rays1);
+  EXPECT_TRUE(hundred.stats.warnings.empty()) << hundred.stats.line("sky");
+  bool warned = false;
+  for (const auto& w : strict.stats.warnings) warned |= w.find("the target is not met") != std::string::npos;
+  EXPECT_TRUE(warned) << strict.stats.line("sky");
+}
+
 // Sky only: E = E_sky AO; with the wall, the crease gets half the sky.
 TEST(SkyLighting, SkyIsScaledAO) {
   auto sf = scenes::floorWithWall(2.0, 1.0, 8);

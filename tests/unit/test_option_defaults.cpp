@@ -97,6 +97,17 @@ TEST(OptionDefaults, AmbientEveryMode) {
   EXPECT_EQ(kAOColorMappings.get(defaults(FilterKind::AmbientOcclusion), "color_mapping"), AOColorMapping::Grey);
 }
 
+// The same sun by default wherever there is one: sky lighting's sun was
+// warm (sRGB 255, 244, 214) where radiosity's, photon mapping's and the
+// reference's is white, so the same sun_irradiance gave 0.908 of the
+// reference's irradiance (an outside audit).
+TEST(OptionDefaults, OneSunColourInEveryFilter) {
+  const glm::vec3 sky = defaults(FilterKind::SkyLighting).getVec("sun_color");
+  for (FilterKind k : {FilterKind::Radiosity, FilterKind::PhotonMapping, FilterKind::PathTracedReference})
+    EXPECT_EQ(defaults(k).getVec("sun_color"), sky) << int(k);
+  EXPECT_EQ(sky, glm::vec3(1.f));
+}
+
 void expectSame(const SkySun& got, const SkySun& want) {
   SAME(skyRadiance);
   SAME(sunDirection);

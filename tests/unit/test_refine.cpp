@@ -248,7 +248,19 @@ TEST(Refine, ClosedMeshStaysClosedAreaAndAttributesKept) {
     a.faceSelected.push_back(f == 5 ? 1 : 0);
   }
   a.vertexColor.assign(in.vertexCount(), glm::u8vec3(200, 100, 50));
+  for (size_t v = 0; v < in.vertexCount(); ++v) a.vertexSelected.push_back(v % 3 ? 1 : 0);
   const MeshAttributes ra = refineAttributes(a, m);
+  // A new vertex is selected where both its parents are; file normals carried
+  // over as the refiner carries the scene's (the CLI writes them back).
+  ASSERT_EQ(ra.vertexSelected.size(), m.scene.vertexCount());
+  for (size_t v = 0; v < m.scene.vertexCount(); ++v)
+    EXPECT_EQ(ra.vertexSelected[v], v < m.inputVertices ? a.vertexSelected[v]
+                                                         : uint8_t(ra.vertexSelected[m.vertexParents[v].x] &&
+                                                                   ra.vertexSelected[m.vertexParents[v].y]));
+  const std::vector<glm::vec3> carried = refineVertexNormals(in.vertexNormals, m);
+  ASSERT_EQ(carried.size(), m.scene.vertexCount());
+  for (size_t v = 0; v < carried.size(); ++v) EXPECT_LT(glm::length(carried[v] - m.scene.vertexNormals[v]), 1e-5f);
+  EXPECT_TRUE(refineVertexNormals({}, m).empty());
   ASSERT_EQ(ra.faceColor.size(), m.scene.faceCount());
   for (size_t f = 0; f < m.scene.faceCount(); ++f) {
     EXPECT_EQ(ra.faceQuality[f], float(m.sourceFace[f]));
@@ -359,6 +371,13 @@ TEST(Refine, BudgetAndDepthRespectedAndDeterministic) {
   bool saysBudget = false;
   for (const auto& note : capped.result.stats.notes) saysBudget |= note.find("patch budget") != std::string::npos;
   EXPECT_TRUE(saysBudget) << capped.result.stats.line("refine");
+  EXPECT_TRUE(capped.result.stats.warnings.empty()) << capped.result.stats.line("refine");
+  // A budget below the input's patch count refines nothing, and says so.
+  o.refinement.maxPatches = int(s.faceCount()) - 1;
+  const AdaptiveRadiosity none = solveRadiosityAdaptive(s, o);
+  EXPECT_EQ(none.mesh.scene.faceCount(), s.faceCount());
+  ASSERT_EQ(none.result.stats.warnings.size(), 1u);
+  EXPECT_NE(none.result.stats.warnings[0].find("below the mesh's"), std::string::npos);
   // Determinism: one thread against two.
   o.refinement.maxDepth = 2;
   o.refinement.maxPatches = 200000;

@@ -57,8 +57,7 @@ struct AmbientOptions {
   float coneAngleDeg = 45.f;     // half-angle
   float falloffExponent = 1.f;   // obscurance
   glm::vec3 skyRadiantColor{1.f};  // linear
-  // Linear; the dialog's default, sRGB (255, 244, 214).
-  glm::vec3 sunColor{srgbToLinear(1.f), srgbToLinear(244.f / 255.f), srgbToLinear(214.f / 255.f)};
+  glm::vec3 sunColor{1.f};       // linear; white, as in every filter with a sun
   float skyIrradiance = 1.f;     // W/m^2 on an unoccluded surface
   float sunIrradiance = 3.f;     // W/m^2 on a surface facing the sun
   glm::vec3 sunDirection = *unitDirection({0.3f, 1.f, 0.2f});  // towards the sun, unit length

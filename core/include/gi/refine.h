@@ -97,7 +97,12 @@ RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, c
 
 // The attributes of the input mesh carried to the refined one: face colour,
 // quality and selection from the source face; vertex colours of new vertices
-// interpolated (in linear light) between their parents.
+// interpolated (in linear light) between their parents; a new vertex
+// selected where both its parents are.
 MeshAttributes refineAttributes(const MeshAttributes& a, const RefinedMesh& m);
+// Vertex normals of the input carried to the refined mesh: a midpoint takes
+// the normalised sum of its edge's two ends (an input vertex keeps its own;
+// empty stays empty).
+std::vector<glm::vec3> refineVertexNormals(const std::vector<glm::vec3>& n, const RefinedMesh& m);
 
 }  // namespace gi
