@@ -33,8 +33,11 @@ std::vector<ParamSpec> PhotonOptions::specs() {
       {.name = "k_nearest", .label = "Photons per estimate",
        .help = "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side "
                "of the surface: their power over the area of that surface within their radius (a disk on a plane, "
-               "half of it at a crease). More photons mean less noise (about 1 / sqrt(k)) but more blur; k = 1 or 2 "
-               "gives an estimate without a finite mean or variance.",
+               "half of it at a crease). At a vertex where a face turns more than 20 degrees from its normal (an "
+               "edge between walls), whose value is the irradiance of its own tilted plane, the photons of the "
+               "faces on both sides tell another quantity: with the direct light computed apart, such a vertex "
+               "takes a final gather of the photon map instead (gather_rays). More photons mean less noise (about "
+               "1 / sqrt(k)) but more blur; k = 1 or 2 gives an estimate without a finite mean or variance.",
        .type = ParamType::Int, .def = 64, .min = 1, .max = 512},
       {.name = "caustic_k", .label = "Photons per caustic estimate",
        .help = "k for the caustic map (photons that reached a diffuse surface through mirrors or glass only). Its "
@@ -200,15 +203,21 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
 // gather, `all` read where its rays land; and the caustic map.
 struct PhotonMaps {
   std::unique_ptr<PhotonMap> global, caustics, all;
+  // Without a final gather: the crease vertices (creaseVertices) that gather
+  // from `all` all the same; empty if none.
+  std::vector<uint8_t> crease;
   unsigned globalPaths = 7u;
   size_t bytes = 0;  // the photons and the trees
 };
 
 PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, const std::vector<Photon>& causticPhotons,
-                     const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& lastHit) {
+                     const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& lastHit,
+                     std::vector<uint8_t> crease) {
   PhotonMaps m;
+  m.crease = std::move(crease);
   m.globalPaths = r.opt.directLight ? (1u << kIndirectPhoton) : 7u;
   const bool gather = r.opt.directLight && r.opt.finalGather;
+  const bool creaseGather = !m.crease.empty();
   // Caustic photons (L S+ D) have their own map, shot by projection towards
   // the mirrors and glass, whenever the direct light is apart; otherwise one
   // map holds every photon. The (single-threaded) builds run side by side.
@@ -225,7 +234,7 @@ PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, con
       },
       [&] {
         // Without the photons of a path's last allowed hit: the gather's rays add that reflection.
-        if (gather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface, &lastHit);
+        if (gather || creaseGather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface, &lastHit);
       });
   m.bytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
   for (const auto* map : {m.global.get(), m.caustics.get(), m.all.get()})
@@ -252,6 +261,9 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
     if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
   };
   std::vector<glm::vec3> gathered;
+  // A final gather everywhere, or (k nearest) at the crease vertices only.
+  const bool gatherAll = m.all && m.crease.empty();
+  auto gatheredAt = [&](size_t i) { return gatherAll || (m.all && m.crease[i]); };
   if (m.all) {
     gathered = specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps,
                                    [&](uint32_t f, const glm::vec3& y, const glm::vec3& side) {
@@ -260,7 +272,8 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
                                                                            PhotonKernel::Uniform, nullptr, &used);
                                      count(used);
                                      return s.faceRho(f) * H;
-                                   });
+                                   },
+                                   gatherAll ? nullptr : &m.crease);
   }
   parallelBlocks(nv, progress, "density estimation", [&](size_t b, size_t end) {
     for (size_t i = b; i < end; ++i) {
@@ -271,11 +284,12 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const
       // bounce beyond the vertex (all indirect); a map's by their tag.
       glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
       glm::vec3* byPath = split ? parts : nullptr;
-      glm::vec3 H = m.all ? gathered[i]
-                          : m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max,
-                                                 PhotonKernel::Uniform, &e1, &used, byPath);
-      if (m.all) parts[kPathIndirect] = gathered[i];
-      if (!m.all) count(used);
+      const bool fg = gatheredAt(i);
+      glm::vec3 H = fg ? gathered[i]
+                       : m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max,
+                                              PhotonKernel::Uniform, &e1, &used, byPath);
+      if (fg) parts[kPathIndirect] = gathered[i];
+      if (!fg) count(used);
       if (m.caustics)
         H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2,
                                     nullptr, byPath);
@@ -299,23 +313,32 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   const PhotonOptions& opt = r.opt;
   Timer traceTimer;
   const bool gather = opt.directLight && opt.finalGather;
+  // Crease vertices gather (the direct light apart; all light from photons
+  // would need the gather to see the lights too).
+  std::vector<uint8_t> crease;
+  if (opt.directLight && !gather) {
+    crease = creaseVertices(r.s, r.mat);
+    if (std::find(crease.begin(), crease.end(), uint8_t(1)) == crease.end()) crease.clear();
+  }
   std::vector<uint8_t> lastHit;
   std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts,
-                                             gather ? &lastHit : nullptr);
+                                             gather || !crease.empty() ? &lastHit : nullptr);
   std::vector<Photon> causticPhotons;
   if (r.projection)
     causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
   const double traceSeconds = traceTimer.seconds();
   Timer buildTimer;
   const GatherSurface surface(r.s);
-  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts, lastHit);
+  const size_t creaseCount = size_t(std::count(crease.begin(), crease.end(), uint8_t(1)));
+  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts, lastHit, std::move(crease));
   const double buildSeconds = buildTimer.seconds();
   if (contents) {
     // The same membership as the trees': `all` (final gather) or the global
     // paths, and the caustic map from the projection or the global trace.
-    const unsigned globalMask = maps.all ? 7u : maps.global ? maps.globalPaths : 0u;
+    const bool all = maps.all && maps.crease.empty();
+    const unsigned globalMask = all ? 7u : maps.global ? maps.globalPaths : 0u;
     for (size_t i = 0; i < photons.size(); ++i)
-      if (((globalMask >> photons[i].path) & 1u) && !(maps.all && lastHit[i])) contents->global.push_back(photons[i]);
+      if (((globalMask >> photons[i].path) & 1u) && !(all && lastHit[i])) contents->global.push_back(photons[i]);
     if (maps.caustics) {
       for (const Photon& p : r.projection && !causticPhotons.empty() ? causticPhotons : photons)
         if (p.path == kCausticPhoton) contents->caustic.push_back(p);
@@ -331,14 +354,18 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   for (const Photon& p : photons) globalCount += (maps.globalPaths >> p.path) & 1u;
   st.add("photons_global_map", double(globalCount));
   e.check.surfaceArea = surface.totalArea();
-  e.check.mapPhotons = maps.all ? maps.all->size() : maps.global->size();
+  e.check.mapPhotons = maps.global ? maps.global->size() : maps.all->size();
   e.check.causticPhotons = maps.caustics ? maps.caustics->size() : 0;
   e.check.kNearestEstimates = true;
   st.add("photons_caustic_map", maps.caustics ? double(maps.caustics->size()) : 0.0);
   st.add("photon_memory_mb", maps.bytes / 1048576.0);
   if (!r.specular) st.note("no caustic map: the scene has no mirror, glass or glossy faces");
   else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
-  if (maps.all) st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
+  if (maps.all && maps.crease.empty())
+    st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
+  else if (maps.all)
+    st.note(std::to_string(creaseCount) + " vertices at creases gather the photon map (" +
+            std::to_string(opt.gatherRays) + " rays each): there a density estimate reads the faces on both sides");
   return e;
 }
 

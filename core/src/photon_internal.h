@@ -68,8 +68,20 @@ void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGathe
 // cosine-weighted rays from origins[v] follow them (up to 16 interactions;
 // a glossy lobe by one sample of it) and, at the
 // first diffuse face, add value(face, point, its unit normal) if the ray hit its front (0 otherwise).
+// `only` (one flag per vertex, or null for all): the vertices to gather at; the others get 0.
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
-    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value);
+    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value,
+    const std::vector<uint8_t>* only = nullptr);
+
+// A vertex at a crease: one of its diffuse faces turns more than
+// kCreaseDegrees from its (averaged) normal. There the k-nearest density
+// estimate reads the photons of the faces on both sides, the mean of their
+// irradiances near the crease, not the irradiance of the vertex's own tilted
+// plane that the vertex value is (the reference, radiosity and the final
+// gather see the hemisphere of the vertex normal): the k-nearest mode
+// gathers there instead.
+constexpr double kCreaseDegrees = 20.0;
+std::vector<uint8_t> creaseVertices(const Scene& s, const VertexMaterial& mat);
 
 }  // namespace gi

@@ -183,12 +183,13 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
-    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value) {
+    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value,
+    const std::vector<uint8_t>* only) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
-      if (!mat.valid[v]) continue;
+      if (!mat.valid[v] || (only && !(*only)[v])) continue;
       SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
       Rng rng(hash3(uint32_t(v), key, 0xfau));
       const Frame frame(mat.n[v]);
@@ -235,6 +236,21 @@ std::vector<glm::vec3> specularFinalGather(
     }
   });
   return H;
+}
+
+std::vector<uint8_t> creaseVertices(const Scene& s, const VertexMaterial& mat) {
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  const float cosMax = float(std::cos(kCreaseDegrees * M_PI / 180.0));
+  std::vector<uint8_t> crease(s.vertexCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f] || s.faceMaterial(f) != Material::Diffuse) continue;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = s.triangles[f][k];
+      if (mat.valid[v] && glm::dot(faceN[f], mat.n[v]) < cosMax) crease[v] = 1;
+    }
+  }
+  return crease;
 }
 
 }  // namespace gi
