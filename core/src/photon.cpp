@@ -172,12 +172,17 @@ struct PhotonEstimate {
 
 // Direct light by light sampling at every vertex (area emitters, the point
 // or spot light, the sky and the sun), or none when the photons carry it.
-std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress) {
+// The sky through the mesh's openings (a window) is sampled through them as
+// luminaires, as radiosity does (gi/sky.h); its log lines go to *st.
+std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress, RunStats* st) {
   std::vector<glm::vec3> Hd(r.s.vertexCount(), glm::vec3(0.f));
   if (!r.opt.directLight) return Hd;
   Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress);
   const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
-  const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed);
+  const SkyOpenings openings = findSkyOpenings(r.s, r.caster, r.opt.outside, r.opt.seed);
+  if (st) openings.report(*st);
+  const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed, VertexPart(),
+                                         Progress(nullptr), &openings);
   for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i] + Ho[i];
   return Hd;
 }
@@ -473,7 +478,7 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   const PhotonRun run{s, caster, opt, mat, origins, eps, specular, projection, vertexPaths, r2max};
 
   Timer directTimer;
-  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15));
+  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15), &st);
   const double directSeconds = directTimer.seconds();
   PhotonTraceStats ts;
   PhotonEstimate photons;
