@@ -53,7 +53,7 @@ std::vector<glm::vec3> gatherIndirect(const Scene& s, const RayCaster& caster, c
   // the near hits read, where the solver kept them (res.Rbounces).
   const int K = opt.bounces;
   const bool haveBounces = K > 0 && res.Rbounces.size() == size_t(K);
-  const bool refineNear = K < 0 || haveBounces;
+  const bool refineNear = K < 0 || K == 1 || haveBounces;  // one bounce reads no patch values
   const int nearLevels = K == 1 ? 0 : kNearLevels;
   // R^(m) of face f (m < 0: converged, m = 0: nothing reflected yet).
   const auto patchR = [&](uint32_t f, int m) -> glm::vec3 {
