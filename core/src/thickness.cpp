@@ -131,6 +131,24 @@ RobustMean robustMean(std::vector<float>& L, bool reject) {
       b = lo;
       e = hi;
       meanOf(b, e, mean, sd);
+      // The standard error of a trimmed mean: the winsorised sample's
+      // standard deviation (the values cut off set to the nearest kept one)
+      // over (k / n) sqrt(n), k of n kept (Tukey and McLaughlin 1963). The
+      // kept values' own spread over sqrt(k) ignores that the window was
+      // chosen from the same sample: at 16 rays per vertex the z-scores of
+      // a sphere's thickness had an RMS of 1.77, 6.5% beyond 3 (an outside audit).
+      const size_t k = size_t(e - b);
+      double ws = 0, wss = 0;
+      for (size_t i = 0; i < n; ++i) {
+        const double x = std::clamp(double(L[i]), double(*b), double(*(e - 1)));
+        ws += x;
+        wss += x * x;
+      }
+      const double wmean = ws / double(n), wvar = std::max(0.0, (wss - double(n) * wmean * wmean) / double(n - 1));
+      r.count = k;
+      r.mean = mean;
+      r.stdError = k > 1 ? std::sqrt(wvar) * std::sqrt(double(n)) / double(k) : 0.0;
+      return r;
     }
   }
   r.count = size_t(e - b);
@@ -207,6 +225,15 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
             " vertices found the opposite side with fewer than half their rays (" + std::to_string(noHit) +
             " with none): the mesh is open, its normals point inwards, or it has inner shells; thickness is "
             "measured only where rays leave through the back of a face");
+  // The robust mean's window (median +- sd) comes from the same few lengths:
+  // from 16 rays its error bars hold (a sphere's z-scores: RMS 1.19 at 16,
+  // 0.62 at 32 rays), below they understate the error (1.95 at 8).
+  const int fewest = opt.targetError > 0.0 ? std::min(opt.minRays, opt.maxRays) : opt.raysPerVertex;
+  if (opt.rejectOutliers && fewest < kRobustMinRays)
+    st.warn(std::string(opt.targetError > 0.0 ? "min_rays " : "rays_per_vertex ") + std::to_string(fewest) +
+            " is below " + std::to_string(kRobustMinRays) +
+            " with reject_outliers: the robust mean's window is estimated from too few lengths, and its "
+            "standard errors understate the error (and its value is biased, a few percent at 8 rays)");
   if (opt.targetError > 0.0) {
     size_t unmet = 0;
     for (size_t i = 0; i < nv; ++i)

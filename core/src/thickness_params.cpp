@@ -30,7 +30,8 @@ std::vector<ParamSpec> ThicknessOptions::specs() {
                .type = ParamType::Float, .def = 60.0, .min = 0.5, .max = 89.0});
   s.push_back({.name = "reject_outliers", .label = "Reject outliers",
                .help = "Average only the lengths within one standard deviation of their median (Shapira et al. "
-                       "2008), so that rays slipping through a gap or along a fin do not count. Off: the plain mean.",
+                       "2008), so that rays slipping through a gap or along a fin do not count; needs 16 rays or "
+                       "more (fewer: the window comes from too few lengths, and the log warns). Off: the plain mean.",
                .type = ParamType::Bool, .def = true});
   s.push_back(seedSpec("ray directions"));
   return s;

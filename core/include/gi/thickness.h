@@ -52,11 +52,15 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
 
 // The robust mean of lengths (sorted in place): the mean of those within one
 // standard deviation of the median (or of all, if !reject), with its
-// standard error; count = how many were averaged.
+// standard error (a trimmed mean's: the winsorised standard deviation over
+// (k / n) sqrt(n), Tukey and McLaughlin 1963); count = how many were averaged.
 struct RobustMean {
   double mean = 0.0, stdError = 0.0;
   size_t count = 0;
 };
 RobustMean robustMean(std::vector<float>& lengths, bool reject);
+// Fewer rays than this with reject_outliers are warned about (the window
+// comes from too few lengths: error bars too small, value biased).
+constexpr int kRobustMinRays = 16;
 
 }  // namespace gi
