@@ -69,7 +69,7 @@ VertexFile readVertexFile(const std::string& path) {
   if (bytes.empty()) failRead(path, "the file is empty (0 bytes)");
   const detail::Polygons p = detail::readPly(bytes, path);
   detail::checkPolygons(p, path);
-  return {p.points.size(), detail::vertexAttributes(p)};
+  return {p.points.size(), detail::vertexAttributes(p), p.points};
 }
 
 }  // namespace gi::io

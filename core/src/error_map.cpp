@@ -115,7 +115,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     } else if (measure == ErrorMeasure::ZScore) {
       const double sr = sigmaRef.empty() ? 0.0 : sigmaRef[i], sv = sigmaValue.empty() ? 0.0 : sigmaValue[i];
       const double s = std::sqrt(sr * sr + sv * sv);
-      if (!(s > 0.0) || !std::isfinite(s)) {
+      if (!(s > 0.0) || !std::isfinite(s) || sr < 0.0 || sv < 0.0) {  // a negative error bar is no error bar
         if (d != 0.0) ++undefined;  // a difference with no error bar: no z
         continue;
       }
@@ -149,7 +149,10 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   RunStats& st = out.stats;
   st.add("vertices", double(used));
   st.add("rms_error", used ? std::sqrt(sumD2 / double(used)) : 0.0);
-  st.add("relative_rms_error", sumR2 > 0 ? std::sqrt(sumD2 / sumR2) : 0.0);
+  if (sumR2 > 0 || sumD2 == 0)
+    st.add("relative_rms_error", sumR2 > 0 ? std::sqrt(sumD2 / sumR2) : 0.0);
+  else
+    st.note("no relative RMS error: the reference is 0 at every vertex and the value is not");
   st.add("max_abs_error", maxAbs);
   st.add("mean_error", used ? sumD / double(used) : 0.0);
   if (measure == ErrorMeasure::ZScore) {
@@ -164,7 +167,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
                    : "; every error is 0: all white"));
   if (undefined)
     st.note(std::to_string(undefined) + " vertices with no defined " + kErrorMeasures.logName(measure) +
-            " (reference 0, no error bar, or not finite): 0 written");
+            " (reference 0, no error bar or a negative one, or not finite): 0 written");
   return out;
 }
 
@@ -205,6 +208,25 @@ std::vector<float> attributeValues(const std::vector<VertexAttribute>& attrs, co
   return scalarValues(*a);
 }
 
+// The file's vertices must be the mesh's, in the same order: equal positions
+// up to a float's rounding of the scene's size (files hold floats). The
+// vertex count alone let a file with its vertices in another order through,
+// and every value was compared with another vertex's.
+void checkSameVertices(const Scene& s, const VertexFile& f, const std::string& file) {
+  if (f.positions.size() != s.vertexCount()) return;  // a reader without positions
+  const double diag = sceneDiagonal(s);
+  for (size_t i = 0; i < f.positions.size(); ++i) {
+    const glm::dvec3 p = s.toWorld(s.positions[i]);
+    // A float's rounding of the coordinates (far from the origin) and of the size.
+    const double tol = 1e-5 * diag + 1e-6 * std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    if (!(glm::length(p - f.positions[i]) <= tol) && std::isfinite(p.x + p.y + p.z))
+      throw std::invalid_argument("the reference " + file + "'s vertex " + std::to_string(i) + " lies at (" +
+                                  fmt(f.positions[i].x) + ", " + fmt(f.positions[i].y) + ", " + fmt(f.positions[i].z) +
+                                  "), the mesh's at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) +
+                                  "): it must be the same mesh with its vertices in the same order");
+  }
+}
+
 }  // namespace
 
 void computeErrorMap(const FilterInput& in, FilterResult& res) {
@@ -237,6 +259,7 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (f.vertexCount != nv)
       throw std::invalid_argument("the reference " + o.file + " has " + std::to_string(f.vertexCount) +
                                   " vertices and the mesh " + std::to_string(nv) + ": it must be the same mesh");
+    checkSameVertices(in.scene, f, o.file);
     r = attributeValues(f.attributes, o.reference, o.file, "");
     if (!o.referenceError.empty() && find(f.attributes, o.referenceError))
       sr = attributeValues(f.attributes, o.referenceError, o.file, "", true);
@@ -245,6 +268,9 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   if (o.measure == ErrorMeasure::ZScore && sr.empty() && sv.empty())
     throw std::invalid_argument("a z-score needs a standard error, and the reference has no attribute '" +
                                 o.referenceError + "' (and no value_error is named)");
+  if (o.measure == ErrorMeasure::ZScore && sr.empty() && !o.referenceError.empty())
+    res.stats.warn("the reference has no attribute '" + o.referenceError +
+                   "' (reference_error): the z-scores take the reference as exact, with value_error's bars alone");
   if (o.measure != ErrorMeasure::ZScore && !o.valueError.empty())
     res.stats.warn("value_error is used only by the z-score");
   if (v.size() != nv || r.size() != nv) throw std::logic_error("error map: attribute of the wrong size");

@@ -189,6 +189,55 @@ TEST(ErrorMap, ReferenceFileAndClearErrors) {
     errorMapOf(sf, leftOnMesh(ref), {{"reference_source", "1"}, {"reference_file", (dir / "gi_no_such.ply").string()}});
   });
   EXPECT_NE(noFile.find("no such file"), std::string::npos) << noFile;
+  // The same mesh with its vertices in reverse order (faces remapped): the
+  // vertex count matches, but every value would meet another vertex's (an
+  // outside audit: accepted silently); its positions tell.
+  const std::string reversed = (dir / "gi_errormap_reversed.ply").string();
+  {
+    const size_t nv = sf.scene.vertexCount();
+    std::vector<glm::dvec3> pts(nv);
+    for (size_t i = 0; i < nv; ++i) pts[nv - 1 - i] = sf.scene.toWorld(sf.scene.positions[i]);
+    std::vector<glm::uvec3> tris;
+    for (const auto& t : sf.scene.triangles)
+      tris.push_back({uint32_t(nv - 1 - t.x), uint32_t(nv - 1 - t.y), uint32_t(nv - 1 - t.z)});
+    std::vector<float> q(nv);
+    for (size_t i = 0; i < nv; ++i) q[nv - 1 - i] = ref.vertexQuality[i];
+    io::writePly(reversed, Scene::fromAbsolute(pts, tris), MeshAttributes{}, q, {});
+  }
+  const std::string order = messageOf([&] {
+    errorMapOf(sf, leftOnMesh(ref), {{"reference_source", "1"}, {"reference_file", reversed}, {"reference_attribute", "quality"}});
+  });
+  EXPECT_NE(order.find("in the same order"), std::string::npos) << order;
   std::filesystem::remove(file);
   std::filesystem::remove(other);
+  std::filesystem::remove(reversed);
+}
+
+// Error bars the z-score cannot use are said, not passed over: a
+// reference_error the mesh lacks while value_error is named (the z-scores
+// then take the value's bars alone: a warning), and negative standard
+// errors (no z there, counted with the undefined ones); a reference of 0
+// everywhere has no relative RMS error (it read 0, a perfect match).
+TEST(ErrorMap, UnusableErrorBarsAreSaid) {
+  const auto sf = scenes::cornellBox(300.0);
+  const size_t nv = sf.scene.vertexCount();
+  std::vector<float> value(nv, 2.f), refv(nv, 1.f), sigma(nv, 0.5f), bad(nv, 0.5f);
+  bad[0] = -1.f;
+  const std::vector<VertexAttribute> attrs = {{kQualityAttribute, 1, value}, {"Reference", 1, refv},
+                                              {"ValueError", 1, sigma}, {"Bad", 1, bad}};
+  const FilterResult typo = errorMapOf(sf, attrs, {{"reference_error", "RefStdErrTYPO"}, {"value_error", "ValueError"},
+                                                   {"error_measure", "2"}});
+  ASSERT_EQ(typo.stats.warnings.size(), 1u);
+  EXPECT_NE(typo.stats.warnings[0].find("RefStdErrTYPO"), std::string::npos);
+  EXPECT_FLOAT_EQ(typo.vertexQuality[1], 2.f);  // (2 - 1) / 0.5
+  const FilterResult negative = errorMapOf(sf, attrs, {{"reference_error", "Bad"}, {"error_measure", "2"}});
+  EXPECT_EQ(negative.vertexQuality[0], 0.f);
+  EXPECT_FLOAT_EQ(negative.vertexQuality[1], 2.f);
+  bool said = false;
+  for (const auto& n : negative.stats.notes) said |= n.find("1 vertices with no defined") != std::string::npos;
+  EXPECT_TRUE(said);
+  const std::vector<VertexAttribute> zero = {{kQualityAttribute, 1, value}, {"Reference", 1, std::vector<float>(nv, 0.f)}};
+  const FilterResult r0 = errorMapOf(sf, zero, {});
+  EXPECT_TRUE(std::isnan(r0.stats.get("relative_rms_error", std::nan(""))));
+  EXPECT_GT(r0.stats.get("rms_error"), 1.9);
 }

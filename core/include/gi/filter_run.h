@@ -51,6 +51,7 @@ inline const char* const kQualityAttribute = "quality";
 struct VertexFile {
   size_t vertexCount = 0;
   std::vector<VertexAttribute> attributes;
+  std::vector<glm::dvec3> positions;  // absolute; empty where a reader has none
 };
 using VertexFileReader = std::function<VertexFile(const std::string& path)>;
 
