@@ -288,7 +288,8 @@ class DirectLight {
   // n) to luminaire L, averaged over the patch; *best: the patch's base
   // point of largest F.
   double patchFormFactor(size_t L, const glm::dvec3 p[3], const glm::dvec3& n, glm::dvec3* best) const {
-    return meanOverTriangle(p, [&](const glm::dvec3& x) { return lums_.formFactor(L, x, n); }, targets_[L], best);
+    return meanOverTriangle(p, [&](const glm::dvec3& x) { return lums_.formFactor(L, x, n); }, targets_[L], eps_,
+                            best);
   }
 
   // The log: luminaires found and the method used, and the shadow rays cast.

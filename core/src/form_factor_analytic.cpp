@@ -230,8 +230,17 @@ double triangleToTriangleFormFactor(const glm::dvec3 s[3], const glm::dvec3 t[3]
 }
 
 double meanOverTriangle(const glm::dvec3 s[3], const std::function<double(const glm::dvec3&)>& g,
-                        const FormFactorTarget& target, glm::dvec3* best) {
+                        const FormFactorTarget& target, double inPlane, glm::dvec3* best) {
   const Tri src{s[0], s[1], s[2]};
+  if (best) *best = src.centroid();
+  const glm::dvec3 cr = glm::cross(s[1] - s[0], s[2] - s[0]);
+  const double l = glm::length(cr);
+  if (!(l > 0.0)) return 0.0;
+  const glm::dvec3 n = cr / l;
+  double front = -std::numeric_limits<double>::infinity();
+  for (const auto& e : target.edges) front = std::max(front, glm::dot(n, e[0] - s[0]));
+  if (front <= inPlane) return 0.0;
+  if (!target.twoSided && heightAbovePlane(target.normal, target.origin, s[0], s[1], s[2]) <= inPlane) return 0.0;
   // Far from the target, the centroid alone: its error, about (r / d)^2 / 4, is below 0.1%.
   const double d = glm::length(src.centroid() - target.centre) - src.radius() - target.radius;
   if (d >= kMeanNear * src.radius()) {

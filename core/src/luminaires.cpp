@@ -252,6 +252,7 @@ FormFactorTarget Luminaires::target(size_t i) const {
   t.normal = L.normal;
   t.origin = L.origin;
   t.area = L.area;
+  t.twoSided = L.portal;
   auto narrowest = [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
     const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     const double half = longest > 0 ? 0.5 * glm::length(glm::cross(b - a, c - a)) / longest : 0.0;

@@ -58,6 +58,7 @@ struct FormFactorTarget {
   double area = 0.0, narrowest = 0.0;
   glm::dvec3 centre{0.0};
   double radius = 0.0;
+  bool twoSided = false;  // seen from either side (a sky portal); else from its normal's side only
 };
 
 // The mean of g over source triangle s, g the unoccluded factor from a point
@@ -67,8 +68,13 @@ struct FormFactorTarget {
 // (the comparison, then the target's edges: exact up to about 0.3% where s
 // meets the target at a common edge or a thin gap). The one-point rule's
 // error, about (r / d)^2 / 4, is below 0.1% where it is used.
-// *best (optional): the base point of largest g.
+// *best (optional): the base point of largest g. 0 without evaluating g
+// where the target lies wholly behind or in s's plane, or s wholly behind or
+// in a one-sided target's, up to inPlane (the scene's ray offset: coplanar
+// faces whose corners were rounded off the plane are coplanar; without it
+// the edge rule split such pairs to its budget, and a furnace whose every
+// face emits took 100 times as long).
 double meanOverTriangle(const glm::dvec3 s[3], const std::function<double(const glm::dvec3&)>& g,
-                        const FormFactorTarget& target, glm::dvec3* best = nullptr);
+                        const FormFactorTarget& target, double inPlane, glm::dvec3* best = nullptr);
 
 }  // namespace gi
