@@ -417,7 +417,7 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
                             n * direct.eps();
         const LuminaireEstimate est = direct.estimate(x, n, smp, uint32_t(k), budget,
                                                       hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i), &sums);
-        sum += glm::dvec3(est.H);
+        if (!direct.exact()) sum += glm::dvec3(est.H);  // with luminaires the sums give the patch's value
         r += est.rays;
         pen += est.penumbra;
       }
