@@ -90,23 +90,32 @@ double distanceToSegment(const glm::dvec3& x, const glm::dvec3& p, const glm::dv
 // bounded below by h less the sub-triangle's radius). The extent across
 // the edge, not the radius: a sliver along an edge keeps its shape under
 // midpoint subdivision, and measured by its length it was split to the
-// last level everywhere (a 192-patch tube took 355 s).
+// last level everywhere (a 192-patch tube took 355 s). A corner within
+// onPlane (the scene's ray offset) of the target's plane is on it: a
+// sub-triangle with a side on a common edge has its centroid's w = 3 h / sin
+// of the faces' angle, so the rule would split it to the budget wherever
+// rounding (corners of a refined mesh, stored as floats) lifts that side
+// off the plane; the factor there is nearly constant across the edge (the
+// target's edge is seen at the same angle from every distance), which the
+// comparison handles (a patch of a sheared room beside its emitting
+// ceiling took 16,390 splits, 12 evaluations each).
 struct TargetEdges {
   std::array<glm::dvec3, 2> own[3];
   const std::array<glm::dvec3, 2>* edges = own;
   size_t count = 3;
   glm::dvec3 unitNormal{0.0}, origin{0.0};
-  double area = 0, narrowest = 0;
-  TargetEdges(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) : own{{a, b}, {b, c}, {c, a}}, origin(a) {
+  double area = 0, narrowest = 0, onPlane = 0;
+  TargetEdges(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, double onPlane_)
+      : own{{a, b}, {b, c}, {c, a}}, origin(a), onPlane(onPlane_) {
     const glm::dvec3 cr = glm::cross(b - a, c - a);
     area = 0.5 * glm::length(cr);
     unitNormal = area > 0 ? cr / (2.0 * area) : glm::dvec3(0.0);
     const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
     narrowest = longest > 0 ? area / longest : 0.0;  // half the smallest altitude
   }
-  explicit TargetEdges(const FormFactorTarget& t)
+  TargetEdges(const FormFactorTarget& t, double onPlane_)
       : edges(t.edges.data()), count(t.edges.size()), unitNormal(t.normal), origin(t.origin), area(t.area),
-        narrowest(t.narrowest) {}
+        narrowest(t.narrowest), onPlane(onPlane_) {}
   TargetEdges(const TargetEdges&) = delete;
   TargetEdges& operator=(const TargetEdges&) = delete;
   bool mustSplit(const Tri& t, double tolPerShare) const {
@@ -132,7 +141,8 @@ struct TargetEdges {
     auto side = [&](const glm::dvec3& x) { return glm::dot(unitNormal, x - origin); };
     const double h = std::fabs(side(m));
     const double ha = side(t.a), hb = side(t.b), hc = side(t.c);
-    const bool oneSide = (ha > 0 && hb > 0 && hc > 0) || (ha < 0 && hb < 0 && hc < 0);
+    const bool oneSide =
+        (ha > onPlane && hb > onPlane && hc > onPlane) || (ha < -onPlane && hb < -onPlane && hc < -onPlane);
     if ((!oneSide || w <= 3.0 * h) && w <= narrowest) return false;
     const double d = h - t.radius();
     return d <= 0 || area / (M_PI * d * d) > tolPerShare;
@@ -150,18 +160,20 @@ struct TargetEdges {
 // common edge, which is where the splitting concentrates.
 constexpr int kEdgeLevels = 6;
 
-// At most this many sub-triangles a pair splits for the target's edges
-// alone (3 evaluations each): a bound on the cost of any configuration the
-// rule above misjudges (the catalogue's hardest case, plates 0.01 apart,
-// takes about 9,000 per triangle pair).
-constexpr long kEdgeSplitBudget = 16384;
+// At most this many sub-triangles a pair splits, for the comparison and the
+// target's edges together (12 evaluations each): a bound on the cost of any
+// configuration the rules above misjudge (the catalogue's hardest case,
+// plates 0.01 apart, splits about 9,000 per triangle pair; a patch beside a
+// light at a common edge, under 100; without a shared bound, a hostile
+// pair could split 38,000).
+constexpr long kSplitBudget = 16384;
 
 // target: null for the comparison alone (levelsLeft levels: it splits while
 // levelsLeft > 1); else the comparison splits while levelsLeft > kEdgeLevels
 // + 1 (as many levels as without a target) and the target's edges for
-// kEdgeLevels more, while *edgeBudget lasts.
+// kEdgeLevels more, while *splitBudget lasts (null: no budget).
 template <class G>
-double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* target, long* edgeBudget,
+double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* target, long* splitBudget,
               int levelsLeft, double tolPerShare) {
   const auto q = t.quarters();
   // The middle quarter's centroid is t's own: its value is known.
@@ -170,13 +182,11 @@ double refine(const Tri& t, double w, double wg, const G& g, const TargetEdges* 
   // The comparison splits for up to levelsLeft levels, the target's edges
   // for kEdgeLevels more (a strip 0.001 high at a common edge needs 11).
   const bool compared = levelsLeft > (target ? kEdgeLevels + 1 : 1) && std::fabs(sum - wg) > tolPerShare * w;
-  if (levelsLeft <= 1) return sum;
-  if (!compared) {
-    if (!target || *edgeBudget <= 0 || !target->mustSplit(t, tolPerShare)) return sum;
-    --*edgeBudget;
-  }
+  if (levelsLeft <= 1 || (splitBudget && *splitBudget <= 0)) return sum;
+  if (!compared && (!target || !target->mustSplit(t, tolPerShare))) return sum;
+  if (splitBudget) --*splitBudget;
   sum = 0;
-  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, edgeBudget, levelsLeft - 1, tolPerShare);
+  for (int k = 0; k < 4; ++k) sum += refine(q[k], 0.25 * w, wq[k], g, target, splitBudget, levelsLeft - 1, tolPerShare);
   return sum;
 }
 
@@ -258,11 +268,11 @@ double meanOverTriangle(const glm::dvec3 s[3], const std::function<double(const 
   }
   if (d >= kMeanNear * 0.5 * src.radius()) return Fbase;
   const double tolPerShare = kRelTol * std::max(Fbase, kFloorF);
-  const TargetEdges edges(target);
-  long edgeBudget = kEdgeSplitBudget;
+  const TargetEdges edges(target, inPlane);
+  long splitBudget = kSplitBudget;
   double F = 0;
   for (size_t k = 0; k < base.size(); ++k)
-    F += refine(base[k], w, wg[k], g, &edges, &edgeBudget, kMaxRefine + kEdgeLevels, tolPerShare);
+    F += refine(base[k], w, wg[k], g, &edges, &splitBudget, kMaxRefine + kEdgeLevels, tolPerShare);
   return F;
 }
 
@@ -310,12 +320,12 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     for (size_t k = 0; k < base.size(); ++k) Fbase += (wg[k] = w * g(xs[k]));
     const bool near = d < kNear * rBase;
     const double tolPerShare = kRelTol * std::max(Fbase, kFloorF);
-    const TargetEdges target(pa, pb, pc);
-    long edgeBudget = kEdgeSplitBudget;
+    const TargetEdges target(pa, pb, pc, inPlane);
+    long splitBudget = kSplitBudget;
     double F = 0;
     for (size_t k = 0; k < base.size(); ++k) {
       const double f =
-          near ? refine(base[k], w, wg[k], g, &target, &edgeBudget, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
+          near ? refine(base[k], w, wg[k], g, &target, &splitBudget, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
       if (f <= 0) continue;
       // Visibility: one ray per base point to a random point of j, for all of
       // that base sub-triangle's refined quarters (as many rays as before refinement).
