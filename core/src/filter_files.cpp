@@ -1,5 +1,7 @@
 #include "gi/filter_files.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -19,7 +21,14 @@ std::string stdErrorImagePath(const std::string& imagePath) { return imageStem(i
 
 namespace {
 
+// A picture's path, and its PFM's beside it. The pictures are PNG whatever
+// the name says: a name that promises another format (x.jpg, or none) is
+// refused before any work rather than holding PNG data under it.
 void image(FilterFiles& f, const std::string& png, const std::string& parameter) {
+  std::string ext = png.substr(imageStem(png).size());
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".png")
+    throw std::invalid_argument(parameter + " '" + png + "': the pictures are written as PNG; give a name ending in .png");
   f.writes.push_back({png, parameter});
   f.writes.push_back({pfmPath(png), parameter});
 }

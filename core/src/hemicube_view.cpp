@@ -166,7 +166,7 @@ std::vector<ParamSpec> hemicubeViewSpecs() {
                "h = 2 / this.",
        .type = ParamType::Int, .def = 512, .min = 16, .max = 4096},
       {.name = "image_path", .label = "Image file",
-       .help = "Where to write the pictures as PNG (and beside each a PFM of its linear colours, not of the delta "
+       .help = "Where to write the pictures as PNG (a name ending in .png; and beside each a PFM of its linear colours, not of the delta "
                "form factors: those are the faces' quality): the cells by patch "
                "at this path, the delta form factors at NAME_dff.png and the Nusselt disk at NAME_nusselt.png. "
                "Empty: MeshLab shows them as raster layers only, and the command-line tool writes none.",

@@ -142,7 +142,7 @@ std::vector<ParamSpec> RenderOptions::specs() {
   for (const ParamSpec& p : pointLightSpecs()) s.push_back(p);
   s.push_back(seedSpec("pixel samples, lights and photons"));
   s.push_back({.name = "image_path", .label = "Image file",
-               .help = "Where to write the image: a PNG (sRGB at the exposure below) and, beside it, the linear "
+               .help = "Where to write the image (a name ending in .png): a PNG (sRGB at the exposure below) and, beside it, the linear "
                        "radiance as a PFM (same name, .pfm) for numerical comparison; path traced, also each pixel's "
                        "standard error as NAME_stderr.png and .pfm. Empty: MeshLab shows the images as raster layers "
                        "only, and the command-line tool writes no image.",

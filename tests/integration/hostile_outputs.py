@@ -79,8 +79,10 @@ def cornell(d, name="in.ply"):
 
 
 # --------------------------------------------------------------- overwrite --
-# (id, set-up in the folder, arguments relative to it). Refused before any
-# work: exit 1, one line "... would overwrite ...", every file as it was.
+# (id, set-up in the folder, arguments relative to it[, the refusal's words
+# where they are not "would overwrite": an image path that is no PNG name is
+# refused for that first]). Refused before any work: exit 1, one line, every
+# file as it was.
 def setup_links(d):
     cornell(d)
     os.symlink("in.ply", os.path.join(d, "link.ply"))
@@ -98,32 +100,34 @@ OVERWRITE = [
     ("save_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", "in.ply"]),
     ("residual_csv", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", "in.ply"]),
     ("export_system", ["radiosity", "in.ply", "-o", "p_B.mtx", "--export_system", "p"]),  # p_F.mtx, ..., p_B.mtx
-    ("image_path", ["render", "in.ply", "--image_path", "in.ply"]),
+    ("image_path", ["render", "in.ply", "--image_path", "in.ply"], "written as PNG"),  # the name alone refuses it
+    ("image_and_result", ["render", "in.ply", "--image_path", "x.png", "--save-result", "x.png"]),
     ("image_pfm", ["render", "in.ply", "--image_path", "in.png", "--layer", "in.pfm"]),
-    ("hemicube_image", ["hemicube", "in.ply", "--image_path", "link.ply"]),
+    ("hemicube_image", ["hemicube", "in.ply", "--image_path", "link.ply"], "written as PNG"),
+    ("hemicube_pfm", ["hemicube", "in.ply", "--image_path", "in.png", "--layer", "in_dff.pfm"]),
     ("layer", ["radiosity", "in.ply", "--layer", "lay.ply", "-o", "lay.ply"]),
     ("reference_file", ["errormap", "in.ply", "-o", "refc.ply", "--reference_source", "PLY file",
                         "--reference_file", "refc.ply"]),
     ("photon_layer", ["photonmap", "o.Photons.ply", "-o", "o.ply", "--photon_layer", "true"]),
     ("script_mesh", ["script", "ao", "--mesh", "in.ply", "-o", "hard.ply"]),
-    ("two_outputs", ["render", "in.ply", "-o", "o.ply", "--image_path", "o.ply"]),
+    ("two_outputs", ["render", "in.ply", "-o", "o.ply", "--image_path", "o.ply"], "written as PNG"),
     ("output_and_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", "./o.ply"]),
 ]
 
 
 def check_overwrite(gi, tmp):
     failures = []
-    for cid, args in OVERWRITE:
+    for cid, args, *fragment in OVERWRITE:
         d = os.path.join(tmp, "case_" + cid)
         os.makedirs(d)
         setup_links(d)
-        for extra in ("lay.ply", "refc.ply", "o.Photons.ply", "in.pfm"):
+        for extra in ("lay.ply", "refc.ply", "o.Photons.ply", "in.pfm", "in_dff.pfm"):
             if extra in args:
                 cornell(d, extra)
         before = snapshot(tmp)
         argv = fast(args) + ([] if args[0] == "script" else ["-q"])
         rc, _, lines = run([gi] + argv, cwd=d)
-        why = one_error(rc, lines, "would overwrite")
+        why = one_error(rc, lines, fragment[0] if fragment else "would overwrite")
         if not why and snapshot(tmp) != before:
             why = "the files changed"
         report(failures, "output %s (%s)" % (cid, " ".join(args)), why, rc, lines)

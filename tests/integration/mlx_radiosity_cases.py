@@ -189,18 +189,23 @@ def case_raytrace(c):
                            "--image_path", ref, *size), os.path.join(c.tmp, "pt.ply"))
     _, _, pt = read_pfm(ref[:-4] + ".pfm")
     check(not [f for f in os.listdir(c.tmp) if f.endswith(".tmp")], "images written through temporaries, none left")
-    # The plugin checks its output files before any work, as the CLI does (io/output_files.h): an
-    # image over the file a loaded layer came from, an image in a folder that does not exist.
+    # The plugin checks its output files before any work, as the CLI does (io/output_files.h): a
+    # file over the one a loaded layer came from (the residual CSV: an image must be named .png, and
+    # one named as the mesh is refused for that), an image in a folder that does not exist.
     copy = os.path.join(c.tmp, "box_copy.ply")
     with open(box, "rb") as f:
         original = f.read()
     with open(copy, "wb") as f:
         f.write(original)
-    log = c.server(copy, c.script("over", "render", "--mesh", copy, "--image_path", copy, *size), expect_ok=False)
+    log = c.server(copy, c.script("over", "radiosity", "--mesh", copy, "--residual_csv", copy), expect_ok=False)
     with open(copy, "rb") as f:
         kept = f.read() == original
     check("would overwrite the input" in log and "layer" in log and kept,
-          "an image over the loaded mesh's file is refused, the file kept")
+          "a file over the loaded mesh's file is refused, the file kept")
+    log = c.server(copy, c.script("overimg", "render", "--mesh", copy, "--image_path", copy, *size), expect_ok=False)
+    with open(copy, "rb") as f:
+        kept = f.read() == original
+    check("written as PNG" in log and "rays" not in log and kept, "an image path not named .png is refused, the file kept")
     log = c.server(box, c.script("nofolder", "render", "--mesh", box, "--image_path",
                                  os.path.join(c.tmp, "none", "i.png"), *size), expect_ok=False)
     check("does not exist" in log and "rays" not in log, "an image in a missing folder is refused before any ray")

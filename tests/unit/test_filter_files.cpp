@@ -73,6 +73,15 @@ TEST(FilterFiles, HemicubeNamesItsThreePicturesAndTheirPfm) {
   EXPECT_TRUE(written(plan).count("out/hc_nusselt.pfm"));
   in.values.set("image_path", std::string());
   EXPECT_TRUE(filterFiles(FilterKind::HemicubeOfFace, in.values).writes.empty());
+  // The pictures are PNG: a name promising another format is refused before
+  // any work (it held PNG data under .jpg), a capital .PNG is accepted.
+  for (const char* bad : {"out/hc.jpg", "out/hc", "out.d/hc"}) {
+    in.values.set("image_path", std::string(bad));
+    EXPECT_THROW(filterFiles(FilterKind::HemicubeOfFace, in.values), std::invalid_argument) << bad;
+    EXPECT_THROW(filterFiles(FilterKind::RayTracedView, in.values), std::invalid_argument) << bad;
+  }
+  in.values.set("image_path", std::string("out/HC.PNG"));
+  EXPECT_TRUE(written(filterFiles(FilterKind::HemicubeOfFace, in.values)).count("out/HC_dff.png"));
 }
 
 TEST(FilterFiles, RadiosityNamesItsCsvAndEveryMatrix) {
