@@ -253,10 +253,7 @@ double meanOverTriangle(const glm::dvec3 s[3], const std::function<double(const 
   if (!target.twoSided && heightAbovePlane(target.normal, target.origin, s[0], s[1], s[2]) <= inPlane) return 0.0;
   // Far from the target, the centroid alone: its error, about (r / d)^2 / 4, is below 0.1%.
   const double d = glm::length(src.centroid() - target.centre) - src.radius() - target.radius;
-  if (d >= kMeanNear * src.radius()) {
-    if (best) *best = src.centroid();
-    return g(src.centroid());
-  }
+  if (d >= kMeanNear * src.radius()) return g(src.centroid());
   const std::vector<Tri> base = baseTriangles(src, 1);
   const double w = 1.0 / double(base.size());
   std::vector<double> wg(base.size());

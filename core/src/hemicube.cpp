@@ -196,12 +196,15 @@ double FormFactors::hemicubeAt(uint32_t i, const glm::vec3& c, float phi, std::v
     total += face.accumulate(F, lost, keep ? &keep->faces[size_t(v)] : nullptr);
   }
   for (double& x : F) x /= total;
+  // At most 1: lost and total sum the same cells in another order (a face
+  // that sees nothing read 1.0000000000000155).
+  const double lostFraction = std::min(1.0, lost / total);
   if (keep) {
     keep->total = total;
     keep->F = F;
-    keep->lost = lost / total;
+    keep->lost = lostFraction;
   }
-  return lost / total;
+  return lostFraction;
 }
 
 HemicubeCells FormFactors::hemicubeCells(uint32_t i) const {

@@ -87,6 +87,19 @@ TEST(HemicubeView, DeltaFormFactorsSumToOne) {
   EXPECT_NEAR(hemicubeDeltaFormFactor(128, true, 64, 64), h * h / M_PI, h * h * h * h);
 }
 
+// A face that sees nothing loses everything: exactly 1, not more (lost and
+// the total sum the same cells in another order: it read
+// 1.0000000000000155 at 128 cells across).
+TEST(HemicubeView, ALoneFaceLosesAtMostEverything) {
+  const Scene s = Scene::fromAbsolute({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+  const auto caster = makeEmbreeCaster(s);
+  for (int res : {16, 128, 200}) {
+    const HemicubeView v = hemicubeView(s, *caster, 0, res, 16);
+    EXPECT_LE(v.cells.lost, 1.0) << res;
+    EXPECT_NEAR(v.cells.lost, 1.0, 1e-12) << res;
+  }
+}
+
 // The per-patch sums of the cells are the hemicube method's row (one view at
 // the centre), bit for bit, and the filter writes exactly what 'GI: Form
 // Factors of Selected Face' writes with the hemicube method.
