@@ -159,6 +159,7 @@ struct PhotonRun {
   bool projection;        // caustic photons aimed at them
   unsigned vertexPaths;   // the photon paths the vertex estimates read
   float r2max;            // squared gather radius cap
+  const SkyOpenings& openings;  // the sky's openings (gi/sky.h; none without a sky)
 };
 
 // The photons' irradiance at the vertices.
@@ -173,16 +174,14 @@ struct PhotonEstimate {
 // Direct light by light sampling at every vertex (area emitters, the point
 // or spot light, the sky and the sun), or none when the photons carry it.
 // The sky through the mesh's openings (a window) is sampled through them as
-// luminaires, as radiosity does (gi/sky.h); its log lines go to *st.
-std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress, RunStats* st) {
+// luminaires, as radiosity does (gi/sky.h).
+std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress) {
   std::vector<glm::vec3> Hd(r.s.vertexCount(), glm::vec3(0.f));
   if (!r.opt.directLight) return Hd;
   Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress);
   const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
-  const SkyOpenings openings = findSkyOpenings(r.s, r.caster, r.opt.outside, r.opt.seed);
-  if (st) openings.report(*st);
   const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed, VertexPart(),
-                                         Progress(nullptr), &openings);
+                                         Progress(nullptr), &r.openings);
   for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i] + Ho[i];
   return Hd;
 }
@@ -446,6 +445,24 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
   return totalsOver(out.B, out.stdError, mat.valid);
 }
 
+// Where the openings are the only way in from outside (no cosine rays
+// kept: gi/sky.h), the sky's and the sun's photons aim at a sphere around
+// their portals instead of the scene's: the same lines through the
+// openings, none spent on the outsides of the walls. True where it did.
+bool aimAtOpenings(const SkyOpenings& openings, const Scene& s, PhotonOptions& opt) {
+  if (!opt.outside.any() || !openings.any() || openings.rest) return false;
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  for (const SkyPortal& p : openings.portals)
+    for (const glm::dvec3& c : p.corners) lo = glm::min(lo, c), hi = glm::max(hi, c);
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  double r = 0;
+  for (const SkyPortal& p : openings.portals)
+    for (const glm::dvec3& c : p.corners) r = std::max(r, glm::length(c - centre));
+  opt.outsideAimCentre = glm::vec3(centre);
+  opt.outsideAimRadius = float(r * 1.001 + sceneScale(s).rayEpsilon);
+  return true;
+}
+
 // The photon map at every vertex with a normal (computePhotonMap splits the
 // two-sided ones first).
 VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, const PhotonOptions& optWorld,
@@ -475,10 +492,15 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   // Which photons the vertex estimate reads: all, or all but the direct ones.
   const unsigned vertexPaths = opt.directLight ? (1u << kCausticPhoton) | (1u << kIndirectPhoton) : 7u;
   const float r2max = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
-  const PhotonRun run{s, caster, opt, mat, origins, eps, specular, projection, vertexPaths, r2max};
+  // The sky's openings: its direct light through their portals, and where
+  // they are the only way in, the sky's and the sun's photons aimed at them.
+  const SkyOpenings openings = findSkyOpenings(s, caster, opt.outside, opt.seed);
+  openings.report(st);
+  const bool aimed = aimAtOpenings(openings, s, opt);
+  const PhotonRun run{s, caster, opt, mat, origins, eps, specular, projection, vertexPaths, r2max, openings};
 
   Timer directTimer;
-  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15), &st);
+  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15));
   const double directSeconds = directTimer.seconds();
   PhotonTraceStats ts;
   PhotonEstimate photons;
@@ -506,7 +528,11 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
                           : "all light from the photon map");
   if (opt.outside.any() && specular && opt.causticProjection && opt.directLight)
     st.note("caustic_projection not used: with a sky or a sun the global photons carry every caustic");
-  if (opt.outside.any()) st.note("sky and sun photons enter from a disk covering the scene's bounding sphere");
+  if (opt.outside.any() && !aimed) st.note("sky and sun photons enter from a disk covering the scene's bounding sphere");
+  if (aimed) {
+    st.add("outside_photon_aim_radius", opt.outsideAimRadius * s.unit);
+    st.note("sky and sun photons aimed at the sky openings (the only way in): from a disk of their sphere's radius");
+  }
   const size_t specOnly = std::count(mat.valid.begin(), mat.valid.end(), uint8_t(0));
   if (specOnly)
     st.note(std::to_string(specOnly) + " vertices on mirror, glass or glossy faces only, unusable, or without a normal "

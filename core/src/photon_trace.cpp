@@ -77,7 +77,17 @@ class PhotonLights {
         centre_ = 0.5f * (lo + hi);
         radius_ = 0.5f * glm::length(hi - lo) * 1.01f + float(sceneScale(s).rayEpsilon);
       }
-      const double disk = M_PI * double(radius_) * radius_;
+      // The disk covers the aim sphere (the scene's, or the openings') and
+      // starts outside the scene's sphere: every line towards -w through
+      // the aim sphere crosses it before the scene.
+      aimCentre_ = centre_;
+      aimRadius_ = radius_;
+      if (o.outsideAimRadius > 0.f && o.outsideAimRadius < radius_) {
+        aimCentre_ = o.outsideAimCentre;
+        aimRadius_ = o.outsideAimRadius;
+      }
+      aimDistance_ = glm::length(aimCentre_ - centre_) + radius_;
+      const double disk = M_PI * double(aimRadius_) * aimRadius_;
       skyPower_ = o.outside.sky() ? 4.0 * M_PI * double(luminance(o.outside.skyRadiance)) * disk : 0.0;
       sunScale_ = sunDiskScale(o.outside.sunAngularRadiusDeg);
       // Through a disk facing each sampled direction: E_sun <n.w> = E_sun (1 + cos a) / 2 on a facing
@@ -140,12 +150,13 @@ class PhotonLights {
  private:
   // From the sky (a < pSky of the outside power) or the sun: w towards the
   // light (uniform over the sphere, pdf 1 / (4 pi); uniform in the sun's
-  // cone, pdf 1 / Omega), a point uniform on the disk of radius R facing w
-  // at the centre + R w; the photon carries L / (pdf_w pdf_disk p count).
+  // cone, pdf 1 / Omega), a point uniform on the disk of the aim sphere's
+  // radius R facing w, D along w from its centre (outside the scene); the
+  // photon carries L / (pdf_w pdf_disk p count).
   Emission sampleOutside(float a, float b, glm::vec2 u1, double pOut, double count) const {
     const double pSky = skyPower_ / (skyPower_ + sunPower_);
     const bool sky = a < pSky;
-    const double disk = M_PI * double(radius_) * radius_;
+    const double disk = M_PI * double(aimRadius_) * aimRadius_;
     glm::vec3 w;
     glm::vec3 power;
     if (sky) {
@@ -157,15 +168,15 @@ class PhotonLights {
       power = o_.outside.sunIrradiance * float(disk * sunScale_ / (pOut * (1.0 - pSky) * count));
     }
     const float ad = sky ? a / float(pSky) : (a - float(pSky)) / float(1.0 - pSky);
-    const float r = radius_ * std::sqrt(std::clamp(ad, 0.f, 1.f)), phi = 2.f * float(M_PI) * b;
-    const glm::vec3 o = centre_ + radius_ * w + Frame(w).toWorld({r * std::cos(phi), r * std::sin(phi), 0.f});
+    const float r = aimRadius_ * std::sqrt(std::clamp(ad, 0.f, 1.f)), phi = 2.f * float(M_PI) * b;
+    const glm::vec3 o = aimCentre_ + aimDistance_ * w + Frame(w).toWorld({r * std::cos(phi), r * std::sin(phi), 0.f});
     return {o, -w, power, glm::vec3(0.f)};
   }
 
   EmitterSampler area_;
   const PhotonOptions& o_;
-  glm::vec3 centre_{0.f};
-  float radius_ = 0.f;
+  glm::vec3 centre_{0.f}, aimCentre_{0.f};
+  float radius_ = 0.f, aimRadius_ = 0.f, aimDistance_ = 0.f;
   double skyPower_ = 0.0, sunPower_ = 0.0, inner_ = 0.0;
   double pointPower_ = 0.0, total_ = 0.0, cosSpot_ = -1.0;
   double sunScale_ = 1.0;

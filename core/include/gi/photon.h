@@ -5,7 +5,9 @@
 // the photon starts on the disk of the bounding sphere's radius R facing w,
 // outside the scene, and travels along -w with the power L x (solid angle)
 // x pi R^2 / count: 4 E_sky pi R^2 / count, or E_sun pi R^2 / count, so that
-// a surface facing the light receives E_sky or E_sun per unit area), low-
+// a surface facing the light receives E_sky or E_sun per unit area; where
+// the sky's openings are the only way in, R and the disk those of a sphere
+// around their portals), low-
 // discrepancy in position and direction, and are
 // traced with Russian roulette through diffuse (Lambertian), mirror and glass
 // faces (gi/specular.h) and glossy ones (the GGX lobe, gi/glossy.h,
@@ -62,6 +64,13 @@ struct PhotonOptions {
   double alpha = 2.0 / 3.0;   // PPM: fraction of new photons kept per pass
   PointLight point;           // optional point or spot light (relative to the scene origin, world units)
   SkySun outside;             // sky and sun: photons enter from a disk covering the scene's bounding sphere
+  // Or a smaller sphere every way in from outside passes through (local
+  // units; radius 0: the scene's bounding sphere): photon mapping sets the
+  // sky openings' (gi/sky.h) where they are the only way in, a window room's
+  // window, so that the photons shot at it are not spent on the walls'
+  // outsides (about 1% entered a room through its window before).
+  glm::vec3 outsideAimCentre{0.f};
+  float outsideAimRadius = 0.f;
   bool lightPathSplit = false;  // also B per light-path kind (light_paths.h)
   uint32_t seed = 0;
   // Memory the stored photons may take (gi/memory_limit.h); 0: what the
