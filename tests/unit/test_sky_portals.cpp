@@ -317,7 +317,8 @@ TEST(SkyPortals, PhotonMapTakesTheSkyThroughTheWindow) {
 // flux, E_sky x 0.64 (nothing outside the room shades it), stored at the
 // first hits (max_depth 0): both ways within 4 binomial standard errors of
 // it (a photon enters with probability q: relative error sqrt((1 - q) /
-// (N q))), and computePhotonMap aims by itself.
+// (N q))); the sun's likewise (6,266 and 59,742 of 100,000 enter); and
+// computePhotonMap aims by itself.
 TEST(SkyPortals, PhotonsAimAtTheWindow) {
   const Scene s = windowRoom(true).scene();
   auto caster = makeEmbreeCaster(s);
@@ -348,6 +349,25 @@ TEST(SkyPortals, PhotonsAimAtTheWindow) {
     EXPECT_NEAR(ts.storedPower / flux, 1.0, 4 * se) << (aim ? "aimed" : "bounding sphere");
   }
   EXPECT_GT(double(stored[1]), 6.0 * double(stored[0]));
+  // The sun's photons aim there too (the sky still finds the portal): its
+  // flux through the window, E_sun cos(theta) x 0.64, theta from the
+  // window's normal (-x: the window is in the wall x = 2).
+  PhotonOptions sun = o;
+  sun.outside.skyRadiance = glm::vec3(1e-6f);
+  sun.outside.sunIrradiance = glm::vec3(1.f);
+  sun.outside.sunDirection = glm::normalize(glm::vec3(1.f, 0.3f, 0.2f));
+  const double sunFlux = double(sun.outside.sunDirection.x) * flux;
+  for (int aim : {0, 1}) {
+    PhotonOptions a = sun;
+    if (aim) a.outsideAimCentre = glm::vec3(centre), a.outsideAimRadius = float(radius * 1.001);
+    PhotonTraceStats ts;
+    tracePhotons(s, *caster, a, 0, size_t(N), Progress(nullptr), ts);
+    const double q = double(ts.stored) / N, se = std::sqrt((1 - q) / (N * q));
+    std::printf("sun, %s: %zu of %.0f photons enter, power %.5f for %.5f (%+.2f%%, standard error %.2f%%)\n",
+                aim ? "aimed at the window" : "bounding sphere", ts.stored, N, ts.storedPower, sunFlux,
+                100 * (ts.storedPower / sunFlux - 1), 100 * se);
+    EXPECT_NEAR(ts.storedPower / sunFlux, 1.0, 4 * se + 1e-4) << (aim ? "sun, aimed" : "sun, bounding sphere");
+  }
   const VertexRadiometry r = computePhotonMap(s, *caster, o);
   EXPECT_NEAR(r.stats.get("outside_photon_aim_radius") / s.unit, radius, 0.01 * radius);
   EXPECT_GT(r.stats.get("photons_stored"), 6.0 * double(stored[0]));
