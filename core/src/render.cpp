@@ -275,6 +275,11 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
       if (l > 0) { rel += res.stdError[p] / l; ++relN; }
     }
     st.add("mean_radiance", lum / double(n));
+    // Every pixel black: nothing lit in view (an eye inside an object sees
+    // only back faces, which are black; or the camera looks away).
+    if (n > 0 && !(lum > 0))
+      st.warn("the image is black: no eye ray reached a lit surface (is the camera inside an object, or looking "
+              "away from the scene?)");
     st.add("rms_std_error", std::sqrt(err2 / double(n)));
     st.add("mean_relative_std_error", relN ? rel / double(relN) : 0.0);
   }
@@ -290,6 +295,10 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   if (o.mode == RenderMode::Whitted) {
     st.add("area_lights", double(ctx.areaLightCount()));
     if (luminance(o.skyRadiance) > 0.f) st.note("Whitted: the sky is seen but lights no diffuse surface");
+    if (!s.material.empty() &&
+        std::any_of(s.material.begin(), s.material.end(), [](Material m) { return m == Material::Glossy; }))
+      st.note("Whitted: glossy faces reflect one ray in the mirror direction weighted by their Fresnel factor (a "
+              "sharp mirror; the distributed and path-traced modes sample their lobe)");
     if (o.sunIrradiance != glm::vec3(0.f) && o.sunAngularRadiusDeg > 0.f)
       st.note("Whitted: the sun lights as a point at infinity (sharp shadows)");
     if (c.belowWeight) st.note(std::to_string(c.belowWeight) + " branches below whitted_min_weight not traced");

@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
+#include <tuple>
 
 #include "gi/glossy.h"
 #include "gi/photon.h"
@@ -182,6 +184,42 @@ TEST(RenderModes, GlossyFloorUnderUniformEmitters) {
     const double tol = 4 * std::sqrt(var) / n + 0.003 * luminance(glm::vec3(expect));
     EXPECT_NEAR(luminance(glm::vec3(mean)), luminance(glm::vec3(expect)), tol) << renderModeName(m);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], expect[k], 2 * tol) << renderModeName(m) << " channel " << k;
+  }
+  // Whitted has no glossy reflection: it reflects one mirror ray, and says so.
+  RenderOptions o;
+  o.mode = RenderMode::Whitted;
+  o.camera = Camera::lookAt(eye, target, {0, 1, 0}, 2, 16, 16);
+  const RenderResult w = run(s, o);
+  EXPECT_TRUE(std::any_of(w.stats.notes.begin(), w.stats.notes.end(),
+                          [](const std::string& n) { return n.find("glossy faces reflect one ray") != std::string::npos; }));
+}
+
+// A camera whose every eye ray meets only back faces (outside a closed room
+// whose normals face in, as an eye inside an object sees it) or nothing
+// gets a black image in every mode, and a warning saying why it may be;
+// inside the room, none.
+TEST(RenderModes, BlackImageIsSaid) {
+  SceneBuilder b;
+  b.box({-1, -1, -1}, {1, 1, 1}, glm::vec3(0.5f), glm::vec3(1.f), Material::Diffuse, true);
+  const Scene s = b.build();
+  auto blackWarning = [](const RenderResult& r) {
+    return std::any_of(r.stats.warnings.begin(), r.stats.warnings.end(),
+                       [](const std::string& w) { return w.find("the image is black") != std::string::npos; });
+  };
+  for (RenderMode m : {RenderMode::Whitted, RenderMode::Distributed, RenderMode::PathTraced}) {
+    RenderOptions o;
+    o.mode = m;
+    o.samplesPerPixel = 4;
+    for (const auto& [eye, target, black] : {std::tuple{glm::dvec3(0, 0, -5), glm::dvec3(0, 0, 0), true},
+                                             std::tuple{glm::dvec3(0, 0, -5), glm::dvec3(0, 0, -10), true},
+                                             std::tuple{glm::dvec3(0, 0, -0.5), glm::dvec3(0, 0, 1), false}}) {
+      o.camera = Camera::lookAt(eye - s.origin, target - s.origin, {0, 1, 0}, 40, 8, 8);
+      const RenderResult r = run(s, o);
+      double sum = 0;
+      for (const glm::vec3& p : r.image.px) sum += luminance(p);
+      EXPECT_EQ(sum == 0, black) << renderModeName(m);
+      EXPECT_EQ(blackWarning(r), black) << renderModeName(m) << ", eye z " << eye.z << ", target z " << target.z;
+    }
   }
 }
 
