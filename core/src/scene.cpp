@@ -1,6 +1,7 @@
 #include "gi/scene.h"
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -155,6 +156,10 @@ std::vector<uint8_t> usableFaceMask(const Scene& s) {
       double area2 = glm::length(glm::cross(b - a, c - a));
       // Degenerate: zero area, or height below float resolution of its longest edge.
       if (!(area2 > 1e-12 * l2) || l2 == 0.0) continue;
+      // Or too small for its normal in float (edges of 1e-12: the cross
+      // product's square underflows, and a ray from it had no direction).
+      const glm::vec3 m = faceNormalUnnormalized(s, f);
+      if (!(glm::dot(m, m) >= std::numeric_limits<float>::min())) continue;
       ok[f] = 1;
     }
   });

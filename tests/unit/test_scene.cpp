@@ -24,6 +24,8 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 //   f4 index out of range (invalid)                 f5 collinear (degenerate), emitter
 //   f6 usable, zero emission                        f7 collinear on far vertices (degenerate)
 //   f8 sliver of height 1e-13 (degenerate)          f9 NaN vertex and bad index (invalid first)
+//   f10 edges of 1e-12 (degenerate: its normal underflows in float; Monte
+//       Carlo form factors cast a ray without a direction from it)
 gi::Scene defectScene() {
   gi::Scene s;
   s.positions = {
@@ -36,9 +38,10 @@ gi::Scene defectScene() {
       {0.5f, 1e-13f, 0},                // 10: only in the sliver -> isolated
       {-1, -1, -1},                     // 11: in no face -> isolated
       {0, -kInf, 0},                    // 12: in no face, not finite
+      {0, 0, 0}, {1e-12f, 0, 0}, {0, 1e-12f, 1e-13f},  // 13-15: only in the tiny f10 -> isolated
   };
   s.triangles = {{0, 1, 2}, {0, 1, 3}, {0, 4, 2}, {0, 0, 1}, {0, 1, 99},
-                 {0, 1, 5}, {0, 1, 6}, {7, 8, 9}, {0, 1, 10}, {3, 3, 1000}};
+                 {0, 1, 5}, {0, 1, 6}, {7, 8, 9}, {0, 1, 10}, {3, 3, 1000}, {13, 14, 15}};
   s.emission.assign(s.faceCount(), glm::vec3(0.f));
   s.emission[0] = {2.f, 1.f, 0.5f};
   s.emission[5] = {5.f, 5.f, 5.f};  // on a degenerate face: does not count
@@ -49,14 +52,14 @@ gi::Scene defectScene() {
 TEST(AnalyzeScene, CountsEveryDefect) {
   const gi::Scene s = defectScene();
   const gi::SceneReport r = gi::analyzeScene(s);
-  EXPECT_EQ(r.vertices, 13u);
-  EXPECT_EQ(r.faces, 10u);
+  EXPECT_EQ(r.vertices, 16u);
+  EXPECT_EQ(r.faces, 11u);
   EXPECT_EQ(r.nonFiniteVertices, 3u);   // 3, 4, 12
   EXPECT_EQ(r.facesOnNonFinite, 2u);    // f1, f2
   EXPECT_EQ(r.invalidFaces, 3u);        // f3 (repeated), f4 (range), f9 (both)
-  EXPECT_EQ(r.degenerateFaces, 3u);     // f5, f7, f8
+  EXPECT_EQ(r.degenerateFaces, 4u);     // f5, f7, f8, f10
   EXPECT_EQ(r.usableFaces(), 2u);       // f0, f6
-  EXPECT_EQ(r.isolatedVertices, 6u);    // 5, 7, 8, 9, 10, 11 (finite, in no usable face)
+  EXPECT_EQ(r.isolatedVertices, 9u);    // 5, 7, 8, 9, 10, 11, 13-15 (finite, in no usable face)
   EXPECT_EQ(r.emitterFaces, 1u);
   // luminance(2, 1, 0.5) * 0.5 = (0.4252 + 0.7152 + 0.0361) * 0.5; tolerance 1e-6.
   EXPECT_NEAR(r.emittedPower, (0.2126 * 2 + 0.7152 + 0.0722 * 0.5) * 0.5, 1e-6);
@@ -67,7 +70,7 @@ TEST(AnalyzeScene, CountsEveryDefect) {
   EXPECT_GT(r.rayEpsilon, 0.0);
   // The mask used by the casters agrees with the counts.
   const auto ok = gi::usableFaceMask(s);
-  EXPECT_EQ(ok, (std::vector<uint8_t>{1, 0, 0, 0, 0, 0, 1, 0, 0, 0}));
+  EXPECT_EQ(ok, (std::vector<uint8_t>{1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0}));
   EXPECT_NE(r.summary().find("2 usable"), std::string::npos) << r.summary();
 }
 
