@@ -360,9 +360,11 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // What the vertices gather from, and the indirect irradiance it gives.
   sweep(sol.Rprev, sol.H);
   if (!fixed && sol.residual >= tolerance) {
-    char b[200];
-    std::snprintf(b, sizeof b, "not converged: hierarchical solve stopped at %d sweeps with the residual %.3g above the tolerance %.3g",
-                  maxSweeps, sol.residual, tolerance);
+    char b[240];
+    std::snprintf(b, sizeof b,
+                  "not converged: hierarchical solve stopped at max_iterations = %d sweeps per refinement round (%d "
+                  "rounds) with the residual %.3g above the tolerance %.3g",
+                  maxSweeps, rounds, sol.residual, tolerance);
     sol.stats.warn(b);
   }
   if (budgetHit && capped)

@@ -137,8 +137,10 @@ DirectSetup directSetup(const Scene& s, const RayCaster& caster, const Radiosity
 // Emitted = absorbed + escaped, with the direct light's share from the
 // shadow rays and the reflected share from the rows (R = reflected radiosity).
 // `complete`: the solution is meant to hold all the light (no bounce count,
-// and converged: a solve stopped early has said so already).
-void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R, bool complete, RunStats& st) {
+// and converged: a solve stopped early has said so already); `tolerance`:
+// the one it converged to.
+void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R, bool complete, double tolerance,
+                 RunStats& st) {
   double absorbed = 0, escaped = u.P;
   for (size_t i = 0; i < u.n; ++i) {
     if (u.A[i] == 0) continue;
@@ -157,7 +159,16 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
   // solution of all bounces off by more than 1% creates or loses light: rows
   // of F summing above 1 (the analytic quadrature beside contacts, magnified
   // by 1 / (1 - rho) at high reflectance).
-  if (complete && balance > 0.01) {
+  // A loose tolerance leaves light unaccounted by itself (tolerance 1 on the
+  // Cornell box: 8.4%): a note naming it, not the form factors.
+  if (complete && balance > 0.01 && tolerance > 1e-3) {
+    char b[240];
+    std::snprintf(b, sizeof b,
+                  "energy balance off by %.1f%% at the tolerance %.3g: a solve stopped this early leaves part of the "
+                  "light unaccounted (lower the tolerance to check the form factors)",
+                  100.0 * balance, tolerance);
+    st.note(b);
+  } else if (complete && balance > 0.01) {
     char b[320];
     std::snprintf(b, sizeof b,
                   "energy balance off by %.1f%%: the power absorbed and escaping differs from the power emitted "
@@ -172,10 +183,10 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
 // reflected radiosity Rgather, one sweep behind R when a bounce count is
 // fixed: the gather adds that bounce), B = E + R per face and per vertex.
 void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R,
-                    std::vector<glm::vec3> Rgather, bool fixedBounces, RadiosityResult& res) {
+                    std::vector<glm::vec3> Rgather, bool fixedBounces, double tolerance, RadiosityResult& res) {
   const bool complete = std::none_of(res.stats.warnings.begin(), res.stats.warnings.end(),
                                      [](const std::string& w) { return w.rfind("not converged", 0) == 0; });
-  energyStats(u, row, R, complete && !fixedBounces, res.stats);
+  energyStats(u, row, R, complete && !fixedBounces, tolerance, res.stats);
   res.Rgather = std::move(Rgather);
   res.Hindirect.assign(u.n, glm::vec3(0.f));
   for (size_t i = 0; i < u.n; ++i)
@@ -233,7 +244,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   if (!opt.ambientTerm || solver != RadiositySolver::Progressive) res.ambient = glm::vec3(0.f);
   else res.stats.add("ambient_term", luminance(res.ambient));
   snap.finish(R, res.ambient);
-  finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, stop.fixed, res);
+  finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, stop.fixed, tol, res);
   if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");
   return res;
 }

@@ -40,19 +40,21 @@ namespace {
 // r / (1 - r) (each further sweep returns at most r of the last change, or
 // of the unshot power); with F the power found so far, the converged total
 // is F + M, of which M / (F + M) (increasing in M: the bound gives a bound)
-// is missing.
+// is missing: a bound on the total, not on each patch (a Cornell box after
+// one Jacobi sweep: 32% stated, 11.7% short in all, one patch 92%).
 void warnIfNotConverged(const Setup& u, const std::vector<glm::vec3>& R, double residual, double tol, double r,
                         int maxIter, const char* per, RunStats& st) {
   if (residual < tol) return;
   double found = u.P;
   for (size_t i = 0; i < u.n; ++i) found += u.A[i] * luminance(R[i]);
   const double missing = residual * u.P * r / (1.0 - r);
-  char b[400];
+  char b[480];
   if (r < 1.0)
     std::snprintf(b, sizeof b,
                   "not converged: stopped at max_iterations = %d %s with the residual %.3g above the tolerance %.3g; "
-                  "with reflectance up to %.4g the radiosity may be short by up to %.1f%% of its converged value "
-                  "(raise max_iterations, or 0 = automatic)",
+                  "with reflectance up to %.4g the total radiosity (the power the surfaces send) may be short by up "
+                  "to %.1f%% of its converged value, patches far from the lights by more (raise max_iterations, or "
+                  "0 = automatic)",
                   maxIter, per, residual, tol, r, std::ceil(1000.0 * missing / (found + missing)) / 10.0);
   else
     std::snprintf(b, sizeof b,
