@@ -56,7 +56,8 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   for (const char* shown : {"Radiosity", "Irradiance", "Radiance", "Reference"})
     if (in.attrs.vertexColorShows.empty() && in.attribute(shown)) in.attrs.vertexColorShows = shown;
   if (v.has("reflectance_source"))
-    if (auto err = applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog))
+    if (auto err =
+            applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog, &res.setupWarnings))
       throw std::invalid_argument(*err);
   if (v.has("mirror_layers")) {
     std::string log;
@@ -453,6 +454,8 @@ void estimateFilter(FilterKind kind, FilterInput& in, FilterResult& res, const P
     case FilterKind::HemicubeOfFace: detail::runHemicube(in, res); break;
     case FilterKind::ErrorMap: computeErrorMap(in, res); break;
   }
+  // The conventions' warnings first (they concern the input).
+  res.stats.warnings.insert(res.stats.warnings.begin(), res.setupWarnings.begin(), res.setupWarnings.end());
 }
 
 void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res) {

@@ -210,8 +210,10 @@ std::vector<ParamSpec> displaySpecs() {
 namespace {
 
 // rho per face from the chosen source, *msg the log's part ("reflectance
-// from ..."); the error sentence when the mesh lacks that source.
-std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg) {
+// from ..."), *warnings (if given) the clamp of rho >= 1; the error sentence
+// when the mesh lacks that source.
+std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg,
+                                          std::vector<std::string>* warnings) {
   const size_t nf = s.faceCount();
   auto src = kReflectanceSources.get(v, "reflectance_source");
   const glm::vec3 constant = v.getVec("reflectance");
@@ -251,7 +253,13 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
   if (resultColors)
     *msg += " (the vertex colours display an earlier filter's result, " + a.vertexColorShows +
             ", not a reflectance: choose 'Vertex color' to use them anyway)";
-  if (clamped) *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
+  if (clamped) {
+    *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
+    if (warnings)
+      warnings->push_back(std::to_string(clamped) + " reflectance channels at or above 1 (white colours) limited to "
+                          "0.999: rho >= 1 reflects more light than it receives; in a closed room B reaches about "
+                          "1000 times its emission there (choose a reflectance below 1)");
+  }
   return std::nullopt;
 }
 
@@ -287,9 +295,9 @@ std::string setEmission(Scene& s, const MeshAttributes& a, const ParamValues& v)
 }  // namespace
 
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
-                                                 bool withEmitters, std::string* log) {
+                                                 bool withEmitters, std::string* log, std::vector<std::string>* warnings) {
   std::string msg;
-  if (auto err = setReflectance(s, a, v, &msg)) return err;
+  if (auto err = setReflectance(s, a, v, &msg, warnings)) return err;
   if (withEmitters) msg += setEmission(s, a, v);
   if (log) *log = msg;
   return std::nullopt;

@@ -351,14 +351,17 @@ def case_robust(c):
         lines = [l for l in p.stderr.splitlines() if l.strip()]
         check(p.returncode != 0 and len(lines) == 1 and words in lines[0],
               "refused at once: exit %d, one line: %s" % (p.returncode, lines[-1][:120] if lines else ""))
-    # Non-convergence is a warning in the JSON: rho 0.999 stopped by the bounds set here.
+    # Non-convergence is a warning in the JSON: rho 0.999 stopped by the bounds set here (after
+    # the warning that white, rho 1, was limited to 0.999).
     white = lit + ["--reflectance", "255,255,255"]
     p = run_gi(c, ["radiosity", box, "-q", "--json", "--max_iterations", "50"] + white)
     w = json.loads(p.stdout)["warnings"]
-    check(p.returncode == 0 and len(w) == 1 and "not converged" in w[0], "radiosity stopped early warns: %s" % w[:1])
+    check(p.returncode == 0 and len(w) == 2 and "limited to 0.999" in w[0] and "not converged" in w[1],
+          "radiosity stopped early warns: %s" % w[1:2])
     p = run_gi(c, ["reference", box, "-q", "--json", "--max_depth", "20", "--samples_per_vertex", "4"] + white)
     w = json.loads(p.stdout)["warnings"]
-    check(p.returncode == 0 and len(w) == 1 and "max_depth = 20" in w[0], "reference cut by max_depth warns: %s" % w[:1])
+    check(p.returncode == 0 and len(w) == 2 and "limited to 0.999" in w[0] and "max_depth = 20" in w[1],
+          "reference cut by max_depth warns: %s" % w[1:2])
 
 
 CASES = {"raytrace": case_raytrace, "cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,

@@ -18,6 +18,7 @@
 #include "gi/render.h"
 #include "gi/scene_setup.h"
 #include "gi/scenes.h"
+#include "filter_input.h"
 #include "mesh_io.h"
 
 using namespace gi;
@@ -395,6 +396,23 @@ TEST(RadiosityWarnings, EnergyBalanceOff) {
   const RadiosityResult m = solveRadiosity(s, *caster, o);
   EXPECT_LT(m.stats.get("energy_balance_error"), 0.01);
   EXPECT_FALSE(warned(m.stats, "energy balance off by")) << all(m.stats);
+}
+
+// White colours are rho = 1, which creates light: the conventions limit it
+// to 0.999 and the run's log warns (it was a note in the scene line only),
+// with what it means; a grey reflectance says nothing.
+TEST(RadiosityWarnings, WhiteReflectanceLimitedIsWarned) {
+  for (const char* colour : {"255,255,255", "188,188,188"}) {
+    FilterInput in = test::filterInput(FilterKind::Radiosity, scenes::closedBox(1.0, 2, true));
+    const auto specs = filterSpecs(FilterKind::Radiosity);
+    const double diag = analyzeScene(in.scene).diagonal;
+    for (const auto& [k, v] : {std::pair<const char*, const char*>{"reflectance_source", "Constant"},
+                               {"reflectance", colour}, {"emitter_source", "Face quality above threshold"},
+                               {"emitter_quality_threshold", "-1"}, {"rays_per_patch", "64"}})
+      in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+    const FilterResult r = runFilter(FilterKind::Radiosity, in);
+    EXPECT_EQ(warned(r.stats, "limited to 0.999"), colour[0] == '2' && colour[1] == '5') << colour << ": " << all(r.stats);
+  }
 }
 
 // A loose tolerance leaves light unaccounted by itself: the Cornell box at

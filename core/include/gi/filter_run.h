@@ -127,6 +127,7 @@ struct FilterResult {
 
   SceneReport report;    // the scene the algorithm saw (after the conventions)
   std::string setupLog;  // reflectance, emitters, materials: what the conventions chose
+  std::vector<std::string> setupWarnings;  // what of it the log warns of (added to stats by the estimate)
   RunStats stats;        // the algorithm's numbers, notes and warnings
 
   const VertexAttribute* attribute(const std::string& name) const;

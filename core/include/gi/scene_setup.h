@@ -58,9 +58,11 @@ std::vector<ParamSpec> geometrySceneSpecs();
 std::vector<ParamSpec> displaySpecs();
 
 // Sets rho (and, if withEmitters, emission) of `s` from its attributes.
-// Returns an error sentence when the result cannot be used (e.g. rho >= 1).
+// Returns an error sentence when the result cannot be used; *warnings gets
+// what the run's log must warn of (white colours, rho >= 1, limited to 0.999).
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
-                                                 bool withEmitters, std::string* log = nullptr);
+                                                 bool withEmitters, std::string* log = nullptr,
+                                                 std::vector<std::string>* warnings = nullptr);
 
 // Mirror and glass (photon mapping and the reference): which layers are
 // specular, by name patterns, and their colour and index of refraction.
