@@ -415,6 +415,26 @@ TEST(RadiosityWarnings, WhiteReflectanceLimitedIsWarned) {
   }
 }
 
+// A face repeated (same corners, same turn) shadows its copy at random: the
+// run warns, as the scene line already noted; the box without it says
+// nothing.
+TEST(SceneWarnings, DuplicatedFacesAreWarned) {
+  for (bool duplicate : {false, true}) {
+    scenes::SceneFile sf = scenes::closedBox(1.0, 2, true);
+    if (duplicate) {
+      sf.scene.triangles.push_back(sf.scene.triangles[0]);
+      sf.scene.rho.push_back(sf.scene.rho[0]);
+      sf.scene.emission.push_back(sf.scene.emission[0]);
+      if (!sf.attrs.faceColor.empty()) sf.attrs.faceColor.push_back(sf.attrs.faceColor[0]);
+      if (!sf.attrs.faceQuality.empty()) sf.attrs.faceQuality.push_back(sf.attrs.faceQuality[0]);
+    }
+    FilterInput in = test::filterInput(FilterKind::AmbientOcclusion, sf);
+    in.values.set("rays_per_vertex", 16);
+    const FilterResult r = runFilter(FilterKind::AmbientOcclusion, in);
+    EXPECT_EQ(warned(r.stats, "repeat another face's corners"), duplicate) << all(r.stats);
+  }
+}
+
 // A loose tolerance leaves light unaccounted by itself: the Cornell box at
 // tolerance 1 stops after one sweep, 8.4% off balance. A note names the
 // tolerance; the warning about the form factors (Monte Carlo rows here,
