@@ -451,6 +451,15 @@ TEST(RadiosityWarnings, EnergyBalanceAtALooseToleranceNamesIt) {
   EXPECT_TRUE(std::any_of(r.stats.notes.begin(), r.stats.notes.end(), [](const std::string& n) {
     return n.find("energy balance off by") != std::string::npos && n.find("at the tolerance 1") != std::string::npos;
   }));
+  // The other end: a tolerance below float precision is noted as such.
+  for (double tol : {1e-4, 1e-9}) {
+    o.tolerance = tol;
+    const RunStats st = solveRadiosity(s, *caster, o).stats;
+    const bool noted = std::any_of(st.notes.begin(), st.notes.end(), [](const std::string& n) {
+      return n.find("below the radiosity's float precision") != std::string::npos;
+    });
+    EXPECT_EQ(noted, tol < 1e-6) << tol;
+  }
 }
 
 // A room whose faces point out of it (a box built as a solid) turns its
