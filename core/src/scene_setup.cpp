@@ -257,8 +257,8 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
     *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
     if (warnings)
       warnings->push_back(std::to_string(clamped) + " reflectance channels at or above 1 (white colours) limited to "
-                          "0.999: rho >= 1 reflects more light than it receives; in a closed room B reaches about "
-                          "1000 times its emission there (choose a reflectance below 1)");
+                          "0.999: rho = 1 returns all the light it receives, and a closed room never converges; at "
+                          "0.999 B there reaches about 1000 times the emission (choose a reflectance below 1)");
   }
   return std::nullopt;
 }
