@@ -1,10 +1,10 @@
 #include "gi/scene.h"
 
 #include <algorithm>
-#include <limits>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

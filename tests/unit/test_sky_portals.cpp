@@ -90,6 +90,16 @@ SkySun sky(float E) {
   return o;
 }
 
+// Photon mapping under the sky of irradiance 1, photons stored at their
+// first hits only (max_depth 0).
+PhotonOptions firstHitSkyPhotons(int photons) {
+  PhotonOptions o;
+  o.outside = sky(1.f);
+  o.maxDepth = 0;
+  o.photons = photons;
+  return o;
+}
+
 // Per vertex: the sky through the openings (portals, and cosine rays where
 // they are still needed) with `rays`, and cosine rays alone with `refRays`;
 // the mean and the RMS of the differences over the vertices the sky
@@ -289,10 +299,7 @@ TEST(SkyPortals, RadiosityTakesTheSkyThroughTheWindow) {
 TEST(SkyPortals, PhotonMapTakesTheSkyThroughTheWindow) {
   const Scene s = windowRoom(true).scene();
   auto caster = makeEmbreeCaster(s);
-  PhotonOptions o;
-  o.outside = sky(1.f);
-  o.maxDepth = 0;
-  o.photons = 1000;
+  const PhotonOptions o = firstHitSkyPhotons(1000);
   const VertexRadiometry r = computePhotonMap(s, *caster, o);
   EXPECT_EQ(r.stats.get("sky_portals"), 1.0);
   const auto R = vertexSkySunIrradiance(s, *caster, sky(1.f), 16384, 11);
@@ -322,11 +329,8 @@ TEST(SkyPortals, PhotonMapTakesTheSkyThroughTheWindow) {
 TEST(SkyPortals, PhotonsAimAtTheWindow) {
   const Scene s = windowRoom(true).scene();
   auto caster = makeEmbreeCaster(s);
-  PhotonOptions o;
-  o.outside = sky(1.f);
-  o.maxDepth = 0;
+  PhotonOptions o = firstHitSkyPhotons(100000);
   o.directLight = false;
-  o.photons = 100000;
   const SkyOpenings op = findSkyOpenings(s, *caster, o.outside, 0);
   ASSERT_EQ(op.portals.size(), 1u);
   ASSERT_FALSE(op.rest);
@@ -335,19 +339,21 @@ TEST(SkyPortals, PhotonsAimAtTheWindow) {
   double radius = 0;
   for (const glm::dvec3& c : op.portals[0].corners) radius = std::max(radius, glm::length(c - centre));
   const double N = o.photons, flux = 0.64 / double(s.unit * s.unit);  // local units
-  size_t stored[2];
-  for (int aim : {0, 1}) {
-    PhotonOptions a = o;
+  // The photons of `light` that enter, from the bounding sphere or aimed at
+  // the window: their power against `expected` (plus `slack`).
+  auto enter = [&](const PhotonOptions& light, bool aim, double expected, double slack, const char* what) {
+    PhotonOptions a = light;
     if (aim) a.outsideAimCentre = glm::vec3(centre), a.outsideAimRadius = float(radius * 1.001);
     PhotonTraceStats ts;
     tracePhotons(s, *caster, a, 0, size_t(N), Progress(nullptr), ts);
-    stored[aim] = ts.stored;
     const double q = double(ts.stored) / N, se = std::sqrt((1 - q) / (N * q));
-    std::printf("%s: %zu of %.0f photons enter, power %.5f for %.5f (%+.2f%%, standard error %.2f%%)\n",
-                aim ? "aimed at the window" : "bounding sphere", ts.stored, N, ts.storedPower, flux,
-                100 * (ts.storedPower / flux - 1), 100 * se);
-    EXPECT_NEAR(ts.storedPower / flux, 1.0, 4 * se) << (aim ? "aimed" : "bounding sphere");
-  }
+    std::printf("%s, %s: %zu of %.0f photons enter, power %.5f for %.5f (%+.2f%%, standard error %.2f%%)\n", what,
+                aim ? "aimed at the window" : "bounding sphere", ts.stored, N, ts.storedPower, expected,
+                100 * (ts.storedPower / expected - 1), 100 * se);
+    EXPECT_NEAR(ts.storedPower / expected, 1.0, 4 * se + slack) << what << (aim ? ", aimed" : ", bounding sphere");
+    return ts.stored;
+  };
+  const size_t stored[2] = {enter(o, false, flux, 0.0, "sky"), enter(o, true, flux, 0.0, "sky")};
   EXPECT_GT(double(stored[1]), 6.0 * double(stored[0]));
   // The sun's photons aim there too (the sky still finds the portal): its
   // flux through the window, E_sun cos(theta) x 0.64, theta from the
@@ -357,17 +363,7 @@ TEST(SkyPortals, PhotonsAimAtTheWindow) {
   sun.outside.sunIrradiance = glm::vec3(1.f);
   sun.outside.sunDirection = glm::normalize(glm::vec3(1.f, 0.3f, 0.2f));
   const double sunFlux = double(sun.outside.sunDirection.x) * flux;
-  for (int aim : {0, 1}) {
-    PhotonOptions a = sun;
-    if (aim) a.outsideAimCentre = glm::vec3(centre), a.outsideAimRadius = float(radius * 1.001);
-    PhotonTraceStats ts;
-    tracePhotons(s, *caster, a, 0, size_t(N), Progress(nullptr), ts);
-    const double q = double(ts.stored) / N, se = std::sqrt((1 - q) / (N * q));
-    std::printf("sun, %s: %zu of %.0f photons enter, power %.5f for %.5f (%+.2f%%, standard error %.2f%%)\n",
-                aim ? "aimed at the window" : "bounding sphere", ts.stored, N, ts.storedPower, sunFlux,
-                100 * (ts.storedPower / sunFlux - 1), 100 * se);
-    EXPECT_NEAR(ts.storedPower / sunFlux, 1.0, 4 * se + 1e-4) << (aim ? "sun, aimed" : "sun, bounding sphere");
-  }
+  for (bool aim : {false, true}) enter(sun, aim, sunFlux, 1e-4, "sun");
   const VertexRadiometry r = computePhotonMap(s, *caster, o);
   EXPECT_NEAR(r.stats.get("outside_photon_aim_radius") / s.unit, radius, 0.01 * radius);
   EXPECT_GT(r.stats.get("photons_stored"), 6.0 * double(stored[0]));
