@@ -1,6 +1,7 @@
 #include "gi/ambient.h"
 
 #include "ambient_internal.h"
+#include "ao_strata.h"
 
 #include <algorithm>
 #include <array>
@@ -53,11 +54,21 @@ class AmbientKernel {
     coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
     sunScale_ = sunDiskScale(o.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
+    strata_ = o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone;
+    grid_ = StrataGrid::forRays(o.raysPerVertex);
   }
 
   VertexOut run(uint32_t vi, const glm::vec3& org, const glm::vec3& n) const {
     VertexOut out;
     const Frame frame(n);
+    if (strata_) {
+      const StrataEstimate e = strataOcclusion(caster_, hash3(vi, o_.seed, 0x53u), org, frame, tfar_, grid_);
+      out.value = float(e.value);
+      out.stdError = float(std::sqrt(e.variance));
+      out.rays = e.rays;
+      if (o_.bentNormals) out.bent = glm::length(e.bent) > 0.f ? glm::normalize(e.bent) : n;
+      return out;
+    }
     const Frame cone(o_.coneDirection);
     SobolOwenStream seq(hash3(vi, o_.seed, 0x41u));
     const bool adaptive = o_.targetError > 0.0;
@@ -172,6 +183,8 @@ class AmbientKernel {
   const RayCaster& caster_;
   const AmbientOptions& o_;
   float tfar_, coneCos_, sunCos_, sunScale_;
+  bool strata_;       // the adaptive strata estimator (ao_strata.h)
+  StrataGrid grid_;
   double target_;  // the adaptive stop, in the units of the per-ray values
 };
 
@@ -191,6 +204,13 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
     throw std::invalid_argument("obscurance needs a maximum distance > 0 (its falloff is relative to it)");
   if (!(o.maxDistance >= 0.0)) throw std::invalid_argument("max_distance must be >= 0");
   if (o.raysPerVertex < 1) throw std::invalid_argument("rays_per_vertex must be >= 1");
+  if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Obscurance)
+    throw std::invalid_argument("the adaptive strata estimator tests visibility only; obscurance (hit distances) "
+                                "needs the per-vertex or shared estimator");
+  if (o.estimator == AOEstimator::Strata && o.targetError > 0.0)
+    throw std::invalid_argument("the adaptive strata estimator takes a fixed rays_per_vertex (it splits strata "
+                                "where occlusion edges are, not until an error is met); set target_error 0, or use "
+                                "the per-vertex or shared estimator for a target error");
   if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
   if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
     throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");
@@ -358,10 +378,14 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   // shared one casts just its first round there, and those rays serve its
   // neighbours' pools).
   const bool hemisphereRays = opt.mode != AmbientMode::Sky && !opt.useCone;
-  const int openVertexRays = opt.targetError > 0.0 ? std::max(opt.minRays, kRound) : opt.raysPerVertex;
+  // (An open vertex under adaptive strata also splits its horizon row: 3 rays a column.)
+  const StrataGrid grid = StrataGrid::forRays(opt.raysPerVertex);
+  const int openVertexRays = opt.targetError > 0.0                     ? std::max(opt.minRays, kRound)
+                             : opt.estimator == AOEstimator::Strata ? grid.strata() + 3 * grid.cols
+                                                                    : opt.raysPerVertex;
   const bool openWithin = opt.skipOpenVertices && hemisphereRays && opt.maxDistance > 0.0;
   const bool openEverywhere = opt.skipOpenVertices && hemisphereRays && !(opt.maxDistance > 0.0) &&
-                              opt.estimator == AOEstimator::PerVertex && openVertexRays >= 128;
+                              opt.estimator != AOEstimator::Shared && openVertexRays >= 128;
   if (openWithin || openEverywhere) {
     std::unique_ptr<OpenSpaceTest> within;
     std::unique_ptr<SceneBelowTest> everywhere;
@@ -391,6 +415,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const bool shared = opt.estimator == AOEstimator::Shared && opt.mode != AmbientMode::Sky && !opt.useCone;
   if (opt.estimator == AOEstimator::Shared && !shared)
     res.stats.note("the cone's ratio estimator is computed per vertex (not shared)");
+  if (opt.estimator == AOEstimator::Strata && opt.useCone)
+    res.stats.note("the cone's ratio estimator is computed per vertex (not in adaptive strata)");
   Timer traceTimer;
   SharedStats shareStats;
   // The progress bar's share of the two-sided vertices (two casts each).

@@ -107,6 +107,13 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                          "(e.g. 0.02, minimum rays 8) reaches a given error with 6 to 8 times fewer rays and about "
                          "a third of the time; on meshes of a few thousand to 30k vertices, or where the occlusion "
                          "changes from vertex to vertex, per vertex is as fast or faster. "
+                         "'Adaptive strata' (occlusion, fixed count): each vertex's hemisphere is cut into about "
+                         "rays_per_vertex strata (R rows of elevation by 2R of azimuth), one jittered ray each, "
+                         "and a stratum is split into four where its neighbours disagree (an occlusion edge "
+                         "crosses it), so rays go where the shadows' edges are; still unbiased (a stratum's split "
+                         "never depends on its own ray) and still per vertex. It casts about 1.6 times "
+                         "rays_per_vertex on occluded vertices and reached the per-vertex estimator's error "
+                         "about 1.5 times sooner on the two bunnies (README). "
                          "The cone option is always per vertex.",
                  .type = ParamType::Enum, .def = kAOEstimators.index(AOEstimator::PerVertex),
                  .choices = kAOEstimators.choices()});

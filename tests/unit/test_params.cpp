@@ -487,7 +487,7 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
       {"emitter_source", L{"Selected faces", "Face quality above threshold", "None", "Auto"}},
       {"color_mapping", L{"Grey", "Multiply colour", "Keep colour"}},
       {"ray_batching", L{"Single", "Packet8", "Stream"}},
-      {"estimator", L{"Per vertex", "Shared with neighbours"}},
+      {"estimator", L{"Per vertex", "Shared with neighbours", "Adaptive strata"}},
       {"form_factor_method", L{"Monte Carlo", "Analytic point-to-polygon", "Hemicube", "Auto"}},
       {"solver", L{"Auto", "Jacobi", "Gauss-Seidel", "Progressive refinement", "Hierarchical"}},
       {"vertex_output", L{"Final gather", "Interpolated indirect", "Patch average"}},

@@ -36,11 +36,15 @@ inline constexpr auto kBatchModes = makeEnumTable<BatchMode>({
     {BatchMode::Stream, "Stream", "streams"},
 });
 // PerVertex: each vertex's own rays only (independent estimates, the
-// estimator above). Shared: neighbours' rays pooled where they agree (gi/ao_shared.h).
-enum class AOEstimator { PerVertex, Shared };
+// estimator above). Shared: neighbours' rays pooled where they agree
+// (gi/ao_shared.h). Strata: each vertex's own rays, one per stratum of its
+// hemisphere, the strata at occlusion edges split (core/src/ao_strata.h;
+// occlusion only, a fixed count).
+enum class AOEstimator { PerVertex, Shared, Strata };
 inline constexpr auto kAOEstimators = makeEnumTable<AOEstimator>({
     {AOEstimator::PerVertex, "Per vertex", "per vertex"},
     {AOEstimator::Shared, "Shared with neighbours", "shared with neighbours"},
+    {AOEstimator::Strata, "Adaptive strata", "adaptive strata"},
 });
 
 struct AmbientOptions {

@@ -1,0 +1,64 @@
+// Ambient occlusion of one vertex by adaptive strata.
+//   AO(p) = 1/pi ∫_H V(p, w) cos(theta) dw = ∫_[0,1)^2 V(p, w(x, y)) dx dy,
+//   w(x, y) = (sqrt(x) cos 2 pi y, sqrt(x) sin 2 pi y, sqrt(1 - x))
+// in the vertex's frame (Malley's method in polar form: uniform (x, y) give
+// cosine-weighted directions, so the cell areas are the cosine-weighted
+// solid angles over pi). The square is cut into R rows of x (rows of
+// elevation: the last row holds the horizon) and C = 2R columns of y
+// (azimuth), and each stratum gets one jittered sample (Cook 1986,
+// "Stochastic sampling in computer graphics", ACM TOG 5(1)). Visibility is a
+// step function, so only strata crossed by an occlusion edge carry
+// variance; a stratum is split into its four quarters when one of the pairs
+// of its opposite neighbours (above and below, left and right, the two
+// diagonals) disagree, an occlusion edge then likely crossing it (adaptive
+// refinement where neighbouring samples differ, as in Mitchell 1987,
+// "Generating antialiased images at low sampling densities", SIGGRAPH). The
+// quarter holding the stratum's sample keeps it; the other three get one
+// jittered sample each. The row beyond the horizon is the tangent plane,
+// counted occluded; the row above the zenith row is that row half a turn
+// away (the cells meet at the pole); columns wrap.
+//
+// Unbiased, whatever the split rule: a stratum's split is decided by other
+// strata's samples only, which are independent of its own, so given the
+// decision its sample and its quarters' samples stay uniform in their cells
+// (the kept sample, given the quarter it fell in, is uniform in that
+// quarter), and each cell's mean is an unbiased estimate of its share.
+//   AO ~ sum over strata s of A (V_s, or the mean of its quarters' V if split),
+// A = 1/(R C). Its variance is sum_s A^2 Var_s; with one sample per stratum
+// Var_s is estimated by collapsing strata in pairs (Cochran 1977, "Sampling
+// Techniques", 3rd ed., section 5A.12, one unit per stratum): two unsplit
+// neighbours in a row (columns 2m and 2m + 1) count A^2 (V_a - V_b)^2, whose
+// mean is A^2 (Var_a + Var_b + (mu_a - mu_b)^2), an upper bound; quarters
+// likewise in pairs, (A/4)^2 (V_a - V_b)^2; an unsplit stratum whose
+// partner was split counts A^2 (V_s - mean of the partner's quarters)^2.
+// The bound misses what no sample saw (an occluder thinner than a stratum
+// that two partners both miss), as any sample-based estimate must.
+#pragma once
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "gi/raycaster.h"
+#include "gi/sampling.h"
+
+namespace gi {
+
+struct StrataGrid {
+  int rows = 8, cols = 16;
+  // About n strata: R rows and 2R columns, R = round(sqrt(n / 2)), at least 1.
+  static StrataGrid forRays(int n);
+  int strata() const { return rows * cols; }
+};
+
+struct StrataEstimate {
+  double value = 0.0, variance = 0.0;
+  int rays = 0, split = 0;         // rays cast, strata split
+  glm::vec3 bent{0.f};             // sum of the open samples' directions times their cells' areas
+};
+
+// One vertex: rays from org (tnear 0, tfar), directions in frame; key seeds
+// the jitter (the same key gives the same rays and result, on any thread).
+StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame,
+                               float tfar, StrataGrid grid);
+
+}  // namespace gi
