@@ -51,7 +51,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "integration"))
 from plyread import read_ply  # noqa: E402
-from ao_report import plot, speedup_table  # noqa: E402
+from ao_report import OURS, plot, speedup_table  # noqa: E402
 
 MESHLAB_AO_SCRIPT = """<!DOCTYPE FilterScript>
 <FilterScript>
@@ -272,9 +272,9 @@ class Bench:
 
     def cached_ours(self, scene, mesh):
         """The settings of ours in the cache for this mesh and binary: ray counts per vertex, shared ray counts,
-        adaptive targets, and whether the meshlabserver run is there."""
+        adaptive targets, adaptive strata counts, and whether the meshlabserver run is there."""
         prefix = "|".join(["ours", scene, signature(mesh), self.ours_sig]) + "|"
-        per_vertex, shared, targets, server = set(), set(), set(), False
+        per_vertex, shared, targets, strata, server = set(), set(), set(), set(), False
         for key in self.cache:
             if not key.startswith(prefix):
                 continue
@@ -288,7 +288,9 @@ class Bench:
                 shared.add(int(words[words.index("--rays_per_vertex") + 1]))
             elif label == "ours, shared, adaptive":
                 targets.add(float(words[words.index("--target_error") + 1]))
-        return sorted(per_vertex), sorted(shared), sorted(targets, reverse=True), server
+            elif label == "ours, adaptive strata":
+                strata.add(int(words[words.index("--rays_per_vertex") + 1]))
+        return sorted(per_vertex), sorted(shared), sorted(targets, reverse=True), sorted(strata), server
 
     def keep(self, q, key):
         d = os.path.join(self.results, "ao_runs")
@@ -436,6 +438,7 @@ def main():
                     "e.g. scan_470k=128,scan_1.9M=32 (overrides the defaults and --max-ref-rays-total)")
     ap.add_argument("--per-vertex-rays", default="", help="ray counts of ours per vertex (a,b,c; default by size)")
     ap.add_argument("--shared-rays", default="", help="ray counts of ours shared (default by size)")
+    ap.add_argument("--strata-rays", default="", help="rays_per_vertex (strata) of ours, adaptive strata (default by size)")
     ap.add_argument("--targets", default="", help="adaptive targets of ours shared (default 0.04,0.02,0.01,0.005)")
     ap.add_argument("--repeats", type=int, default=0, help="runs of ours per setting (0: 3 below 50k vertices, else 1)")
     ap.add_argument("--no-server", action="store_true", help="leave out the run of ours through meshlabserver")
@@ -477,18 +480,20 @@ def main():
         per_vertex = [n for n in (8, 16, 32, 64, 128, 256, 512, 1024, 2048) if n * nv <= max(a.max_rays_total, 2048 * 5e4)]
         shared = [n for n in (4, 8, 16, 32, 64, 128, 256, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
         targets = [0.04, 0.02, 0.01, 0.005]
+        strata = [n for n in (32, 50, 72, 98, 128, 162, 200, 288, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
         # explicit settings (a loaded machine: the few around MeshLab's error)
         per_vertex = [int(x) for x in a.per_vertex_rays.split(",") if x] if a.per_vertex_rays else per_vertex
         shared = [int(x) for x in a.shared_rays.split(",") if x] if a.shared_rays else shared
         targets = [float(x) for x in a.targets.split(",") if x] if a.targets else targets
+        strata = [int(x) for x in a.strata_rays.split(",") if x] if a.strata_rays else strata
         if a.repeats:
             repeats = a.repeats
         if a.quick:
-            per_vertex, shared, targets = [16, 64, 256], [8, 32, 128], [0.01]
+            per_vertex, shared, targets, strata = [16, 64, 256], [8, 32, 128], [0.01], [32, 128]
         if a.peers_only:
             continue
         if a.cached_ours_only:  # every setting of ours already measured on this mesh with this binary
-            per_vertex, shared, targets, server = b.cached_ours(scene, mesh)
+            per_vertex, shared, targets, strata, server = b.cached_ours(scene, mesh)
             a.no_server = not server
         for n in per_vertex:
             b.ours(scene, mesh, nv, ref, "ours, per vertex", ["--rays_per_vertex", str(n), "--seed", "1"],
@@ -496,6 +501,9 @@ def main():
         for n in shared:
             b.ours(scene, mesh, nv, ref, "ours, shared", ["--estimator", "1", "--rays_per_vertex", str(n), "--seed", "1"],
                    "rays_per_vertex", n, repeats)
+        for n in strata:
+            b.ours(scene, mesh, nv, ref, "ours, adaptive strata",
+                   ["--estimator", "2", "--rays_per_vertex", str(n), "--seed", "1"], "rays_per_vertex", n, repeats)
         for t in targets:
             b.ours(scene, mesh, nv, ref, "ours, shared, adaptive",
                    ["--estimator", "1", "--target_error", str(t), "--min_rays", "8", "--seed", "1"], "target_error", t, repeats)
@@ -506,7 +514,7 @@ def main():
         ran = {(views, tex): b.meshlab(scene, mesh, nv, ref_ml, views, tex, ml_repeats, a.cached_meshlab_only)
                for views, tex in ml_configs}
         rows = [r for r in b.rows if r["scene"] == scene]
-        for ours in ("ours, shared", "ours, per vertex", "ours, shared, adaptive"):
+        for ours in OURS:
             mine = [r for r in rows if r["method"] == ours]
             for views, tex in main_configs:
                 if not ran[(views, tex)]:

@@ -2,7 +2,7 @@
 speed-ups at MeshLab's error and the two plots (error against time per mesh,
 speed-up against vertex count)."""
 
-OURS = ("ours, per vertex", "ours, shared", "ours, shared, adaptive")
+OURS = ("ours, per vertex", "ours, shared", "ours, shared, adaptive", "ours, adaptive strata")
 
 
 def load_range(loads):
@@ -22,8 +22,8 @@ def speedup_table(summary):
     """Markdown: per mesh and MeshLab setting, MeshLab's time and RMS error, and for each of ours the time and rays
     per vertex to reach that error and the speed-up; the load averages around each side's runs."""
     lines = ["| mesh (vertices) | MeshLab views, depth map | MeshLab time | MeshLab RMS (raw) | load, MeshLab | "
-             "ours per vertex | ours shared, fixed | ours shared, adaptive | load, ours |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "ours per vertex | ours shared, fixed | ours shared, adaptive | ours adaptive strata | load, ours |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     keys = []
     for s in summary:
         if (s["scene"], s["views"], s["tex"]) not in keys:
@@ -67,7 +67,8 @@ def plot(rows, scene_names, summary, path, speedup_path):
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(9.6, 4.6))
     for (views, tex), style in (((512, 512), "o-"), ((1024, 512), "s--"), ((512, 2048), "^-"), ((1024, 2048), "v--")):
-        for ours, colour in (("ours, shared", "C0"), ("ours, per vertex", "C1"), ("ours, shared, adaptive", "C2")):
+        for ours, colour in (("ours, shared", "C0"), ("ours, per vertex", "C1"), ("ours, shared, adaptive", "C2"),
+                             ("ours, adaptive strata", "C3")):
             pts = sorted((s["vertices"], s["speedup"]) for s in summary
                          if s["views"] == views and s["tex"] == tex and s["ours"] == ours and s["speedup"])
             if pts:
