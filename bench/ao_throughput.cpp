@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include <memory>
+#include <mutex>
 
 #include <algorithm>
 #include <cstdio>
@@ -49,6 +50,35 @@ struct BareEmbree {
   ~BareEmbree() { rtcReleaseScene(scene); rtcReleaseDevice(dev); }
 };
 
+RTCRay bareRay(const glm::vec3& o, const glm::vec3& d, float tfar) {
+  RTCRay r;
+  r.org_x = o.x; r.org_y = o.y; r.org_z = o.z; r.tnear = 0.f;
+  r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z; r.time = 0.f;
+  r.tfar = tfar; r.mask = 0xffffffffu; r.id = 0; r.flags = 0;
+  return r;
+}
+
+// Casts through `c` and keeps every fan's rays, in the order cast (run on
+// one thread, so that the bare loop replays one vertex's rays after another
+// as ours casts them): the adaptive strata estimator's rays depend on what
+// its first rays met.
+class RecordingCaster : public RayCaster {
+ public:
+  explicit RecordingCaster(const RayCaster& c) : c_(c) {}
+  Hit intersect(const Ray& r) const override { return c_.intersect(r); }
+  bool occluded(const Ray& r) const override { return c_.occluded(r); }
+  void occludedFan(const glm::vec3& o, const glm::vec3* dirs, size_t n, float tfar, uint8_t* occ) const override {
+    c_.occludedFan(o, dirs, n, tfar, occ);
+    std::lock_guard<std::mutex> lock(m_);
+    for (size_t i = 0; i < n; ++i) rays.push_back(bareRay(o, dirs[i], tfar));
+  }
+  mutable std::vector<RTCRay> rays;
+
+ private:
+  const RayCaster& c_;
+  mutable std::mutex m_;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -76,20 +106,32 @@ int main(int argc, char** argv) {
       seq.nextBlock(m, &u0[size_t(b)], &u1[size_t(b)]);
       cosineHemisphereBlock(m, &u0[size_t(b)], &u1[size_t(b)], &lx[size_t(b)], &ly[size_t(b)], &lz[size_t(b)]);
     }
-    for (int j = 0; j < rpv; ++j) {
-      const glm::vec3 d = f.t * lx[size_t(j)] + f.b * ly[size_t(j)] + f.n * lz[size_t(j)];
-      RTCRay& r = rays[i * size_t(rpv) + size_t(j)];
-      r.org_x = origins[i].x; r.org_y = origins[i].y; r.org_z = origins[i].z; r.tnear = 0.f;
-      r.dir_x = d.x; r.dir_y = d.y; r.dir_z = d.z; r.time = 0.f;
-      r.tfar = HUGE_VALF; r.mask = 0xffffffffu; r.id = 0; r.flags = 0;
-    }
+    for (int j = 0; j < rpv; ++j)
+      rays[i * size_t(rpv) + size_t(j)] =
+          bareRay(origins[i], f.t * lx[size_t(j)] + f.b * ly[size_t(j)] + f.n * lz[size_t(j)], HUGE_VALF);
   }
   BareEmbree bare(s, false), bareRobust(s, true);
-  std::vector<double> tBare, tBareRobust, tOurs, tOursSingle, tOursStream, tShared, tSharedPooling;
+  std::vector<double> tBare, tBareRobust, tOurs, tOursSingle, tOursStream, tShared, tSharedPooling, tStrata,
+      tStrataBare;
   double sharedRays = 0;
   size_t occludedBare = 0;
-  auto bareLoop = [&](RTCScene scene) {
-    std::vector<RTCRay> work = rays;
+  // The adaptive strata estimator with rpv strata: its rays, recorded once.
+  AmbientOptions strata;
+  strata.raysPerVertex = rpv;
+  strata.batch = BatchMode::Single;
+  strata.mergeDuplicates = false;
+  strata.skipOpenVertices = false;  // every vertex casts, as in the loops above
+  strata.estimator = AOEstimator::Strata;
+  std::vector<RTCRay> strataRays;
+  {
+    auto caster = makeEmbreeCaster(s, BatchMode::Single);
+    RecordingCaster rec(*caster);
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    computeAmbient(s, rec, strata);
+    strataRays.swap(rec.rays);
+  }
+  auto bareLoop = [&](RTCScene scene, const std::vector<RTCRay>& from = {}) {
+    std::vector<RTCRay> work = from.empty() ? rays : from;
     Timer t;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
       RTCIntersectContext ctx;
@@ -125,6 +167,11 @@ int main(int argc, char** argv) {
     sharedRays = res.stats.get("rays");
     tShared.push_back(sharedRays / res.stats.get("rays_per_second"));
     tSharedPooling.push_back(tShared.back() + res.stats.get("pooling_seconds"));
+    // Adaptive strata: its casting time (direction generation and split
+    // decisions included) against the bare loop over its own rays.
+    const AmbientResult st = computeAmbient(s, *caster, strata);
+    tStrata.push_back(st.stats.get("rays") / st.stats.get("rays_per_second"));
+    tStrataBare.push_back(bareLoop(bareRobust.scene, strataRays));
   }
   const double n = double(rays.size());
   std::printf("{\"mesh\": \"%s\", \"vertices\": %zu, \"faces\": %zu, \"rays\": %.0f, \"occluded_fraction\": %.6f,\n"
@@ -133,13 +180,16 @@ int main(int argc, char** argv) {
               " \"ratio_ours_packet8_to_bare\": %.4f, \"ratio_ours_single_to_bare\": %.4f, \"ratio_ours_stream_to_bare\": %.4f,\n"
               " \"ratio_ours_single_to_bare_robust\": %.4f, \"ours_shared_rays_per_second\": %.6g,\n"
               " \"ratio_ours_shared_to_bare\": %.4f, \"ratio_ours_shared_to_bare_robust\": %.4f,\n"
-              " \"ours_shared_with_pooling_rays_per_second\": %.6g, \"ratio_ours_shared_with_pooling_to_bare_robust\": %.4f,"
-              " \"repeats\": %d}\n",
+              " \"ours_shared_with_pooling_rays_per_second\": %.6g, \"ratio_ours_shared_with_pooling_to_bare_robust\": %.4f,\n"
+              " \"strata_rays\": %.0f, \"ours_strata_rays_per_second\": %.6g, \"bare_embree_robust_strata_rays_per_second\": %.6g,\n"
+              " \"ratio_ours_strata_to_bare_robust\": %.4f, \"repeats\": %d}\n",
               argv[1], nv, s.faceCount(), n, double(occludedBare) / n, n / median(tBare), n / median(tBareRobust), n / median(tOurs),
               n / median(tOursSingle), n / median(tOursStream), median(tBare) / median(tOurs),
               median(tBare) / median(tOursSingle), median(tBare) / median(tOursStream),
               median(tBareRobust) / median(tOursSingle), sharedRays / median(tShared),
               median(tBare) / median(tShared) * sharedRays / n, median(tBareRobust) / median(tShared) * sharedRays / n,
-              sharedRays / median(tSharedPooling), median(tBareRobust) / median(tSharedPooling) * sharedRays / n, repeats);
+              sharedRays / median(tSharedPooling), median(tBareRobust) / median(tSharedPooling) * sharedRays / n,
+              double(strataRays.size()), double(strataRays.size()) / median(tStrata),
+              double(strataRays.size()) / median(tStrataBare), median(tStrataBare) / median(tStrata), repeats);
   return 0;
 }
