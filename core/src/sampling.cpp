@@ -6,13 +6,6 @@
 
 namespace gi {
 
-// sin and cos on [-pi/4, pi/4].
-static inline void fastSinCos(float x, float& s, float& c) {
-  const float x2 = x * x;
-  s = x * (1.f + x2 * (-1.f / 6 + x2 * (1.f / 120 + x2 * (-1.f / 5040 + x2 * (1.f / 362880)))));
-  c = 1.f + x2 * (-0.5f + x2 * (1.f / 24 + x2 * (-1.f / 720 + x2 * (1.f / 40320 + x2 * (-1.f / 3628800)))));
-}
-
 glm::vec3 cosineHemisphere(glm::vec2 u) {
   // Malley's method on a uniform disk (concentric map, Shirley and Chiu 1997).
   float a = 2.f * u.x - 1.f, b = 2.f * u.y - 1.f;
@@ -23,8 +16,8 @@ glm::vec3 cosineHemisphere(glm::vec2 u) {
   // phi is in [-pi/4, pi/2 + pi/4]; fold to [-pi/4, pi/4] and use short
   // Taylor series (error < 2e-9 there) instead of the libm calls.
   float c, sn;
-  if (phi > 0.785398163f) { fastSinCos(1.570796327f - phi, sn, c); std::swap(c, sn); }
-  else fastSinCos(phi, sn, c);
+  if (phi > 0.785398163f) { sinCosQuarterPi(1.570796327f - phi, sn, c); std::swap(c, sn); }
+  else sinCosQuarterPi(phi, sn, c);
   float x = r * c, y = r * sn;
   float z = std::sqrt(std::fmax(0.f, 1.f - x * x - y * y));
   return {x, y, z};
@@ -54,7 +47,7 @@ GI_BLOCK_CLONES void cosineHemisphereBlock(int n, const float* u0, const float* 
     const float num = first ? b : a;
     const float t = r != 0.f ? num / r : 0.f;
     float sn, c;
-    fastSinCos(0.785398163f * t, sn, c);
+    sinCosQuarterPi(0.785398163f * t, sn, c);
     x[j] = r * (first ? c : sn);
     y[j] = r * (first ? sn : c);
     z[j] = std::sqrt(std::max(0.f, 1.f - r * r));  // max, not fmax (a call): the loop vectorises; no NaN here
