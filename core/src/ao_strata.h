@@ -4,8 +4,9 @@
 // in the vertex's frame (Malley's method in polar form: uniform (x, y) give
 // cosine-weighted directions, so the cell areas are the cosine-weighted
 // solid angles over pi). The square is cut into R rows of x (rows of
-// elevation: the last row holds the horizon) and C = 2R columns of y
-// (azimuth), and each stratum gets one jittered sample (Cook 1986,
+// elevation: the last row holds the horizon; thinner towards it, x_i =
+// 1 - (1 - i/R)^1.25) and C = 2R columns of y (azimuth), and each stratum
+// gets one jittered sample (Cook 1986,
 // "Stochastic sampling in computer graphics", ACM TOG 5(1)). Visibility is a
 // step function, so only strata crossed by an occlusion edge carry
 // variance; a stratum is split into its four quarters when one of the pairs
@@ -23,14 +24,15 @@
 // decision its sample and its quarters' samples stay uniform in their cells
 // (the kept sample, given the quarter it fell in, is uniform in that
 // quarter), and each cell's mean is an unbiased estimate of its share.
-//   AO ~ sum over strata s of A (V_s, or the mean of its quarters' V if split),
-// A = 1/(R C). Its variance is sum_s A^2 Var_s; with one sample per stratum
+//   AO ~ sum over strata s of A_s (V_s, or the mean of its quarters' V if split),
+// A_s = (x_{i+1} - x_i)/C in row i. Its variance is sum_s A_s^2 Var_s; with one sample per stratum
 // Var_s is estimated by collapsing strata in pairs (Cochran 1977, "Sampling
-// Techniques", 3rd ed., section 5A.12, one unit per stratum): two unsplit
-// neighbours in a row (columns 2m and 2m + 1) count A^2 (V_a - V_b)^2, whose
-// mean is A^2 (Var_a + Var_b + (mu_a - mu_b)^2), an upper bound; quarters
-// likewise in pairs, (A/4)^2 (V_a - V_b)^2; an unsplit stratum whose
-// partner was split counts A^2 (V_s - mean of the partner's quarters)^2.
+// Techniques", 3rd ed., ch. 5A, collapsed strata, one unit per stratum): two unsplit
+// neighbours in a row (columns 2m and 2m + 1, of one area A) count
+// A^2 (V_a - V_b)^2, whose mean is A^2 (Var_a + Var_b + (mu_a - mu_b)^2),
+// an upper bound; quarters likewise in pairs, (A/4)^2 (V_a - V_b)^2; an
+// unsplit stratum whose partner was split counts A^2 (V_s - mean of the
+// partner's quarters)^2; and at least (1/n)^2 / 4 in all.
 // The bound misses what no sample saw (an occluder thinner than a stratum
 // that two partners both miss), as any sample-based estimate must.
 #pragma once
