@@ -38,9 +38,11 @@ inline glm::vec2 jitter(uint32_t key, uint32_t index) {
 struct Directions {
   std::vector<float> cosCol, sinCol;
   int cols = 0;
+  float step = 0.f;  // a column's width in radians
   void setColumns(int c) {
     if (c == cols) return;
     cols = c;
+    step = float(6.283185307179586 / c);
     cosCol.resize(size_t(c));
     sinCol.resize(size_t(c));
     for (int j = 0; j < c; ++j) {
@@ -53,7 +55,7 @@ struct Directions {
   glm::vec3 operator()(const Frame& fr, float x, int j, float f) const {
     const float sinT = std::sqrt(std::max(0.f, x)), cosT = std::sqrt(std::max(0.f, 1.f - x));
     float sd, cd;
-    sinCosQuarterPi(6.283185307f * (f - 0.5f) / float(cols), sd, cd);
+    sinCosQuarterPi(step * (f - 0.5f), sd, cd);
     const float c = cosCol[size_t(j)] * cd - sinCol[size_t(j)] * sd;
     const float s = sinCol[size_t(j)] * cd + cosCol[size_t(j)] * sd;
     return fr.t * (sinT * c) + fr.b * (sinT * s) + fr.n * cosT;
@@ -93,23 +95,33 @@ struct Strata {
     direction.setColumns(C);
   }
 
-  // Base stratum (i, j)'s ray for the split rule: the tangent plane below
-  // the last row (occluded), the zenith row half a turn away above the first.
-  int at(int i, int j) const {
-    if (i >= R) return 0;
-    if (i < 0) { i = 0; j += C / 2; }
-    j %= C;
-    if (j < 0) j += C;
-    return open[size_t(i * C + j)];
+  // The base rays padded for the split rule (C + 2 columns, wrapping; R + 2
+  // rows): above the zenith row that row half a turn away (the cells meet at
+  // the pole), below the horizon row the tangent plane (occluded).
+  std::vector<uint8_t> padded;
+  void pad() {
+    const int W = C + 2;
+    padded.resize(size_t(R + 2) * size_t(W));
+    auto row = [&](int r, auto value) {
+      uint8_t* p = &padded[size_t(r) * size_t(W)];
+      for (int j = 0; j < C; ++j) p[j + 1] = value(j);
+      p[0] = p[C];
+      p[C + 1] = p[1];
+    };
+    row(0, [&](int j) { return open[size_t((j + C / 2) % C)]; });
+    for (int i = 0; i < R; ++i) row(i + 1, [&](int j) { return open[size_t(i * C + j)]; });
+    row(R + 1, [](int) { return uint8_t(0); });
   }
 
   void castBase(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame, float tfar) {
-    for (int i = 0, c = 0; i < R; ++i)
+    for (int i = 0, c = 0; i < R; ++i) {
+      const float x0 = rowX[size_t(i)], width = rowX[size_t(i) + 1] - x0;
       for (int j = 0; j < C; ++j, ++c) {
         const glm::vec2 u = jitter(key, uint32_t(c));
-        dirs[size_t(c)] = direction(frame, rowX[size_t(i)] + u.x * (rowX[size_t(i) + 1] - rowX[size_t(i)]), j, u.y);
+        dirs[size_t(c)] = direction(frame, x0 + u.x * width, j, u.y);
         quarter[size_t(c)] = uint8_t((u.x >= 0.5f ? 2 : 0) | (u.y >= 0.5f ? 1 : 0));
       }
+    }
     caster.occludedFan(org, dirs.data(), size_t(n), tfar, occ.data());
     for (int c = 0; c < n; ++c) open[size_t(c)] = occ[size_t(c)] ? 0 : 1;
   }
@@ -120,11 +132,16 @@ struct Strata {
     splitCells.clear();
     qdirs.clear();
     isSplit.assign(size_t(n), 0);
-    for (int i = 0; i < R; ++i)
+    pad();
+    const size_t W = size_t(C) + 2;
+    for (int i = 0; i < R; ++i) {
+      const uint8_t* up = &padded[size_t(i) * W + 1];  // row i - 1, column j at up[j]
+      const uint8_t* mid = up + W;
+      const uint8_t* down = mid + W;
       for (int j = 0; j < C; ++j) {
-        // Never (i, j) itself: the decision must not read the stratum's own ray.
-        const bool split = at(i - 1, j) != at(i + 1, j) || at(i, j - 1) != at(i, j + 1) ||
-                           at(i - 1, j - 1) != at(i + 1, j + 1) || at(i - 1, j + 1) != at(i + 1, j - 1);
+        // Never (i, j) itself (mid[j]): the decision must not read the stratum's own ray.
+        const bool split = up[j] != down[j] || mid[j - 1] != mid[j + 1] || up[j - 1] != down[j + 1] ||
+                           up[j + 1] != down[j - 1];
         if (!split) continue;
         const uint32_t c = uint32_t(i * C + j);
         splitCells.push_back(c);
@@ -136,6 +153,7 @@ struct Strata {
           qdirs.push_back(direction(frame, x, j, 0.5f * (float(q & 1) + u.y)));
         }
       }
+    }
     occ.resize(std::max(occ.size(), qdirs.size()));
     if (!qdirs.empty()) caster.occludedFan(org, qdirs.data(), qdirs.size(), tfar, occ.data());
   }
