@@ -219,6 +219,18 @@ TEST(SplitRun, AmbientOcclusionWithDuplicatesOpenVerticesAndBentNormals) {
   expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion, {{"target_error", "0.05"}, {"max_rays", "256"}}, 3, 16, true);
 }
 
+// Adaptive strata: each vertex's rays keyed by its index in the mesh, so a
+// split run gives the whole run's bits, with duplicates, open vertices and
+// bent normals.
+TEST(SplitRun, AmbientOcclusionByAdaptiveStrata) {
+  const io::LoadedMesh m = unwelded(cornell());
+  const std::map<std::string, std::string> p = {{"estimator", "2"}, {"rays_per_vertex", "32"}, {"max_distance", "20%"},
+                                                {"bent_normals_to_vertex_normals", "true"}};
+  expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion, p, 3, 7, true);
+  expectSplitEqualsWhole(cornell(), FilterKind::AmbientOcclusion, {{"estimator", "2"}, {"rays_per_vertex", "128"}}, 2,
+                         50, false);
+}
+
 // The shared estimator pools neighbours' rays across the parts' borders:
 // each round the parts exchange their vertices' rays (sumOverParts), so the
 // pools, the adaptive rounds and every value are the whole run's. Welded
