@@ -517,10 +517,11 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (opt.estimator == AOEstimator::Strata && !opt.useCone) {
     size_t traced = 0;
     for (size_t i = 0; i < nv; ++i) traced += res.rays[i] > 0;
-    st.add("rays_per_vertex", traced ? rays / double(traced) : 0.0);  // per vertex that cast rays
+    const double perTraced = traced ? rays / double(traced) : 0.0;
+    st.add("rays_per_vertex", perTraced);  // per vertex that cast rays
     char buf[160];
     std::snprintf(buf, sizeof buf, "adaptive strata: %d x %d per vertex, split where occlusion edges cross them: "
-                  "%.1f rays per vertex that cast rays", grid.rows, grid.cols, traced ? rays / double(traced) : 0.0);
+                  "%.1f rays per vertex that cast rays", grid.rows, grid.cols, perTraced);
     st.note(buf);
   }
   if (open)

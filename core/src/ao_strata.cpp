@@ -68,10 +68,9 @@ struct Strata {
   std::vector<glm::vec3> dirs;       // the base rays' directions
   std::vector<uint8_t> open;         // the base rays: 1 = open
   std::vector<uint8_t> quarter;      // which quarter each base ray fell in (2 bits: row half, column half)
-  std::vector<uint32_t> splitCells;  // the split strata, in order
   std::vector<glm::vec3> qdirs;      // their quarters' new rays, 3 a stratum
   std::vector<uint8_t> occ;          // one per ray cast
-  std::vector<uint8_t> isSplit;
+  std::vector<uint8_t> isSplit;      // 1: the stratum was split
   std::vector<float> mean;           // each stratum's estimate
   Directions direction;
   std::vector<float> rowX;           // the rows' bounds in x, R + 1 of them
@@ -129,12 +128,12 @@ struct Strata {
   // Splits the strata whose opposite neighbours disagree and casts their
   // quarters' rays (occ then holds them, 3 a split stratum).
   void castSplits(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame, float tfar) {
-    splitCells.clear();
     qdirs.clear();
     isSplit.assign(size_t(n), 0);
     pad();
     const size_t W = size_t(C) + 2;
     for (int i = 0; i < R; ++i) {
+      const float x0 = rowX[size_t(i)], width = rowX[size_t(i) + 1] - x0;
       const uint8_t* up = &padded[size_t(i) * W + 1];  // row i - 1, column j at up[j]
       const uint8_t* mid = up + W;
       const uint8_t* down = mid + W;
@@ -144,13 +143,11 @@ struct Strata {
                            up[j + 1] != down[j - 1];
         if (!split) continue;
         const uint32_t c = uint32_t(i * C + j);
-        splitCells.push_back(c);
         isSplit[c] = 1;
         for (int q = 0; q < 4; ++q) {
           if (q == quarter[c]) continue;
           const glm::vec2 u = jitter(key, uint32_t(n) + c * 4u + uint32_t(q));
-          const float x = rowX[size_t(i)] + 0.5f * (float(q >> 1) + u.x) * (rowX[size_t(i) + 1] - rowX[size_t(i)]);
-          qdirs.push_back(direction(frame, x, j, 0.5f * (float(q & 1) + u.y)));
+          qdirs.push_back(direction(frame, x0 + 0.5f * (float(q >> 1) + u.x) * width, j, 0.5f * (float(q & 1) + u.y)));
         }
       }
     }
@@ -162,7 +159,6 @@ struct Strata {
   StrataEstimate estimate() {
     StrataEstimate e;
     e.rays = n + int(qdirs.size());
-    e.split = int(splitCells.size());
     double openArea = 0.0, closedArea = 0.0, var = 0.0;
     mean.resize(size_t(n));
     for (int c = 0, k = 0; c < n; ++c) {

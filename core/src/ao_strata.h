@@ -54,7 +54,7 @@ struct StrataGrid {
 
 struct StrataEstimate {
   double value = 0.0, variance = 0.0;
-  int rays = 0, split = 0;         // rays cast, strata split
+  int rays = 0;                    // rays cast
   glm::vec3 bent{0.f};             // sum of the open samples' directions times their cells' areas
 };
 

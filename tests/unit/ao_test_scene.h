@@ -14,6 +14,10 @@
 
 namespace gi::test {
 
+// AO at distance d from a wall of height H on an infinite floor (docs/design.md,
+// "Analytic references").
+inline double wallAO(double d, double H) { return 0.5 + d / (2.0 * std::sqrt(d * d + H * H)); }
+
 // Appends `part` with x -> x * scale + offset (scale per axis) to `s`.
 inline void appendScaled(Scene& s, const Scene& part, const glm::dvec3& scale, const glm::dvec3& offset) {
   std::vector<glm::dvec3> pts;

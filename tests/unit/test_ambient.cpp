@@ -12,10 +12,12 @@
 #include "gi/form_factor_analytic.h"
 #include "gi/open_space.h"
 #include "gi/scenes.h"
+#include "ao_test_scene.h"
 #include "mesh_io.h"
 #include "test_helpers.h"
 
 using namespace gi;
+using gi::test::wallAO;
 
 namespace {
 
@@ -30,7 +32,6 @@ AmbientResult runAO(const Scene& s, int rays, double maxDist = 0.0, uint32_t see
   return computeAmbient(s, *caster, o);
 }
 
-double wallAO(double d, double H) { return 0.5 + d / (2.0 * std::sqrt(d * d + H * H)); }
 
 }  // namespace
 
