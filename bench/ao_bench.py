@@ -272,9 +272,9 @@ class Bench:
 
     def cached_ours(self, scene, mesh):
         """The settings of ours in the cache for this mesh and binary: ray counts per vertex, shared ray counts,
-        adaptive targets, adaptive strata counts, and whether the meshlabserver run is there."""
+        adaptive targets, adaptive strata counts and targets, and whether the meshlabserver run is there."""
         prefix = "|".join(["ours", scene, signature(mesh), self.ours_sig]) + "|"
-        per_vertex, shared, targets, strata, server = set(), set(), set(), set(), False
+        per_vertex, shared, targets, strata, strata_targets, server = set(), set(), set(), set(), set(), False
         for key in self.cache:
             if not key.startswith(prefix):
                 continue
@@ -290,7 +290,10 @@ class Bench:
                 targets.add(float(words[words.index("--target_error") + 1]))
             elif label == "ours, adaptive strata":
                 strata.add(int(words[words.index("--rays_per_vertex") + 1]))
-        return sorted(per_vertex), sorted(shared), sorted(targets, reverse=True), sorted(strata), server
+            elif label == "ours, adaptive strata, adaptive":
+                strata_targets.add(float(words[words.index("--target_error") + 1]))
+        return (sorted(per_vertex), sorted(shared), sorted(targets, reverse=True), sorted(strata),
+                sorted(strata_targets, reverse=True), server)
 
     def keep(self, q, key):
         d = os.path.join(self.results, "ao_runs")
@@ -439,6 +442,8 @@ def main():
     ap.add_argument("--per-vertex-rays", default="", help="ray counts of ours per vertex (a,b,c; default by size)")
     ap.add_argument("--shared-rays", default="", help="ray counts of ours shared (default by size)")
     ap.add_argument("--strata-rays", default="", help="rays_per_vertex (strata) of ours, adaptive strata (default by size)")
+    ap.add_argument("--strata-targets", default="",
+                    help="adaptive targets of ours, adaptive strata (default: 0.02,0.01,0.005 below 50k vertices)")
     ap.add_argument("--targets", default="", help="adaptive targets of ours shared (default 0.04,0.02,0.01,0.005)")
     ap.add_argument("--repeats", type=int, default=0, help="runs of ours per setting (0: 3 below 50k vertices, else 1)")
     ap.add_argument("--no-server", action="store_true", help="leave out the run of ours through meshlabserver")
@@ -481,19 +486,21 @@ def main():
         shared = [n for n in (4, 8, 16, 32, 64, 128, 256, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
         targets = [0.04, 0.02, 0.01, 0.005]
         strata = [n for n in (32, 50, 72, 98, 128, 162, 200, 288, 512) if n * nv <= max(a.max_rays_total, 512 * 5e4)]
+        strata_targets = [] if large else [0.02, 0.01, 0.005]
         # explicit settings (a loaded machine: the few around MeshLab's error)
         per_vertex = [int(x) for x in a.per_vertex_rays.split(",") if x] if a.per_vertex_rays else per_vertex
         shared = [int(x) for x in a.shared_rays.split(",") if x] if a.shared_rays else shared
         targets = [float(x) for x in a.targets.split(",") if x] if a.targets else targets
         strata = [int(x) for x in a.strata_rays.split(",") if x] if a.strata_rays else strata
+        strata_targets = [float(x) for x in a.strata_targets.split(",") if x] if a.strata_targets else strata_targets
         if a.repeats:
             repeats = a.repeats
         if a.quick:
-            per_vertex, shared, targets, strata = [16, 64, 256], [8, 32, 128], [0.01], [32, 128]
+            per_vertex, shared, targets, strata, strata_targets = [16, 64, 256], [8, 32, 128], [0.01], [32, 128], [0.01]
         if a.peers_only:
             continue
         if a.cached_ours_only:  # every setting of ours already measured on this mesh with this binary
-            per_vertex, shared, targets, strata, server = b.cached_ours(scene, mesh)
+            per_vertex, shared, targets, strata, strata_targets, server = b.cached_ours(scene, mesh)
             a.no_server = not server
         for n in per_vertex:
             b.ours(scene, mesh, nv, ref, "ours, per vertex", ["--rays_per_vertex", str(n), "--seed", "1"],
@@ -504,6 +511,9 @@ def main():
         for n in strata:
             b.ours(scene, mesh, nv, ref, "ours, adaptive strata",
                    ["--estimator", "2", "--rays_per_vertex", str(n), "--seed", "1"], "rays_per_vertex", n, repeats)
+        for t in strata_targets:
+            b.ours(scene, mesh, nv, ref, "ours, adaptive strata, adaptive",
+                   ["--estimator", "2", "--target_error", str(t), "--seed", "1"], "target_error", t, repeats)
         for t in targets:
             b.ours(scene, mesh, nv, ref, "ours, shared, adaptive",
                    ["--estimator", "1", "--target_error", str(t), "--min_rays", "8", "--seed", "1"], "target_error", t, repeats)
@@ -514,7 +524,7 @@ def main():
         ran = {(views, tex): b.meshlab(scene, mesh, nv, ref_ml, views, tex, ml_repeats, a.cached_meshlab_only)
                for views, tex in ml_configs}
         rows = [r for r in b.rows if r["scene"] == scene]
-        for ours in OURS:
+        for ours in OURS + ("ours, adaptive strata, adaptive",):  # the last in the results only, not the table
             mine = [r for r in rows if r["method"] == ours]
             for views, tex in main_configs:
                 if not ran[(views, tex)]:

@@ -62,7 +62,11 @@ class AmbientKernel {
     VertexOut out;
     const Frame frame(n);
     if (strata_) {
-      const StrataEstimate e = strataOcclusion(caster_, hash3(vi, o_.seed, 0x53u), org, frame, tfar_, grid_);
+      const uint32_t key = hash3(vi, o_.seed, 0x53u);
+      const StrataEstimate e = o_.targetError > 0.0
+                                   ? strataOcclusionToTarget(caster_, key, org, frame, tfar_,
+                                                             {o_.targetError, o_.minRays, o_.maxRays})
+                                   : strataOcclusion(caster_, key, org, frame, tfar_, grid_);
       out.value = float(e.value);
       out.stdError = float(std::sqrt(e.variance));
       out.rays = e.rays;
@@ -207,10 +211,6 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
   if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Obscurance)
     throw std::invalid_argument("the adaptive strata estimator tests visibility only; obscurance (hit distances) "
                                 "needs the per-vertex or shared estimator");
-  if (o.estimator == AOEstimator::Strata && o.targetError > 0.0)
-    throw std::invalid_argument("the adaptive strata estimator takes a fixed rays_per_vertex (it splits strata "
-                                "where occlusion edges are, not until an error is met); set target_error 0, or use "
-                                "the per-vertex or shared estimator for a target error");
   if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
   if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
     throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");
@@ -282,8 +282,11 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
     // Sky lighting: a vertex's rays are its sky rays and, facing the sun, its
     // fixed sun rays; its error holds the sun's part too.
     const bool sky = o.mode == AmbientMode::Sky;
+    // Adaptive strata stop before a round that might pass max_rays, so
+    // there a vertex above the target is one that stopped for max_rays.
+    const bool strata = o.estimator == AOEstimator::Strata && !o.useCone;
     auto atMax = [&](int rays) {
-      return sky ? rays == o.maxRays || rays == o.maxRays + o.sunRays : rays >= o.maxRays;
+      return sky ? rays == o.maxRays || rays == o.maxRays + o.sunRays : strata || rays >= o.maxRays;
     };
     size_t unmet = 0, traced = 0;
     float worst = 0.f;
@@ -379,10 +382,12 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   // neighbours' pools).
   const bool hemisphereRays = opt.mode != AmbientMode::Sky && !opt.useCone;
   // (An open vertex under adaptive strata also splits its horizon row: 3 rays a column.)
-  const StrataGrid grid = StrataGrid::forRays(opt.raysPerVertex);
-  const int openVertexRays = opt.targetError > 0.0                     ? std::max(opt.minRays, kRound)
-                             : opt.estimator == AOEstimator::Strata ? grid.strata() + 3 * grid.cols
-                                                                    : opt.raysPerVertex;
+  const bool strata = opt.estimator == AOEstimator::Strata && !opt.useCone;
+  const int openVertexRays =
+      strata ? (opt.targetError > 0.0 ? strataRaysWhenOpen(StrataTarget{opt.targetError, opt.minRays, opt.maxRays})
+                                      : strataRaysWhenOpen(StrataGrid::forRays(opt.raysPerVertex)))
+             : opt.targetError > 0.0 ? std::max(opt.minRays, kRound)
+                                     : opt.raysPerVertex;
   const bool openWithin = opt.skipOpenVertices && hemisphereRays && opt.maxDistance > 0.0;
   const bool openEverywhere = opt.skipOpenVertices && hemisphereRays && !(opt.maxDistance > 0.0) &&
                               opt.estimator != AOEstimator::Shared && openVertexRays >= 128;
@@ -514,14 +519,20 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     st.add("rounds", shareStats.rounds);
     st.add("pooling_seconds", shareStats.poolSeconds);
   }
-  if (opt.estimator == AOEstimator::Strata && !opt.useCone) {
+  if (strata) {
     size_t traced = 0;
     for (size_t i = 0; i < nv; ++i) traced += res.rays[i] > 0;
     const double perTraced = traced ? rays / double(traced) : 0.0;
     st.add("rays_per_vertex", perTraced);  // per vertex that cast rays
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "adaptive strata: %d x %d per vertex, split where occlusion edges cross them: "
-                  "%.1f rays per vertex that cast rays", grid.rows, grid.cols, perTraced);
+    char buf[200];
+    const StrataGrid first = StrataGrid::forRays(opt.targetError > 0.0 ? opt.minRays : opt.raysPerVertex);
+    if (opt.targetError > 0.0)
+      std::snprintf(buf, sizeof buf, "adaptive strata to a standard error of %g: rounds of grids from %d x %d, "
+                    "split where occlusion edges cross them: %.1f rays per vertex that cast rays",
+                    opt.targetError, first.rows, first.cols, perTraced);
+    else
+      std::snprintf(buf, sizeof buf, "adaptive strata: %d x %d per vertex, split where occlusion edges cross them: "
+                    "%.1f rays per vertex that cast rays", first.rows, first.cols, perTraced);
     st.note(buf);
   }
   if (open)

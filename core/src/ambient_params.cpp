@@ -21,13 +21,15 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                              "0 = fixed ray count."
                            : "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until its own "
                              "estimated standard error is below this value (between the minimum and maximum ray "
-                             "counts). 0 = fixed ray count.",
+                             "counts; adaptive strata: rounds of ever finer grids, the first of about min_rays "
+                             "strata, each next of twice as many). 0 = fixed ray count.",
                .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = mode == AmbientMode::Sky ? 1e9 : 0.5});
   s.push_back({.name = "min_rays", .label = "Minimum rays (adaptive)",
                .help = "Adaptive sampling never stops before this many rays.",
                .type = ParamType::Int, .def = 32, .min = 1, .max = 1 << 20});
   s.push_back({.name = "max_rays", .label = "Maximum rays (adaptive)",
-               .help = "Adaptive sampling never casts more than this many rays.",
+               .help = "Adaptive sampling never casts more than this many rays (adaptive strata: a round starts "
+                       "only if it stays within this count with every stratum split; the first always runs).",
                .type = ParamType::Int, .def = 4096, .min = 1, .max = 1 << 22});
   const bool obscurance = mode == AmbientMode::Obscurance;
   s.push_back({.name = "max_distance", .label = obscurance ? "Maximum distance" : "Maximum ray distance",
@@ -108,11 +110,12 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                          "a third of the time; on meshes of a few thousand to 30k vertices, or where the occlusion "
                          "changes from vertex to vertex, per vertex is as fast or faster, and adaptive strata "
                          "faster still. "
-                         "'Adaptive strata' (occlusion, fixed count): each vertex's hemisphere is cut into about "
+                         "'Adaptive strata' (occlusion): each vertex's hemisphere is cut into about "
                          "rays_per_vertex strata (R rows of elevation by 2R of azimuth), one jittered ray each, "
                          "and a stratum is split into four where its neighbours disagree (an occlusion edge "
                          "crosses it), so rays go where the shadows' edges are; still unbiased (a stratum's split "
-                         "never depends on its own ray) and still per vertex. It casts about 1.6 times "
+                         "never depends on its own ray) and still per vertex; with a target error, rounds of "
+                         "ever finer grids until it is met. It casts about 1.6 times "
                          "rays_per_vertex on occluded vertices and reached MeshLab's errors 1.4 to 1.6 times "
                          "sooner than the per-vertex estimator on the two bunnies (README). "
                          "The cone option is always per vertex.",

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace gi {
@@ -215,6 +216,38 @@ struct Strata {
 
 }  // namespace
 
+namespace {
+
+// The rounds to a target (ao_strata.h): estimateRound(grid, k) gives round
+// k's estimate; the weighted mix of the rounds so far.
+template <class EstimateRound>
+StrataEstimate rounds(const StrataTarget& t, EstimateRound&& estimateRound) {
+  StrataGrid g = StrataGrid::forRays(t.minRays);
+  double W = 0.0, openSum = 0.0, closedSum = 0.0, varSum = 0.0;
+  StrataEstimate mix;
+  for (uint32_t k = 0;; ++k) {
+    const StrataEstimate e = estimateRound(g, k);
+    const double w = double(g.strata()) * double(g.strata());
+    W += w;
+    openSum += w * e.value;
+    closedSum += w * (1.0 - e.value);
+    varSum += w * w * e.variance;
+    mix.bent += float(w) * e.bent;
+    mix.rays += e.rays;
+    if (varSum <= t.target * t.target * W * W) break;
+    const StrataGrid next = StrataGrid::forRays(2 * g.strata());
+    if (int64_t(mix.rays) + 4 * int64_t(next.strata()) > int64_t(t.maxRays)) break;
+    g = next;
+  }
+  // As in one round: exactly 1 or 0 when every round gave it.
+  const double open = openSum / W;
+  mix.value = open <= 0.5 ? open : 1.0 - closedSum / W;
+  mix.variance = varSum / (W * W);
+  return mix;
+}
+
+}  // namespace
+
 StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame,
                                float tfar, StrataGrid grid) {
   thread_local Strata s;
@@ -222,6 +255,26 @@ StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm:
   s.castBase(caster, key, org, frame, tfar);
   s.castSplits(caster, key, org, frame, tfar);
   return s.estimate();
+}
+
+StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, const glm::vec3& org,
+                                       const Frame& frame, float tfar, const StrataTarget& t) {
+  return rounds(t, [&](StrataGrid g, uint32_t k) {
+    // Round 0 is strataOcclusion's own jitter; later rounds jitter afresh.
+    return strataOcclusion(caster, k == 0 ? key : hash3(key, k, 0x52u), org, frame, tfar, g);
+  });
+}
+
+int strataRaysWhenOpen(StrataGrid grid) { return grid.strata() + 3 * grid.cols; }
+
+int strataRaysWhenOpen(const StrataTarget& t) {
+  return rounds(t, [](StrataGrid g, uint32_t) {
+           StrataEstimate e;
+           e.value = 1.0;
+           e.variance = 0.25 / (double(g.strata()) * g.strata());  // the floor of estimate()
+           e.rays = strataRaysWhenOpen(g);
+           return e;
+         }).rays;
 }
 
 }  // namespace gi

@@ -3,13 +3,17 @@
 // small enough that most strata split), its reported standard errors
 // covering its errors in the places where a split rule can miss an edge
 // (the crease, the contact, the thin disc), the exact cases, determinism,
-// and what it refuses.
+// the rounds to a target standard error (the target held everywhere, rays
+// where the error is, max_rays, unbiased over seeds), and what it refuses.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "gi/ambient.h"
 #include "gi/scenes.h"
@@ -28,6 +32,45 @@ AmbientOptions strata(int rays, uint32_t seed = 1) {
   o.raysPerVertex = rays;
   o.seed = seed;
   return o;
+}
+
+AmbientOptions strataTarget(double target, int minRays = 32, uint32_t seed = 1) {
+  AmbientOptions o = strata(minRays, seed);
+  o.targetError = target;
+  o.minRays = minRays;
+  return o;
+}
+
+// The mean over `seeds` runs of options(seed) against a 65,536-ray
+// per-vertex reference: the mean of z^2 over the vertices (exact ones left
+// out), z = (mean - reference) / sqrt(var/seeds + se_ref^2) with se_ref the
+// reference's binomial bound (its Sobol points do better, so z is
+// conservative), and the worst |z|.
+template <class Options>
+std::pair<double, double> meanZ2OverSeeds(const Scene& s, int seeds, Options&& options) {
+  auto caster = makeEmbreeCaster(s, BatchMode::Single);
+  AmbientOptions ro;
+  ro.raysPerVertex = 65536;
+  ro.seed = 99;
+  const AmbientResult ref = computeAmbient(s, *caster, ro);
+  const size_t nv = s.vertexCount();
+  std::vector<double> sum(nv, 0.0), sumSq(nv, 0.0);
+  for (int k = 0; k < seeds; ++k) {
+    const AmbientResult a = computeAmbient(s, *caster, options(uint32_t(1000 + k)));
+    for (size_t i = 0; i < nv; ++i) { sum[i] += a.value[i]; sumSq[i] += double(a.value[i]) * a.value[i]; }
+  }
+  double z2 = 0, worst = 0;
+  size_t counted = 0;
+  for (size_t i = 0; i < nv; ++i) {
+    const double m = sum[i] / seeds, var = std::max(0.0, sumSq[i] / seeds - m * m) * seeds / (seeds - 1.0);
+    const double d = m - double(ref.value[i]);
+    const double v = var / seeds + double(ref.stdError[i]) * ref.stdError[i];
+    if (v <= 0.0) { EXPECT_EQ(d, 0.0) << i; continue; }  // both exact (all rays open or all blocked)
+    z2 += d * d / v;
+    worst = std::max(worst, std::fabs(d) / std::sqrt(v));
+    ++counted;
+  }
+  return {z2 / double(counted), worst};
 }
 
 }  // namespace
@@ -96,30 +139,7 @@ TEST(AOStrata, LowerErrorThanPerVertexWithFewerRays) {
 // where occlusion was seen) gives 383 and 602.
 TEST(AOStrata, UnbiasedOverSeeds) {
   for (const Scene& s : {scenes::floorWithWall(2.0, 1.0, 6).scene, scenes::hemisphericalBowl(1.0, 8).scene}) {
-    auto caster = makeEmbreeCaster(s, BatchMode::Single);
-    AmbientOptions ro;
-    ro.raysPerVertex = 65536;
-    ro.seed = 99;
-    const AmbientResult ref = computeAmbient(s, *caster, ro);
-    const size_t nv = s.vertexCount();
-    const int seeds = 512;
-    std::vector<double> sum(nv, 0.0), sumSq(nv, 0.0);
-    for (int k = 0; k < seeds; ++k) {
-      const AmbientResult a = computeAmbient(s, *caster, strata(8, uint32_t(1000 + k)));
-      for (size_t i = 0; i < nv; ++i) { sum[i] += a.value[i]; sumSq[i] += double(a.value[i]) * a.value[i]; }
-    }
-    double z2 = 0, worst = 0;
-    size_t counted = 0;
-    for (size_t i = 0; i < nv; ++i) {
-      const double m = sum[i] / seeds, var = std::max(0.0, sumSq[i] / seeds - m * m) * seeds / (seeds - 1.0);
-      const double d = m - double(ref.value[i]);
-      const double v = var / seeds + double(ref.stdError[i]) * ref.stdError[i];
-      if (v <= 0.0) { EXPECT_EQ(d, 0.0) << i; continue; }  // both exact (all rays open or all blocked)
-      z2 += d * d / v;
-      worst = std::max(worst, std::fabs(d) / std::sqrt(v));
-      ++counted;
-    }
-    z2 /= double(counted);
+    const auto [z2, worst] = meanZ2OverSeeds(s, 512, [](uint32_t seed) { return strata(8, seed); });
     EXPECT_LT(z2, 1.5);
     EXPECT_LT(worst, 5.0);
   }
@@ -183,10 +203,113 @@ TEST(AOStrata, BentNormalsLeanAwayFromTheWall) {
   EXPECT_GT(glm::dot(r.bentNormal[v], q.bentNormal[v]), 0.999f);  // within 2.6 degrees
 }
 
+// To a target standard error (rounds of ever finer grids, ao_strata.h), in
+// every region of the test scene at targets 0.02 and 0.01: every vertex that
+// cast rays reports meeting the target (the default max_rays, 4096, is not
+// reached there), the mean (error / reported standard error)^2 is at most
+// 1.2 as at fixed counts (the reference's variance in the denominator; the
+// stop reads the estimates, so this is what checks that stopping early did
+// not leave errors the reports miss) and the RMS error is below the target.
+// Measured: mean z^2 0.26 to 0.36 by region at 0.02, 0.14 to 0.33 at 0.01.
+TEST(AOStrata, TargetHoldsEverywhereAgainstTheReference) {
+  const TestScene& t = scene();
+  const AmbientResult& ref = reference(t.s);
+  for (double target : {0.02, 0.01}) {
+    const AmbientResult a = run(t.s, strataTarget(target));
+    for (const Region& r : regions(t)) {
+      double z2 = 0, sq = 0;
+      size_t counted = 0;
+      for (size_t i : r.v) {
+        const double d = double(a.value[i]) - double(ref.value[i]);
+        sq += d * d;
+        if (a.rays[i] > 0) { ASSERT_LE(a.stdError[i], target) << r.name << " vertex " << i; }
+        const double v = double(a.stdError[i]) * a.stdError[i] + double(ref.stdError[i]) * ref.stdError[i];
+        if (v == 0.0) { EXPECT_EQ(d, 0.0) << i; continue; }
+        z2 += d * d / v;
+        ++counted;
+      }
+      ASSERT_GE(counted, 300u) << r.name;
+      RecordProperty("z2_" + std::to_string(target) + "_" + r.name.substr(0, 12), std::to_string(z2 / double(counted)));
+      EXPECT_LE(z2 / double(counted), 1.2) << r.name << ", target " << target;
+      EXPECT_LE(std::sqrt(sq / double(r.v.size())), target) << r.name << ", target " << target;
+    }
+  }
+}
+
+// The rounds: a target every vertex meets with its first grid gives the
+// fixed grid's bits (round 0 is the fixed estimator with the same key);
+// rays go where the error is (at 0.01 the crease's vertices cast more than
+// twice the rays of the vertices whose AO is above 0.99, which stop after
+// the second round as open ones do: measured 522 against 168); an open
+// plane, its rays cast, gives exactly 1 with the rays the schedule predicts
+// (4 x 8 strata and the horizon row's splits, 56 rays, a standard error of
+// 1/64 above 0.01, then 6 x 12 and its splits, 108: 164 rays, combined
+// error 0.5 / sqrt(32^2 + 72^2) = 0.0063); and max_rays bounds every
+// vertex's rays, with a warning where the target is then missed.
+TEST(AOStrata, TargetRoundsAdaptAndStayWithinMaxRays) {
+  const TestScene& t = scene();
+  EXPECT_EQ(run(t.s, strataTarget(0.5)).value, run(t.s, strata(32)).value);
+
+  const AmbientResult a = run(t.s, strataTarget(0.01));
+  const AmbientResult& ref = reference(t.s);
+  const Region crease = regions(t)[0];
+  double creaseRays = 0, openRays = 0;
+  size_t nearlyOpen = 0;
+  for (size_t i : crease.v) creaseRays += a.rays[i];
+  creaseRays /= double(crease.v.size());
+  for (size_t i = 0; i < t.end; ++i)
+    if (a.rays[i] > 0 && ref.value[i] > 0.99f) { openRays += a.rays[i]; ++nearlyOpen; }
+  ASSERT_GT(nearlyOpen, 100u);
+  openRays /= double(nearlyOpen);
+  RecordProperty("crease_rays", std::to_string(creaseRays));
+  RecordProperty("nearly_open_rays", std::to_string(openRays));
+  EXPECT_GT(creaseRays, 2.0 * openRays);
+
+  AmbientOptions open = strataTarget(0.01);
+  open.skipOpenVertices = false;
+  const AmbientResult p = run(scenes::openPlane(1.0, 8).scene, open);
+  for (size_t i = 0; i < p.value.size(); ++i) {
+    EXPECT_EQ(p.value[i], 1.f);
+    EXPECT_EQ(p.rays[i], 164);
+    EXPECT_NEAR(p.stdError[i], 0.5 / std::sqrt(32.0 * 32.0 + 72.0 * 72.0), 1e-6);
+  }
+
+  AmbientOptions capped = strataTarget(0.001);
+  capped.maxRays = 300;
+  const AmbientResult c = run(t.s, capped);
+  int most = 0;
+  for (int r : c.rays) most = std::max(most, r);
+  EXPECT_LE(most, 300);
+  EXPECT_GT(most, 0);
+  bool warned = false;
+  for (const auto& w : c.stats.warnings) warned |= w.find("max_rays 300") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+// Unbiased with rounds, up to the sequential stop: the mean over 512 seeds
+// with a first grid of 8 strata and a target of 0.05, where vertices stop
+// after one to four rounds, on the floor by a wall and the bowl as above
+// (same bounds). Measured: mean z^2 0.17 and 0.20, the vertices casting 56
+// to 211 and 92 to 208 rays. Weights taken from each round's own variance
+// estimate (inverse-variance weights, which read the samples) gave 0.19 and
+// 0.22 here, within this test's power; the fixed weights are kept because
+// they are unbiased by construction.
+TEST(AOStrata, TargetRoundsUnbiasedOverSeeds) {
+  for (const Scene& s : {scenes::floorWithWall(2.0, 1.0, 6).scene, scenes::hemisphericalBowl(1.0, 8).scene}) {
+    const AmbientResult one = run(s, strataTarget(0.05, 8));
+    const auto [fewest, most] = std::minmax_element(one.rays.begin(), one.rays.end());
+    RecordProperty("rays_" + std::to_string(s.vertexCount()), std::to_string(*fewest) + " to " + std::to_string(*most));
+    EXPECT_GE(*most, 2 * *fewest);  // the vertices stop after different rounds
+    const auto [z2, worst] = meanZ2OverSeeds(s, 512, [](uint32_t seed) { return strataTarget(0.05, 8, seed); });
+    RecordProperty("z2_" + std::to_string(s.vertexCount()), std::to_string(z2));
+    EXPECT_LT(z2, 1.5);
+    EXPECT_LT(worst, 5.0);
+  }
+}
+
 // What it cannot estimate is refused with one line: obscurance (it needs
-// hit distances, not a visible/blocked test) and a target error (the count
-// is fixed by the strata); the cone's ratio estimator stays per vertex, said
-// in a note, with the per-vertex bits.
+// hit distances, not a visible/blocked test); the cone's ratio estimator
+// stays per vertex, said in a note, with the per-vertex bits.
 TEST(AOStrata, RefusesWhatItCannotEstimate) {
   const Scene s = scenes::floorWithWall(2.0, 1.0, 4).scene;
   auto caster = makeEmbreeCaster(s);
@@ -194,14 +317,6 @@ TEST(AOStrata, RefusesWhatItCannotEstimate) {
   o.mode = AmbientMode::Obscurance;
   o.maxDistance = 0.5;
   EXPECT_THROW(computeAmbient(s, *caster, o), std::invalid_argument);
-  o = strata(64);
-  o.targetError = 0.01;
-  try {
-    computeAmbient(s, *caster, o);
-    ADD_FAILURE() << "a target error with adaptive strata was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("fixed rays_per_vertex"), std::string::npos) << e.what();
-  }
   o = strata(64);
   o.useCone = true;
   const AmbientResult c = computeAmbient(s, *caster, o);
