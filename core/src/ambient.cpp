@@ -211,6 +211,16 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
   if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Obscurance)
     throw std::invalid_argument("the adaptive strata estimator tests visibility only; obscurance (hit distances) "
                                 "needs the per-vertex or shared estimator");
+  if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone && o.targetError > 0.0) {
+    // Rounds never pass max_rays (ao_strata.h), so the first must fit with every stratum split.
+    const StrataGrid first = StrataGrid::forRays(o.minRays);
+    if (4 * int64_t(first.strata()) > int64_t(o.maxRays))
+      throw std::invalid_argument("adaptive strata: the first round (" + std::to_string(first.rows) + " x " +
+                                  std::to_string(first.cols) + " strata for min_rays " + std::to_string(o.minRays) +
+                                  ") may cast " + std::to_string(4 * first.strata()) +
+                                  " rays with every stratum split, above max_rays " + std::to_string(o.maxRays) +
+                                  "; raise max_rays or lower min_rays");
+  }
   if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
   if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
     throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");

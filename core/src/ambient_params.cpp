@@ -29,7 +29,7 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                .type = ParamType::Int, .def = 32, .min = 1, .max = 1 << 20});
   s.push_back({.name = "max_rays", .label = "Maximum rays (adaptive)",
                .help = "Adaptive sampling never casts more than this many rays (adaptive strata: a round starts "
-                       "only if it stays within this count with every stratum split; the first always runs).",
+                       "only if it stays within this count with every stratum split, the first one too).",
                .type = ParamType::Int, .def = 4096, .min = 1, .max = 1 << 22});
   const bool obscurance = mode == AmbientMode::Obscurance;
   s.push_back({.name = "max_distance", .label = obscurance ? "Maximum distance" : "Maximum ray distance",

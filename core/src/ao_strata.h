@@ -48,8 +48,8 @@
 // rounds stop at the first whose combined standard error is at most the
 // target (sequential sampling: the stop reads the estimates, as the
 // per-vertex estimator's does), or before a round that, with every stratum
-// split (4 rays each), would take the vertex past max_rays; the first round
-// always runs.
+// split (4 rays each), would take the vertex past max_rays (the first round
+// must fit: computeAmbient refuses a max_rays below its worst case).
 #pragma once
 #include <cstdint>
 

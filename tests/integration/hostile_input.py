@@ -206,6 +206,8 @@ CASES = [
      ["ao", "FILE", "--rays_per_vertex"], "rays_per_vertex"),
     ("cli_bad_number", "a parameter that is no number", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
      ["ao", "FILE", "--rays_per_vertex", "abc"], "rays_per_vertex"),
+    ("cli_strata_max_rays", "adaptive strata to a target with max_rays below its first round", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
+     ["ao", "FILE", "--estimator", "Adaptive strata", "--target_error", "0.01", "--max_rays", "100"], "above max_rays 100"),
     ("cli_strata_obscurance", "obscurance by adaptive strata", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
      ["obscurance", "FILE", "--estimator", "Adaptive strata"], "tests visibility only"),
     ("cli_no_input", "no input file", None, ["ao"], "input"),

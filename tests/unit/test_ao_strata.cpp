@@ -308,7 +308,8 @@ TEST(AOStrata, TargetRoundsUnbiasedOverSeeds) {
 }
 
 // What it cannot estimate is refused with one line: obscurance (it needs
-// hit distances, not a visible/blocked test); the cone's ratio estimator
+// hit distances, not a visible/blocked test) and, to a target, a max_rays
+// that its first round could pass (rounds never pass it); the cone's ratio estimator
 // stays per vertex, said in a note, with the per-vertex bits.
 TEST(AOStrata, RefusesWhatItCannotEstimate) {
   const Scene s = scenes::floorWithWall(2.0, 1.0, 4).scene;
@@ -317,6 +318,16 @@ TEST(AOStrata, RefusesWhatItCannotEstimate) {
   o.mode = AmbientMode::Obscurance;
   o.maxDistance = 0.5;
   EXPECT_THROW(computeAmbient(s, *caster, o), std::invalid_argument);
+  o = strataTarget(0.01);
+  o.maxRays = 127;  // the first round, 4 x 8 strata, may cast 128 with every stratum split
+  try {
+    computeAmbient(s, *caster, o);
+    ADD_FAILURE() << "a max_rays below the first round's worst case was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("above max_rays 127"), std::string::npos) << e.what();
+  }
+  o.maxRays = 128;
+  EXPECT_NO_THROW(computeAmbient(s, *caster, o));
   o = strata(64);
   o.useCone = true;
   const AmbientResult c = computeAmbient(s, *caster, o);
