@@ -24,6 +24,13 @@ namespace {
 
 constexpr int kRound = 32;  // rays per adaptive round (a power of two keeps Sobol prefixes balanced)
 
+// Whether the adaptive strata estimator runs (ao_strata.h): occlusion only
+// (obscurance is refused; the cone's ratio estimator and sky lighting stay
+// per vertex).
+bool strataRuns(const AmbientOptions& o) {
+  return o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone;
+}
+
 // Running sums of per-ray contributions (a division-free Welford stand-in;
 // values are in [0,1] so double sums lose nothing that matters).
 struct Moments {
@@ -54,7 +61,7 @@ class AmbientKernel {
     coneCos_ = std::cos(glm::radians(o.coneAngleDeg));
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
     sunScale_ = sunDiskScale(o.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
-    strata_ = o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone;
+    strata_ = strataRuns(o);
     grid_ = StrataGrid::forRays(o.raysPerVertex);
   }
 
@@ -211,7 +218,7 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
   if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Obscurance)
     throw std::invalid_argument("the adaptive strata estimator tests visibility only; obscurance (hit distances) "
                                 "needs the per-vertex or shared estimator");
-  if (o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone && o.targetError > 0.0) {
+  if (strataRuns(o) && o.targetError > 0.0) {
     // Rounds never pass max_rays (ao_strata.h), so the first must fit with every stratum split.
     const StrataGrid first = StrataGrid::forRays(o.minRays);
     if (4 * int64_t(first.strata()) > int64_t(o.maxRays))
@@ -294,7 +301,7 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
     const bool sky = o.mode == AmbientMode::Sky;
     // Adaptive strata stop before a round that might pass max_rays, so
     // there a vertex above the target is one that stopped for max_rays.
-    const bool strata = o.estimator == AOEstimator::Strata && !o.useCone;
+    const bool strata = strataRuns(o);
     auto atMax = [&](int rays) {
       return sky ? rays == o.maxRays || rays == o.maxRays + o.sunRays : strata || rays >= o.maxRays;
     };
@@ -392,7 +399,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   // neighbours' pools).
   const bool hemisphereRays = opt.mode != AmbientMode::Sky && !opt.useCone;
   // (An open vertex under adaptive strata also splits its horizon row: 3 rays a column.)
-  const bool strata = opt.estimator == AOEstimator::Strata && !opt.useCone;
+  const bool strata = strataRuns(opt);
   const int openVertexRays =
       strata ? (opt.targetError > 0.0 ? strataRaysWhenOpen(StrataTarget{opt.targetError, opt.minRays, opt.maxRays})
                                       : strataRaysWhenOpen(StrataGrid::forRays(opt.raysPerVertex)))

@@ -229,6 +229,10 @@ TEST(SplitRun, AmbientOcclusionByAdaptiveStrata) {
   expectSplitEqualsWhole(m, FilterKind::AmbientOcclusion, p, 3, 7, true);
   expectSplitEqualsWhole(cornell(), FilterKind::AmbientOcclusion, {{"estimator", "2"}, {"rays_per_vertex", "128"}}, 2,
                          50, false);
+  // to a target: rounds per vertex, keyed by the mesh's index as the fixed grid
+  expectSplitEqualsWhole(cornell(), FilterKind::AmbientOcclusion,
+                         {{"estimator", "2"}, {"target_error", "0.01"}, {"min_rays", "8"}, {"max_rays", "1024"}}, 3, 11,
+                         true);
 }
 
 // The shared estimator pools neighbours' rays across the parts' borders:
