@@ -12,6 +12,7 @@ m="$root/test_meshes"
 "$gi" script ao --estimator "Shared with neighbours" --target_error 0.01 --min_rays 8 \
   -o "$ex/ambient_occlusion_shared.mlx"
 "$gi" script ao --estimator "Adaptive strata" --rays_per_vertex 128 -o "$ex/ambient_occlusion_strata.mlx"
+"$gi" script ao --estimator "Adaptive strata" --target_error 0.01 -o "$ex/ambient_occlusion_strata_adaptive.mlx"
 "$gi" script thickness --rays_per_vertex 64 -o "$ex/thickness.mlx"
 "$gi" script obscurance --mesh "$m/bunny.ply" --max_distance 20% -o "$ex/obscurance_bunny.mlx"
 "$gi" script sky --sun_direction 0.4,1,0.3 --sun_angular_radius 2 -o "$ex/sky_lighting.mlx"

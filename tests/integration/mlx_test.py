@@ -200,7 +200,7 @@ def case_examples(c):
     root = os.path.dirname(c.meshes)
     ex = os.path.join(root, "examples")
     meshes = {"ambient_occlusion": "bunny", "ambient_occlusion_adaptive": "bunny", "ambient_occlusion_shared": "bunny",
-              "ambient_occlusion_strata": "bunny", "thickness": "bunny", "obscurance_bunny": "bunny",
+              "ambient_occlusion_strata": "bunny", "ambient_occlusion_strata_adaptive": "bunny", "thickness": "bunny", "obscurance_bunny": "bunny",
               "sky_lighting": "floor_wall", "radiosity_cornell": "cornell_box", "radiosity_cornell_one_bounce": "cornell_box",
               "photonmap_cornell": "cornell_box", "reference_cornell": "cornell_box", "form_factors_face0": "closed_box"}
     scripts = sorted(f[:-4] for f in os.listdir(ex) if f.endswith(".mlx"))
