@@ -1,7 +1,7 @@
 #include "gi/ambient.h"
 
 #include "ambient_internal.h"
-#include "ao_strata.h"
+#include "gi/ao_strata.h"
 
 #include <algorithm>
 #include <array>
@@ -24,7 +24,7 @@ namespace {
 
 constexpr int kRound = 32;  // rays per adaptive round (a power of two keeps Sobol prefixes balanced)
 
-// Whether the adaptive strata estimator runs (ao_strata.h): occlusion only
+// Whether the adaptive strata estimator runs (gi/ao_strata.h): occlusion only
 // (obscurance is refused; the cone's ratio estimator and sky lighting stay
 // per vertex).
 bool strataRuns(const AmbientOptions& o) {
@@ -194,7 +194,7 @@ class AmbientKernel {
   const RayCaster& caster_;
   const AmbientOptions& o_;
   float tfar_, coneCos_, sunCos_, sunScale_;
-  bool strata_;       // the adaptive strata estimator (ao_strata.h)
+  bool strata_;       // the adaptive strata estimator (gi/ao_strata.h)
   StrataGrid grid_;
   double target_;  // the adaptive stop, in the units of the per-ray values
 };
@@ -219,7 +219,7 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
     throw std::invalid_argument("the adaptive strata estimator tests visibility only; obscurance (hit distances) "
                                 "needs the per-vertex or shared estimator");
   if (strataRuns(o) && o.targetError > 0.0) {
-    // Rounds never pass max_rays (ao_strata.h), so the first must fit with every stratum split.
+    // Rounds never pass max_rays (gi/ao_strata.h), so the first must fit with every stratum split.
     const StrataGrid first = StrataGrid::forRays(o.minRays);
     if (4 * int64_t(first.strata()) > int64_t(o.maxRays))
       throw std::invalid_argument("adaptive strata: the first round (" + std::to_string(first.rows) + " x " +
@@ -544,8 +544,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     char buf[200];
     const StrataGrid first = StrataGrid::forRays(opt.targetError > 0.0 ? opt.minRays : opt.raysPerVertex);
     if (opt.targetError > 0.0)
-      std::snprintf(buf, sizeof buf, "adaptive strata to a standard error of %g: rounds of grids from %d x %d, "
-                    "split where occlusion edges cross them: %.1f rays per vertex that cast rays",
+      std::snprintf(buf, sizeof buf, "adaptive strata to a standard error of %g: grids from %d x %d, quartered "
+                    "each round, split where occlusion edges cross them: %.1f rays per vertex that cast rays",
                     opt.targetError, first.rows, first.cols, perTraced);
     else
       std::snprintf(buf, sizeof buf, "adaptive strata: %d x %d per vertex, split where occlusion edges cross them: "

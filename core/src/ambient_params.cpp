@@ -22,7 +22,8 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                            : "Adaptive sampling: if > 0, each vertex casts rays in rounds of 32 until its own "
                              "estimated standard error is below this value (between the minimum and maximum ray "
                              "counts; adaptive strata: rounds of ever finer grids, the first of about min_rays "
-                             "strata, each next of twice as many). 0 = fixed ray count.",
+                             "strata, each next with every stratum cut into four, keeping every ray cast). "
+                             "0 = fixed ray count.",
                .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = mode == AmbientMode::Sky ? 1e9 : 0.5});
   s.push_back({.name = "min_rays", .label = "Minimum rays (adaptive)",
                .help = "Adaptive sampling never stops before this many rays.",

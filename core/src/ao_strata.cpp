@@ -1,4 +1,4 @@
-#include "ao_strata.h"
+#include "gi/ao_strata.h"
 
 #include <algorithm>
 #include <cmath>
@@ -68,8 +68,12 @@ struct Strata {
   int R = 0, C = 0, n = 0;
   std::vector<glm::vec3> dirs;       // the base rays' directions
   std::vector<uint8_t> open;         // the base rays: 1 = open
+  std::vector<glm::vec2> at;         // where each base ray lies in its stratum ([0,1)^2: row, column)
   std::vector<uint8_t> quarter;      // which quarter each base ray fell in (2 bits: row half, column half)
+  std::vector<uint8_t> have;         // 1: the stratum's base ray came from the coarser grid (refine)
   std::vector<glm::vec3> qdirs;      // their quarters' new rays, 3 a stratum
+  std::vector<glm::vec2> qat;        // where each quarter's ray lies in its quarter
+  int cast = 0;                      // base rays cast on this grid (the rest came from the coarser one)
   std::vector<uint8_t> occ;          // one per ray cast
   std::vector<uint8_t> isSplit;      // 1: the stratum was split
   std::vector<float> mean;           // each stratum's estimate
@@ -80,7 +84,7 @@ struct Strata {
 
   void reset(StrataGrid g) {
     R = g.rows; C = g.cols; n = R * C;
-    if (rowsOf != R) {  // equal steps in t, x = 1 - (1 - t)^kRowPower: thinner rows towards the horizon
+    if (rowsOf != R) {  // (rowsOf -1: rows halved by refine)  // equal steps in t, x = 1 - (1 - t)^kRowPower: thinner rows towards the horizon
       rowsOf = R;
       rowX.resize(size_t(R) + 1);
       rowArea.resize(size_t(R));
@@ -90,7 +94,64 @@ struct Strata {
     }
     dirs.resize(size_t(n));
     open.resize(size_t(n));
+    at.resize(size_t(n));
     quarter.resize(size_t(n));
+    have.assign(size_t(n), 0);
+    occ.resize(std::max(occ.size(), size_t(n)));
+    direction.setColumns(C);
+  }
+
+  // The next grid of a target's rounds: every stratum cut into its four
+  // quarters (its row halved in x, its column in y), each quarter keeping
+  // the ray that lies in it (the stratum's own, or one cast for the quarter
+  // when the stratum was split), so only the empty quarters need rays.
+  // Each ray is uniform in the quarter it lies in and independent of the
+  // others, which is all the split rule and the estimate need.
+  std::vector<float> rowX2;
+  std::vector<glm::vec3> dirs2;
+  std::vector<uint8_t> open2, have2;
+  std::vector<glm::vec2> at2;
+  void refine() {
+    const int R2 = 2 * R, C2 = 2 * C, n2 = 4 * n;
+    rowX2.resize(size_t(R2) + 1);
+    for (int i = 0; i < R; ++i) {
+      rowX2[size_t(2 * i)] = rowX[size_t(i)];
+      rowX2[size_t(2 * i) + 1] = 0.5f * (rowX[size_t(i)] + rowX[size_t(i) + 1]);
+    }
+    rowX2[size_t(R2)] = rowX[size_t(R)];
+    dirs2.resize(size_t(n2));
+    open2.resize(size_t(n2));
+    at2.resize(size_t(n2));
+    have2.assign(size_t(n2), 0);
+    auto keep = [&](int i, int j, int q, glm::vec2 u, const glm::vec3& d, uint8_t o) {
+      const size_t f = size_t(2 * i + (q >> 1)) * size_t(C2) + size_t(2 * j + (q & 1));
+      dirs2[f] = d; open2[f] = o; at2[f] = u; have2[f] = 1;
+    };
+    for (int c = 0, k = 0; c < n; ++c) {
+      const int i = c / C, j = c % C, own = quarter[size_t(c)];
+      const glm::vec2 u = at[size_t(c)];
+      keep(i, j, own, {2.f * u.x - float(own >> 1), 2.f * u.y - float(own & 1)}, dirs[size_t(c)], open[size_t(c)]);
+      if (!isSplit[size_t(c)]) continue;
+      for (int q = 0, m = 0; q < 4; ++q) {
+        if (q == own) continue;
+        const size_t r = 3 * size_t(k) + size_t(m++);
+        keep(i, j, q, qat[r], qdirs[r], occ[r] ? 0 : 1);
+      }
+      ++k;
+    }
+    rowX.swap(rowX2);
+    dirs.swap(dirs2);
+    open.swap(open2);
+    at.swap(at2);
+    have.swap(have2);
+    R = R2; C = C2; n = n2;
+    rowsOf = -1;
+    rowArea.resize(size_t(R));
+    for (int i = 0; i < R; ++i) rowArea[size_t(i)] = (double(rowX[size_t(i) + 1]) - rowX[size_t(i)]) / C;
+    quarter.resize(size_t(n));
+    for (int c = 0; c < n; ++c)
+      if (have[size_t(c)])
+        quarter[size_t(c)] = uint8_t((at[size_t(c)].x >= 0.5f ? 2 : 0) | (at[size_t(c)].y >= 0.5f ? 1 : 0));
     occ.resize(std::max(occ.size(), size_t(n)));
     direction.setColumns(C);
   }
@@ -113,23 +174,39 @@ struct Strata {
     row(R + 1, [](int) { return uint8_t(0); });
   }
 
+  // One jittered ray in each stratum that has none yet.
+  std::vector<uint32_t> castAt;
+  std::vector<glm::vec3> castDirs;
   void castBase(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame, float tfar) {
+    castAt.clear();
     for (int i = 0, c = 0; i < R; ++i) {
       const float x0 = rowX[size_t(i)], width = rowX[size_t(i) + 1] - x0;
       for (int j = 0; j < C; ++j, ++c) {
+        if (have[size_t(c)]) continue;
         const glm::vec2 u = jitter(key, uint32_t(c));
         dirs[size_t(c)] = direction(frame, x0 + u.x * width, j, u.y);
+        at[size_t(c)] = u;
         quarter[size_t(c)] = uint8_t((u.x >= 0.5f ? 2 : 0) | (u.y >= 0.5f ? 1 : 0));
+        castAt.push_back(uint32_t(c));
       }
     }
-    caster.occludedFan(org, dirs.data(), size_t(n), tfar, occ.data());
-    for (int c = 0; c < n; ++c) open[size_t(c)] = occ[size_t(c)] ? 0 : 1;
+    cast = int(castAt.size());
+    if (cast == n) {
+      caster.occludedFan(org, dirs.data(), size_t(n), tfar, occ.data());
+      for (int c = 0; c < n; ++c) open[size_t(c)] = occ[size_t(c)] ? 0 : 1;
+      return;
+    }
+    castDirs.resize(castAt.size());
+    for (size_t r = 0; r < castAt.size(); ++r) castDirs[r] = dirs[castAt[r]];
+    if (!castAt.empty()) caster.occludedFan(org, castDirs.data(), castDirs.size(), tfar, occ.data());
+    for (size_t r = 0; r < castAt.size(); ++r) open[castAt[r]] = occ[r] ? 0 : 1;
   }
 
   // Splits the strata whose opposite neighbours disagree and casts their
   // quarters' rays (occ then holds them, 3 a split stratum).
   void castSplits(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame, float tfar) {
     qdirs.clear();
+    qat.clear();
     isSplit.assign(size_t(n), 0);
     pad();
     const size_t W = size_t(C) + 2;
@@ -148,6 +225,7 @@ struct Strata {
         for (int q = 0; q < 4; ++q) {
           if (q == quarter[c]) continue;
           const glm::vec2 u = jitter(key, uint32_t(n) + c * 4u + uint32_t(q));
+          qat.push_back(u);
           qdirs.push_back(direction(frame, x0 + 0.5f * (float(q >> 1) + u.x) * width, j, 0.5f * (float(q & 1) + u.y)));
         }
       }
@@ -159,7 +237,7 @@ struct Strata {
   // The estimate, its collapsed-pair variance and the bent normal's sum.
   StrataEstimate estimate() {
     StrataEstimate e;
-    e.rays = n + int(qdirs.size());
+    e.rays = cast + int(qdirs.size());
     double openArea = 0.0, closedArea = 0.0, var = 0.0;
     mean.resize(size_t(n));
     for (int c = 0, k = 0; c < n; ++c) {
@@ -218,39 +296,24 @@ struct Strata {
 
 namespace {
 
-// The rounds to a target (ao_strata.h): estimateRound(grid, k) gives round
-// k's estimate; the weighted mix of the rounds so far.
-template <class EstimateRound>
-StrataEstimate rounds(const StrataTarget& t, EstimateRound&& estimateRound) {
-  StrataGrid g = StrataGrid::forRays(t.minRays);
-  double W = 0.0, openSum = 0.0, closedSum = 0.0, varSum = 0.0;
-  StrataEstimate mix;
-  for (uint32_t k = 0;; ++k) {
-    const StrataEstimate e = estimateRound(g, k);
-    const double w = double(g.strata()) * double(g.strata());
-    W += w;
-    openSum += w * e.value;
-    closedSum += w * (1.0 - e.value);
-    varSum += w * w * e.variance;
-    mix.bent += float(w) * e.bent;
-    mix.rays += e.rays;
-    if (varSum <= t.target * t.target * W * W) break;
-    const StrataGrid next = StrataGrid::forRays(2 * g.strata());
-    if (int64_t(mix.rays) + 4 * int64_t(next.strata()) > int64_t(t.maxRays)) break;
-    g = next;
-  }
-  // As in one round: exactly 1 or 0 when every round gave it.
-  const double open = openSum / W;
-  mix.value = open <= 0.5 ? open : 1.0 - closedSum / W;
-  mix.variance = varSum / (W * W);
-  return mix;
+// Whether a target's next round (every stratum quartered, gi/ao_strata.h) fits
+// in maxRays with every new stratum split: its new base rays (the quarters
+// of n strata, less the n rays kept and the quarterRays cast for splits)
+// and up to 3 more for each of its 4n strata.
+bool nextRoundFits(int64_t rays, int64_t n, int64_t quarterRays, int maxRays) {
+  return rays + (3 * n - quarterRays) + 12 * n <= int64_t(maxRays);
+}
+
+Strata& threadStrata() {
+  thread_local Strata s;
+  return s;
 }
 
 }  // namespace
 
 StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame,
                                float tfar, StrataGrid grid) {
-  thread_local Strata s;
+  Strata& s = threadStrata();
   s.reset(grid);
   s.castBase(caster, key, org, frame, tfar);
   s.castSplits(caster, key, org, frame, tfar);
@@ -259,22 +322,43 @@ StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm:
 
 StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, const glm::vec3& org,
                                        const Frame& frame, float tfar, const StrataTarget& t) {
-  return rounds(t, [&](StrataGrid g, uint32_t k) {
-    // Round 0 is strataOcclusion's own jitter; later rounds jitter afresh.
-    return strataOcclusion(caster, k == 0 ? key : hash3(key, k, 0x52u), org, frame, tfar, g);
-  });
+  Strata& s = threadStrata();
+  // Round 0 is strataOcclusion's own grid and jitter; later rounds jitter their new rays afresh.
+  StrataEstimate e = strataOcclusion(caster, key, org, frame, tfar, StrataGrid::forRays(t.minRays));
+  int rays = e.rays;
+  for (uint32_t k = 1; e.variance > t.target * t.target && nextRoundFits(rays, s.n, int64_t(s.qdirs.size()), t.maxRays);
+       ++k) {
+    const uint32_t roundKey = hash3(key, k, 0x52u);
+    s.refine();
+    s.castBase(caster, roundKey, org, frame, tfar);
+    s.castSplits(caster, roundKey, org, frame, tfar);
+    e = s.estimate();
+    rays += e.rays;
+  }
+  e.rays = rays;
+  return e;
+}
+
+StrataGridView lastStrataGrid() {
+  const Strata& s = threadStrata();
+  return {s.R, s.C, std::vector<float>(s.rowX.begin(), s.rowX.begin() + s.R + 1),
+          std::vector<glm::vec3>(s.dirs.begin(), s.dirs.begin() + s.n),
+          std::vector<uint8_t>(s.have.begin(), s.have.begin() + s.n)};
 }
 
 int strataRaysWhenOpen(StrataGrid grid) { return grid.strata() + 3 * grid.cols; }
 
 int strataRaysWhenOpen(const StrataTarget& t) {
-  return rounds(t, [](StrataGrid g, uint32_t) {
-           StrataEstimate e;
-           e.value = 1.0;
-           e.variance = 0.25 / (double(g.strata()) * g.strata());  // the floor of estimate()
-           e.rays = strataRaysWhenOpen(g);
-           return e;
-         }).rays;
+  // Every round: the horizon row split (3 rays a column), the variance at
+  // estimate()'s floor, 0.25 / n^2.
+  StrataGrid g = StrataGrid::forRays(t.minRays);
+  int64_t n = g.strata(), cols = g.cols, rays = n + 3 * cols;
+  while (0.25 / (double(n) * double(n)) > t.target * t.target && nextRoundFits(rays, n, 3 * cols, t.maxRays)) {
+    rays += (3 * n - 3 * cols) + 3 * (2 * cols);
+    n *= 4;
+    cols *= 2;
+  }
+  return int(rays);
 }
 
 }  // namespace gi

@@ -340,8 +340,8 @@ TEST(SkyLighting, TargetErrorIsInWattsPerSquareMetre) {
   for (size_t i = 0; i < one.value.size(); ++i) {
     if (one.rays[i] == 0) continue;
     EXPECT_EQ(one.rays[i], hundred.rays[i]) << "vertex " << i;
-    if (hundred.rays[i] < o.maxRays) EXPECT_LE(hundred.stdError[i], 2.f) << "vertex " << i;
-    if (strict.rays[i] < o.maxRays) EXPECT_LE(strict.stdError[i], 0.02f) << "vertex " << i;
+    if (hundred.rays[i] < o.maxRays) { EXPECT_LE(hundred.stdError[i], 2.f) << "vertex " << i; }
+    if (strict.rays[i] < o.maxRays) { EXPECT_LE(strict.stdError[i], 0.02f) << "vertex " << i; }
     rays1 += one.rays[i], raysStrict += strict.rays[i];
   }
   std::printf("sky rays: %.0f at 0.02 of a sky of 1 W/m^2, %.0f at 0.02 of 100 W/m^2\n", rays1, raysStrict);

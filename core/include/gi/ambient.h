@@ -38,8 +38,8 @@ inline constexpr auto kBatchModes = makeEnumTable<BatchMode>({
 // PerVertex: each vertex's own rays only (independent estimates, the
 // estimator above). Shared: neighbours' rays pooled where they agree
 // (gi/ao_shared.h). Strata: each vertex's own rays, one per stratum of its
-// hemisphere, the strata at occlusion edges split (core/src/ao_strata.h;
-// occlusion only, a fixed count).
+// hemisphere, the strata at occlusion edges split (gi/ao_strata.h;
+// occlusion only).
 enum class AOEstimator { PerVertex, Shared, Strata };
 inline constexpr auto kAOEstimators = makeEnumTable<AOEstimator>({
     {AOEstimator::PerVertex, "Per vertex", "per vertex"},

@@ -36,22 +36,26 @@
 // The bound misses what no sample saw (an occluder thinner than a stratum
 // that two partners both miss), as any sample-based estimate must.
 //
-// To a target standard error (strataOcclusionToTarget): rounds of
-// independent grids (each jittered afresh), the first of about min_rays
-// strata, each next of about twice the last one's strata, combined with
-// weights w_k = S_k^2 fixed in advance (S_k the round's strata: an
-// estimate's variance falls about as S^-2 when the edges' strata dominate,
-// measured S^-1.9 on bunny_fine, so these weights are near the inverse
-// variances without reading any sample):
-//   AO ~ sum_k w_k AO_k / sum_k w_k,  Var ~ sum_k w_k^2 Var_k / (sum_k w_k)^2,
-// each round unbiased, so the mix is, for a fixed number of rounds. The
-// rounds stop at the first whose combined standard error is at most the
-// target (sequential sampling: the stop reads the estimates, as the
-// per-vertex estimator's does), or before a round that, with every stratum
-// split (4 rays each), would take the vertex past max_rays (the first round
-// must fit: computeAmbient refuses a max_rays below its worst case).
+// To a target standard error (strataOcclusionToTarget): rounds of ever
+// finer grids, the first of about min_rays strata, each next one every
+// stratum of the last cut into its four quarters (its row halved in x, its
+// column in y). A quarter keeps the ray that lies in it (the stratum's
+// own, or the one cast for it when the stratum was split), so a round casts
+// only the empty quarters' rays and its own splits, and the finest grid's
+// estimate uses every ray cast (the same rays a fixed grid of that size
+// would cast, less the row spacing: halved rows instead of x_i's power).
+// Still unbiased: a kept ray, given the quarter it lies in, is uniform in
+// it; the empty quarters get fresh ones; so every stratum of the new grid
+// holds one uniform ray independent of the others', and its split is again
+// decided by its neighbours' rays only. The rounds stop at the first whose
+// standard error is at most the target (sequential sampling: the stop
+// reads the estimates, as the per-vertex estimator's does), or before a
+// round that, with every new stratum split, would take the vertex past
+// max_rays (the first round must fit: computeAmbient refuses a max_rays
+// below its worst case, 4 rays a stratum).
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -94,5 +98,17 @@ StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, co
 // large.
 int strataRaysWhenOpen(StrataGrid grid);
 int strataRaysWhenOpen(const StrataTarget& t);
+
+// The last grid estimated on this thread (by strataOcclusion, or the last
+// round of strataOcclusionToTarget), for checks: the rows' bounds in x
+// (rows + 1), the columns, and per stratum (row-major) its base ray's
+// direction and whether that ray was kept from the coarser grid.
+struct StrataGridView {
+  int rows = 0, cols = 0;
+  std::vector<float> rowX;
+  std::vector<glm::vec3> dirs;
+  std::vector<uint8_t> kept;
+};
+StrataGridView lastStrataGrid();
 
 }  // namespace gi
