@@ -84,7 +84,9 @@ struct Strata {
 
   void reset(StrataGrid g) {
     R = g.rows; C = g.cols; n = R * C;
-    if (rowsOf != R) {  // (rowsOf -1: rows halved by refine)  // equal steps in t, x = 1 - (1 - t)^kRowPower: thinner rows towards the horizon
+    // Equal steps in t, x = 1 - (1 - t)^kRowPower: thinner rows towards the
+    // horizon (rowsOf -1 after refine: the rows were halved).
+    if (rowsOf != R) {
       rowsOf = R;
       rowX.resize(size_t(R) + 1);
       rowArea.resize(size_t(R));
@@ -292,10 +294,6 @@ struct Strata {
   }
 };
 
-}  // namespace
-
-namespace {
-
 // Whether a target's next round (every stratum quartered, gi/ao_strata.h) fits
 // in maxRays with every new stratum split: its new base rays (the quarters
 // of n strata, less the n rays kept and the quarterRays cast for splits)
@@ -341,6 +339,7 @@ StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, co
 
 StrataGridView lastStrataGrid() {
   const Strata& s = threadStrata();
+  if (s.n == 0) return {};
   return {s.R, s.C, std::vector<float>(s.rowX.begin(), s.rowX.begin() + s.R + 1),
           std::vector<glm::vec3>(s.dirs.begin(), s.dirs.begin() + s.n),
           std::vector<uint8_t>(s.have.begin(), s.have.begin() + s.n)};
