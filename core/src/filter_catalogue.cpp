@@ -18,6 +18,11 @@ const std::vector<FilterDesc>& allFilters() {
        "Directions are cosine-distributed (so each ray counts 0 or 1) and come from an Owen-scrambled Sobol "
        "sequence per vertex: the error falls faster than plain Monte Carlo's N<sup>-1/2</sup>. "
        "With a target error each vertex stops as soon as its own standard error is small enough. "
+       "Two other estimators (parameter Estimator): <i>shared with neighbours</i> pools the rays of nearby "
+       "vertices where their values agree (Lepski's rule; fewest rays on dense scans of 100k vertices and more), "
+       "and <i>adaptive strata</i> cuts each hemisphere into strata with one jittered ray each and splits those "
+       "an occlusion edge crosses (fewest rays on meshes of a few thousand to 30k vertices; with a target error "
+       "the grid is refined round by round, every ray kept). "
        "The result goes to vertex <b>quality</b> (the AO value) and vertex <b>colour</b> (grey, AO x 255).<br>"
        "Unlike MeshLab's depth-map 'Ambient Occlusion' it needs no GPU, is seeded and deterministic, and its "
        "values span [0,1] (MeshLab's top out at 0.25). Other visible layers can occlude (Scene extent).",
