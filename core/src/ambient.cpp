@@ -30,6 +30,16 @@ constexpr int kRound = 32;  // rays per adaptive round (a power of two keeps Sob
 bool strataRuns(const AmbientOptions& o) {
   return o.estimator == AOEstimator::Strata && o.mode == AmbientMode::Occlusion && !o.useCone;
 }
+// Its rounds to a target, and its grid: the fixed one, or the first round's.
+StrataTarget strataTargetOf(const AmbientOptions& o) { return {o.targetError, o.minRays, o.maxRays}; }
+StrataGrid firstStrataGrid(const AmbientOptions& o) {
+  return StrataGrid::forRays(o.targetError > 0.0 ? o.minRays : o.raysPerVertex);
+}
+
+// A bent normal: the mean open direction, or the normal where none was open.
+glm::vec3 bentOrNormal(const glm::vec3& sum, const glm::vec3& n) {
+  return glm::length(sum) > 0.f ? glm::normalize(sum) : n;
+}
 
 // Running sums of per-ray contributions (a division-free Welford stand-in;
 // values are in [0,1] so double sums lose nothing that matters).
@@ -62,7 +72,7 @@ class AmbientKernel {
     sunCos_ = std::cos(glm::radians(o.sunAngularRadiusDeg));
     sunScale_ = sunDiskScale(o.sunAngularRadiusDeg);  // a facing surface gets E_sun (gi/sky.h)
     strata_ = strataRuns(o);
-    grid_ = StrataGrid::forRays(o.raysPerVertex);
+    grid_ = firstStrataGrid(o);
   }
 
   VertexOut run(uint32_t vi, const glm::vec3& org, const glm::vec3& n) const {
@@ -71,13 +81,12 @@ class AmbientKernel {
     if (strata_) {
       const uint32_t key = hash3(vi, o_.seed, 0x53u);
       const StrataEstimate e = o_.targetError > 0.0
-                                   ? strataOcclusionToTarget(caster_, key, org, frame, tfar_,
-                                                             {o_.targetError, o_.minRays, o_.maxRays})
+                                   ? strataOcclusionToTarget(caster_, key, org, frame, tfar_, strataTargetOf(o_))
                                    : strataOcclusion(caster_, key, org, frame, tfar_, grid_);
       out.value = float(e.value);
       out.stdError = float(std::sqrt(e.variance));
       out.rays = e.rays;
-      if (o_.bentNormals) out.bent = glm::length(e.bent) > 0.f ? glm::normalize(e.bent) : n;
+      if (o_.bentNormals) out.bent = bentOrNormal(e.bent, n);
       return out;
     }
     const Frame cone(o_.coneDirection);
@@ -132,7 +141,7 @@ class AmbientKernel {
     if (o_.useCone) out.value = den > 0 ? float(num / den) : 0.f;
     else out.value = float(w.mean());
     out.stdError = float(stdError(w, done, num, den, numSq, denSq, numDen));
-    if (o_.bentNormals) out.bent = glm::length(bent) > 0.f ? glm::normalize(bent) : n;
+    if (o_.bentNormals) out.bent = bentOrNormal(bent, n);
     if (o_.mode == AmbientMode::Sky) out = addSun(out, vi, n, org);
     return out;
   }
@@ -220,7 +229,7 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
                                 "needs the per-vertex or shared estimator");
   if (strataRuns(o) && o.targetError > 0.0) {
     // Rounds never pass max_rays (gi/ao_strata.h), so the first must fit with every stratum split.
-    const StrataGrid first = StrataGrid::forRays(o.minRays);
+    const StrataGrid first = firstStrataGrid(o);
     if (4 * int64_t(first.strata()) > int64_t(o.maxRays))
       throw std::invalid_argument("adaptive strata: the first round (" + std::to_string(first.rows) + " x " +
                                   std::to_string(first.cols) + " strata for min_rays " + std::to_string(o.minRays) +
@@ -401,8 +410,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   // (An open vertex under adaptive strata also splits its horizon row: 3 rays a column.)
   const bool strata = strataRuns(opt);
   const int openVertexRays =
-      strata ? (opt.targetError > 0.0 ? strataRaysWhenOpen(StrataTarget{opt.targetError, opt.minRays, opt.maxRays})
-                                      : strataRaysWhenOpen(StrataGrid::forRays(opt.raysPerVertex)))
+      strata ? (opt.targetError > 0.0 ? strataRaysWhenOpen(strataTargetOf(opt)) : strataRaysWhenOpen(firstStrataGrid(opt)))
              : opt.targetError > 0.0 ? std::max(opt.minRays, kRound)
                                      : opt.raysPerVertex;
   const bool openWithin = opt.skipOpenVertices && hemisphereRays && opt.maxDistance > 0.0;
@@ -542,7 +550,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     const double perTraced = traced ? rays / double(traced) : 0.0;
     st.add("rays_per_vertex", perTraced);  // per vertex that cast rays
     char buf[200];
-    const StrataGrid first = StrataGrid::forRays(opt.targetError > 0.0 ? opt.minRays : opt.raysPerVertex);
+    const StrataGrid first = firstStrataGrid(opt);
     if (opt.targetError > 0.0)
       std::snprintf(buf, sizeof buf, "adaptive strata to a standard error of %g: grids from %d x %d, quartered "
                     "each round, split where occlusion edges cross them: %.1f rays per vertex that cast rays",

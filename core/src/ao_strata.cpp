@@ -82,6 +82,12 @@ struct Strata {
   std::vector<double> rowArea;       // a stratum's area in each row
   int rowsOf = 0;
 
+  // A stratum's area in each row, from the rows' bounds.
+  void setRowAreas() {
+    rowArea.resize(size_t(R));
+    for (int i = 0; i < R; ++i) rowArea[size_t(i)] = (double(rowX[size_t(i) + 1]) - rowX[size_t(i)]) / C;
+  }
+
   void reset(StrataGrid g) {
     R = g.rows; C = g.cols; n = R * C;
     // Equal steps in t, x = 1 - (1 - t)^kRowPower: thinner rows towards the
@@ -89,10 +95,9 @@ struct Strata {
     if (rowsOf != R) {
       rowsOf = R;
       rowX.resize(size_t(R) + 1);
-      rowArea.resize(size_t(R));
       for (int i = 0; i <= R; ++i) rowX[size_t(i)] = float(1.0 - std::pow(1.0 - double(i) / R, kRowPower));
       rowX[size_t(R)] = 1.f;
-      for (int i = 0; i < R; ++i) rowArea[size_t(i)] = (double(rowX[size_t(i) + 1]) - rowX[size_t(i)]) / C;
+      setRowAreas();
     }
     dirs.resize(size_t(n));
     open.resize(size_t(n));
@@ -148,8 +153,7 @@ struct Strata {
     have.swap(have2);
     R = R2; C = C2; n = n2;
     rowsOf = -1;
-    rowArea.resize(size_t(R));
-    for (int i = 0; i < R; ++i) rowArea[size_t(i)] = (double(rowX[size_t(i) + 1]) - rowX[size_t(i)]) / C;
+    setRowAreas();
     quarter.resize(size_t(n));
     for (int c = 0; c < n; ++c)
       if (have[size_t(c)])
@@ -193,11 +197,6 @@ struct Strata {
       }
     }
     cast = int(castAt.size());
-    if (cast == n) {
-      caster.occludedFan(org, dirs.data(), size_t(n), tfar, occ.data());
-      for (int c = 0; c < n; ++c) open[size_t(c)] = occ[size_t(c)] ? 0 : 1;
-      return;
-    }
     castDirs.resize(castAt.size());
     for (size_t r = 0; r < castAt.size(); ++r) castDirs[r] = dirs[castAt[r]];
     if (!castAt.empty()) caster.occludedFan(org, castDirs.data(), castDirs.size(), tfar, occ.data());
