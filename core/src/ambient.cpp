@@ -419,13 +419,13 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (openWithin || openEverywhere) {
     std::unique_ptr<OpenSpaceTest> within;
     std::unique_ptr<SceneBelowTest> everywhere;
-    if (openWithin) within = std::make_unique<OpenSpaceTest>(scene, float(rep.rayEpsilon));
+    if (openWithin) within = std::make_unique<OpenSpaceTest>(scene, float(rep.rayEpsilon), normals, &usable);
     else everywhere = std::make_unique<SceneBelowTest>(scene, float(rep.rayEpsilon), normals, &usable);
     std::vector<uint8_t> isOpen(nv, 0);
     parallelBlocks(nv, progress.sub(0.0, 0.05), "finding open vertices", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         if (status[i] != kTrace) continue;
-        isOpen[i] = (within ? within->hemisphereEmpty(scene.positions[i], normals[i], float(opt.maxDistance))
+        isOpen[i] = (within ? within->openWithin(uint32_t(i), float(opt.maxDistance))
                             : everywhere->sceneBelow(uint32_t(i))) ? 1 : 0;
       }
     });

@@ -3,69 +3,234 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
 
-#include <nanoflann.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 
 namespace gi {
 
 struct OpenSpaceTest::Impl {
-  struct Cloud {
-    std::vector<glm::vec3> pts;
-    size_t kdtree_get_point_count() const { return pts.size(); }
-    float kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
-    template <class B> bool kdtree_get_bbox(B&) const { return false; }
+  struct Face {
+    glm::vec3 c;   // centroid
+    float r;       // bounding radius around it
+    uint32_t face;
   };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
+  struct Node {
+    glm::vec3 clo, chi;       // box of the faces' centroids
+    glm::vec3 centre, half;   // box of their corners
+    glm::vec3 m{0.f};         // small nodes: their mean face normal (unit; 0: none), and their
+    float lo = 0.f, hi = 0.f, rho = 0.f;  // corners x as m.(x - centre) in [lo, hi], |x - centre| across m <= rho
+    float maxR;               // their largest radius
+    uint32_t begin, end;      // their faces in faces
+    int32_t left = -1, right = -1;  // children; -1: a leaf
+  };
+  static constexpr uint32_t kLeaf = 8, kSlab = 64;
   const Scene& s;
+  const std::vector<glm::vec3>& normals;
   float eps;
-  Cloud cloud;            // centroids of usable faces
-  std::vector<uint32_t> face;
-  std::vector<float> radius;  // bounding radius around the centroid
+  std::vector<Face> faces;
+  std::vector<Node> nodes;
+  std::vector<uint8_t> ringAbove;  // per vertex: one of its own faces blocks (the leaf's test)
   float maxRadius = 0.f;
-  std::unique_ptr<Tree> tree;
-  Impl(const Scene& sc, float e) : s(sc), eps(e) {}
+  Impl(const Scene& sc, const std::vector<glm::vec3>& n, float e) : s(sc), normals(n), eps(e) {}
+
+  // The leaf's test of one face against a vertex at p with normal n: a
+  // corner at or above the plane eps/2 over the tangent plane.
+  bool rises(uint32_t face, const glm::vec3& p, const glm::vec3& n) const {
+    const auto& t = s.triangles[face];
+    float h = -HUGE_VALF;
+    for (int j = 0; j < 3; ++j) h = std::max(h, glm::dot(n, s.positions[t[j]] - p));
+    return !(h < 0.5f * eps);
+  }
+
+  // The slab of a small node: its faces' corners along their mean normal,
+  // and how far across it they lie from the box's centre (padded for float
+  // rounding). Tight where the faces are nearly flat, where the box's own
+  // bound is loose by the box's size.
+  void slab(Node& node) const {
+    glm::dvec3 sum(0.0);
+    for (uint32_t i = node.begin; i < node.end; ++i) {
+      const auto& t = s.triangles[faces[i].face];
+      const glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+      sum += glm::cross(b - a, c - a);
+    }
+    const double len = glm::length(sum);
+    if (!(len > 0.0) || !std::isfinite(len)) return;
+    const glm::dvec3 m = sum / len, c(node.centre);
+    double lo = HUGE_VAL, hi = -HUGE_VAL, rho2 = 0.0;
+    for (uint32_t i = node.begin; i < node.end; ++i) {
+      const auto& t = s.triangles[faces[i].face];
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 d = glm::dvec3(s.positions[t[k]]) - c;
+        const double along = glm::dot(m, d);
+        lo = std::min(lo, along);
+        hi = std::max(hi, along);
+        rho2 = std::max(rho2, glm::dot(d, d) - along * along);
+      }
+    }
+    const double pad = 1e-5 * glm::length(glm::dvec3(node.half)) + 1e-30;
+    node.m = glm::vec3(m);
+    node.lo = float(lo - pad);
+    node.hi = float(hi + pad);
+    node.rho = float(std::sqrt(std::max(rho2, 0.0)) + pad);
+  }
+
+  // Nodes of the subtree over n faces: its shape depends on n alone (median
+  // splits), so every subtree's place in nodes is known before it is built
+  // and the two halves can be built at once.
+  std::map<uint32_t, uint32_t> subtreeNodes;
+  uint32_t nodeCount(uint32_t n) {
+    if (n <= kLeaf) return 1;
+    const auto it = subtreeNodes.find(n);
+    if (it != subtreeNodes.end()) return it->second;
+    const uint32_t c = 1 + nodeCount(n / 2) + nodeCount(n - n / 2);
+    subtreeNodes.emplace(n, c);
+    return c;
+  }
+
+  // Fills nodes[id] over faces[b, e) (its subtree in the nodes after it),
+  // split at the median centroid along the longest side of the centroids'
+  // box; the corners' box and the largest radius come up from the children.
+  void build(size_t id, uint32_t b, uint32_t e) {
+    glm::vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
+    for (uint32_t i = b; i < e; ++i) { lo = glm::min(lo, faces[i].c); hi = glm::max(hi, faces[i].c); }
+    Node node;
+    node.clo = lo;
+    node.chi = hi;
+    node.begin = b;
+    node.end = e;
+    if (e - b <= kLeaf) {
+      glm::vec3 clo(HUGE_VALF), chi(-HUGE_VALF);
+      float r = 0.f;
+      for (uint32_t i = b; i < e; ++i) {
+        const auto& t = s.triangles[faces[i].face];
+        for (int k = 0; k < 3; ++k) { clo = glm::min(clo, s.positions[t[k]]); chi = glm::max(chi, s.positions[t[k]]); }
+        r = std::max(r, faces[i].r);
+      }
+      node.centre = 0.5f * (clo + chi);
+      node.half = 0.5f * (chi - clo) * (1.f + 1e-6f);  // float rounding of centre +- half stays inside
+      node.maxR = r;
+    } else {
+      const glm::vec3 size = hi - lo;
+      const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+      const uint32_t mid = b + (e - b) / 2;
+      std::nth_element(faces.begin() + b, faces.begin() + mid, faces.begin() + e,
+                       [axis](const Face& u, const Face& v) { return u.c[axis] < v.c[axis]; });
+      node.left = int32_t(id + 1);
+      node.right = int32_t(id + 1 + (mid - b <= kLeaf ? 1 : subtreeNodes.at(mid - b)));  // read only: filled before
+      auto buildLeft = [&] { build(size_t(node.left), b, mid); };
+      auto buildRight = [&] { build(size_t(node.right), mid, e); };
+      if (e - b > 16384) tbb::parallel_invoke(buildLeft, buildRight);
+      else { buildLeft(); buildRight(); }
+      const Node &l = nodes[size_t(node.left)], &r = nodes[size_t(node.right)];
+      const glm::vec3 clo = glm::min(l.centre - l.half, r.centre - r.half), chi = glm::max(l.centre + l.half, r.centre + r.half);
+      node.centre = 0.5f * (clo + chi);
+      node.half = 0.5f * (chi - clo) * (1.f + 1e-6f);
+      node.maxR = std::max(l.maxR, r.maxR);
+    }
+    if (e - b <= kSlab) slab(node);
+    nodes[id] = node;
+  }
 };
 
-OpenSpaceTest::OpenSpaceTest(const Scene& s, float eps) : impl_(std::make_unique<Impl>(s, eps)) {
-  const auto ok = usableFaceMask(s);
-  for (size_t f = 0; f < ok.size(); ++f) {
-    if (!ok[f]) continue;
-    const auto& t = s.triangles[f];
-    const glm::vec3 c = (s.positions[t.x] + s.positions[t.y] + s.positions[t.z]) / 3.f;
-    float r = 0.f;
-    for (int k = 0; k < 3; ++k) r = std::max(r, glm::length(s.positions[t[k]] - c));
-    impl_->cloud.pts.push_back(c);
-    impl_->face.push_back(uint32_t(f));
-    impl_->radius.push_back(r * 1.0001f);
-    impl_->maxRadius = std::max(impl_->maxRadius, r * 1.0001f);
+OpenSpaceTest::OpenSpaceTest(const Scene& s, float eps, const std::vector<glm::vec3>& normals,
+                             const std::vector<uint8_t>* usable)
+    : impl_(std::make_unique<Impl>(s, normals, eps)) {
+  std::vector<uint8_t> own;
+  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
+  Impl& m = *impl_;
+  for (size_t f = 0; f < ok.size(); ++f)
+    if (ok[f]) m.faces.push_back({glm::vec3(0.f), 0.f, uint32_t(f)});
+  // Each face's centroid and radius, and which of its corners it refuses: a
+  // vertex's own face is within the reach of its rays (the vertex lies in
+  // the face's bounding sphere), so if it rises the vertex is not open.
+  std::vector<uint8_t> refuses(m.faces.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, m.faces.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      Impl::Face& face = m.faces[i];
+      const auto& t = s.triangles[face.face];
+      const glm::vec3 c = (s.positions[t.x] + s.positions[t.y] + s.positions[t.z]) / 3.f;
+      float rad = 0.f;
+      for (int k = 0; k < 3; ++k) rad = std::max(rad, glm::length(s.positions[t[k]] - c));
+      face.c = c;
+      face.r = rad * 1.0001f;
+      for (int k = 0; k < 3; ++k)
+        if (m.rises(face.face, s.positions[t[k]], normals[t[k]])) refuses[i] |= uint8_t(1u << k);
+    }
+  });
+  m.ringAbove.assign(s.vertexCount(), 0);
+  for (size_t i = 0; i < m.faces.size(); ++i) {
+    m.maxRadius = std::max(m.maxRadius, m.faces[i].r);
+    const auto& t = s.triangles[m.faces[i].face];
+    for (int k = 0; k < 3; ++k)
+      if (refuses[i] & (1u << k)) m.ringAbove[t[k]] = 1;
   }
-  impl_->tree = std::make_unique<Impl::Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  impl_->tree->buildIndex();
+  if (m.faces.empty()) return;
+  const uint32_t n = uint32_t(m.faces.size());
+  m.nodes.resize(m.nodeCount(n));
+  m.build(0, 0, n);
 }
 
 OpenSpaceTest::~OpenSpaceTest() = default;
 
-bool OpenSpaceTest::hemisphereEmpty(const glm::vec3& p, const glm::vec3& n, float maxDistance) const {
+bool OpenSpaceTest::openWithin(uint32_t vertex, float maxDistance) const {
   const Impl& m = *impl_;
-  if (m.cloud.pts.empty()) return true;
+  if (m.nodes.empty()) return true;
+  if (m.ringAbove[vertex]) return false;
+  const glm::vec3 p = m.s.positions[vertex], n = m.normals[vertex];
   // Ray origins lie within sqrt(2) eps of p (lifted by eps, and pulled by
   // eps into the faces at lopsided one-rings): reach 2 eps beyond maxDistance.
+  const float reach = maxDistance + 2.f * m.eps;
   const float R = maxDistance + m.maxRadius + 2.f * m.eps;
-  std::vector<std::pair<uint32_t, float>> found;
-  nanoflann::SearchParams params;
-  params.sorted = false;
-  const float q[3] = {p.x, p.y, p.z};
-  m.tree->radiusSearch(q, R * R, found, params);
-  for (const auto& [k, d2] : found) {
-    // Outside the reach of every ray (origin p + n eps, length maxDistance)?
-    if (std::sqrt(d2) - m.radius[k] > maxDistance + 2.f * m.eps) continue;
-    // Entirely at or below the plane at height eps/2 over the tangent plane?
-    // Rays start at height eps and go up, so they cannot reach it.
-    const auto& t = m.s.triangles[m.face[k]];
-    float h = -HUGE_VALF;
-    for (int j = 0; j < 3; ++j) h = std::max(h, glm::dot(n, m.s.positions[t[j]] - p));
-    if (h < 0.5f * m.eps) continue;
-    return false;
+  const float limit = 0.5f * m.eps;
+  // A face blocks when it is within the reach of some ray (its bounding
+  // sphere) and a corner lies at or above the plane eps/2 over the tangent
+  // plane (rays start at height eps and go up, so nothing lower meets them).
+  // Searched in a tree of boxes, skipping nodes out of reach or wholly below
+  // that plane (bounds in double with a margin for the faces' float tests:
+  // the box's, and for small nodes their slab's), the highest first: a
+  // vertex that is not open meets a blocking face soon.
+  const glm::dvec3 pd(p), nd(n), an(glm::abs(nd));
+  const double ln = glm::length(nd);
+  auto height = [&](const Impl::Node& k) {  // an upper bound of k's corners' heights; -inf: out of reach
+    const glm::dvec3 out = glm::max(glm::dvec3(k.clo) - pd, pd - glm::dvec3(k.chi));
+    const double dist = glm::length(glm::max(out, glm::dvec3(0.0)));
+    if (dist - double(k.maxR) > double(reach) * (1.0 + 1e-5) || dist > double(R) * (1.0 + 1e-5)) return -HUGE_VAL;
+    const glm::dvec3 c = glm::dvec3(k.centre) - pd, half(k.half);
+    double h = glm::dot(nd, c) + glm::dot(an, half);
+    if (k.m != glm::vec3(0.f)) {
+      const glm::dvec3 md(k.m);
+      const double along = glm::dot(nd, md);
+      h = std::min(h, glm::dot(nd, c) + std::max(along * double(k.lo), along * double(k.hi)) +
+                          glm::length(nd - along * md) * double(k.rho));
+    }
+    return h + 1e-5 * ln * (glm::length(c) + glm::length(half));
+  };
+  if (!(height(m.nodes[0]) >= double(limit))) return true;
+  int32_t stack[128];  // nodes that may hold a blocking face
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Impl::Node& k = m.nodes[size_t(stack[--top])];
+    if (k.left < 0) {
+      for (uint32_t i = k.begin; i < k.end; ++i) {
+        const Impl::Face& f = m.faces[i];
+        const glm::vec3 d = f.c - p;
+        const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+        if (!(d2 < R * R) || std::sqrt(d2) - f.r > reach) continue;
+        if (m.rises(f.face, p, n)) return false;
+      }
+      continue;
+    }
+    const int32_t a = k.left, b = k.right;
+    const double ha = height(m.nodes[size_t(a)]), hb = height(m.nodes[size_t(b)]);
+    const bool aFirst = ha >= hb;
+    const double hLast = aFirst ? hb : ha, hFirst = aFirst ? ha : hb;
+    if (hLast >= double(limit)) stack[top++] = aFirst ? b : a;
+    if (hFirst >= double(limit)) stack[top++] = aFirst ? a : b;
   }
   return true;
 }

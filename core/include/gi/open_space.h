@@ -1,7 +1,12 @@
 // Proofs that a vertex is fully open, so that it needs no rays at all.
 // OpenSpaceTest: no geometry lies above its tangent plane within a distance
-// (every ray limited to that distance escapes). Conservative: "false" means
-// "maybe".
+// (every ray limited to that distance escapes): a usable face within reach
+// of a ray (its bounding sphere) with a corner eps/2 or more above the plane
+// refuses it. A tree of boxes over the faces, searched without the faces out
+// of reach or wholly below the plane: bounded by each node's box, and for
+// nodes of 64 faces or fewer by their slab along their mean normal (tight on
+// nearly flat parts, where a box's bound is loose by its size), after a quick
+// refusal from the vertex's own faces. Conservative: "false" means "maybe".
 #pragma once
 #include <memory>
 #include <vector>
@@ -14,9 +19,11 @@ namespace gi {
 
 class OpenSpaceTest {
  public:
-  OpenSpaceTest(const Scene& s, float eps);
+  // normals: the vertex normals the rays use (kept by reference, as is s).
+  OpenSpaceTest(const Scene& s, float eps, const std::vector<glm::vec3>& normals,
+                const std::vector<uint8_t>* usable = nullptr);
   ~OpenSpaceTest();
-  bool hemisphereEmpty(const glm::vec3& p, const glm::vec3& n, float maxDistance) const;
+  bool openWithin(uint32_t vertex, float maxDistance) const;
 
  private:
   struct Impl;
