@@ -232,7 +232,9 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   const Progress progress(stderrProgress(a.quiet || !writer));
   if (cluster::size() > 1 && !a.cacheDir.empty()) throw std::invalid_argument("--cache is for a run in one process, not under mpirun");
   FilterResult r = prepareFilter(kind, in);
-  const io::ResultKey key{desc.cliName, a.input, sceneHash(in.scene), describe(specs, in.values)};
+  // The scene's hash only where a result file records it (a pass over every byte of the mesh).
+  const bool keyed = !a.cacheDir.empty() || !a.saveResult.empty();
+  const io::ResultKey key{desc.cliName, a.input, keyed ? sceneHash(in.scene) : 0, describe(specs, in.values)};
   const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
   bool reused = false;
   std::error_code noFile;
