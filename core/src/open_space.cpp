@@ -12,6 +12,38 @@
 
 namespace gi {
 
+namespace {
+
+// The axis of a box's longest side: the trees below split there.
+int longestAxis(const glm::vec3& size) { return size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2; }
+
+// Depth-first search of a tree of nodes (children left and right; left < 0:
+// a leaf) for a leaf where hit(leaf) holds, through the nodes whose bound
+// reaches: of two children the higher bound is searched first, so that a
+// vertex that is not open meets what refuses it soon.
+template <class Node, class Bound, class Reaches, class Hit>
+bool searchHighestFirst(const std::vector<Node>& nodes, Bound&& bound, Reaches&& reaches, Hit&& hit) {
+  int32_t stack[128];  // a depth-first search holds at most two nodes per level
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& k = nodes[size_t(stack[--top])];
+    if (k.left < 0) {
+      if (hit(k)) return true;
+      continue;
+    }
+    const int32_t a = k.left, b = k.right;
+    const double ha = bound(nodes[size_t(a)]), hb = bound(nodes[size_t(b)]);
+    const bool aFirst = ha >= hb;
+    const double hLast = aFirst ? hb : ha, hFirst = aFirst ? ha : hb;
+    if (reaches(hLast)) stack[top++] = aFirst ? b : a;
+    if (reaches(hFirst)) stack[top++] = aFirst ? a : b;
+  }
+  return false;
+}
+
+}  // namespace
+
 struct OpenSpaceTest::Impl {
   struct Face {
     glm::vec3 c;   // centroid
@@ -114,8 +146,7 @@ struct OpenSpaceTest::Impl {
       node.half = 0.5f * (chi - clo) * (1.f + 1e-6f);  // float rounding of centre +- half stays inside
       node.maxR = r;
     } else {
-      const glm::vec3 size = hi - lo;
-      const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+      const int axis = longestAxis(hi - lo);
       const uint32_t mid = b + (e - b) / 2;
       std::nth_element(faces.begin() + b, faces.begin() + mid, faces.begin() + e,
                        [axis](const Face& u, const Face& v) { return u.c[axis] < v.c[axis]; });
@@ -209,37 +240,25 @@ bool OpenSpaceTest::openWithin(uint32_t vertex, float maxDistance) const {
     }
     return h + 1e-5 * ln * (glm::length(c) + glm::length(half));
   };
-  if (!(height(m.nodes[0]) >= double(limit))) return true;
-  int32_t stack[128];  // nodes that may hold a blocking face
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Impl::Node& k = m.nodes[size_t(stack[--top])];
-    if (k.left < 0) {
-      for (uint32_t i = k.begin; i < k.end; ++i) {
-        const Impl::Face& f = m.faces[i];
-        const glm::vec3 d = f.c - p;
-        const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
-        if (!(d2 < R * R) || std::sqrt(d2) - f.r > reach) continue;
-        if (m.rises(f.face, p, n)) return false;
-      }
-      continue;
+  const auto reaches = [&](double h) { return h >= double(limit); };
+  if (!reaches(height(m.nodes[0]))) return true;
+  return !searchHighestFirst(m.nodes, height, reaches, [&](const Impl::Node& k) {
+    for (uint32_t i = k.begin; i < k.end; ++i) {
+      const Impl::Face& f = m.faces[i];
+      const glm::vec3 d = f.c - p;
+      const float d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+      if (!(d2 < R * R) || std::sqrt(d2) - f.r > reach) continue;
+      if (m.rises(f.face, p, n)) return true;
     }
-    const int32_t a = k.left, b = k.right;
-    const double ha = height(m.nodes[size_t(a)]), hb = height(m.nodes[size_t(b)]);
-    const bool aFirst = ha >= hb;
-    const double hLast = aFirst ? hb : ha, hFirst = aFirst ? ha : hb;
-    if (hLast >= double(limit)) stack[top++] = aFirst ? b : a;
-    if (hFirst >= double(limit)) stack[top++] = aFirst ? a : b;
-  }
-  return true;
+    return false;
+  });
 }
 
 struct SceneBelowTest::Impl {
   struct Node {
     glm::vec3 centre, half;  // box of the node's points
     uint32_t begin, end;     // its points in pts
-    int32_t left = -1;       // children left and left + 1; -1: a leaf
+    int32_t left = -1, right = -1;  // children (right = left + 1); -1: a leaf
   };
   static constexpr uint32_t kLeaf = 8;
   std::vector<glm::vec3> pts;
@@ -254,15 +273,15 @@ struct SceneBelowTest::Impl {
   void build(size_t id, uint32_t b, uint32_t e) {
     glm::vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
     for (uint32_t i = b; i < e; ++i) { lo = glm::min(lo, pts[i]); hi = glm::max(hi, pts[i]); }
-    nodes[id] = {0.5f * (lo + hi), 0.5f * (hi - lo), b, e, -1};
+    nodes[id] = {0.5f * (lo + hi), 0.5f * (hi - lo), b, e, -1, -1};
     if (e - b <= kLeaf) return;
-    const glm::vec3 size = hi - lo;
-    const int axis = size.x >= size.y && size.x >= size.z ? 0 : size.y >= size.z ? 1 : 2;
+    const int axis = longestAxis(hi - lo);
     const uint32_t mid = b + (e - b) / 2;
     std::nth_element(pts.begin() + b, pts.begin() + mid, pts.begin() + e,
                      [axis](const glm::vec3& u, const glm::vec3& v) { return u[axis] < v[axis]; });
     const size_t left = nodes.size();
     nodes[id].left = int32_t(left);
+    nodes[id].right = int32_t(left + 1);
     nodes.resize(left + 2);
     build(left, b, mid);
     build(left + 1, mid, e);
@@ -330,27 +349,12 @@ bool SceneBelowTest::sceneBelow(uint32_t v) const {
   for (const glm::dvec3& q : m.extremes)
     if (glm::dot(nd, q - pd) > limit) return false;
   if (bound(m.nodes[0]) <= limit) return true;
-  int32_t stack[128];  // nodes whose box reaches above the limit
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Impl::Node& k = m.nodes[size_t(stack[--top])];
-    if (k.left < 0) {
-      for (uint32_t i = k.begin; i < k.end; ++i)
-        if (glm::dot(nd, glm::dvec3(m.pts[i]) - pd) > limit) return false;
-      continue;
-    }
-    // The children reaching above the limit, the higher one pushed last so
-    // that it is searched first: a vertex that is not open meets a point
-    // above its plane soon.
-    const int32_t a = k.left, b = k.left + 1;
-    const double ha = bound(m.nodes[size_t(a)]), hb = bound(m.nodes[size_t(b)]);
-    const bool aFirst = ha >= hb;
-    const double hLast = aFirst ? hb : ha, hFirst = aFirst ? ha : hb;
-    if (hLast > limit) stack[top++] = aFirst ? b : a;
-    if (hFirst > limit) stack[top++] = aFirst ? a : b;
-  }
-  return true;
+  const auto reaches = [limit](double h) { return h > limit; };
+  return !searchHighestFirst(m.nodes, bound, reaches, [&](const Impl::Node& k) {
+    for (uint32_t i = k.begin; i < k.end; ++i)
+      if (glm::dot(nd, glm::dvec3(m.pts[i]) - pd) > limit) return true;
+    return false;
+  });
 }
 
 }  // namespace gi
