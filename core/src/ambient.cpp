@@ -416,7 +416,9 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const bool openWithin = opt.skipOpenVertices && hemisphereRays && opt.maxDistance > 0.0;
   const bool openEverywhere = opt.skipOpenVertices && hemisphereRays && !(opt.maxDistance > 0.0) &&
                               opt.estimator != AOEstimator::Shared && openVertexRays >= 128;
+  double proofSeconds = -1.0;  // the proof's time, its tree included (-1: not run)
   if (openWithin || openEverywhere) {
+    const Timer proofTimer;
     std::unique_ptr<OpenSpaceTest> within;
     std::unique_ptr<SceneBelowTest> everywhere;
     if (openWithin) within = std::make_unique<OpenSpaceTest>(scene, float(rep.rayEpsilon), normals, &usable);
@@ -431,6 +433,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     });
     for (size_t i = 0; i < nv; ++i)
       if (isOpen[i]) { status[i] = kOpen; ++open; }
+    proofSeconds = proofTimer.seconds();
   }
 
   AmbientResult res;
@@ -535,6 +538,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   st.add("mean", counted ? sum / double(counted) : 0.0);
   st.add("rms_error_estimate", counted ? std::sqrt(var / double(counted)) : 0.0);
   st.add("skipped_open", double(open));
+  if (proofSeconds >= 0.0) st.add("open_proof_seconds", proofSeconds);
   st.add("skipped_duplicates", double(duplicates));
   st.add("skipped_invalid", double(invalid));
   if (shared) {
