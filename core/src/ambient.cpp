@@ -417,14 +417,26 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const bool openEverywhere = opt.skipOpenVertices && hemisphereRays && !(opt.maxDistance > 0.0) &&
                               opt.estimator != AOEstimator::Shared && openVertexRays >= 128;
   double proofSeconds = -1.0;  // the proof's time, its tree included (-1: not run)
+  std::string proofNote;       // why it was not run
   if (openWithin || openEverywhere) {
     const Timer proofTimer;
     std::unique_ptr<OpenSpaceTest> within;
     std::unique_ptr<SceneBelowTest> everywhere;
-    if (openWithin) within = std::make_unique<OpenSpaceTest>(scene, float(rep.rayEpsilon), normals, &usable);
+    if (openWithin) within = std::make_unique<OpenSpaceTest>(scene, float(rep.rayEpsilon), normals, &usable, false);
     else everywhere = std::make_unique<SceneBelowTest>(scene, float(rep.rayEpsilon), normals, &usable);
+    std::vector<uint32_t> candidates;  // of the whole run, so that every part decides alike
+    for (size_t i = 0; within && i < nv; ++i)
+      if (status[i] == kTrace || status[i] == kOtherPart) candidates.push_back(uint32_t(i));
+    const OpenSpaceTest::Plan plan =
+        within ? within->plan(candidates, float(opt.maxDistance), openVertexRays) : OpenSpaceTest::Plan{true};
+    const bool prove = plan.pays;
+    if (!prove)
+      proofNote = "the proof that vertices are open within max_distance was not run: " +
+                  std::string(plan.ownFacesOnly ? "at most " : "") + std::to_string(int(std::lround(100.0 * plan.share))) +
+                  "% of a sample of " + std::to_string(plan.sampled) + " open, at " + std::to_string(openVertexRays) +
+                  " rays each, would save less than the proof costs";
     std::vector<uint8_t> isOpen(nv, 0);
-    parallelBlocks(nv, progress.sub(0.0, 0.05), "finding open vertices", [&](size_t b, size_t e) {
+    parallelBlocks(prove ? nv : 0, progress.sub(0.0, 0.05), "finding open vertices", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         if (status[i] != kTrace) continue;
         isOpen[i] = (within ? within->openWithin(uint32_t(i), float(opt.maxDistance))
@@ -539,6 +551,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   st.add("rms_error_estimate", counted ? std::sqrt(var / double(counted)) : 0.0);
   st.add("skipped_open", double(open));
   if (proofSeconds >= 0.0) st.add("open_proof_seconds", proofSeconds);
+  if (!proofNote.empty()) st.note(proofNote);
   st.add("skipped_duplicates", double(duplicates));
   st.add("skipped_invalid", double(invalid));
   if (shared) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -168,7 +169,7 @@ struct OpenSpaceTest::Impl {
 };
 
 OpenSpaceTest::OpenSpaceTest(const Scene& s, float eps, const std::vector<glm::vec3>& normals,
-                             const std::vector<uint8_t>* usable)
+                             const std::vector<uint8_t>* usable, bool buildTree)
     : impl_(std::make_unique<Impl>(s, normals, eps)) {
   std::vector<uint8_t> own;
   const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
@@ -199,7 +200,12 @@ OpenSpaceTest::OpenSpaceTest(const Scene& s, float eps, const std::vector<glm::v
     for (int k = 0; k < 3; ++k)
       if (refuses[i] & (1u << k)) m.ringAbove[t[k]] = 1;
   }
-  if (m.faces.empty()) return;
+  if (buildTree) build();
+}
+
+void OpenSpaceTest::build() {
+  Impl& m = *impl_;
+  if (m.faces.empty() || !m.nodes.empty()) return;
   const uint32_t n = uint32_t(m.faces.size());
   m.nodes.resize(m.nodeCount(n));
   m.build(0, 0, n);
@@ -209,8 +215,9 @@ OpenSpaceTest::~OpenSpaceTest() = default;
 
 bool OpenSpaceTest::openWithin(uint32_t vertex, float maxDistance) const {
   const Impl& m = *impl_;
-  if (m.nodes.empty()) return true;
   if (m.ringAbove[vertex]) return false;
+  if (m.faces.empty()) return true;
+  if (m.nodes.empty()) throw std::logic_error("OpenSpaceTest::openWithin before build()");
   const glm::vec3 p = m.s.positions[vertex], n = m.normals[vertex];
   // Ray origins lie within sqrt(2) eps of p (lifted by eps, and pulled by
   // eps into the faces at lopsided one-rings): reach 2 eps beyond maxDistance.
@@ -252,6 +259,26 @@ bool OpenSpaceTest::openWithin(uint32_t vertex, float maxDistance) const {
     }
     return false;
   });
+}
+
+OpenSpaceTest::Plan OpenSpaceTest::plan(const std::vector<uint32_t>& candidates, float maxDistance, int rays) {
+  constexpr size_t kSample = 256;
+  constexpr double kRaysPerProof = 8.0;
+  const size_t stride = std::max<size_t>(1, candidates.size() / kSample);
+  Plan p;
+  size_t open = 0;
+  for (size_t k = 0; k < candidates.size(); k += stride, ++p.sampled) open += !impl_->ringAbove[candidates[k]];
+  p.share = p.sampled ? double(open) / double(p.sampled) : 0.0;
+  if (p.share * double(rays) < kRaysPerProof) {
+    p.ownFacesOnly = true;
+    return p;
+  }
+  build();
+  open = 0;
+  for (size_t k = 0; k < candidates.size(); k += stride) open += openWithin(candidates[k], maxDistance);
+  p.share = p.sampled ? double(open) / double(p.sampled) : 0.0;
+  p.pays = p.share * double(rays) >= kRaysPerProof;
+  return p;
 }
 
 struct SceneBelowTest::Impl {
