@@ -400,12 +400,13 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   }
   // Vertices whose rays provably all escape get 1 without rays: nothing
   // above the tangent plane within max_distance, or, for rays of any length,
-  // in the whole scene. The second proof costs about as much as 50 to 100 of
-  // an open vertex's rays (measured on the bunny, bunny_fine and scan_118k:
-  // 0.35 to 0.45 microseconds a vertex), so it runs where an open vertex
-  // would cast at least 128 rays, and for the per-vertex estimator only (the
-  // shared one casts just its first round there, and those rays serve its
-  // neighbours' pools).
+  // in the whole scene. The first costs about 6 to 9 of a vertex's rays, so
+  // it runs where a sample says it pays (OpenSpaceTest::plan). The second
+  // costs about as much as 50 to 100 of an open vertex's rays (measured on
+  // the bunny, bunny_fine and scan_118k: 0.35 to 0.45 microseconds a
+  // vertex), so it runs where an open vertex would cast at least 128 rays,
+  // and for the per-vertex estimator only (the shared one casts just its
+  // first round there, and those rays serve its neighbours' pools).
   const bool hemisphereRays = opt.mode != AmbientMode::Sky && !opt.useCone;
   // (An open vertex under adaptive strata also splits its horizon row: 3 rays a column.)
   const bool strata = strataRuns(opt);
@@ -430,11 +431,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
     const OpenSpaceTest::Plan plan =
         within ? within->plan(candidates, float(opt.maxDistance), openVertexRays) : OpenSpaceTest::Plan{true};
     const bool prove = plan.pays;
-    if (!prove)
-      proofNote = "the proof that vertices are open within max_distance was not run: " +
-                  std::string(plan.ownFacesOnly ? "at most " : "") + std::to_string(int(std::lround(100.0 * plan.share))) +
-                  "% of a sample of " + std::to_string(plan.sampled) + " open, at " + std::to_string(openVertexRays) +
-                  " rays each, would save less than the proof costs";
+    if (!prove) proofNote = plan.whyNot(openVertexRays);
     std::vector<uint8_t> isOpen(nv, 0);
     parallelBlocks(prove ? nv : 0, progress.sub(0.0, 0.05), "finding open vertices", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {

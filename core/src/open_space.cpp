@@ -281,6 +281,13 @@ OpenSpaceTest::Plan OpenSpaceTest::plan(const std::vector<uint32_t>& candidates,
   return p;
 }
 
+std::string OpenSpaceTest::Plan::whyNot(int rays) const {
+  return "the proof that vertices are open within max_distance was not run: " +
+         std::string(ownFacesOnly ? "at most " : "") + std::to_string(int(std::lround(100.0 * share))) +
+         "% of a sample of " + std::to_string(sampled) + " open, at " + std::to_string(rays) +
+         " rays each, would save less than the proof costs";
+}
+
 struct SceneBelowTest::Impl {
   struct Node {
     glm::vec3 centre, half;  // box of the node's points

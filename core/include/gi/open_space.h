@@ -9,6 +9,7 @@
 // refusal from the vertex's own faces. Conservative: "false" means "maybe".
 #pragma once
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -43,6 +44,7 @@ class OpenSpaceTest {
     double share = 0.0;         // of the sample: open, or (ownFacesOnly) not refused by its own faces
     size_t sampled = 0;
     bool ownFacesOnly = false;  // settled by that bound, without the tree
+    std::string whyNot(int rays) const;  // the log's line where it does not pay
   };
   Plan plan(const std::vector<uint32_t>& candidates, float maxDistance, int rays);
 
