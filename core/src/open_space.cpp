@@ -85,11 +85,7 @@ struct OpenSpaceTest::Impl {
   // bound is loose by the box's size.
   void slab(Node& node) const {
     glm::dvec3 sum(0.0);
-    for (uint32_t i = node.begin; i < node.end; ++i) {
-      const auto& t = s.triangles[faces[i].face];
-      const glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
-      sum += glm::cross(b - a, c - a);
-    }
+    for (uint32_t i = node.begin; i < node.end; ++i) sum += glm::dvec3(faceNormalUnnormalized(s, faces[i].face));
     const double len = glm::length(sum);
     if (!(len > 0.0) || !std::isfinite(len)) return;
     const glm::dvec3 m = sum / len, c(node.centre);
@@ -266,17 +262,17 @@ OpenSpaceTest::Plan OpenSpaceTest::plan(const std::vector<uint32_t>& candidates,
   constexpr double kRaysPerProof = 8.0;
   const size_t stride = std::max<size_t>(1, candidates.size() / kSample);
   Plan p;
-  size_t open = 0;
-  for (size_t k = 0; k < candidates.size(); k += stride, ++p.sampled) open += !impl_->ringAbove[candidates[k]];
-  p.share = p.sampled ? double(open) / double(p.sampled) : 0.0;
-  if (p.share * double(rays) < kRaysPerProof) {
-    p.ownFacesOnly = true;
-    return p;
-  }
+  auto shareOf = [&](auto&& open) {  // the share of the sample for which open(vertex) holds
+    size_t yes = 0;
+    p.sampled = 0;
+    for (size_t k = 0; k < candidates.size(); k += stride, ++p.sampled) yes += open(candidates[k]);
+    return p.sampled ? double(yes) / double(p.sampled) : 0.0;
+  };
+  p.share = shareOf([this](uint32_t v) { return !impl_->ringAbove[v]; });
+  p.ownFacesOnly = p.share * double(rays) < kRaysPerProof;
+  if (p.ownFacesOnly) return p;
   build();
-  open = 0;
-  for (size_t k = 0; k < candidates.size(); k += stride) open += openWithin(candidates[k], maxDistance);
-  p.share = p.sampled ? double(open) / double(p.sampled) : 0.0;
+  p.share = shareOf([&](uint32_t v) { return openWithin(v, maxDistance); });
   p.pays = p.share * double(rays) >= kRaysPerProof;
   return p;
 }
