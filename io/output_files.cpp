@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -47,11 +48,23 @@ void checkWritable(const Named& out, std::map<std::string, std::string>& folders
   if (there && S_ISDIR(st.st_mode)) throw std::invalid_argument(cannot + "it is a directory");
   if (there && access(target.c_str(), W_OK) != 0) throw std::invalid_argument(cannot + std::strerror(errno));
   if (there && !S_ISREG(st.st_mode)) return;  // a device or a pipe, written in place
+  if (!there && target.size() >= PATH_MAX)
+    throw std::invalid_argument(cannot + "the path is " + std::to_string(target.size()) + " bytes long, at most " +
+                                std::to_string(PATH_MAX - 1) + " are taken");
   const fs::path parent = fs::path(target).parent_path().empty() ? fs::path(".") : fs::path(target).parent_path();
   std::error_code ec;
   const fs::file_status pst = fs::status(parent, ec);
   if (!fs::exists(pst)) throw std::invalid_argument(cannot + "the folder " + parent.string() + " does not exist");
   if (!fs::is_directory(pst)) throw std::invalid_argument(cannot + parent.string() + " is not a folder");
+  // A name the folder cannot hold (ENAMETOOLONG) would otherwise fail only
+  // when the result is written, after the computation.
+  if (!there) {
+    const size_t nameBytes = fs::path(target).filename().string().size();
+    const long nameMax = ::pathconf(parent.c_str(), _PC_NAME_MAX);
+    if (nameMax > 0 && nameBytes > size_t(nameMax))
+      throw std::invalid_argument(cannot + "its name is " + std::to_string(nameBytes) + " bytes long, and the folder " +
+                                  parent.string() + " takes names of at most " + std::to_string(nameMax));
+  }
   // The file is written to a temporary beside it and renamed: the folder must take a new file.
   auto [it, fresh] = folders.emplace(parent.string(), "");
   if (fresh) it->second = io::cannotCreateBeside(target);

@@ -21,7 +21,8 @@ struct Named {
 
 // Throws std::invalid_argument with one sentence if `out` cannot be written:
 // an empty name, a folder, a folder that does not exist or takes no new file,
-// or an existing file that is not writable.
+// a new file's name or path longer than the folder takes, or an existing file
+// that is not writable.
 void checkWritable(const Named& out);
 
 // checkWritable for each output, then the sentence "the output X (-o) would

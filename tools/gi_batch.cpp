@@ -135,6 +135,8 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
   std::string line;
   for (int n = 1; std::getline(f, line); ++n) {
     const std::string where = "manifest " + path + " line " + std::to_string(n) + ": ";
+    if (line.find('\0') != std::string::npos)  // no file name holds one: a binary file or a damaged line
+      throw std::invalid_argument(where + "holds a NUL byte (is the manifest a text file?)");
     std::vector<std::string> w;
     try {
       w = words(line);
@@ -175,15 +177,24 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
     char slash = 0, rest = 0;
     if (std::sscanf(text.c_str(), "%lld %c %lld %c", &i, &slash, &n, &rest) != 3 || slash != '/')
       throw std::invalid_argument("--shard '" + text + "': expected I/N, e.g. 0/16");
-  } else if (const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT")) {
+  } else if (std::getenv("SLURM_ARRAY_TASK_COUNT")) {
+    // Each variable an integer (a garbled one must not make every task shard 0).
     auto num = [](const char* name, long long fallback) {
       const char* v = std::getenv(name);
-      return v && *v ? std::atoll(v) : fallback;
+      if (!v || !*v) return fallback;
+      char* end = nullptr;
+      errno = 0;
+      const long long x = std::strtoll(v, &end, 10);
+      if (end == v || *end != '\0' || errno == ERANGE || x < 0 || x > (1LL << 40))
+        throw std::invalid_argument(std::string(name) + " = '" + v + "' is not a Slurm array index or count");
+      return x;
     };
-    n = std::atoll(count);
+    n = num("SLURM_ARRAY_TASK_COUNT", 1);
+    if (n < 1) throw std::invalid_argument("SLURM_ARRAY_TASK_COUNT = 0: the job array has no task (or pass --shard I/N)");
     const long long step = std::max(1LL, num("SLURM_ARRAY_TASK_STEP", 1));
-    i = (num("SLURM_ARRAY_TASK_ID", 0) - num("SLURM_ARRAY_TASK_MIN", 0)) / step;
-    if (n < 1 || i < 0 || i >= n)
+    const long long offset = num("SLURM_ARRAY_TASK_ID", 0) - num("SLURM_ARRAY_TASK_MIN", 0);
+    i = offset < 0 || offset % step != 0 ? -1 : offset / step;
+    if (i < 0 || i >= n)
       throw std::invalid_argument("SLURM_ARRAY_TASK_ID " + std::string(std::getenv("SLURM_ARRAY_TASK_ID") ? std::getenv("SLURM_ARRAY_TASK_ID") : "?") +
                                   " is not one of " + std::to_string(n) +
                                   " evenly spaced tasks: submit with --array=0-" + std::to_string(n - 1) + " or pass --shard I/N");

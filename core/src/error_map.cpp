@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace gi {
@@ -98,7 +99,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   ErrorMapResult out;
   out.error.assign(n, 0.f);
   double sumD2 = 0, sumR2 = 0, sumD = 0, maxAbs = 0, sumZ2 = 0;
-  size_t used = 0, undefined = 0, beyond3 = 0, zCount = 0;
+  size_t used = 0, undefined = 0, beyond3 = 0, zCount = 0, saturated = 0;
   for (size_t i = 0; i < n; ++i) {
     const double v = value[i], r = reference[i];
     if (!std::isfinite(v) || !std::isfinite(r)) { ++undefined; continue; }
@@ -121,6 +122,14 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
       }
       e = d / s;
       sumZ2 += e * e, ++zCount, beyond3 += std::abs(e) > 3.0;
+    }
+    // Beyond single precision (values near 3e38 of opposite signs, or
+    // divided by a tiny reference): the largest float of its sign, so that a
+    // huge error stays huge instead of becoming a non-finite value written
+    // as 0.
+    if (std::abs(e) > double(std::numeric_limits<float>::max())) {
+      e = std::copysign(double(std::numeric_limits<float>::max()), e);
+      ++saturated;
     }
     out.error[i] = float(e);
   }
@@ -165,6 +174,9 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   st.note(std::string("quality = ") + kErrorMeasures.logName(measure) +
           (R > 0.0 ? "; colour ramp blue -" + fmt(R) + ", white 0, red +" + fmt(R) + (colorRange > 0 ? "" : " (automatic)")
                    : "; every error is 0: all white"));
+  if (saturated)
+    st.warn(std::to_string(saturated) + " errors beyond single precision were written as +-" +
+            fmt(double(std::numeric_limits<float>::max())));
   if (undefined)
     st.note(std::to_string(undefined) + " vertices with no defined " + kErrorMeasures.logName(measure) +
             " (reference 0, no error bar or a negative one, or not finite): 0 written");

@@ -160,6 +160,9 @@ def check_failed_writes(gi, tmp):
     return failures
 
 
+LONG = "n" * 300  # a file name no Linux file system takes
+
+
 def check_early(gi, tmp):
     """An output that cannot be written is reported before the computation: nothing else written, no progress."""
     failures = []
@@ -168,7 +171,15 @@ def check_early(gi, tmp):
              ("csv_folder", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", "/nonexistent/r.csv"], "/nonexistent"),
              ("export_folder", ["radiosity", "in.ply", "-o", "o.ply", "--export_system", "/nonexistent/p"], "/nonexistent"),
              ("proc", ["ao", "in.ply", "-o", "/proc/x.ply"], "/proc/x.ply"),
-             ("cache_folder", ["ao", "in.ply", "-o", "o.ply", "--cache", "/nonexistent/c"], "/nonexistent")]
+             ("cache_folder", ["ao", "in.ply", "-o", "o.ply", "--cache", "/nonexistent/c"], "/nonexistent"),
+             # names longer than a folder takes (255 bytes): refused before the computation, not when written
+             ("long_name", ["ao", "in.ply", "-o", LONG + ".ply"], "bytes long"),
+             ("long_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", LONG + ".json"], "bytes long"),
+             ("long_csv", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", LONG + ".csv"], "bytes long"),
+             ("long_export", ["radiosity", "in.ply", "-o", "o.ply", "--export_system", LONG], "bytes long"),
+             ("long_image", ["render", "in.ply", "-o", "o.ply", "--image_path", LONG + ".png"], "bytes long"),
+             ("long_hemicube", ["hemicube", "in.ply", "-o", "o.ply", "--image_path", LONG + ".png"], "bytes long"),
+             ("long_path", ["ao", "in.ply", "-o", "/".join([".."] * 1400) + "/o.ply"], "bytes long")]
     for cid, args, fragment in cases:
         d = os.path.join(tmp, "early_" + cid)
         os.makedirs(d)
@@ -283,6 +294,11 @@ def check_side_files(gi, tmp):
             f.write("mtllib %s\n%s" % (lib, tri))
     with open(os.path.join(d, "missing.txt"), "w") as f:
         f.write("no_such_mesh.ply\n")
+    with open(os.path.join(d, "nul.txt"), "wb") as f:
+        f.write(b"in.ply\0junk\n")
+    with open(os.path.join(d, "long.txt"), "w") as f:
+        f.write("in.ply\n%s.ply\n" % LONG)
+    array = {"SLURM_ARRAY_TASK_MIN": "0", "SLURM_ARRAY_TASK_COUNT": "2"}
     cases = [  # (what, arguments, fragment, environment)
         ("an OBJ whose material library is a pipe", ["ao", "fifo.obj", "-o", "o.ply", "-q"], "not a regular file", None),
         ("an OBJ whose material library is /dev/zero", ["ao", "zero.obj", "-o", "o.ply", "-q"], "not a regular file", None),
@@ -294,6 +310,18 @@ def check_side_files(gi, tmp):
          "1 of 1 meshes failed", None),
         ("SLURM_CPUS_PER_TASK beyond int", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout"],
          "SLURM_CPUS_PER_TASK", {"SLURM_CPUS_PER_TASK": "99999999999"}),
+        # a garbled task id must not make every task of the array compute shard 0
+        ("SLURM_ARRAY_TASK_ID not a number", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "SLURM_ARRAY_TASK_ID", dict(array, SLURM_ARRAY_TASK_ID="x")),
+        ("SLURM_ARRAY_TASK_ID between steps", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "evenly spaced", dict(array, SLURM_ARRAY_TASK_ID="1", SLURM_ARRAY_TASK_STEP="2")),
+        ("SLURM_ARRAY_TASK_COUNT 0", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "SLURM_ARRAY_TASK_COUNT", dict(array, SLURM_ARRAY_TASK_ID="0", SLURM_ARRAY_TASK_COUNT="0")),
+        ("a NUL byte in a manifest line", ["batch", "ao", "-q", "--manifest", "nul.txt", "-o", "bout_nul"],
+         "NUL byte", None),
+        # refused before any mesh is computed (each mesh's summary could not be written)
+        ("a mesh name longer than a summary's", ["batch", "ao", "--manifest", "long.txt", "-o", "bout_long"],
+         "bytes long", None),
     ]
     for what, args, fragment, env in cases:
         rc, _, lines = run([gi] + args, cwd=d, timeout=60, env=env)

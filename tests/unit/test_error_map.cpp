@@ -2,11 +2,13 @@
 // known perturbation (difference, relative, z-score, the summary), z-scores
 // of one path-traced reference against an independent one (another seed)
 // spread as N(0, 1), a reference from a PLY file, and a clear error for a
-// missing attribute or a file of another vertex count.
+// missing attribute or a file of another vertex count; errors beyond single
+// precision written as the largest float.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -240,4 +242,30 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   const FilterResult r0 = errorMapOf(sf, zero, {});
   EXPECT_TRUE(std::isnan(r0.stats.get("relative_rms_error", std::nan(""))));
   EXPECT_GT(r0.stats.get("rms_error"), 1.9);
+}
+
+// An error beyond single precision (values near +-3e38, or a relative error
+// over a tiny reference) is written as the largest float of its sign and
+// said, never as a non-finite value (which a mesh writer turns into 0: "no
+// error"); the colour range stays finite.
+TEST(ErrorMap, ErrorsBeyondSinglePrecisionStayHuge) {
+  const float big = 3e38f, top = std::numeric_limits<float>::max();
+  const std::vector<float> value = {big, -big, 1e10f, 1.f}, ref = {-big, big, 1e-30f, 0.5f};
+  const ErrorMapResult d = errorMap(value, ref, {}, {}, ErrorMeasure::Difference, 0.0);
+  EXPECT_EQ(d.error[0], top);  // 6e38
+  EXPECT_EQ(d.error[1], -top);
+  EXPECT_FLOAT_EQ(d.error[2], 1e10f);
+  const ErrorMapResult r = errorMap(value, ref, {}, {}, ErrorMeasure::Relative, 0.0);
+  EXPECT_FLOAT_EQ(r.error[0], 2.f);  // 6e38 / 3e38
+  EXPECT_EQ(r.error[2], top);        // 1e10 / 1e-30
+  EXPECT_FLOAT_EQ(r.error[3], 1.f);
+  for (const ErrorMapResult* m : {&d, &r}) {
+    for (float e : m->error) EXPECT_TRUE(std::isfinite(e));
+    EXPECT_TRUE(std::isfinite(m->range) && m->range > 0.0);
+    ASSERT_EQ(m->stats.warnings.size(), 1u);
+    const std::string said = (m == &d ? "2" : "1") + std::string(" errors beyond single precision");
+    EXPECT_EQ(m->stats.warnings[0].rfind(said, 0), 0u) << m->stats.warnings[0];
+  }
+  const ErrorMapResult fine = errorMap({1.f, 2.f}, {1.5f, 1.f}, {}, {}, ErrorMeasure::Relative, 0.0);
+  EXPECT_TRUE(fine.stats.warnings.empty());
 }
