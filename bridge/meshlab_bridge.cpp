@@ -145,9 +145,20 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
 }
 
 double documentDiagonal(MeshDocument& md) {
+  // Over the vertices the faces use, as the engine's scale (Scene::fromAbsolute,
+  // sceneScale): a vertex no face uses, far away, moves no default. A layer
+  // without faces counts by its box.
   vcg::Box3<MESHLAB_SCALAR> box;
-  for (MeshModel* m : compat::meshes(md))
-    if (m == md.mm() || m->isVisible()) box.Add(m->cm.bbox);
+  for (MeshModel* m : compat::meshes(md)) {
+    if (!(m == md.mm() || m->isVisible())) continue;
+    bool faces = false;
+    for (const CFaceO& f : m->cm.face) {
+      if (f.IsD()) continue;
+      for (int k = 0; k < 3; ++k) box.Add(f.cP(k));
+      faces = true;
+    }
+    if (!faces) box.Add(m->cm.bbox);
+  }
   const double d = box.IsNull() ? 1.0 : double(box.Diag());
   return d > 0 && std::isfinite(d) ? d : 1.0;
 }

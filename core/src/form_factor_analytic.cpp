@@ -294,10 +294,15 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
   uint64_t rays = 0, far = 0;
   for (uint32_t j = 0; j < uint32_t(s_.faceCount()); ++j) {
     if (j == i || !ok_[j]) continue;
-    // Negligible far pairs: F <= A_j / (pi d^2) for any point of i, with d a
-    // lower bound of the distance between the two triangles' bounding spheres.
+    // Far pairs: F <= A_j / (pi d^2) < kNegligibleF for any point of i, with
+    // d a lower bound of the distance between the two triangles' bounding
+    // spheres. Such a factor changes across i by less than i's size over d
+    // (1/1800 or less), so i's centroid and one visibility ray give it. (They
+    // were dropped: each is negligible, but a far plate cut into many small
+    // faces lost its whole factor, and a receiver that sees only far faces
+    // received nothing; an outside audit.)
     const double d = glm::length(centroid_[i] - centroid_[j]) - radius_[i] - radius_[j];
-    if (d > 0 && area_[j] / (M_PI * d * d) < kNegligibleF) { ++far; continue; }
+    const bool farPair = d > 0 && area_[j] / (M_PI * d * d) < kNegligibleF;
     const auto& tj = s_.triangles[j];
     const glm::dvec3 pa(s_.positions[tj.x]), pb(s_.positions[tj.y]), pc(s_.positions[tj.z]);
     // j wholly behind (or in) i's plane, or i wholly behind j's: F = 0 at
@@ -313,6 +318,21 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     auto g = [&](const glm::dvec3& x) {
       return glm::dot(nj, x - pa) > 0 ? pointToTriangleFormFactor(x, n, pa, pb, pc) : 0.0;  // 0 where j faces away
     };
+    if (farPair) {
+      ++far;
+      const double f = g(centroid_[i]);
+      if (!(f > 0)) continue;
+      if (!unoccluded_) {
+        ++rays;
+        const glm::vec3 from = glm::vec3(centroid_[i]) + normal_[i] * eps_;
+        if (!visibleToRandomPoint(caster_, from, s_.positions[tj.x], s_.positions[tj.y], s_.positions[tj.z], rng, eps_))
+          continue;
+      }
+      r.j.push_back(j);
+      r.F.push_back(float(f));
+      total += f;
+      continue;
+    }
     double Fbase = 0;
     for (size_t k = 0; k < base.size(); ++k) Fbase += (wg[k] = w * g(xs[k]));
     const bool near = d < kNear * rBase;

@@ -395,6 +395,9 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
             "% of the emitted power");
   e.check.lostPowerFraction = ts.emittedPower > 0 ? ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0;
   st.add("lost_power_fraction", e.check.lostPowerFraction);
+  for (int c = 0; c < 3; ++c)
+    if (ts.emittedRGB[c] > 0 && ts.lostRGB[c] / ts.emittedRGB[c] > e.check.lostChannelShare)
+      e.check.lostChannelShare = ts.lostRGB[c] / ts.emittedRGB[c], e.check.lostChannel = c;
   warnMeaninglessPhotonParameters(r.opt, e.check, st);
   if (e.verticesWithoutPhotons)
     st.note(std::to_string(e.verticesWithoutPhotons) +

@@ -30,6 +30,8 @@ struct PhotonGatherCheck {
   size_t fewEstimates = 0;       // of those, the ones with fewer than kFewPhotons
   bool kNearestEstimates = false;  // k-nearest estimates (not progressive)
   double lostPowerFraction = 0;  // of the emitted power, still carried by paths cut at max_depth
+  double lostChannelShare = 0;   // the same in the channel that loses the largest share of its power
+  int lostChannel = 0;           // which (0 red, 1 green, 2 blue)
 };
 // A handful: below it an estimate's relative noise exceeds 1 / sqrt(4) = 50%.
 constexpr int kFewPhotons = 4;

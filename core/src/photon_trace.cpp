@@ -263,6 +263,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         const PhotonKeys k = photonKeys(opt.seed, uint64_t(first) + i, 0x9e37u, 0x51edu);
         const auto em = lights.sample(sobolOwen2D(k.index, k.pos), sobolOwen2D(k.index, k.dir), double(count));
         glm::vec3 power = em.power;
+        st.emittedRGB += glm::dvec3(power);
         Rng rng(hash3(k.index, k.rng, 0x7u));
         Ray ray;
         ray.o = em.o + em.n * eps;
@@ -301,7 +302,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
             // the path's own cut power below is part of it.
             lastBlocks[b].push_back(depth == opt.maxDepth);
             flaggedLast = depth == opt.maxDepth && path != kCausticPhoton;
-            if (flaggedLast) st.lostPower += luminance(power);
+            if (flaggedLast) st.lostPower += luminance(power), st.lostRGB += glm::dvec3(power);
           }
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
@@ -318,7 +319,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         }
         if (depth == hits) {
           ++st.lostAtMaxDepth;
-          if (!flaggedLast) st.lostPower += luminance(power);
+          if (!flaggedLast) st.lostPower += luminance(power), st.lostRGB += glm::dvec3(power);
         }
       }
       budget.add(out.size(), end - b * kBlock);
@@ -350,6 +351,8 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
     stats.escaped += t.escaped;
     stats.storedPower += t.storedPower;
     stats.lostPower += t.lostPower;
+    stats.lostRGB += t.lostRGB;
+    stats.emittedRGB += t.emittedRGB;
   }
   stats.stored = stats.direct + stats.caustic + stats.indirect;
   stats.emitted += count;

@@ -27,11 +27,31 @@ double Scene::unitFor(double diagonal) {
 }
 
 namespace {
-// Bounding box of the finite points, in double; {lo > hi} if there are none.
-std::pair<glm::dvec3, glm::dvec3> finiteBox(const std::vector<glm::dvec3>& pts) {
+// The vertices some triangle uses (its three indices in range): the scene's
+// size, its local frame and its ray offsets follow them, so that a vertex no
+// face uses, far away, moves none of them (one at 1e5 from a unit scene made
+// every offset 1.7 units, and every AO value 1). Empty: no triangle uses any.
+std::vector<uint8_t> referenced(size_t nv, const std::vector<glm::uvec3>& tris, size_t offset = 0,
+                                std::vector<uint8_t> mask = {}) {
+  for (const auto& t : tris) {
+    if (t.x >= nv || t.y >= nv || t.z >= nv) continue;
+    if (mask.empty()) mask.assign(offset + nv, 0);
+    mask[offset + t.x] = mask[offset + t.y] = mask[offset + t.z] = 1;
+  }
+  return mask;
+}
+// Bounding box of the finite points (those the mask keeps, if any of them is
+// finite, else all), in double; {lo > hi} if there are none.
+std::pair<glm::dvec3, glm::dvec3> finiteBox(const std::vector<glm::dvec3>& pts, const std::vector<uint8_t>& keep = {}) {
   glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-  for (const auto& p : pts)
-    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const glm::dvec3& p = pts[i];
+    if ((keep.empty() || keep[i]) && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  }
+  if (!(lo.x <= hi.x) && !keep.empty()) return finiteBox(pts);
   return {lo, hi};
 }
 // The diagonal hi - lo, without overflow for coordinates near the double range.
@@ -44,7 +64,7 @@ double diagonalOf(const glm::dvec3& lo, const glm::dvec3& hi) {
 
 Scene Scene::fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris) {
   Scene s;
-  const auto [lo, hi] = finiteBox(pts);
+  const auto [lo, hi] = finiteBox(pts, referenced(pts.size(), tris));
   s.origin = lo.x <= hi.x ? lo * 0.5 + hi * 0.5 : glm::dvec3(0.0);
   s.unit = unitFor(diagonalOf(lo, hi));
   s.positions.reserve(pts.size());
@@ -76,7 +96,10 @@ size_t Scene::append(const Scene& o) {
   world.reserve(positions.size() + o.positions.size());
   for (const auto& p : positions) world.push_back(toWorld(p));
   for (const auto& p : o.positions) world.push_back(o.toWorld(p));
-  const auto [lo, hi] = finiteBox(world);
+  std::vector<uint8_t> used = referenced(positions.size(), triangles);
+  if (!used.empty()) used.resize(world.size(), 0);
+  used = referenced(o.positions.size(), o.triangles, positions.size(), std::move(used));
+  const auto [lo, hi] = finiteBox(world, used);
   const double newUnit = unitFor(diagonalOf(lo, hi));
   if (newUnit != unit) {
     const double k = unit / newUnit;
@@ -328,10 +351,14 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
 }
 
 SceneScale sceneScale(const Scene& s) {
+  const std::vector<uint8_t> used = referenced(s.vertexCount(), s.triangles);
+  bool any = false;  // a used vertex that is finite (else all vertices count)
+  for (size_t i = 0; i < used.size() && !any; ++i) any = used[i] && finite3(s.positions[i]);
   glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
   double maxAbs = 0.0;
-  for (const glm::vec3& p : s.positions) {
-    if (!finite3(p)) continue;
+  for (size_t i = 0; i < s.vertexCount(); ++i) {
+    const glm::vec3& p = s.positions[i];
+    if (!finite3(p) || (any && !used[i])) continue;
     lo = glm::min(lo, glm::dvec3(p));
     hi = glm::max(hi, glm::dvec3(p));
     maxAbs = std::max({maxAbs, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});

@@ -213,6 +213,33 @@ TEST(AmbientOcclusionStress, ScaleAndOffsetInvariant) {
   }
 }
 
+// A vertex no face uses, far away (1e5 from a scene of size 2, as a stray
+// point left in a scan), moves nothing: the local frame, the scene's scale
+// and ray offset and every AO value are those of the scene without it, bit
+// for bit. (It made the diagonal 173,000 and the ray offsets 1.7: every value
+// 1; and the local frame's centre 5e4 away, so positions lost their float
+// precision.)
+TEST(AmbientOcclusionStress, FarUnusedVertexChangesNothing) {
+  const auto sf = scenes::floorWithWall(2.0, 0.5, 10);
+  std::vector<glm::dvec3> pts;
+  for (const auto& p : sf.scene.positions) pts.push_back(sf.scene.toWorld(p));
+  const Scene plain = Scene::fromAbsolute(pts, sf.scene.triangles);
+  pts.push_back(glm::dvec3(1e5));
+  const Scene stray = Scene::fromAbsolute(pts, sf.scene.triangles);
+  EXPECT_EQ(stray.origin, plain.origin);
+  EXPECT_EQ(stray.unit, plain.unit);
+  EXPECT_EQ(sceneScale(stray).rayEpsilon, sceneScale(plain).rayEpsilon);
+  EXPECT_EQ(sceneDiagonal(stray), sceneDiagonal(plain));
+  const AmbientResult a = runAO(plain, 64), b = runAO(stray, 64);
+  ASSERT_EQ(b.value.size(), a.value.size() + 1);
+  for (size_t i = 0; i < a.value.size(); ++i) ASSERT_EQ(b.value[i], a.value[i]) << "vertex " << i;
+  // Appended as a part of its own: the union's frame is still the surface's.
+  Scene joined = plain;
+  joined.append(Scene::fromAbsolute({glm::dvec3(1e5), glm::dvec3(-1e5)}, {}));
+  EXPECT_EQ(joined.unit, plain.unit);
+  EXPECT_EQ(sceneScale(joined).rayEpsilon, sceneScale(plain).rayEpsilon);
+}
+
 TEST(AmbientOcclusionStress, BadGeometryNeverGivesNaN) {
   auto sf = scenes::floorWithWall(2.0, 1.0, 4);
   Scene s = sf.scene;

@@ -1,6 +1,6 @@
 // Form factors: Monte Carlo, analytic and hemicube against the closed forms of
 // docs/design.md ("Analytic references"), reciprocity and closure, point to
-// polygon, far pairs skipped, coaxial disks. The radiosity solvers:
+// polygon, far pairs by one point, coaxial disks. The radiosity solvers:
 // test_radiosity.cpp.
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -154,8 +154,8 @@ TEST(FormFactors, PointToPolygonClosedForms) {
   EXPECT_EQ(pointToTriangleFormFactor(x, n, {0, 0, -1}, {1, 0, -1}, {0, 1, -1}), 0.0);  // behind
 }
 
-// Negligible far pairs are skipped by a distance bound, without changing the
-// factors that matter: plates at distance 1 plus a copy 1,000 away (face
+// Far pairs, found by a distance bound and taken by one point, leave the
+// factors that matter unchanged: plates at distance 1 plus a copy 1,000 away (face
 // pairs across: F < 1e-8). Tolerance 5e-3: the ray offset, a fraction of the
 // now larger scene, lifts the sample points by 0.01.
 TEST(FormFactors, FarPairsSkipped) {
@@ -177,6 +177,66 @@ TEST(FormFactors, FarPairsSkipped) {
     Aa += faceArea(s, i);
   }
   EXPECT_NEAR(F / Aa, Falone / Aa, 5e-3);
+}
+
+// The closed forms far apart (an outside audit found parallel rectangles 1
+// x 1 at 3,000 +0.7% and at 10,000 0, coaxial unit disks at 10,000 -25%):
+// parallel rectangles against the 4-D Gauss-Legendre quadrature of the
+// kernel c^2 / (pi r^4) (8 nodes a side: analytic in the offsets, whose
+// range is 1/c of the kernel's radius of convergence, so exact to about
+// 1e-13 from c = 10), coaxial unit disks against (S - sqrt(S^2 - 4)) / 2 =
+// 1/S + 1/S^3 + 2/S^5 + ... with S = L^2 + 2. Relative tolerance 1e-9.
+TEST(FormFactors, ClosedFormsHoldFarApart) {
+  // Gauss-Legendre nodes and weights on [0, 1] (Newton on P_8).
+  constexpr int n = 8;
+  double node[n], weight[n];
+  for (int i = 0; i < n; ++i) {
+    double z = std::cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p0 = 1, p1 = z;
+      for (int k = 2; k <= n; ++k) { const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k; p0 = p1; p1 = p2; }
+      dp = n * (z * p1 - p0) / (z * z - 1);
+      const double dz = p1 / dp;
+      z -= dz;
+      if (std::fabs(dz) < 1e-16) break;
+    }
+    node[i] = 0.5 * (1 - z);
+    weight[i] = 1.0 / ((1 - z * z) * dp * dp);  // 2 / ((1 - z^2) P'^2), halved for [0, 1]
+  }
+  for (double c : {10.0, 100.0, 3000.0, 1e4, 1e5, 1e6}) {
+    double F = 0;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        for (int e = 0; e < n; ++e)
+          for (int f = 0; f < n; ++f) {
+            const double dx = node[a] - node[e], dy = node[b] - node[f], r2 = dx * dx + dy * dy + c * c;
+            F += weight[a] * weight[b] * weight[e] * weight[f] * c * c / (M_PI * r2 * r2);
+          }
+    EXPECT_NEAR(parallelRectanglesF(1, 1, c) / F, 1.0, 1e-9) << "parallel 1 x 1 at " << c;
+    EXPECT_NEAR(parallelRectanglesF(1, 0.01, c) / parallelRectanglesF(0.01, 1, c), 1.0, 1e-9);
+    const double S = c * c + 2;
+    EXPECT_NEAR(coaxialDisksF(1, 1, c) / (1 / S + 1 / (S * S * S) + 2 / (S * S * S * S * S)), 1.0, 1e-9)
+        << "disks at " << c;
+  }
+  EXPECT_NEAR(parallelRectanglesF(1, 1, 1), 0.199825, 1e-6);  // near: the same as before
+  EXPECT_NEAR(coaxialDisksF(1, 1, 1), 0.381966, 1e-6);
+}
+
+// Far pairs by one point and one ray: unit plates 100 apart, each cut into
+// 512 triangles, every pair across far (F below 6.2e-8 by distance), keep
+// their factor, 3.1829e-5 by the closed form. (Each far pair was dropped:
+// the plates' factor was 0; an outside audit.) One point per pair errs by
+// about (size / distance)^2 = 1e-4 relatively; nothing lies in between.
+TEST(FormFactors, FarPlatesKeepTheirFactor) {
+  auto sf = scenes::parallelPlates(100.0, 16);
+  auto caster = makeEmbreeCaster(sf.scene);
+  FormFactors ff(sf.scene, *caster, {FormFactorMethod::Analytic, 0, 8, 64, 0});
+  std::vector<FormFactorRow> rows(sf.scene.faceCount());
+  for (uint32_t i = 0; i < sf.scene.faceCount(); ++i) rows[i] = ff.row(i);
+  const size_t split = sf.scene.faceCount() / 2;
+  EXPECT_EQ(ff.farPairsSkipped(), 2 * uint64_t(split) * split);
+  EXPECT_NEAR(plateToPlate(sf.scene, rows, split, true) / parallelPlates(1, 1, 100), 1.0, 1e-3);
+  EXPECT_NEAR(plateToPlate(sf.scene, rows, split, false) / parallelPlates(1, 1, 100), 1.0, 1e-3);
 }
 
 // Coplanar faces whose corners were rounded off the plane (a face and its

@@ -94,7 +94,7 @@ class FormFactors {
   size_t patchCount() const { return area_.size(); }
   double area(uint32_t i) const { return area_[i]; }
   uint64_t raysCast() const;
-  uint64_t farPairsSkipped() const;  // analytic: pairs with F provably below kNegligibleF
+  uint64_t farPairsSkipped() const;  // analytic: pairs with F provably below kNegligibleF, by one point and one ray
   static constexpr double kNegligibleF = 1e-7;
   // The hemicube of patch i seen from its centre, as the hemicube method's
   // one-view row computes it (the same F, bit for bit), with its cells.

@@ -93,7 +93,7 @@ struct SceneReport {
   size_t twoSidedPairs = 0;        // corners with faces of both turns (a two-sided surface's faces)
   double emittedPower = 0.0;       // luminance-weighted, W
   glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
-  double diagonal = 0.0;           // bbox diagonal (world units)
+  double diagonal = 0.0;           // bbox diagonal of the vertices some face uses (world units)
   double rayEpsilon = 0.0;         // offset for ray origins (local units)
   size_t usableFaces() const { return faces - invalidFaces - degenerateFaces - facesOnNonFinite; }
   std::string summary() const;     // one line for logs
@@ -106,7 +106,7 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::
 // Only the scale (one pass over the vertices): what the algorithms need for
 // their ray offsets, without the defect counts of a full report.
 struct SceneScale {
-  double diagonal = 0.0;    // bbox diagonal over finite vertices (local units)
+  double diagonal = 0.0;    // bbox diagonal over the finite vertices some face uses (all if none; local units)
   double rayEpsilon = 0.0;  // offset for ray origins (local units)
 };
 SceneScale sceneScale(const Scene& s);
