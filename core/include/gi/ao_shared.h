@@ -50,7 +50,11 @@
 // (they share rays); each vertex's own error is what is reported. The bias
 // of pooling, which Lepski's rule keeps within gamma standard errors of the
 // smaller scales, is counted by adding the square of the last accepted
-// ring's step (A_h - A_{h-1}) to the variance: a bias below each vertex's
+// ring's step (A_h - A_{h-1}) to the variance (from 256 own rays, of the
+// larger of it and the whole departure A_h - A_0 from the vertex's own
+// mean, whose scrambled Sobol points are then far more precise than the
+// binomial bound: at tight targets Lepski's rule otherwise let the pools
+// drift from it ring by ring): a bias below each vertex's
 // noise still adds up along a band of vertices (tests/unit/test_ao_shared.cpp:
 // errors against an independent per-vertex reference over all vertices and
 // apart at a crease with its contact shadow, a sphere resting on a floor, a
