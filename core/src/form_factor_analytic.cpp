@@ -360,7 +360,7 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
     }
   }
   rays_[i] += rays;
-  farSkipped_[i] += far;
+  farPairs_[i] += far;
   r.escaped = float(std::max(0.0, 1.0 - total));
   return r;
 }

@@ -32,9 +32,6 @@ std::string fmt(double x) {
   return b;
 }
 
-}  // namespace
-
-namespace {
 // sqrt(1 + v^2) atan(u / sqrt(1 + v^2)) - atan(u), without the cancellation
 // of its two terms for small u: from atan's series, the sum over k >= 1 of
 // (-1)^(k+1) u^(2k+1) / (2k+1) (1 - (1 + v^2)^-k).
@@ -46,6 +43,7 @@ double atanDifference(double u, double v) {
     sum += (k % 2 ? 1.0 : -1.0) * power / (2 * k + 1) * -std::expm1(-k * lv);
   return sum;
 }
+
 }  // namespace
 
 // Howell's C-11 in a form without cancellation: its logarithm is

@@ -21,7 +21,7 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
   area_.resize(s.faceCount());
   normal_.resize(s.faceCount());
   rays_.assign(s.faceCount(), 0);
-  farSkipped_.assign(s.faceCount(), 0);
+  farPairs_.assign(s.faceCount(), 0);
   centroid_.assign(s.faceCount(), glm::dvec3(0.0));
   radius_.assign(s.faceCount(), 0.0);
   for (size_t f = 0; f < s.faceCount(); ++f) {
@@ -44,9 +44,9 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
   if (set_.method == FormFactorMethod::Analytic) unoccluded_ = pairwiseUnoccluded(s);
 }
 
-uint64_t FormFactors::farPairsSkipped() const {
+uint64_t FormFactors::farPairsByOnePoint() const {
   uint64_t t = 0;
-  for (uint64_t r : farSkipped_) t += r;
+  for (uint64_t r : farPairs_) t += r;
   return t;
 }
 

@@ -464,8 +464,9 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));
-  if (ff.farPairsSkipped())
-    res.stats.note(std::to_string(ff.farPairsSkipped()) + " far pairs (F < 1e-7 proved by distance) by one point and one ray each, not refined");
+  if (ff.farPairsByOnePoint())
+    res.stats.note(std::to_string(ff.farPairsByOnePoint()) +
+                   " far pairs (F < 1e-7 proved by distance) by one point and one ray each, not refined");
   res.stats.add("patches", double(u.n));
   if (slow) res.stats.warn(*slow);
   res.stats.add("memory_estimate_MB", (mem.rest + (mem.fits ? mem.matrix : 0.0)) / 1048576.0);

@@ -158,7 +158,7 @@ TEST(FormFactors, PointToPolygonClosedForms) {
 // factors that matter unchanged: plates at distance 1 plus a copy 1,000 away (face
 // pairs across: F < 1e-8). Tolerance 5e-3: the ray offset, a fraction of the
 // now larger scene, lifts the sample points by 0.01.
-TEST(FormFactors, FarPairsSkipped) {
+TEST(FormFactors, FarPairsTakenByOnePoint) {
   auto near = scenes::parallelPlates(1.0, 4);
   Scene s = near.scene;
   Scene far = test::transformed(near.scene, 1.0, glm::dvec3(1e3, 0, 0));
@@ -167,7 +167,7 @@ TEST(FormFactors, FarPairsSkipped) {
   FormFactors ff(s, *caster, {FormFactorMethod::Analytic, 0, 8, 64, 0});
   std::vector<FormFactorRow> rows(s.faceCount());
   for (uint32_t i = 0; i < s.faceCount(); ++i) rows[i] = ff.row(i);
-  EXPECT_GE(ff.farPairsSkipped(), uint64_t(near.scene.faceCount()) * near.scene.faceCount());
+  EXPECT_GE(ff.farPairsByOnePoint(), uint64_t(near.scene.faceCount()) * near.scene.faceCount());
   const auto alone = allRows(near.scene, 0, 0, FormFactorMethod::Analytic, 8);
   const size_t half = near.scene.faceCount() / 2;
   double F = 0, Falone = 0, Aa = 0;
@@ -234,7 +234,7 @@ TEST(FormFactors, FarPlatesKeepTheirFactor) {
   std::vector<FormFactorRow> rows(sf.scene.faceCount());
   for (uint32_t i = 0; i < sf.scene.faceCount(); ++i) rows[i] = ff.row(i);
   const size_t split = sf.scene.faceCount() / 2;
-  EXPECT_EQ(ff.farPairsSkipped(), 2 * uint64_t(split) * split);
+  EXPECT_EQ(ff.farPairsByOnePoint(), 2 * uint64_t(split) * split);
   EXPECT_NEAR(plateToPlate(sf.scene, rows, split, true) / parallelPlates(1, 1, 100), 1.0, 1e-3);
   EXPECT_NEAR(plateToPlate(sf.scene, rows, split, false) / parallelPlates(1, 1, 100), 1.0, 1e-3);
 }

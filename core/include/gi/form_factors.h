@@ -94,7 +94,9 @@ class FormFactors {
   size_t patchCount() const { return area_.size(); }
   double area(uint32_t i) const { return area_[i]; }
   uint64_t raysCast() const;
-  uint64_t farPairsSkipped() const;  // analytic: pairs with F provably below kNegligibleF, by one point and one ray
+  // Analytic: the pairs with F provably below kNegligibleF, taken at the
+  // source's centroid with one visibility ray.
+  uint64_t farPairsByOnePoint() const;
   static constexpr double kNegligibleF = 1e-7;
   // The hemicube of patch i seen from its centre, as the hemicube method's
   // one-view row computes it (the same F, bit for bit), with its cells.
@@ -121,7 +123,7 @@ class FormFactors {
   std::vector<glm::vec3> normal_;
   std::vector<uint8_t> ok_;
   mutable std::vector<uint64_t> rays_;        // per patch, for the statistics
-  mutable std::vector<uint64_t> farSkipped_;  // per patch, for the statistics
+  mutable std::vector<uint64_t> farPairs_;  // per patch, for the statistics
   std::vector<glm::dvec3> centroid_;
   std::vector<double> radius_;
 };
