@@ -21,6 +21,19 @@
 
 using namespace gi;
 
+namespace {
+
+// The furnace: inside a closed sphere (1,280 faces facing in) of uniform
+// reflectance rho and emission E = 1, B = E / (1 - rho) everywhere.
+VertexRadiometry furnace(const glm::vec3& rho, const PhotonOptions& o) {
+  auto sf = scenes::sphere(1.0, 3, true);
+  scenes::setUniform(sf, rho, glm::vec3(1.f));
+  auto caster = makeEmbreeCaster(sf.scene);
+  return computePhotonMap(sf.scene, *caster, o);
+}
+
+}  // namespace
+
 // Fresnel: ((n - 1) / (n + 1))^2 = 0.04 at normal incidence for n = 1.5; the
 // same value from both sides along a refracted pair (reciprocity); 1 beyond
 // the critical angle asin(1 / 1.5) = 41.8 deg; Snell's law for the direction.
@@ -165,14 +178,11 @@ TEST(PhotonMap, FurnaceSphere) {
 // average; Russian roulette survives with rho, so weights stay bounded).
 // 20k photons (about 1M stored), k = 400: mean within 3%, every vertex within 25%.
 TEST(PhotonMap, FurnaceNearOne) {
-  auto sf = scenes::sphere(1.0, 3, true);
-  scenes::setUniform(sf, glm::vec3(0.98f), glm::vec3(1.f));
-  auto caster = makeEmbreeCaster(sf.scene);
   PhotonOptions o;
   o.photons = 20000;
   o.kNearest = 400;
   o.maxDepth = 5000;
-  const VertexRadiometry r = computePhotonMap(sf.scene, *caster, o);
+  const VertexRadiometry r = furnace(glm::vec3(0.98f), o);
   double mean = 0;
   for (const auto& b : r.B) {
     mean += b.g;
@@ -190,15 +200,12 @@ TEST(PhotonMap, FurnaceNearOne) {
 // must cover the measured darkness (within 2%: 60,000 photons, k = 200)
 // and be red's own share (39.0%; at most 0.9^8 = 43%).
 TEST(PhotonMap, DepthCutWarningBoundsTheDarknessOfAColour) {
-  auto sf = scenes::sphere(1.0, 3, true);
   const glm::vec3 rho(0.9f, 0.5f, 0.1f);
-  scenes::setUniform(sf, rho, glm::vec3(1.f));
-  auto caster = makeEmbreeCaster(sf.scene);
   PhotonOptions o;
   o.photons = 60000;
   o.kNearest = 200;
   o.maxDepth = 8;
-  const VertexRadiometry r = computePhotonMap(sf.scene, *caster, o);
+  const VertexRadiometry r = furnace(rho, o);
   double mean = 0;
   for (const auto& b : r.B) mean += luminance(b);
   mean /= double(r.B.size());
