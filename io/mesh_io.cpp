@@ -7,6 +7,7 @@
 #include <iterator>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +15,7 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
 #include "atomic_file.h"
+#include "gi/color.h"
 #include "mesh_parts.h"
 #include "output_files.h"
 #include "vertex_file.h"
@@ -52,6 +54,36 @@ struct QuietOpenMesh {
   ~QuietOpenMesh() { ::omerr().enable(), ::omlog().enable(), ::omout().enable(); }
 };
 
+// What OpenMesh reads of an OBJ, set as the file gives it: the coordinates
+// in double (OpenMesh reads them as float: a plane 0.1 wide at 1e6 came out
+// 0.125 wide), each vertex OpenMesh appended for a non-manifold face taking
+// the coordinates of the file's vertex at that corner (OpenMesh keeps the
+// faces and their corners in the file's order: checked, else its own
+// points stand); and face colours from the materials' Kd where every face
+// has one. Kd is a linear reflectance (the MTL format's diffuse
+// reflectivity), so it is stored as the sRGB byte whose linear value it is.
+void objAsTheFileSays(const Counts& file, const std::map<std::string, glm::dvec3>& kd, Polygons& p) {
+  std::vector<glm::dvec3> exact(p.points.size());
+  std::vector<uint8_t> known(p.points.size(), 0);
+  for (size_t i = 0; i < file.points.size() && i < exact.size(); ++i) exact[i] = file.points[i], known[i] = 1;
+  bool same = p.index.size() == file.corners.size();
+  for (size_t k = 0; same && k < p.index.size(); ++k) {
+    const uint32_t v = p.index[k], f = file.corners[k];
+    if (v < file.points.size()) same = v == f;
+    else if (v < exact.size() && f < file.points.size()) exact[v] = file.points[f], known[v] = 1;
+  }
+  if (same && std::all_of(known.begin(), known.end(), [](uint8_t b) { return b != 0; })) p.points = exact;
+  std::vector<glm::u8vec3> colors;
+  for (const int mtl : file.faceMaterial) {
+    const auto it = mtl >= 0 ? kd.find(file.materialNames[size_t(mtl)]) : kd.end();
+    if (it == kd.end()) return;  // a face without a Kd: no face colours (vertex colours or the constant apply)
+    glm::u8vec3 c;
+    for (int k = 0; k < 3; ++k) c[k] = uint8_t(std::lround(255.0 * double(linearToSrgb(float(it->second[k])))));
+    colors.push_back(c);
+  }
+  if (colors.size() + 1 == p.faceStart.size()) p.faceColor = std::move(colors);
+}
+
 // OBJ and STL through OpenMesh, after checkObj / checkStl. Vertex indices are
 // OpenMesh's: the file's, plus copies of non-manifold vertices appended. An
 // OBJ is read from its path when it has one, so that OpenMesh finds its
@@ -64,17 +96,22 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   PolyMesh m;
   OpenMesh::IO::Options opt;
   // OpenMesh 9's STL reader reports colours it does not set: ask for none.
+  // An OBJ's colours: a vertex's only where every vertex has one (OpenMesh
+  // gives the others black), a face's from its material's Kd, read here (it
+  // leaves a face without one undefined: different on every run).
+  const bool objColors = ext == "obj" && declared.vertices > 0 && declared.coloredVertices == declared.vertices;
   if (ext == "obj") {
-    m.request_vertex_colors();
-    m.request_face_colors();
+    if (objColors) {
+      m.request_vertex_colors();
+      opt += OpenMesh::IO::Options::VertexColor;
+    }
     m.request_vertex_normals();
-    opt += OpenMesh::IO::Options::VertexColor;
-    opt += OpenMesh::IO::Options::FaceColor;  // from the material's Kd
     opt += OpenMesh::IO::Options::VertexNormal;
   } else if (stlBinary) {
     opt += OpenMesh::IO::Options::Binary;
   }
   std::string text(bytes);
+  std::map<std::string, glm::dvec3> kd;  // material -> Kd, the first library's that defines it
   if (ext == "obj" && !path.empty()) {
     // OpenMesh opens each library as the file's folder + its name: check those it will read.
     const std::string folder = path.substr(0, path.rfind('/') + 1);
@@ -89,7 +126,7 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
       } catch (const std::invalid_argument& e) {
         failRead(name, e.what());
       }
-      detail::checkMaterial(material, file);
+      for (const auto& [mtl, value] : detail::checkMaterial(material, file)) kd.emplace(mtl, value);
     }
   } else {
     for (size_t at : declared.materialLines) text[at] = '#';  // from memory: no library is opened
@@ -112,8 +149,7 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
     failRead(name, "OpenMesh read " + std::to_string(m.n_faces()) + " faces and " + std::to_string(m.n_vertices()) +
                        " vertices of the " + std::to_string(declared.faces) + " and " + std::to_string(declared.vertices) +
                        " in the file");
-  const bool hasVC = ext == "obj" && opt.vertex_has_color(), hasVN = ext == "obj" && opt.vertex_has_normal();
-  const bool hasFC = ext == "obj" && opt.face_has_color();
+  const bool hasVC = objColors && opt.vertex_has_color(), hasVN = ext == "obj" && opt.vertex_has_normal();
 
   Polygons p;
   p.points.resize(m.n_vertices());
@@ -127,8 +163,8 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   for (auto f : m.faces()) {
     for (auto v : m.fv_range(f)) p.index.push_back(uint32_t(v.idx()));
     p.faceStart.push_back(uint32_t(p.index.size()));
-    if (hasFC) p.faceColor.push_back({m.color(f)[0], m.color(f)[1], m.color(f)[2]});
   }
+  if (ext == "obj") objAsTheFileSays(declared, kd, p);
   return p;
 }
 

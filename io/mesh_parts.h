@@ -4,6 +4,7 @@
 // a whole token and finite, every index is in range.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -74,10 +75,18 @@ struct Counts {
   size_t vertices = 0, faces = 0;
   std::vector<std::string> materialFiles;  // OBJ: the mtllib names, as OpenMesh reads them
   std::vector<size_t> materialLines;       // and the byte offsets of those lines
+  // OBJ, as the file gives them (OpenMesh reads coordinates as float and
+  // leaves the colour of a face without a material's Kd undefined):
+  std::vector<glm::dvec3> points;          // every 'v', in double
+  std::vector<uint32_t> corners;           // every face's vertices (0-based), face after face
+  std::vector<int> faceMaterial;           // per face: index into materialNames, -1 before any usemtl
+  std::vector<std::string> materialNames;  // the usemtl names, in order of first use
+  size_t coloredVertices = 0;              // 'v' lines with r g b
 };
 Counts checkObj(std::string_view bytes, const std::string& name);  // text_formats.cpp
-// An OBJ material library: every Kd must be three numbers in 0..1.
-void checkMaterial(std::string_view bytes, const std::string& name);
+// An OBJ material library: every Kd must be three numbers in 0..1. Returns
+// each material's Kd (newmtl name -> Kd; a material without Kd is absent).
+std::map<std::string, glm::dvec3> checkMaterial(std::string_view bytes, const std::string& name);
 // Binary (the size is exactly 84 + 50 n bytes, as OpenMesh decides too) or
 // ASCII ("solid ..."); sets `binary`.
 Counts checkStl(std::string_view bytes, const std::string& name, bool& binary);

@@ -152,6 +152,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
   Lines in{bytes, name, Comments::WholeLines};
   Counts c;
   size_t nvt = 0, nvn = 0;
+  int material = -1;  // the current usemtl
   std::vector<uint32_t> face;
   auto numbers = [&](size_t lo, size_t hi, const char* what) {
     const size_t n = in.words.size() - 1;
@@ -180,6 +181,10 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
         double rgb = 0;
         if (parseDouble(in.words[k], rgb) && (rgb < 0 || rgb > 1)) failRead(name, in.at() + ": a vertex colour outside 0..1");
       }
+      glm::dvec3 q(0.0);
+      for (int k = 0; k < 3; ++k) parseDouble(in.words[size_t(k) + 1], q[k]);
+      c.points.push_back(q);
+      c.coloredVertices += in.words.size() == 7;
       ++c.vertices;
     } else if (key == "vt") {
       numbers(2, 3, "2 or 3 texture coordinates");
@@ -209,7 +214,17 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       }
       if (const uint32_t twice = repeatedIndex(face); twice != kNone)
         failRead(name, in.at() + ": the face lists vertex " + std::to_string(twice + 1) + " twice");
+      c.corners.insert(c.corners.end(), face.begin(), face.end());
+      c.faceMaterial.push_back(material);
       ++c.faces;
+    } else if (key == "usemtl") {
+      // OpenMesh takes the rest of the line, trimmed, as the name.
+      std::string_view m = in.line.substr(in.line.find("usemtl") + 6);
+      m.remove_prefix(std::min(m.size(), m.find_first_not_of(" \t")));
+      m = m.substr(0, m.find_last_not_of(" \t") + 1);
+      const auto at = std::find(c.materialNames.begin(), c.materialNames.end(), m);
+      material = int(at - c.materialNames.begin());
+      if (at == c.materialNames.end()) c.materialNames.emplace_back(m);
     } else if (key == "mtllib") {
       // OpenMesh takes the rest of the line, trimmed, as one file name.
       std::string_view file = in.line.substr(in.line.find("mtllib") + 6);
@@ -217,7 +232,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       file = file.substr(0, file.find_last_not_of(" \t") + 1);
       c.materialFiles.emplace_back(file);
       c.materialLines.push_back(size_t(in.line.data() - bytes.data()));
-    } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "l" || key == "p") {
+    } else if (key == "o" || key == "g" || key == "s" || key == "l" || key == "p") {
       // Names, groups and materials (OpenMesh reads the material's Kd as face colour); lines and points are ignored.
     } else {
       failRead(name, in.at() + ": unsupported OBJ statement " + quoted(in.line));
@@ -226,16 +241,28 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
   return c;
 }
 
-void checkMaterial(std::string_view bytes, const std::string& name) {
+std::map<std::string, glm::dvec3> checkMaterial(std::string_view bytes, const std::string& name) {
   Lines in{bytes, name, Comments::WholeLines};
+  std::map<std::string, glm::dvec3> kd;
+  std::string current;
+  bool named = false;
   while (in.next()) {
+    if (in.words[0] == "newmtl") {
+      std::string_view m = in.line.substr(in.line.find("newmtl") + 6);
+      m.remove_prefix(std::min(m.size(), m.find_first_not_of(" \t")));
+      current = std::string(m.substr(0, m.find_last_not_of(" \t") + 1));
+      named = true;
+      continue;
+    }
     if (in.words[0] != "Kd") continue;
-    double v = 0;
+    glm::dvec3 v(0.0);
     bool ok = in.words.size() == 4;
-    for (size_t k = 1; ok && k < 4; ++k) ok = parseDouble(in.words[k], v) && v >= 0 && v <= 1;
+    for (size_t k = 1; ok && k < 4; ++k) ok = parseDouble(in.words[k], v[int(k) - 1]) && v[int(k) - 1] >= 0 && v[int(k) - 1] <= 1;
     // OpenMesh converts Kd to colour bytes unchecked.
     if (!ok) failRead(name, in.at() + ": 'Kd' needs 3 numbers in 0..1, found " + quoted(in.line));
+    if (named) kd[current] = v;
   }
+  return kd;
 }
 
 Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {

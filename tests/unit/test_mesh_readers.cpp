@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -234,7 +235,53 @@ TEST(MeshReaders, ObjFormsColoursAndMaterials) {
   fs::remove_all(dir);
   ASSERT_EQ(m.attrs.faceColor.size(), 2u);
   EXPECT_EQ(m.attrs.faceColor[0], glm::u8vec3(255, 0, 0));
-  EXPECT_NEAR(m.attrs.faceColor[1].r, 128, 1);
+  // Kd is a linear reflectance: 0.5 is stored as the sRGB byte 188 (linear 0.503).
+  EXPECT_EQ(m.attrs.faceColor[1], glm::u8vec3(188, 188, 188));
+}
+
+// What OpenMesh alone got wrong in an OBJ (an outside audit): coordinates
+// read as float (a plane 0.1 wide at 1e6 came out 0.125 wide), also for the
+// vertices it appends at a non-manifold edge; the colour of a face without a
+// material's Kd left undefined (different on every run), an unknown
+// material black; vertices without a colour black beside coloured ones.
+TEST(MeshReaders, ObjKeepsDoublePrecisionAndOnlyWholeColours) {
+  const double o = 1e6 + 0.123;
+  char buf[512];
+  // Three triangles on one edge (0-1): OpenMesh appends copies of the third's corners.
+  std::snprintf(buf, sizeof buf,
+                "v %.6f %.6f 0\nv %.6f %.6f 0\nv %.6f %.6f 0\nv %.6f %.6f 0.1\nv %.6f %.6f -0.1\n"
+                "f 1 2 3\nf 2 1 4\nf 1 2 5\n",
+                o, o, o + 0.1, o, o + 0.05, o + 0.1, o + 0.05, o - 0.05, o + 0.05, o - 0.05);
+  const auto m = gi::io::parseMesh(buf, "obj", "far.obj");
+  const double file[5][3] = {{o, o, 0}, {o + 0.1, o, 0}, {o + 0.05, o + 0.1, 0}, {o + 0.05, o - 0.05, 0.1},
+                             {o + 0.05, o - 0.05, -0.1}};
+  const uint32_t corner[3][3] = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  ASSERT_EQ(m.scene.faceCount(), 3u);
+  EXPECT_GT(m.scene.vertexCount(), 5u);  // OpenMesh appended copies
+  for (int f = 0; f < 3; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 p = m.scene.toWorld(m.scene.positions[m.scene.triangles[size_t(f)][k]]);
+      // The scene keeps float offsets from its centre (about 1e-8 here); OpenMesh's floats were 2e-3 off.
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], file[corner[f][k]][c], 1e-6) << "face " << f << " corner " << k;
+    }
+
+  const std::string dir = tempPath("objmtl");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 0.7 0.4 0.1\nnewmtl shiny\nKs 1 1 1\n";
+  const std::string quad = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+  for (const std::string& faces : {std::string("f 1 2 3\nusemtl red\nf 1 3 4\n"),      // before any usemtl
+                                   std::string("usemtl shiny\nf 1 2 3\nusemtl red\nf 1 3 4\n"),  // no Kd
+                                   std::string("usemtl nowhere\nf 1 2 3\nusemtl red\nf 1 3 4\n")}) {
+    std::ofstream(dir + "/m.obj") << quad + faces;
+    EXPECT_TRUE(gi::io::loadMesh(dir + "/m.obj").attrs.faceColor.empty()) << faces;
+  }
+  std::ofstream(dir + "/m.obj") << quad + "usemtl red\nf 1 2 3\nf 1 3 4\n";
+  const auto red = gi::io::loadMesh(dir + "/m.obj");
+  ASSERT_EQ(red.attrs.faceColor.size(), 2u);
+  EXPECT_EQ(red.attrs.faceColor[0], glm::u8vec3(218, 170, 89));  // linear 0.7 0.4 0.1 as sRGB bytes
+  fs::remove_all(dir);
+  const auto partial = gi::io::parseMesh("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n", "obj", "p.obj");
+  EXPECT_TRUE(partial.attrs.vertexColor.empty());
 }
 
 TEST(MeshReaders, AsciiStlCornersAreMerged) {
