@@ -391,6 +391,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   for (const Link& l : links) leafLinks += (t.nodes[l.p].leaf() && t.nodes[l.q].leaf()) ? 1 : 0;
   const double unit2 = s.unit * s.unit;
   sol.stats.add("emitted_power_W", P * unit2);
+  if (set.enteringPower > 0) sol.stats.add("sky_sun_power_W", set.enteringPower * unit2);  // as the flat solvers say
   sol.stats.add("absorbed_power_W", absorbed * unit2);
   sol.stats.add("reflected_power_W", reflected * unit2);
   if (set.closureRays > 0 && !fixed) {  // what escapes is known from the closure rays; all bounces

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -277,6 +279,54 @@ TEST(ScenesIo, AsciiPolygonsAreFanTriangulated) {
   EXPECT_TRUE(m.attrs.vertexColor.empty());
   EXPECT_TRUE(m.scene.vertexNormals.empty());
   for (size_t f = 0; f < 3; ++f) EXPECT_GT(gi::faceNormalUnnormalized(m.scene, f).z, 0.f);
+}
+
+// A concave polygon is cut into triangles inside it (ear clipping; a fan
+// from its reflex corner covered the notch outside: the quad (2,0),
+// (0.5,0.5), (0,2), (0,0) of area 1 came out 3; an outside audit), in PLY,
+// OFF and OBJ alike; a convex one keeps the fan's triangles. An L-shaped
+// hexagon and a concave star of 10 corners too: the areas add up to the
+// polygon's (shoelace) and every triangle faces the polygon's way.
+TEST(ScenesIo, ConcavePolygonsAreCutInsideThem) {
+  struct Poly { std::vector<glm::dvec2> p; double area; };
+  std::vector<glm::dvec2> star;
+  for (int k = 0; k < 10; ++k) {
+    const double a = kPi * k / 5, r = k % 2 ? 0.4 : 1.0;
+    star.push_back({r * std::cos(a), r * std::sin(a)});
+  }
+  double starArea = 0;
+  for (size_t k = 0; k < star.size(); ++k) {
+    const auto &a = star[k], &b = star[(k + 1) % star.size()];
+    starArea += 0.5 * (a.x * b.y - b.x * a.y);
+  }
+  const std::vector<Poly> polys = {{{{2, 0}, {0.5, 0.5}, {0, 2}, {0, 0}}, 1.0},
+                                   {{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, 3.0},
+                                   {star, starArea}};
+  for (const Poly& poly : polys) {
+    const size_t n = poly.p.size();
+    std::string ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                      "property list uchar int vertex_indices\nend_header\n";
+    std::string off = "OFF\n" + std::to_string(n) + " 1 0\n", obj, face = std::to_string(n), objFace = "f";
+    for (size_t k = 0; k < n; ++k) {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.17g %.17g 0.5\n", poly.p[k].x, poly.p[k].y);
+      ply += line, off += line, obj += std::string("v ") + line;
+      face += " " + std::to_string(k), objFace += " " + std::to_string(k + 1);
+    }
+    ply += face + "\n", off += face + "\n", obj += objFace + "\n";
+    for (const auto& [format, text] : {std::pair{"ply", ply}, std::pair{"off", off}, std::pair{"obj", obj}}) {
+      const auto m = gi::io::parseMesh(text, format, std::string("p.") + format);
+      ASSERT_EQ(m.scene.faceCount(), n - 2) << format;
+      double area = 0;
+      for (size_t f = 0; f < m.scene.faceCount(); ++f) {
+        const glm::vec3 c = gi::faceNormalUnnormalized(m.scene, f);
+        EXPECT_GT(c.z, 0.f) << format << ", " << n << " corners, triangle " << f;
+        area += 0.5 * double(glm::length(c));
+      }
+      EXPECT_NEAR(area, poly.area, 1e-6 * poly.area) << format << ", " << n << " corners";
+    }
+  }
 }
 
 TEST(ScenesIo, ObjOffAndStlAreRead) {

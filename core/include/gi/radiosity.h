@@ -103,6 +103,7 @@ struct RadiosityResult {
   double residual = 0.0;            // relative, at the end
   std::vector<double> residualHistory;  // per sweep or per shot (progressive: unshot power fraction)
   glm::vec3 ambient{0.f};           // the ambient term added to B (RadiosityOptions::ambientTerm), else 0
+  glm::vec3 ambientRho{0.f};        // the area mean reflectance it assumes (its 1 / (1 - rho) of bounces)
   // B per vertex (patch average, with the ambient term when it is on) after
   // each requested step; a step the solve did not reach holds the final state.
   struct Snapshot {
