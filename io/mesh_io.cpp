@@ -187,6 +187,71 @@ struct ByteWriter {
 
 namespace {
 
+// A polygon's triangles as corner positions k (0..n-1) of its vertex list v:
+// a fan from the first corner where the polygon is convex (the same
+// triangles as before for every convex face), else ear clipping in the
+// plane of its Newell normal, so that a concave polygon's triangles stay
+// inside it (a fan from a reflex corner covered the notch outside: a quad
+// of area 1 came out 3; an outside audit). Ears are clipped in O(n^2); a
+// polygon of more than kMaxEarClipped corners, or one where no ear is
+// found (self-intersecting), keeps the fan for what is left.
+constexpr size_t kMaxEarClipped = 256;
+void triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, std::vector<glm::uvec3>& out) {
+  out.clear();
+  auto fan = [&](const std::vector<uint32_t>& k) {
+    for (size_t i = 1; i + 1 < k.size(); ++i) out.push_back({k[0], k[i], k[i + 1]});
+  };
+  std::vector<uint32_t> left(n);
+  for (size_t i = 0; i < n; ++i) left[i] = uint32_t(i);
+  if (n <= 3 || n > kMaxEarClipped) return fan(left);
+  glm::dvec3 normal(0.0);  // Newell's normal
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec3 &a = pts[v[i]], &b = pts[v[(i + 1) % n]];
+    normal += glm::dvec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+  }
+  if (!(glm::length(normal) > 0.0)) return fan(left);
+  // The plane's two axes, from the polygon's own first corner (2-D coordinates
+  // of the same scale as the polygon).
+  const glm::dvec3 nz = glm::normalize(normal);
+  const glm::dvec3 ax = glm::normalize(std::fabs(nz.x) < 0.9 ? glm::cross(nz, glm::dvec3(1, 0, 0)) : glm::cross(nz, glm::dvec3(0, 1, 0)));
+  const glm::dvec3 ay = glm::cross(nz, ax);
+  std::vector<glm::dvec2> q(n);
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec3 d = pts[v[i]] - pts[v[0]];
+    q[i] = {glm::dot(d, ax), glm::dot(d, ay)};
+  }
+  auto turn = [&](uint32_t a, uint32_t b, uint32_t c) {  // > 0: counter-clockwise about the normal
+    return (q[b].x - q[a].x) * (q[c].y - q[a].y) - (q[b].y - q[a].y) * (q[c].x - q[a].x);
+  };
+  bool convex = true;
+  for (size_t i = 0; i < n && convex; ++i) convex = turn(uint32_t(i), uint32_t((i + 1) % n), uint32_t((i + 2) % n)) >= 0.0;
+  if (convex) return fan(left);
+  auto inside = [&](uint32_t p, uint32_t a, uint32_t b, uint32_t c) {
+    return turn(a, b, p) >= 0.0 && turn(b, c, p) >= 0.0 && turn(c, a, p) >= 0.0;
+  };
+  // Walking round the corners, clipping each ear met: a whole round without
+  // one means a self-intersecting polygon.
+  size_t i = 0, misses = 0;
+  while (left.size() > 3 && misses < left.size()) {
+    const size_t m = left.size();
+    i %= m;
+    const uint32_t a = left[(i + m - 1) % m], b = left[i], c = left[(i + 1) % m];
+    bool ear = turn(a, b, c) > 0.0;  // reflex or flat: no ear
+    for (size_t j = 0; j < m && ear; ++j) {
+      const uint32_t p = left[j];
+      if (p != a && p != b && p != c && q[p] != q[a] && q[p] != q[b] && q[p] != q[c]) ear = !inside(p, a, b, c);
+    }
+    if (!ear) {
+      ++i, ++misses;
+      continue;
+    }
+    out.push_back({a, b, c});
+    left.erase(left.begin() + long(i));
+    misses = 0;
+  }
+  fan(left);
+}
+
 LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
   if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
     failRead(name, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
@@ -201,11 +266,13 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   const size_t nf = p.faceStart.size() - 1;
   std::vector<glm::uvec3> tris;
   tris.reserve(p.index.size());
+  std::vector<glm::uvec3> corners;
   for (size_t f = 0; f < nf; ++f) {
     const uint32_t* v = p.index.data() + p.faceStart[f];
     const size_t n = p.faceStart[f + 1] - p.faceStart[f];
-    for (size_t k = 1; k + 1 < n; ++k) {  // fan
-      tris.push_back({v[0], v[k], v[k + 1]});
+    triangulate(p.points, v, n, corners);
+    for (const glm::uvec3& k : corners) {
+      tris.push_back({v[k.x], v[k.y], v[k.z]});
       out.triangleToFace.push_back(uint32_t(f));
       if (!p.faceColor.empty()) out.attrs.faceColor.push_back(p.faceColor[f]);
       if (!p.faceQuality.empty()) out.attrs.faceQuality.push_back(p.faceQuality[f]);
