@@ -1,6 +1,7 @@
 #include "mesh_io.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -88,11 +89,34 @@ void objAsTheFileSays(const Counts& file, const std::map<std::string, glm::dvec3
 // OpenMesh's: the file's, plus copies of non-manifold vertices appended. An
 // OBJ is read from its path when it has one, so that OpenMesh finds its
 // material library (face colours from Kd).
+// An ASCII STL from checkStl's corners, in double: equal corners merged
+// (each new one numbered as it first appears) and triangles left with a
+// repeated corner dropped, as OpenMesh does, but without its float
+// coordinates (a plane 0.1 wide at 1e6 came out 0.125 wide).
+Polygons asciiStl(const Counts& file) {
+  Polygons p;
+  std::map<std::array<double, 3>, uint32_t> id;
+  uint32_t corner[3];
+  for (size_t t = 0; t + 2 < file.points.size(); t += 3) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3& q = file.points[t + size_t(k)];
+      const auto [it, fresh] = id.emplace(std::array<double, 3>{q.x, q.y, q.z}, uint32_t(p.points.size()));
+      if (fresh) p.points.push_back(q);
+      corner[k] = it->second;
+    }
+    if (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]) continue;
+    p.index.insert(p.index.end(), corner, corner + 3);
+    p.faceStart.push_back(uint32_t(p.index.size()));
+  }
+  return p;
+}
+
 Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
   Counts declared;
   bool stlBinary = false;
   if (ext == "obj") declared = detail::checkObj(bytes, name);
   else declared = detail::checkStl(bytes, name, stlBinary);
+  if (ext == "stl" && !stlBinary) return asciiStl(declared);
   PolyMesh m;
   OpenMesh::IO::Options opt;
   // OpenMesh 9's STL reader reports colours it does not set: ask for none.

@@ -318,7 +318,12 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
   for (next(); in.words[0] != "endsolid"; next()) {
     check({"facet", "normal"}, 3);
     next(), check({"outer", "loop"}, 0);
-    for (int k = 0; k < 3; ++k) next(), check({"vertex"}, 3);
+    for (int k = 0; k < 3; ++k) {
+      next(), check({"vertex"}, 3);
+      glm::dvec3 q(0.0);
+      for (int d = 0; d < 3; ++d) parseDouble(in.words[size_t(d) + 1], q[d]);
+      c.points.push_back(q);  // in double (OpenMesh reads them as float)
+    }
     next(), check({"endloop"}, 0);
     next(), check({"endfacet"}, 0);
     ++c.faces;

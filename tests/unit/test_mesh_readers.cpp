@@ -243,7 +243,8 @@ TEST(MeshReaders, ObjFormsColoursAndMaterials) {
 // read as float (a plane 0.1 wide at 1e6 came out 0.125 wide), also for the
 // vertices it appends at a non-manifold edge; the colour of a face without a
 // material's Kd left undefined (different on every run), an unknown
-// material black; vertices without a colour black beside coloured ones.
+// material black; vertices without a colour black beside coloured ones;
+// an ASCII STL's coordinates read as float too.
 TEST(MeshReaders, ObjKeepsDoublePrecisionAndOnlyWholeColours) {
   const double o = 1e6 + 0.123;
   char buf[512];
@@ -282,6 +283,18 @@ TEST(MeshReaders, ObjKeepsDoublePrecisionAndOnlyWholeColours) {
   fs::remove_all(dir);
   const auto partial = gi::io::parseMesh("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n", "obj", "p.obj");
   EXPECT_TRUE(partial.attrs.vertexColor.empty());
+  // An ASCII STL in double too (OpenMesh read it as float), its equal corners merged.
+  std::snprintf(buf, sizeof buf,
+                "solid s\nfacet normal 0 0 1\nouter loop\nvertex %.6f %.6f 0\nvertex %.6f %.6f 0\nvertex %.6f %.6f 0\n"
+                "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex %.6f %.6f 0\nvertex %.6f %.6f 0\n"
+                "vertex %.6f %.6f 0\nendloop\nendfacet\nendsolid s\n",
+                o, o, o + 0.1, o, o + 0.05, o + 0.1, o, o, o + 0.05, o + 0.1, o - 0.1, o + 0.1);
+  const auto stl = gi::io::parseMesh(buf, "stl", "far.stl");
+  ASSERT_EQ(stl.scene.vertexCount(), 4u);
+  ASSERT_EQ(stl.scene.faceCount(), 2u);
+  const glm::dvec3 last = stl.scene.toWorld(stl.scene.positions[3]);
+  EXPECT_NEAR(last.x, o - 0.1, 1e-6);
+  EXPECT_NEAR(last.y, o + 0.1, 1e-6);
 }
 
 TEST(MeshReaders, AsciiStlCornersAreMerged) {
