@@ -1,5 +1,7 @@
 #include "meshlab_bridge.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -54,6 +56,12 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
     const bool vc = mm->hasDataMask(MeshModel::MM_VERTCOLOR);
     const bool fc = mm->hasDataMask(MeshModel::MM_FACECOLOR);
     const bool fq = mm->hasDataMask(MeshModel::MM_FACEQUALITY);
+    // Vertex colours that display an earlier result on this layer (its
+    // attribute, which readAttributes drops where not every layer has it).
+    std::string shows;
+    for (const char* name : kResultAttributes)
+      if (shows.empty() && vcg::tri::HasPerVertexAttribute(m, name)) shows = name;
+    if (layers.size() > 1 && b.attrs.vertexColorShows.empty()) b.attrs.vertexColorShows = shows;
     for (size_t i = 0; i < m.vert.size(); ++i) {
       const CVertexO& v = m.vert[i];
       if (v.IsD()) continue;
@@ -62,6 +70,7 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
       if (anyVertColor) {
         // Layers without vertex colours count as white-less grey: 188 = 0.5 linear.
         b.attrs.vertexColor.push_back(vc ? glm::u8vec3(v.cC()[0], v.cC()[1], v.cC()[2]) : glm::u8vec3(188));
+        b.attrs.vertexColorGiven.push_back(vc && shows.empty() ? 1 : 0);  // the reflectance rule per layer
       }
       b.attrs.vertexSelected.push_back(v.IsS() ? 1 : 0);
     }
@@ -71,7 +80,10 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
       glm::uvec3 t;
       for (int k = 0; k < 3; ++k) t[k] = uint32_t(part.sceneVertex[vcg::tri::Index(m, f.cV(k))]);
       tris.push_back(t);
-      if (anyFaceColor) b.attrs.faceColor.push_back(fc ? glm::u8vec3(f.cC()[0], f.cC()[1], f.cC()[2]) : glm::u8vec3(188));
+      if (anyFaceColor) {
+        b.attrs.faceColor.push_back(fc ? glm::u8vec3(f.cC()[0], f.cC()[1], f.cC()[2]) : glm::u8vec3(188));
+        b.attrs.faceColorGiven.push_back(fc ? 1 : 0);
+      }
       if (anyFaceQuality) b.attrs.faceQuality.push_back(fq ? float(f.cQ()) : 0.f);
       b.attrs.faceSelected.push_back(f.IsS() ? 1 : 0);
     }
@@ -82,6 +94,11 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
   if (tris.empty()) {
     throw std::invalid_argument(pts.empty() ? "the mesh is empty" : "the mesh has no faces (a point cloud): these filters need triangles");
   }
+  // One layer (or all alike): no masks, the one mesh's rule (a single
+  // layer's displayed result is found from its attribute, as the CLI does).
+  auto allGiven = [](const std::vector<uint8_t>& m) { return std::all_of(m.begin(), m.end(), [](uint8_t g) { return g != 0; }); };
+  if (layers.size() == 1 || allGiven(b.attrs.vertexColorGiven)) b.attrs.vertexColorGiven.clear();
+  if (layers.size() == 1 || allGiven(b.attrs.faceColorGiven)) b.attrs.faceColorGiven.clear();
   b.scene = Scene::fromAbsolute(pts, std::move(tris));
   return b;
 }

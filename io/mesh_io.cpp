@@ -443,8 +443,18 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
     if (b.empty()) a.insert(a.end(), n1, fill);
     else a.insert(a.end(), b.begin(), b.end());
   };
-  merge(into.attrs.faceColor, other.attrs.faceColor, nf0, nf1, glm::u8vec3(188));
-  merge(into.attrs.vertexColor, other.attrs.vertexColor, nv0, nv1, glm::u8vec3(188));
+  // Colours with the masks of which parts gave them (the reflectance rule
+  // then holds per part); a part whose vertex colours display a result
+  // (its attribute, which the merge below may drop as not common) gives none.
+  auto shows = [](const std::vector<VertexAttribute>& attributes) -> std::string {
+    for (const char* name : kResultAttributes)
+      for (const VertexAttribute& a : attributes)
+        if (a.name == name) return name;
+    return "";
+  };
+  if (into.attrs.vertexColorShows.empty() && into.attrs.vertexColorGiven.empty())
+    into.attrs.vertexColorShows = shows(into.attributes);
+  appendColors(into.attrs, nf0, nv0, other.attrs, nf1, nv1, shows(other.attributes));
   merge(into.attrs.faceQuality, other.attrs.faceQuality, nf0, nf1, 0.f);
   merge(into.attrs.faceSelected, other.attrs.faceSelected, nf0, nf1, uint8_t(0));
   merge(into.attrs.vertexSelected, other.attrs.vertexSelected, nv0, nv1, uint8_t(0));

@@ -53,7 +53,7 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   // Vertex colours that display the light an earlier lighting filter left
   // (radiosity, photon mapping, the reference, sky lighting, a view's vertex
   // radiance) are not the surfaces' colours.
-  for (const char* shown : {"Radiosity", "Irradiance", "Radiance", "Reference"})
+  for (const char* shown : kResultAttributes)
     if (in.attrs.vertexColorShows.empty() && in.attribute(shown)) in.attrs.vertexColorShows = shown;
   if (v.has("reflectance_source"))
     if (auto err =

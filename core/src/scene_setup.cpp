@@ -214,42 +214,58 @@ namespace {
 // when the mesh lacks that source.
 std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg,
                                           std::vector<std::string>* warnings) {
-  const size_t nf = s.faceCount();
+  const size_t nf = s.faceCount(), nv = s.vertexCount();
   auto src = kReflectanceSources.get(v, "reflectance_source");
   const glm::vec3 constant = v.getVec("reflectance");
   const glm::vec3 constantLin(srgbToLinear(constant.r), srgbToLinear(constant.g), srgbToLinear(constant.b));
   const bool hasFace = a.faceColor.size() == nf && nf > 0;
-  const bool hasVert = a.vertexColor.size() == s.vertexCount() && s.vertexCount() > 0;
+  const bool hasVert = a.vertexColor.size() == nv && nv > 0;
+  const bool faceMask = a.faceColorGiven.size() == nf, vertMask = a.vertexColorGiven.size() == nv;
   const bool auto_ = src == ReflectanceSource::Auto;
-  const bool resultColors = auto_ && !hasFace && hasVert && !a.vertexColorShows.empty();
-  if (auto_)
-    src = hasFace                    ? ReflectanceSource::FaceColor
-          : hasVert && !resultColors ? ReflectanceSource::VertexColor
-                                     : ReflectanceSource::Constant;
+  // One mesh whose vertex colours display a result (with layers, the masks say it per layer).
+  const bool resultColors = auto_ && !hasFace && hasVert && !vertMask && !a.vertexColorShows.empty();
+  auto faceGiven = [&](size_t f) { return hasFace && (!faceMask || a.faceColorGiven[f]); };
+  auto vertGiven = [&](uint32_t i) { return i < nv && hasVert && !resultColors && (!vertMask || a.vertexColorGiven[i]); };
   if (src == ReflectanceSource::FaceColor && !hasFace) return std::string("reflectance from face colour was asked for, but the mesh has no face colours");
   if (src == ReflectanceSource::VertexColor && !hasVert) return std::string("reflectance from vertex colour was asked for, but the mesh has no vertex colours");
   s.rho.assign(nf, constantLin);
+  size_t used[3] = {0, 0, 0};  // faces from face colour, vertex colour, the constant
   for (size_t f = 0; f < nf; ++f) {
-    if (src == ReflectanceSource::FaceColor) {
+    const auto& t = s.triangles[f];
+    // Per face (Auto): its own colour, else its vertices', else the constant;
+    // a source asked for by name, where the face's layer has it.
+    const bool byFace = (auto_ || src == ReflectanceSource::FaceColor) && faceGiven(f);
+    const bool byVert = !byFace && (auto_ || src == ReflectanceSource::VertexColor) && vertGiven(t.x) &&
+                        vertGiven(t.y) && vertGiven(t.z);
+    if (byFace) {
       const auto& c = a.faceColor[f];
       s.rho[f] = srgb8ToLinear(c.r, c.g, c.b);
-    } else if (src == ReflectanceSource::VertexColor) {
+      ++used[0];
+    } else if (byVert) {
       glm::vec3 sum(0.f);
-      const auto& t = s.triangles[f];
       for (int k = 0; k < 3; ++k) {
-        if (t[k] >= s.vertexCount()) continue;
+        if (t[k] >= nv) continue;
         const auto& c = a.vertexColor[t[k]];
         sum += srgb8ToLinear(c.r, c.g, c.b);
       }
       s.rho[f] = sum / 3.f;
+      ++used[1];
+    } else {
+      ++used[2];
     }
   }
+  if (auto_)
+    src = used[0] == nf ? ReflectanceSource::FaceColor : used[1] == nf ? ReflectanceSource::VertexColor : ReflectanceSource::Constant;
+  const bool mixed = used[0] != nf && used[1] != nf && used[2] != nf;
   // Energy conservation: a white 255 colour is rho = 1, which never converges.
   size_t clamped = 0;
   for (auto& r : s.rho)
     for (int k = 0; k < 3; ++k)
       if (r[k] > 0.999f) { r[k] = 0.999f; ++clamped; }
   *msg = std::string("reflectance from ") + kReflectanceSources.logName(src);
+  if (mixed)
+    *msg = "reflectance per layer: from face colour on " + std::to_string(used[0]) + " faces, from vertex colour on " +
+           std::to_string(used[1]) + ", the constant on " + std::to_string(used[2]) + " (layers without those colours)";
   if (resultColors)
     *msg += " (the vertex colours display an earlier filter's result, " + a.vertexColorShows +
             ", not a reflectance: choose 'Vertex color' to use them anyway)";
@@ -262,6 +278,39 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
   }
   return std::nullopt;
 }
+
+}  // namespace
+
+void appendColors(MeshAttributes& a, size_t nf0, size_t nv0, const MeshAttributes& b, size_t nf1, size_t nv1,
+                  const std::string& bShows) {
+  // The masks of a's part (all given where it has colours and no mask yet) and of b's.
+  auto given = [](std::vector<uint8_t>& mask, bool has, size_t n) {
+    if (mask.size() != n) mask.assign(n, has ? 1 : 0);
+  };
+  const bool aShows = !a.vertexColorShows.empty() && a.vertexColorGiven.empty();
+  if (!a.faceColor.empty() || !b.faceColor.empty()) {
+    given(a.faceColorGiven, !a.faceColor.empty(), nf0);
+    a.faceColor.resize(nf0, glm::u8vec3(188));
+    a.faceColorGiven.insert(a.faceColorGiven.end(), nf1, b.faceColor.empty() ? 0 : 1);
+    if (b.faceColor.empty()) a.faceColor.insert(a.faceColor.end(), nf1, glm::u8vec3(188));
+    else a.faceColor.insert(a.faceColor.end(), b.faceColor.begin(), b.faceColor.end());
+  }
+  if (!a.vertexColor.empty() || !b.vertexColor.empty()) {
+    given(a.vertexColorGiven, !a.vertexColor.empty() && !aShows, nv0);
+    a.vertexColor.resize(nv0, glm::u8vec3(188));
+    a.vertexColorGiven.insert(a.vertexColorGiven.end(), nv1, b.vertexColor.empty() || !bShows.empty() ? 0 : 1);
+    if (b.vertexColor.empty()) a.vertexColor.insert(a.vertexColor.end(), nv1, glm::u8vec3(188));
+    else a.vertexColor.insert(a.vertexColor.end(), b.vertexColor.begin(), b.vertexColor.end());
+  }
+  if (a.vertexColorShows.empty()) a.vertexColorShows = bShows;
+  // All given: no mask (one mesh's rule).
+  auto drop = [](std::vector<uint8_t>& mask) {
+    if (std::all_of(mask.begin(), mask.end(), [](uint8_t g) { return g != 0; })) mask.clear();
+  };
+  drop(a.faceColorGiven), drop(a.vertexColorGiven);
+}
+
+namespace {
 
 // E per face from the chosen source (Auto: the selection if any face is
 // selected, else face quality); the log's part.

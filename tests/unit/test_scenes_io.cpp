@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,9 @@
 #include <unistd.h>
 
 #include "gi/scenes.h"
+#include "gi/color.h"
+#include "gi/scene_setup.h"
+#include "gi/filters.h"
 #include "mesh_io.h"
 #include "result_file.h"
 
@@ -326,6 +330,59 @@ TEST(ScenesIo, ConcavePolygonsAreCutInsideThem) {
       }
       EXPECT_NEAR(area, poly.area, 1e-6 * poly.area) << format << ", " << n << " corners";
     }
+  }
+}
+
+// Several layers keep each its own reflectance rule (an outside audit: a
+// layer without colours beside one with face colours took the filler grey,
+// not the constant; a layer's vertex colours gave way to another's face
+// colours; a layer whose vertex colours display an earlier result, beside
+// one without that result, had them read as reflectance).
+TEST(ScenesIo, LayersKeepTheirOwnReflectanceRule) {
+  auto ply = [](const std::string& vertexProps, const std::string& faceProps, const std::string& vx,
+                const std::string& fx) {
+    std::string h = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n" +
+                    vertexProps + "element face 1\nproperty list uchar int vertex_indices\n" + faceProps + "end_header\n";
+    return h + "0 0 0" + vx + "\n1 0 0" + vx + "\n0 1 0" + vx + "\n3 0 1 2" + fx + "\n";
+  };
+  const std::string rgb = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  const std::string shown = "property float Radiosity_x\nproperty float Radiosity_y\nproperty float Radiosity_z\n";
+  const auto faceColoured = gi::io::parseMesh(ply("", rgb, "", " 200 100 30"), "ply", "f.ply");
+  const auto bare = gi::io::parseMesh(ply("", "", "", ""), "ply", "n.ply");
+  const auto vertexColoured = gi::io::parseMesh(ply(rgb, "", " 30 100 200", ""), "ply", "v.ply");
+  const auto display = gi::io::parseMesh(ply(rgb + shown, "", " 255 255 255 1 1 1", ""), "ply", "r.ply");
+  const auto specs = gi::filterSpecs(gi::FilterKind::Radiosity);
+  auto rho = [&](const gi::io::LoadedMesh& a, const gi::io::LoadedMesh& b, const char* constant) {
+    gi::io::LoadedMesh m = a;
+    gi::io::appendMesh(m, b);
+    gi::ParamValues v = gi::defaultValues(specs, 1.0);
+    v.set("reflectance", glm::vec3(float(std::atof(constant)) / 255.f));
+    gi::Scene s = m.scene;
+    std::string log;
+    EXPECT_FALSE(gi::applySceneConventions(s, m.attrs, v, false, &log, nullptr).has_value());
+    return std::make_pair(s.rho, log);
+  };
+  auto lin = [](int a, int b, int c) { return gi::srgb8ToLinear(uint8_t(a), uint8_t(b), uint8_t(c)); };
+  auto near = [](glm::vec3 a, glm::vec3 b) { return glm::length(a - b) < 1e-6f; };
+  {
+    const auto [r, log] = rho(faceColoured, bare, "100");
+    EXPECT_TRUE(near(r[0], lin(200, 100, 30)));
+    EXPECT_TRUE(near(r[1], lin(100, 100, 100))) << "the layer without colours takes the constant";
+    EXPECT_NE(log.find("reflectance per layer"), std::string::npos) << log;
+  }
+  {
+    const auto [r, log] = rho(vertexColoured, faceColoured, "100");
+    EXPECT_TRUE(near(r[0], lin(30, 100, 200))) << "its own vertex colours";
+    EXPECT_TRUE(near(r[1], lin(200, 100, 30)));
+  }
+  for (bool first : {true, false}) {
+    const auto [r, log] = first ? rho(display, vertexColoured, "188") : rho(vertexColoured, display, "188");
+    EXPECT_TRUE(near(r[first ? 0 : 1], lin(188, 188, 188))) << "displayed result colours are no reflectance";
+    EXPECT_TRUE(near(r[first ? 1 : 0], lin(30, 100, 200)));
+  }
+  {  // one kind of colour everywhere: the one mesh's rule and its log
+    const auto [r, log] = rho(faceColoured, faceColoured, "100");
+    EXPECT_NE(log.find("reflectance from face colour"), std::string::npos) << log;
   }
 }
 

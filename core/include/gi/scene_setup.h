@@ -27,7 +27,25 @@ struct MeshAttributes {
   // left (its attribute's name, e.g. "Radiosity"): they are no reflectance,
   // and the reflectance source 'Auto' passes them over.
   std::string vertexColorShows;
+  // Several layers are one scene: which faces' and vertices' colours a layer
+  // gave (1) and which are the filler of a layer without them, or display
+  // an earlier result in one layer (0). Empty: every colour present is
+  // given (one mesh). The reflectance rule then holds per layer: a layer
+  // without colours takes the constant, not the filler.
+  std::vector<uint8_t> faceColorGiven, vertexColorGiven;
 };
+
+// The per-vertex attributes an earlier lighting filter leaves, whose
+// presence marks the vertex colours as a display of that result (radiosity,
+// photon mapping, the reference, sky lighting, a view's vertex radiance).
+inline constexpr const char* kResultAttributes[] = {"Radiosity", "Irradiance", "Radiance", "Reference"};
+
+// Appends part b's colours (faces nf0.., vertices nv0..) to a's, with the
+// given-masks above: a part without face or vertex colours gets the filler
+// (sRGB 188) marked not given; `bShows` names b's result attribute (its
+// vertex colours then count as not given).
+void appendColors(MeshAttributes& a, size_t nf0, size_t nv0, const MeshAttributes& b, size_t nf1, size_t nv1,
+                  const std::string& bShows);
 
 enum class EmitterSource { SelectedFaces, QualityAbove, None, Auto };
 inline constexpr auto kEmitterSources = makeEnumTable<EmitterSource>({
