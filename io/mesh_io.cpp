@@ -300,6 +300,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
       out.triangleToFace.push_back(uint32_t(f));
       if (!p.faceColor.empty()) out.attrs.faceColor.push_back(p.faceColor[f]);
       if (!p.faceQuality.empty()) out.attrs.faceQuality.push_back(p.faceQuality[f]);
+      if (!p.faceSelected.empty()) out.attrs.faceSelected.push_back(p.faceSelected[f]);
     }
   }
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));

@@ -23,6 +23,7 @@ struct Polygons {
   std::vector<uint32_t> index;
   std::vector<glm::u8vec3> faceColor;      // or empty
   std::vector<float> faceQuality;          // or empty
+  std::vector<uint8_t> faceSelected;       // 1: selected (PLY face flags bit 0x20, as MeshLab saves it), or empty
   // The vertex element's other float and double properties, by name, in
   // file order (what an earlier filter left: "Radiosity_x", "StdError"); a
   // value that is not finite in float is kept as NaN for its reader to judge.

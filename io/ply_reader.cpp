@@ -4,11 +4,12 @@
 // numbers are whole tokens, in range for their declared type; binary data is
 // little or big endian. Read: vertex x y z, nx ny nz, red green blue (integer
 // 0..255 or float 0..1); face vertex_indices (or vertex_index), red green
-// blue, quality (any numeric type); vertex flags (an integer: bit 0x20 is
-// vcglib's SELECTED, as MeshLab saves a selection); the vertex element's
-// other float and double properties are kept by name (an earlier filter's
-// per-vertex results). Every other element and property is skipped by its
-// size, so MeshLab's extras (face flags, texture coordinates) load.
+// blue, quality (any numeric type); vertex and face flags (an integer: bit
+// 0x20 is vcglib's SELECTED, as MeshLab saves a selection: a light selected
+// in MeshLab is an emitter for `gi` too); the vertex element's other float
+// and double properties are kept by name (an earlier filter's per-vertex
+// results). Every other element and property is skipped by its size, so
+// MeshLab's extras (texture coordinates) load.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -187,6 +188,7 @@ void assignRoles(Header& h, const std::string& name) {
       }
       if (face) {
         if (n == "quality") p.role = Role::Quality;
+        else if (n == "flags" && !p.list && isInteger(p.type)) p.role = Role::Flags;
         else if (n == "vertex_indices" || n == "vertex_index") p.role = Role::Indices;
       }
       if (vertex && p.role == Role::Skip && !p.list && !isInteger(p.type)) p.role = Role::Keep;
@@ -335,6 +337,7 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
       out.faceStart.reserve(size_t(e.count) + 1);
       if (colours) out.faceColor.resize(size_t(e.count));
       if (quality) out.faceQuality.resize(size_t(e.count));
+      if (has(e, Role::Flags)) out.faceSelected.resize(size_t(e.count));
     }
     for (uint64_t i = 0; i < e.count; ++i) {
       // Messages are built only on failure: this loop runs once per vertex and face.
@@ -396,7 +399,7 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
           case Role::G: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].g = colourByte(p.type, v); break;
           case Role::B: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].b = colourByte(p.type, v); break;
           case Role::Quality: out.faceQuality[k] = float(v); break;
-          case Role::Flags: out.vertexSelected[k] = (int64_t(v) & 0x20) ? 1 : 0; break;
+          case Role::Flags: (isVertex ? out.vertexSelected : out.faceSelected)[k] = (int64_t(v) & 0x20) ? 1 : 0; break;
           default: break;
         }
       }

@@ -199,9 +199,12 @@ TEST(MeshReaders, MeshLabExtrasAreSkipped) {
         .put(0.f).put(0.f);
   b.put(uint8_t(3)).put(int32_t(0)).put(int32_t(1)).put(int32_t(2)).put(uint8_t(6));
   for (int k = 0; k < 6; ++k) b.put(0.5f);
-  b.put(int32_t(0)).put(uint8_t(9)).put(uint8_t(8)).put(uint8_t(7)).put(uint8_t(255)).put(1.5f);
+  b.put(int32_t(0x20)).put(uint8_t(9)).put(uint8_t(8)).put(uint8_t(7)).put(uint8_t(255)).put(1.5f);
   const auto m = gi::io::parseMesh(b.s, "ply", "meshlab.ply");
   ASSERT_EQ(m.scene.faceCount(), 1u);
+  // The face flags' SELECTED bit (0x20) as MeshLab saves a selection: a light
+  // selected there is an emitter for gi too (they were skipped; an outside audit).
+  EXPECT_EQ(m.attrs.faceSelected, (std::vector<uint8_t>{1}));
   EXPECT_EQ(m.attrs.faceColor, (std::vector<glm::u8vec3>{{9, 8, 7}}));
   EXPECT_EQ(m.attrs.faceQuality, (std::vector<float>{1.5f}));
   ASSERT_EQ(m.scene.vertexNormals.size(), 3u);
