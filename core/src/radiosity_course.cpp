@@ -118,20 +118,32 @@ std::vector<int> parseSnapshotSteps(const std::string& text) {
   return steps;
 }
 
+namespace {
+glm::dvec3 areaMeanRho(const std::vector<double>& A, const std::vector<glm::vec3>& rho) {
+  double Atot = 0;
+  glm::dvec3 rhoA(0.0);
+  for (size_t i = 0; i < A.size(); ++i) Atot += A[i], rhoA += A[i] * glm::dvec3(rho[i]);
+  return Atot > 0 ? rhoA / Atot : glm::dvec3(0.0);
+}
+}  // namespace
+
 glm::vec3 ambientRadiosity(const std::vector<double>& A, const std::vector<glm::vec3>& rho,
                            const std::vector<glm::vec3>& dB) {
   // Per colour channel, as Cohen et al. work per band: one grey rho_avg (the
   // channels' luminance mix) made a closed room of rho (0.79, 0.31, 0.05)
   // 34% dark in red after 306 shots instead of exact (an outside check).
   double Atot = 0;
-  glm::dvec3 rhoA(0.0), unshot(0.0);
+  glm::dvec3 unshot(0.0);
   for (size_t i = 0; i < A.size(); ++i) {
     Atot += A[i];
-    rhoA += A[i] * glm::dvec3(rho[i]);
     unshot += A[i] * glm::dvec3(dB[i]);
   }
   if (!(Atot > 0)) return glm::vec3(0.f);
-  return glm::vec3(unshot / Atot / (glm::dvec3(1.0) - rhoA / Atot));
+  return glm::vec3(unshot / Atot / (glm::dvec3(1.0) - areaMeanRho(A, rho)));
+}
+
+glm::vec3 areaMeanReflectance(const std::vector<double>& A, const std::vector<glm::vec3>& rho) {
+  return glm::vec3(areaMeanRho(A, rho));
 }
 
 SnapshotTaker::SnapshotTaker(const Scene& s, const std::vector<glm::vec3>& E, const std::vector<glm::vec3>& rho,

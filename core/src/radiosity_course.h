@@ -21,6 +21,8 @@ std::vector<ParamSpec> radiosityCourseSpecs();
 // The ambient radiosity A above, RGB (0 for a scene without area).
 glm::vec3 ambientRadiosity(const std::vector<double>& A, const std::vector<glm::vec3>& rho,
                            const std::vector<glm::vec3>& dB);
+// The area mean reflectance rho-bar it assumes, RGB (0 without area).
+glm::vec3 areaMeanReflectance(const std::vector<double>& A, const std::vector<glm::vec3>& rho);
 
 // Keeps B per vertex (patch average) after the steps of opt.snapshotSteps.
 class SnapshotTaker {

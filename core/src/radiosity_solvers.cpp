@@ -206,10 +206,7 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
   if (shots >= maxShots)
     warnIfNotConverged(u, R, res.residual, stop.tol, stop.r, stop.maxIter, "shots per patch", res.stats);
   res.ambient = ambientTerm(u, dB);
-  double Atot = 0;
-  glm::dvec3 rhoA(0.0);
-  for (size_t i = 0; i < u.n; ++i) Atot += u.A[i], rhoA += u.A[i] * glm::dvec3(u.rho[i]);
-  res.ambientRho = Atot > 0 ? glm::vec3(rhoA / Atot) : glm::vec3(0.f);
+  res.ambientRho = areaMeanReflectance(u.A, u.rho);
 }
 
 }  // namespace gi::radiosity
