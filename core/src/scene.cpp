@@ -64,9 +64,22 @@ double diagonalOf(const glm::dvec3& lo, const glm::dvec3& hi) {
 
 Scene Scene::fromAbsolute(const std::vector<glm::dvec3>& pts, std::vector<glm::uvec3> tris) {
   Scene s;
-  const auto [lo, hi] = finiteBox(pts, referenced(pts.size(), tris));
-  s.origin = lo.x <= hi.x ? lo * 0.5 + hi * 0.5 : glm::dvec3(0.0);
-  s.unit = unitFor(diagonalOf(lo, hi));
+  auto frame = [&s](const std::pair<glm::dvec3, glm::dvec3>& box) {
+    const auto& [lo, hi] = box;
+    s.origin = lo.x <= hi.x ? lo * 0.5 + hi * 0.5 : glm::dvec3(0.0);
+    s.unit = unitFor(diagonalOf(lo, hi));
+  };
+  frame(finiteBox(pts, referenced(pts.size(), tris)));
+  // A vertex no face uses so far from the others that its offset overflows
+  // float: the frame of all the vertices instead (as before the used ones
+  // set it), so that no finite vertex becomes infinite.
+  for (const auto& p : pts) {
+    const glm::dvec3 d = glm::abs((p - s.origin) / s.unit);
+    if (std::isfinite(p.x + p.y + p.z) && !(std::max({d.x, d.y, d.z}) <= double(std::numeric_limits<float>::max()))) {
+      frame(finiteBox(pts));
+      break;
+    }
+  }
   s.positions.reserve(pts.size());
   for (const auto& p : pts) s.positions.push_back(glm::vec3((p - s.origin) / s.unit));
   s.triangles = std::move(tris);

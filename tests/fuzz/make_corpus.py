@@ -3,7 +3,7 @@
 every path through the readers (PLY ASCII and both binaries with the
 properties we read and the extras MeshLab writes, OFF and COFF with colours,
 OBJ with normals, texture coordinates, negative indices and vertex colours,
-binary and ASCII STL). Run it again after changing a reader's grammar."""
+binary and ASCII STL, concave polygons). Run it again after changing a reader's grammar."""
 import os
 import struct
 
@@ -43,6 +43,15 @@ write("colour.off", "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 
 write("quad.obj", "# seed\no quad\n" + "".join("v %g %g %g\n" % v for v in quad) +
       "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\ng top\ns off\nf 1/1/1 2/2/1 3/3/1\nf -4//1 -2//1 -1//1\n")
 write("colour.obj", "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n")
+# Concave polygons (ear clipping): an L-shaped hexagon and a notched quad;
+# an OBJ with materials in use (usemtl) and a polygon.
+concave = [(0, 0, 0), (2, 0, 0), (2, 1, 0), (1, 1, 0), (1, 2, 0), (0, 2, 0)]
+notch = [(2, 0, 0), (0.5, 0.5, 0), (0, 2, 0), (0, 0, 0)]
+write("concave.ply", "ply\nformat ascii 1.0\nelement vertex 10\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nproperty int flags\nend_header\n" +
+      "".join("%g %g %g\n" % v for v in concave + notch) + "6 0 1 2 3 4 5 32\n4 6 7 8 9 0\n")
+write("concave.off", "OFF\n6 1 0\n" + "".join("%g %g %g\n" % v for v in concave) + "6 0 1 2 3 4 5\n")
+write("concave.obj", "".join("v %g %g %g\n" % v for v in concave) + "usemtl a\nf 1 2 3 4 5 6\nusemtl b\nf 1 2 3\n")
 stl = b"STLB seed".ljust(80, b" ") + struct.pack("<I", 2)
 for t in ((quad[0], quad[1], quad[2]), (quad[0], quad[2], quad[3])):
     stl += struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *p) for p in t) + b"\0\0"

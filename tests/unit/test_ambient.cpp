@@ -238,6 +238,11 @@ TEST(AmbientOcclusionStress, FarUnusedVertexChangesNothing) {
   joined.append(Scene::fromAbsolute({glm::dvec3(1e5), glm::dvec3(-1e5)}, {}));
   EXPECT_EQ(joined.unit, plain.unit);
   EXPECT_EQ(sceneScale(joined).rayEpsilon, sceneScale(plain).rayEpsilon);
+  // One at the other end of the float range from the faces (the readers'
+  // fuzzer found its offset overflowing float): the frame of all the
+  // vertices, as before, every position finite.
+  const Scene edge = Scene::fromAbsolute({{-3e38, 0, 0}, {-3e38, 1, 0}, {-3e38, 0, 1}, {3e38, 0, 0}}, {{0, 1, 2}});
+  for (const auto& p : edge.positions) EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
 }
 
 TEST(AmbientOcclusionStress, BadGeometryNeverGivesNaN) {
