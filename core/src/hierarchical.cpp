@@ -70,10 +70,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
 
   std::vector<Link> links;
   // The triangle under source point raySourcePoint(k) of every node, for the
-  // rays a link remembers.
-  const size_t nSampled = set.linkRays <= kMaxSampledRays ? size_t(std::max(0, set.linkRays)) : 0;
-  // kHierarchyBytesPerNode counts 4 sampled source points per node.
-  const double baseBytes = double(nn) * (kHierarchyBytesPerNode + 4.0 * (double(nSampled) - 4.0));
+  // rays a link remembers (any of its points may be one).
+  const size_t nSampled = set.linkRays <= kMaxSampledRays ? size_t(kMaxSampledRays) : 0;
+  // kHierarchyBytesPerNode counts 16 sampled source points per node.
+  const double baseBytes = double(nn) * (kHierarchyBytesPerNode + 4.0 * (double(nSampled) - 16.0));
   const double byMemory = (set.memoryBytes - baseBytes) / kHierarchyBytesPerLink;
   const bool capped = set.maxLinks < byMemory;  // the link cap, not the memory, is the limit
   const size_t maxLinks = size_t(std::max(1.0, std::min(byMemory, set.maxLinks)));
@@ -122,6 +122,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // Each thread's kept node points, for all the rounds (one per task would
   // refill megabytes for a few thousand links: small scenes ran 1.5x slower).
   tbb::enumerable_thread_specific<NodePointCache> pointCaches;
+  VisibilityProbe probe{caster, eps, pointCaches};
   // The links refined against the current R: new ones get their F computed
   // (in parallel; each link's rays are fixed by its nodes: deterministic).
   auto refineLinks = [&](bool first, const std::vector<glm::vec3>& Rcur, const Progress& pr) {
@@ -131,7 +132,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     // in a bright room the reflected power is many times the emitted).
     double leaving = P;
     for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
-    Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, &nextFresh};
+    Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, &nextFresh, unoccluded ? nullptr : &probe};
     pr.report(0.0, "refining links");
     Timer rt;
     if (first) {
@@ -150,7 +151,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
         start.push_back({std::numeric_limits<double>::infinity(), 0, 0, kNoHit});
       } else {
         for (size_t k = 0; k < links.size(); ++k) {
-          if (ref.acceptable(links[k].p, links[k].q)) ref.add(links[k], false);
+          bool probed = false;
+          if (ref.acceptable(links[k].p, links[k].q, (links[k].samples & Link::kProbed) != 0, &probed))
+            ref.add(Refiner::marked(links[k], probed), false);
           else start.push_back({ref.power(links[k].p, links[k].q), links[k].p, links[k].q, uint32_t(k)});
         }
       }
@@ -209,11 +212,11 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
         glm::dvec3 h(0.0);
         for (size_t m = start[k]; m < start[k + 1]; ++m) {
           const Link& l = links[m];
-          if (l.samples == Link::kAreaMean) {
+          if (l.areaMean()) {
             h += double(l.F) * Rbar[l.q];
           } else {
             glm::dvec3 r(0.0);
-            for (uint32_t bits = l.samples; bits; bits &= bits - 1)
+            for (uint32_t bits = l.samples & Link::kSampleBits; bits; bits &= bits - 1)
               r += glm::dvec3(R[srcTri[size_t(l.q) * nSampled + size_t(__builtin_ctz(bits))]]);
             h += double(l.F) * r;
           }
@@ -276,7 +279,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     std::fill(rowScale.begin(), rowScale.end(), 1.0);
     std::fill(colScale.begin(), colScale.end(), 1.0);
     bool sampledLinks = false;
-    for (const Link& l : links) sampledLinks |= l.samples != Link::kAreaMean;
+    for (const Link& l : links) sampledLinks |= !l.areaMean();
     closedRoom = set.closureRays > 0 && !sampledLinks;
     for (size_t f = 0; f < nf && closedRoom; ++f) closedRoom = !(g.A[f] > 0) || closure[f] == 1.f;
     rowsMoved = 0;
@@ -427,6 +430,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   sol.stats.add("link_splits", double(splits));
   sol.stats.add("refinement_rounds", double(rounds));
   sol.stats.add("link_rays", double(rays));
+  sol.stats.add("probe_rays", double(probe.rays.load()));
   sol.stats.add("link_form_factor_seconds", ffSeconds);
   sol.stats.add("link_refinement_seconds", refineSeconds);
   sol.stats.add("hierarchy_sweep_seconds", solveSeconds);

@@ -36,6 +36,9 @@ struct Link {
   float F;        // area-mean form factor F_pq; with samples: F_pq per passing sample
   uint32_t samples = kAreaMean;  // bit k: visibility ray k passed (its source point's R is gathered)
   static constexpr uint32_t kAreaMean = 0x80000000u;  // no samples: gather the source's area mean
+  static constexpr uint32_t kProbed = 0x40000000u;    // its receiver's points all see the source alike
+  static constexpr uint32_t kSampleBits = 0xffffu;    // the bits of samples that name rays
+  bool areaMean() const { return (samples & kAreaMean) != 0; }
 };
 
 struct Tree {
@@ -64,10 +67,13 @@ void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[k
                 uint32_t faces[kPoints] = nullptr);
 
 // Visibility ray k of a link pairs point i of the receiver with point j of
-// the source; both point sets are walked in different orders.
+// the source; both point sets are walked in different orders (the first
+// kPoints source points are all of them, each once).
 inline int rayReceiverPoint(int k) { return k % kPoints; }
 inline int raySourcePoint(int k) { return (5 * k + 3 + k / kPoints) % kPoints; }
-constexpr int kMaxSampledRays = 31;  // rays a link can remember (bits of Link::samples)
+// Rays a link from a cluster can remember (bits of Link::samples): one per
+// source point. Above it, links gather their source's area mean.
+constexpr int kMaxSampledRays = kPoints;
 
 // True when no point of the box lies strictly in front of the plane (x0, n):
 // nothing in the box can exchange light with the front of that plane.
@@ -104,6 +110,18 @@ class NodePointCache {
   NodePointSet receiver_;
   std::vector<NodePointSet> sources_;
 };
+
+// The visibility ray between receiver point i and source point j of a link
+// (each lifted off its surface by the ray offset); false where that pair
+// exchanges nothing (either faces away from the other).
+bool linkRay(const NodePointSet& pp, const NodePointSet& pq, int i, int j, float eps, Ray& r);
+
+// Whether the 16 points of receiver p see source q unlike: a ray from each
+// to a point of q it exchanges light with passes for some and not for
+// others, or some exchange light with no point of q (rays counted in
+// `rays`).
+bool linkPartlyVisible(const Geometry& g, const Tree& t, const RayCaster& caster, uint32_t p, uint32_t q, float eps,
+                       uint64_t& rays, NodePointCache& points);
 
 void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, Link& link, int linkRays,
                     bool unoccluded, float eps, uint64_t& rays, NodePointCache& points);

@@ -24,7 +24,7 @@ void refineInParts(Refiner& ref, size_t nParts, const Work& work) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nParts, 1), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       if (stop.load(std::memory_order_relaxed)) return;
-      Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], &partFresh[i]};
+      Refiner part{ref.g, ref.t, ref.Rmax, ref.threshold, ref.maxLinks, parts[i], &partFresh[i], ref.probe};
       part.made = &made;
       part.stop = &stop;
       work(i, part);
@@ -50,6 +50,13 @@ void refineInParts(Refiner& ref, size_t nParts, const Work& work) {
 
 }  // namespace
 
+bool Refiner::partlyVisible(uint32_t p, uint32_t q) const {
+  uint64_t cast = 0;
+  const bool partly = linkPartlyVisible(g, t, probe->caster, p, q, probe->eps, cast, probe->points.local());
+  probe->rays.fetch_add(cast, std::memory_order_relaxed);
+  return partly;
+}
+
 // Refiner::refine(p0, q0) on all threads, with the same links in the same
 // order: the recursion's first levels are unfolded, in its order (each
 // pair as best first decides it), into at least kParts independent pairs
@@ -57,9 +64,10 @@ void refineInParts(Refiner& ref, size_t nParts, const Work& work) {
 void refineDepthFirst(Refiner& ref, uint32_t p0, uint32_t q0) {
   struct Item {
     uint32_t p, q;
-    bool link;  // acceptable: a link as it is
+    bool link;    // acceptable: a link as it is
+    bool probed;  // and found whole (Link::kProbed)
   };
-  std::vector<Item> frontier{{p0, q0, false}}, next;
+  std::vector<Item> frontier{{p0, q0, false, false}}, next;
   uint64_t splits = 0;
   Refiner::Decision d;
   for (bool grew = true; grew && frontier.size() < kParts;) {
@@ -73,16 +81,16 @@ void refineDepthFirst(Refiner& ref, uint32_t p0, uint32_t q0) {
       ref.decide({0.0, it.p, it.q, kNoHit}, d);
       grew = true;
       if (!d.self && d.acceptable) {
-        next.push_back({it.p, it.q, true});
+        next.push_back({it.p, it.q, true, d.probed});
         continue;
       }
       splits += d.self ? 0 : 1;
-      for (int k = 0; k < d.children; ++k) next.push_back({d.child[k].p, d.child[k].q, false});
+      for (int k = 0; k < d.children; ++k) next.push_back({d.child[k].p, d.child[k].q, false, false});
     }
     frontier.swap(next);
   }
   refineInParts(ref, frontier.size(), [&](size_t i, Refiner& part) {
-    if (frontier[i].link) part.add(Link{frontier[i].p, frontier[i].q, 0.f}, true);
+    if (frontier[i].link) part.add(Refiner::marked(Link{frontier[i].p, frontier[i].q, 0.f}, frontier[i].probed), true);
     else part.refine(frontier[i].p, frontier[i].q);
   });
   if (!ref.budgetHit) ref.splits += splits;
@@ -95,7 +103,9 @@ void refineAgain(Refiner& ref, const std::vector<Link>& old) {
   const size_t n = old.size(), nParts = std::min(n, kParts), step = nParts ? (n + nParts - 1) / nParts : 0;
   refineInParts(ref, nParts, [&](size_t i, Refiner& part) {
     for (size_t k = i * step; k < std::min(n, (i + 1) * step) && !part.stop->load(std::memory_order_relaxed); ++k) {
-      if (part.acceptable(old[k].p, old[k].q)) part.add(old[k], false);
+      bool probed = false;
+      if (part.acceptable(old[k].p, old[k].q, (old[k].samples & Link::kProbed) != 0, &probed))
+        part.add(Refiner::marked(old[k], probed), false);
       else part.refine(old[k].p, old[k].q);
     }
   });

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "hierarchy_nodes.h"
@@ -18,6 +19,18 @@ namespace gi::hierarchy {
 
 constexpr float kReceiverConeCos = 0.985f;  // 10 degrees
 constexpr double kSeparation = 0.5;
+// A link into a cluster that some of the cluster's points receive from
+// and others not stays only while it may carry at most this share of the
+// BF threshold (Refiner::acceptable).
+constexpr double kPartialShare = 1.0 / 64.0;
+
+// What the refiner needs to look along a link (Refiner::partlyVisible).
+struct VisibilityProbe {
+  const RayCaster& caster;
+  float eps;
+  tbb::enumerable_thread_specific<NodePointCache>& points;
+  std::atomic<uint64_t> rays{0};
+};
 
 struct Refiner {
   const Geometry& g;
@@ -27,6 +40,7 @@ struct Refiner {
   size_t maxLinks;
   std::vector<Link>& out;
   std::vector<uint8_t>* fresh;       // 1: F still to compute (null: all fresh, not recorded)
+  VisibilityProbe* probe = nullptr;  // null: the scene has no occluders
   uint64_t splits = 0;
   bool budgetHit = false;
   // A part of a refinement on all threads (refineInParts): the
@@ -43,8 +57,25 @@ struct Refiner {
   // triangles or clusters whose normals lie within kReceiverCone of their
   // axis (a wall, a gently curved piece of a scan); sources may be any
   // cluster, their triangles keep their own orientation in F.
+  //
+  // A receiving cluster also spreads what it gathers over triangles that
+  // may not see the source at all: one that reaches past an occluder's
+  // edge (the ceiling and walls where a partition stops short of them) or
+  // past a flat source's plane. The BF threshold is global, so in a room
+  // lit only through such a gap every link may carry a large share of what
+  // arrives there: the half of a room behind a coarse partition read 24%
+  // too bright against the flat solver. So a link into a cluster is looked
+  // along from each of the cluster's 16 points (a ray to a source point it
+  // can receive from, or none where it can receive from no source point),
+  // and where some points receive and others do not it is split until it
+  // may carry at most kPartialShare of the threshold or its receiver is a
+  // triangle (`HierarchicalRadiosity.ThinPartitionStopsTheLight`). A link
+  // looked along and found whole is marked (Link::kProbed) and not looked
+  // along again in later rounds.
   static bool wideReceiver(const Node& n) { return !n.leaf() && n.coneCos < kReceiverConeCos; }
-  bool acceptable(uint32_t p, uint32_t q) const {
+  // `probedBefore`: the link was found whole before; `probedNow`, if given,
+  // is set when it is found whole here.
+  bool acceptable(uint32_t p, uint32_t q, bool probedBefore = false, bool* probedNow = nullptr) const {
     const Node &np = t.nodes[p], &nq = t.nodes[q];
     if (np.leaf() && nq.leaf()) return true;
     if (wideReceiver(np)) return false;
@@ -52,9 +83,18 @@ struct Refiner {
     // Clusters far enough apart that the kernel varies little over them
     // (the 16-point rule's error falls as ((r_p + r_q) / dist)^2).
     if (!(d > 0) || np.r + nq.r > kSeparation * dist) return false;
-    const double Fmax = std::min(1.0, nq.A / (M_PI * d * d));
-    return np.A * Fmax * Rmax[q] <= threshold;
+    const double Fmax = std::min(1.0, nq.A / (M_PI * d * d)), power = np.A * Fmax * Rmax[q];
+    if (!(power <= threshold)) return false;
+    if (np.leaf() || !probe || probedBefore || power <= kPartialShare * threshold) return true;
+    if (partlyVisible(p, q)) return false;
+    if (probedNow) *probedNow = true;
+    return true;
   }
+  static Link marked(Link l, bool probed) {
+    if (probed) l.samples |= Link::kProbed;
+    return l;
+  }
+  bool partlyVisible(uint32_t p, uint32_t q) const;
 
   // A planar node (a triangle, or a flat piece of a wall) sees nothing of a
   // node wholly behind or in its plane, and vice versa.
@@ -135,14 +175,14 @@ struct Refiner {
   // children, or whether the link is acceptable and, if not, the two
   // children of its split (culled ones dropped, their power computed).
   struct Decision {
-    bool self = false, acceptable = false;
+    bool self = false, acceptable = false, probed = false;
     int children = 0;
     Candidate child[4];
   };
   void decide(const Candidate& c, Decision& d) const {
     const Node &np = t.nodes[c.p], &nq = t.nodes[c.q];
     d.self = c.p == c.q;
-    d.acceptable = false;
+    d.acceptable = d.probed = false;
     d.children = 0;
     const auto child = [&](uint32_t p, uint32_t q) {
       if (p != q && culled(p, q)) return;
@@ -154,7 +194,7 @@ struct Refiner {
         for (uint32_t b : {np.left, np.right}) child(a, b);
       return;
     }
-    d.acceptable = acceptable(c.p, c.q);
+    d.acceptable = acceptable(c.p, c.q, false, &d.probed);
     if (d.acceptable) return;
     if (splitsReceiver(np, nq)) {
       child(np.left, c.q);
@@ -193,8 +233,8 @@ struct Refiner {
           const size_t waiting = queue.size + (batch.size() - i - 1);
           if (d.acceptable || out.size() + waiting + 1 >= maxLinks) {
             budgetHit |= !d.acceptable;
-            if (c.old != kNoHit) add(old[c.old], false);
-            else add(Link{c.p, c.q, 0.f}, true);
+            if (c.old != kNoHit) add(marked(old[c.old], d.probed), false);
+            else add(marked(Link{c.p, c.q, 0.f}, d.probed), true);
             continue;
           }
           ++splits;
@@ -216,8 +256,9 @@ struct Refiner {
       return;
     }
     if (culled(p, q)) return;
-    if (acceptable(p, q)) {  // (the budget: refineInParts)
-      add(Link{p, q, 0.f}, true);
+    bool probed = false;
+    if (acceptable(p, q, false, &probed)) {  // (the budget: refineInParts)
+      add(marked(Link{p, q, 0.f}, probed), true);
       return;
     }
     ++splits;

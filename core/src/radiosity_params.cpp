@@ -75,8 +75,9 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "more links, closer to the flat solution (0: every patch pair, the flat solution at its cost).",
        .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0},
       {.name = "link_rays", .label = "Hierarchical: visibility rays per link",
-       .help = "Hierarchical solver only. Rays between paired points of a link's two nodes; the fraction that "
-               "passes scales the link's unoccluded form factor (cost: links x rays).",
+       .help = "Hierarchical solver only. Rays between paired points of a link's two nodes that exchange light; "
+               "the fraction that passes scales the link's unoccluded form factor (cost: links x rays). Up to 16, a "
+               "link from a cluster gathers the radiosity where its passing rays end; above, the cluster's mean.",
        .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
       {.name = "closure_rays", .label = "Hierarchical: closure rays per patch",
        .help = "Hierarchical solver only. The links' form factors are quadratures, so the factors of one patch's "

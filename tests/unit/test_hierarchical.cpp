@@ -451,7 +451,7 @@ TEST(HierarchicalRadiosity, AgreesWithFlatOnTenThousandPatchCornellBox) {
 // and indirect; the direct light is the same code for every run): epsilon 0
 // (every link joins two triangles, no cluster anywhere) is the reference;
 // the default links with sampled sources stay within 0.8% of it, the
-// area-mean rule (what link_rays above 31 falls back to: 32 rays) loses
+// area-mean rule (what link_rays above 16 falls back to: 32 rays) loses
 // more than twice as much. The rules are compared as the links give them,
 // without the closure's balance (closure_rays 0), which moves both.
 TEST(HierarchicalRadiosity, ClusterSourcesGatherWhatTheirRaysSee) {

@@ -91,12 +91,14 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
 
 // Bytes per node and per link the solver holds at its peak (for the memory
 // plan): a node's geometry, its four per-sweep values and the triangles
-// under its sampled source points (16 bytes at 4 link rays); a link's 16
+// under its 16 source points (64 bytes; 16 before 5 December 2026, when
+// only the first link_rays points could be a link's samples); a link's 16
 // bytes twice while it is refined, with its ordering and ray count. With the
 // radiosity solver's 400 per patch (two nodes per triangle): 407 MB for the
 // 321k-triangle benchmark room with 2.6M links (before the sampled sources:
-// 4 bytes less per link and 16 per node), measured peak 402 MB.
-inline constexpr double kHierarchyBytesPerNode = 256;
+// 4 bytes less per link and 16 per node), measured peak 402 MB, then 48
+// bytes more per node (31 MB there).
+inline constexpr double kHierarchyBytesPerNode = 304;
 inline constexpr double kHierarchyBytesPerLink = 56;
 
 }  // namespace gi
