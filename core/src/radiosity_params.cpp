@@ -89,7 +89,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "both what it gathers and what it sends (Sinkhorn balancing): no light is created or lost. "
                "Elsewhere the links stand, and the log's energy_balance_error (against the rays' count of what "
                "escapes) indicates how much light they create or lose (a warning above 5%: use a flat solver there). "
-               "Cost: patches x rays. 0: neither.",
+               "Cost: patches x rays (with occluders, where they serve the indicator alone: at most 8 million "
+               "rays in all, at least 4 a patch). 0: neither.",
        .type = ParamType::Int, .def = 64, .min = 0, .max = 65536},
       {.name = "max_links", .label = "Hierarchical: links at most",
        .help = "Hierarchical solver only. The links stop being refined at this many (as at the memory budget), "

@@ -67,7 +67,8 @@ struct HierarchySettings {
   double maxLinks = 1e18;     // and beyond this many links (refined best first, the strongest kept; a note)
   double enteringPower = 0;   // luminance power the sky and the sun bring onto the surfaces (gi/sky.h), local
                               // units; counts with the emitted power (Hd then holds their irradiance too)
-  int closureRays = 64;       // rays per triangle counting what its row sums to (0: no closure, no energy balance)
+  int closureRays = 64;       // rays per triangle counting what its row sums to (0: no closure, no energy balance;
+                              // with occluders at most 8M in all, at least 4 a triangle: the energy account alone)
   uint32_t seed = 0;          // of those rays
 };
 
