@@ -72,8 +72,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
 
   std::vector<Link> links;
   // The triangle under source point raySourcePoint(k) of every node, for the
-  // rays a link remembers (any of its points may be one).
-  const size_t nSampled = set.linkRays <= kMaxSampledRays ? size_t(kMaxSampledRays) : 0;
+  // rays a link remembers (any of its points may be one; none without
+  // occluders).
+  const size_t nSampled = unoccluded ? 0 : size_t(kPoints);
   // kHierarchyBytesPerNode counts 16 sampled source points per node.
   const double baseBytes = double(nn) * (kHierarchyBytesPerNode + 4.0 * (double(nSampled) - 16.0));
   const double byMemory = (set.memoryBytes - baseBytes) / kHierarchyBytesPerLink;

@@ -34,7 +34,7 @@ struct Node {
 struct Link {
   uint32_t p, q;  // receiver, source
   float F;        // area-mean form factor F_pq; with samples: F_pq per passing sample
-  uint32_t samples = kAreaMean;  // bit k: visibility ray k passed (its source point's R is gathered)
+  uint32_t samples = kAreaMean;  // bit sourceBit(j): a ray to source point j passed (its R is gathered)
   static constexpr uint32_t kAreaMean = 0x80000000u;  // no samples: gather the source's area mean
   static constexpr uint32_t kProbed = 0x40000000u;    // its receiver's points all see the source alike
   static constexpr uint32_t kSampleBits = 0xffffu;    // the bits of samples that name rays
@@ -71,9 +71,10 @@ void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[k
 // kPoints source points are all of them, each once).
 inline int rayReceiverPoint(int k) { return k % kPoints; }
 inline int raySourcePoint(int k) { return (5 * k + 3 + k / kPoints) % kPoints; }
-// Rays a link from a cluster can remember (bits of Link::samples): one per
-// source point. Above it, links gather their source's area mean.
-constexpr int kMaxSampledRays = kPoints;
+// The bit of Link::samples that names source point j: the k < kPoints with
+// raySourcePoint(k) = j (5 * 13 = 1 modulo 16), so that with up to 16 rays
+// bit k is ray k's.
+inline int sourceBit(int j) { return (13 * (j + kPoints - 3)) % kPoints; }
 
 // True when no point of the box lies strictly in front of the plane (x0, n):
 // nothing in the box can exchange light with the front of that plane.
