@@ -359,6 +359,8 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   st.add("photons_global_map", double(globalCount));
   e.check.surfaceArea = surface.totalArea();
   e.check.mapPhotons = maps.global ? maps.global->size() : maps.all->size();
+  for (size_t f = 0; f < r.s.faceCount() && !e.check.reflects; ++f)
+    e.check.reflects = r.s.faceMaterial(f) == Material::Diffuse && luminance(r.s.faceRho(f)) > 0.f;
   e.check.causticPhotons = maps.caustics ? maps.caustics->size() : 0;
   e.check.kNearestEstimates = true;
   st.add("photons_caustic_map", maps.caustics ? double(maps.caustics->size()) : 0.0);

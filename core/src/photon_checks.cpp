@@ -36,6 +36,13 @@ void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGathe
   if (!capTooSmall && c.estimates > 0 && c.fewEstimates * 10 > c.estimates)
     st.warn(std::to_string(c.fewEstimates) + " of " + std::to_string(c.estimates) + " density estimates hold fewer than " +
             std::to_string(kFewPhotons) + " photons (relative noise above 50%): raise max_radius or the photon count");
+  // No photon where surfaces reflect: every photon path ended before the map
+  // kept one (with the direct light sampled, the map keeps only photons
+  // after a bounce), and the result is the direct light alone with no more
+  // than a note (an outside audit: photons 1 left a closed room 23% dark).
+  if (c.mapPhotons == 0 && c.reflects)
+    st.warn("the photon map holds no photons (" + std::to_string(opt.photons) +
+            " photon paths): the light beyond the direct light is missing; shoot more photons");
   if (c.kNearestEstimates) {
     // k Phi / A(r_k): A(r_k) / lambda is Gamma(k)-distributed, so the
     // estimate's mean (k / (k - 1)) is infinite at k = 1, its variance at k = 2.

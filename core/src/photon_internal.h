@@ -29,6 +29,7 @@ struct PhotonGatherCheck {
   size_t estimates = 0;          // estimates that held at least one photon
   size_t fewEstimates = 0;       // of those, the ones with fewer than kFewPhotons
   bool kNearestEstimates = false;  // k-nearest estimates (not progressive)
+  bool reflects = false;         // some diffuse face reflects light (so some belongs in the map)
   double lostPowerFraction = 0;  // of the emitted power, still carried by paths cut at max_depth
   double lostChannelShare = 0;   // the same in the channel that loses the largest share of its power
   int lostChannel = 0;           // which (0 red, 1 green, 2 blue)

@@ -116,6 +116,16 @@ TEST(PhotonWarnings, KNearestBelowThreeOrAboveTheMap) {
   o.kNearest = 64;
   o.photons = 5;  // about 5 photons in the global map
   EXPECT_TRUE(warned(computePhotonMap(s, *caster, o).stats, "exceeds the")) << "k_nearest 64 with 5 paths";
+  // None at all (one path, absorbed or escaped before the map kept one): the
+  // indirect light is missing, said as a warning; a black room keeps none
+  // rightly, and is not warned about.
+  o.photons = 1;
+  const RunStats one = computePhotonMap(s, *caster, o).stats;
+  ASSERT_EQ(one.get("photons_global_map", -1.0), 0.0) << "this path left no photon in the map";
+  EXPECT_TRUE(warned(one, "holds no photons")) << all(one);
+  const Scene black = litBox(4, 0.f);
+  auto blackCaster = makeEmbreeCaster(black);
+  EXPECT_FALSE(warned(computePhotonMap(black, *blackCaster, o).stats, "holds no photons"));
   o.photons = 2000;
   o.progressive = true;  // k only sets the first radius there (whose few photons are said)
   o.kNearest = 1;
