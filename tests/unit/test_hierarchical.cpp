@@ -457,7 +457,7 @@ TEST(HierarchicalRadiosity, AgreesWithFlatOnTenThousandPatchCornellBox) {
 // light is the same code for every run): epsilon 0 (every link joins two
 // triangles, no cluster anywhere) is the reference; the default 4 rays stay
 // within 0.8% of it, and 32 rays, which now gather at the points they reach
-// too, come closer (-0.18% against -0.45%). The links are compared as they
+// too, come closer (-0.18% against -0.41%). The links are compared as they
 // give them, without the closure's balance (closure_rays 0).
 TEST(HierarchicalRadiosity, ClusterSourcesGatherWhatTheirRaysSee) {
   auto sf = scenes::cornellBox(50.0);
