@@ -1,7 +1,5 @@
 #include "meshlab_bridge.h"
 
-#include <algorithm>
-
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -96,9 +94,8 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
   }
   // One layer (or all alike): no masks, the one mesh's rule (a single
   // layer's displayed result is found from its attribute, as the CLI does).
-  auto allGiven = [](const std::vector<uint8_t>& m) { return std::all_of(m.begin(), m.end(), [](uint8_t g) { return g != 0; }); };
-  if (layers.size() == 1 || allGiven(b.attrs.vertexColorGiven)) b.attrs.vertexColorGiven.clear();
-  if (layers.size() == 1 || allGiven(b.attrs.faceColorGiven)) b.attrs.faceColorGiven.clear();
+  if (layers.size() == 1) b.attrs.vertexColorGiven.clear(), b.attrs.faceColorGiven.clear();
+  dropFullColorMasks(b.attrs);
   b.scene = Scene::fromAbsolute(pts, std::move(tris));
   return b;
 }

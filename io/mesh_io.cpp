@@ -222,6 +222,10 @@ namespace {
 constexpr size_t kMaxEarClipped = 256;
 void triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, std::vector<glm::uvec3>& out) {
   out.clear();
+  if (n == 3) {  // most faces: nothing to decide, nothing to allocate
+    out.push_back({0, 1, 2});
+    return;
+  }
   auto fan = [&](const std::vector<uint32_t>& k) {
     for (size_t i = 1; i + 1 < k.size(); ++i) out.push_back({k[0], k[i], k[i + 1]});
   };

@@ -57,6 +57,14 @@ struct Lines {
   std::string at() const { return "line " + std::to_string(number); }
 };
 
+// The rest of an OBJ or MTL line after its keyword, trimmed: what OpenMesh
+// takes as one name (a material, a library file).
+std::string_view restOfLine(std::string_view line, std::string_view keyword) {
+  std::string_view m = line.substr(line.find(keyword) + keyword.size());
+  m.remove_prefix(std::min(m.size(), m.find_first_not_of(" \t")));
+  return m.substr(0, m.find_last_not_of(" \t") + 1);
+}
+
 // OFF colours: 3 or 4 numbers, 0..255 integers or 0..1 floats.
 bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3& c) {
   const size_t n = w.size() - first;
@@ -218,19 +226,12 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       c.faceMaterial.push_back(material);
       ++c.faces;
     } else if (key == "usemtl") {
-      // OpenMesh takes the rest of the line, trimmed, as the name.
-      std::string_view m = in.line.substr(in.line.find("usemtl") + 6);
-      m.remove_prefix(std::min(m.size(), m.find_first_not_of(" \t")));
-      m = m.substr(0, m.find_last_not_of(" \t") + 1);
+      const std::string_view m = restOfLine(in.line, "usemtl");
       const auto at = std::find(c.materialNames.begin(), c.materialNames.end(), m);
       material = int(at - c.materialNames.begin());
       if (at == c.materialNames.end()) c.materialNames.emplace_back(m);
     } else if (key == "mtllib") {
-      // OpenMesh takes the rest of the line, trimmed, as one file name.
-      std::string_view file = in.line.substr(in.line.find("mtllib") + 6);
-      file.remove_prefix(std::min(file.size(), file.find_first_not_of(" \t")));
-      file = file.substr(0, file.find_last_not_of(" \t") + 1);
-      c.materialFiles.emplace_back(file);
+      c.materialFiles.emplace_back(restOfLine(in.line, "mtllib"));
       c.materialLines.push_back(size_t(in.line.data() - bytes.data()));
     } else if (key == "o" || key == "g" || key == "s" || key == "l" || key == "p") {
       // Names, groups and materials (OpenMesh reads the material's Kd as face colour); lines and points are ignored.
@@ -248,9 +249,7 @@ std::map<std::string, glm::dvec3> checkMaterial(std::string_view bytes, const st
   bool named = false;
   while (in.next()) {
     if (in.words[0] == "newmtl") {
-      std::string_view m = in.line.substr(in.line.find("newmtl") + 6);
-      m.remove_prefix(std::min(m.size(), m.find_first_not_of(" \t")));
-      current = std::string(m.substr(0, m.find_last_not_of(" \t") + 1));
+      current = std::string(restOfLine(in.line, "newmtl"));
       named = true;
       continue;
     }

@@ -277,7 +277,6 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
   link.F = float(F);
   if (unoccluded) return;
   Ray r;
-  auto pairRay = [&](int i, int j) { return linkRay(pp, pq, i, j, eps, r); };
   // A cluster source: the mask names the source points some passing ray
   // reached, bit sourceBit(j) for point j (up to kPoints rays, each point at
   // most once; beyond, the points again). Its F is per named point: the
@@ -293,7 +292,7 @@ void linkFormFactor(const Geometry& g, const Tree& t, const RayCaster& caster, L
   for (int k = 0; k < lastK && cast < linkRays; ++k) {
     const int j = raySourcePoint(k);
     int i = rayReceiverPoint(k), tries = 0;
-    while (!pairRay(i, j) && ++tries < kPoints) i = (i + 1) % kPoints;
+    while (!linkRay(pp, pq, i, j, eps, r) && ++tries < kPoints) i = (i + 1) % kPoints;
     if (tries == kPoints) continue;  // source point j sees no point of the receiver
     ++cast;
     if (caster.occluded(r)) continue;

@@ -303,11 +303,12 @@ void appendColors(MeshAttributes& a, size_t nf0, size_t nv0, const MeshAttribute
     else a.vertexColor.insert(a.vertexColor.end(), b.vertexColor.begin(), b.vertexColor.end());
   }
   if (a.vertexColorShows.empty()) a.vertexColorShows = bShows;
-  // All given: no mask (one mesh's rule).
-  auto drop = [](std::vector<uint8_t>& mask) {
-    if (std::all_of(mask.begin(), mask.end(), [](uint8_t g) { return g != 0; })) mask.clear();
-  };
-  drop(a.faceColorGiven), drop(a.vertexColorGiven);
+  dropFullColorMasks(a);
+}
+
+void dropFullColorMasks(MeshAttributes& a) {
+  for (std::vector<uint8_t>* mask : {&a.faceColorGiven, &a.vertexColorGiven})
+    if (std::all_of(mask->begin(), mask->end(), [](uint8_t g) { return g != 0; })) mask->clear();
 }
 
 namespace {

@@ -46,6 +46,8 @@ inline constexpr const char* kResultAttributes[] = {"Radiosity", "Irradiance", "
 // vertex colours then count as not given).
 void appendColors(MeshAttributes& a, size_t nf0, size_t nv0, const MeshAttributes& b, size_t nf1, size_t nv1,
                   const std::string& bShows);
+// Clears a given-mask that marks every colour given (one mesh's rule then).
+void dropFullColorMasks(MeshAttributes& a);
 
 enum class EmitterSource { SelectedFaces, QualityAbove, None, Auto };
 inline constexpr auto kEmitterSources = makeEnumTable<EmitterSource>({
