@@ -33,10 +33,11 @@ std::vector<ParamSpec> PhotonOptions::specs() {
       {.name = "k_nearest", .label = "Photons per estimate",
        .help = "The indirect light at a vertex is estimated from its k nearest photons (global map) on the same side "
                "of the surface: their power over the area of that surface within their radius (a disk on a plane, "
-               "half of it at a crease). At a vertex where a face turns more than 20 degrees from its normal (an "
-               "edge between walls), whose value is the irradiance of its own tilted plane, the photons of the "
-               "faces on both sides tell another quantity: with the direct light computed apart, such a vertex "
-               "takes a final gather of the photon map instead (gather_rays). More photons mean less noise (about "
+               "half of it at a crease). Where a face turning more than 20 degrees from the vertex normal (an edge "
+               "between walls) or another object (a block standing on the floor, a lamp just below the ceiling) "
+               "lies inside that radius, the photons tell another quantity than the vertex's value (the sphere "
+               "counts what the vertex does not see): with the direct light computed apart, such a vertex takes a "
+               "final gather of the photon map instead (gather_rays). More photons mean less noise (about "
                "1 / sqrt(k)) but more blur; k = 1 or 2 gives an estimate without a finite mean or variance.",
        .type = ParamType::Int, .def = 64, .min = 1, .max = 512},
       {.name = "caustic_k", .label = "Photons per caustic estimate",
@@ -147,29 +148,6 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
   return H;
 }
 
-// What the estimators need to know of a run.
-struct PhotonRun {
-  const Scene& s;
-  const RayCaster& caster;
-  const PhotonOptions& opt;  // in local units
-  const VertexMaterial& mat;
-  const std::vector<glm::vec3>& origins;  // ray origins lifted off the vertices
-  float eps;
-  bool specular;          // the scene has mirror or glass faces
-  bool projection;        // caustic photons aimed at them
-  unsigned vertexPaths;   // the photon paths the vertex estimates read
-  float r2max;            // squared gather radius cap
-  const SkyOpenings& openings;  // the sky's openings (gi/sky.h; none without a sky)
-};
-
-// The photons' irradiance at the vertices.
-struct PhotonEstimate {
-  std::vector<glm::vec3> H;
-  std::vector<double> noise;  // Poisson standard error (luminance)
-  size_t verticesWithoutPhotons = 0;
-  PhotonGatherCheck check;
-  std::vector<glm::vec3> byPath[kPathKinds];  // H's terms by the photons' path kind (light_path_split, k nearest)
-};
 
 // Direct light by light sampling at every vertex (area emitters, the point
 // or spot light, the sky and the sun), or none when the photons carry it.
@@ -202,26 +180,12 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
   return e;
 }
 
-// The kd-trees of a k-nearest run over the traced photons (which must
-// outlive them): the global map read at the vertices, or, with a final
-// gather, `all` read where its rays land; and the caustic map.
-struct PhotonMaps {
-  std::unique_ptr<PhotonMap> global, caustics, all;
-  // Without a final gather: the crease vertices (creaseVertices) that gather
-  // from `all` all the same; empty if none.
-  std::vector<uint8_t> crease;
-  unsigned globalPaths = 7u;
-  size_t bytes = 0;  // the photons and the trees
-};
 
 PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, const std::vector<Photon>& causticPhotons,
-                     const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& lastHit,
-                     std::vector<uint8_t> crease) {
+                     const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& hitsLeft) {
   PhotonMaps m;
-  m.crease = std::move(crease);
   m.globalPaths = r.opt.directLight ? (1u << kIndirectPhoton) : 7u;
   const bool gather = r.opt.directLight && r.opt.finalGather;
-  const bool creaseGather = !m.crease.empty();
   // Caustic photons (L S+ D) have their own map, shot by projection towards
   // the mirrors and glass, whenever the direct light is apart; otherwise one
   // map holds every photon. The (single-threaded) builds run side by side.
@@ -237,77 +201,12 @@ PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, con
           m.caustics = std::make_unique<PhotonMap>(photons, 1u << kCausticPhoton, surface);
       },
       [&] {
-        // Without the photons of a path's last allowed hit: the gather's rays add that reflection.
-        if (gather || creaseGather) m.all = std::make_unique<PhotonMap>(photons, 7u, surface, &lastHit);
+        if (gather) m.all = gatherMap(photons, surface, hitsLeft);
       });
   m.bytes = (photons.capacity() + causticPhotons.capacity()) * sizeof(Photon);
   for (const auto* map : {m.global.get(), m.caustics.get(), m.all.get()})
     if (map) m.bytes += map->memoryBytes();
   return m;
-}
-
-// Density estimates at the vertices: the global map there (or the final
-// gather reading `all`) with k_nearest photons, plus the caustic map with
-// caustic_k; counts the estimates that held some or only a few photons.
-PhotonEstimate estimateAtVertices(const PhotonRun& r, const PhotonMaps& m, const Progress& progress) {
-  const Scene& s = r.s;
-  const PhotonOptions& opt = r.opt;
-  const size_t nv = s.vertexCount();
-  PhotonEstimate e;
-  e.H.assign(nv, glm::vec3(0.f));
-  e.noise.assign(nv, 0.0);
-  const bool split = opt.lightPathSplit;
-  if (split)
-    for (auto& h : e.byPath) h.assign(nv, glm::vec3(0.f));
-  std::atomic<size_t> some{0}, few{0};
-  auto count = [&](int used) {
-    if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
-    if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
-  };
-  std::vector<glm::vec3> gathered;
-  // A final gather everywhere, or (k nearest) at the crease vertices only.
-  const bool gatherAll = m.all && m.crease.empty();
-  auto gatheredAt = [&](size_t i) { return gatherAll || (m.all && m.crease[i]); };
-  if (m.all) {
-    gathered = specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps,
-                                   [&](uint32_t f, const glm::vec3& y, const glm::vec3& side) {
-                                     int used = 0;
-                                     const glm::vec3 H = m.all->irradiance(y, side, opt.kNearest, r.r2max,
-                                                                           PhotonKernel::Uniform, nullptr, &used);
-                                     count(used);
-                                     return s.faceRho(f) * H;
-                                   },
-                                   gatherAll ? nullptr : &m.crease);
-  }
-  parallelBlocks(nv, progress, "density estimation", [&](size_t b, size_t end) {
-    for (size_t i = b; i < end; ++i) {
-      if (!r.mat.valid[i]) continue;
-      double e1 = 0, e2 = 0;
-      int used = 0;
-      // The terms by path kind: a final gather's photons lie one diffuse
-      // bounce beyond the vertex (all indirect); a map's by their tag.
-      glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
-      glm::vec3* byPath = split ? parts : nullptr;
-      const bool fg = gatheredAt(i);
-      glm::vec3 H = fg ? gathered[i]
-                       : m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max,
-                                              PhotonKernel::Uniform, &e1, &used, byPath);
-      if (fg) parts[kPathIndirect] = gathered[i];
-      if (!fg) count(used);
-      if (m.caustics)
-        H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2,
-                                    nullptr, byPath);
-      if (split)
-        for (int k = 0; k < kPathKinds; ++k) e.byPath[k][i] = parts[k];
-      e.H[i] = H;
-      e.noise[i] = std::sqrt(e1 * e1 + e2 * e2);
-    }
-  });
-  for (size_t i = 0; i < nv; ++i)
-    if (r.mat.valid[i] && luminance(e.H[i]) <= 0.f) ++e.verticesWithoutPhotons;
-  e.check.estimates = some.load();
-  e.check.fewEstimates = few.load();
-  return e;
 }
 
 // Photon mapping proper (Jensen 1996): trace, build the maps, estimate at
@@ -320,39 +219,42 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   // Crease vertices gather (the direct light apart; all light from photons
   // would need the gather to see the lights too).
   std::vector<uint8_t> crease;
-  if (opt.directLight && !gather) {
-    crease = creaseVertices(r.s, r.mat);
-    if (std::find(crease.begin(), crease.end(), uint8_t(1)) == crease.end()) crease.clear();
-  }
-  std::vector<uint8_t> lastHit;
+  if (opt.directLight && !gather) crease = creaseVertices(r.s, r.mat);
+  // The hits each photon's path had left: a final gather, here or at the
+  // vertices handed over to it, leaves out those with none.
+  std::vector<uint8_t> hitsLeft;
   std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.15, 0.45), ts,
-                                             gather || !crease.empty() ? &lastHit : nullptr);
+                                             opt.directLight ? &hitsLeft : nullptr);
   std::vector<Photon> causticPhotons;
   if (r.projection)
     causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
   const double traceSeconds = traceTimer.seconds();
   Timer buildTimer;
   const GatherSurface surface(r.s);
-  const size_t creaseCount = size_t(std::count(crease.begin(), crease.end(), uint8_t(1)));
-  const PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts, lastHit, std::move(crease));
+  PhotonMaps maps = buildMaps(r, photons, causticPhotons, surface, ts, hitsLeft);
   const double buildSeconds = buildTimer.seconds();
   if (contents) {
     // The same membership as the trees': `all` (final gather) or the global
     // paths, and the caustic map from the projection or the global trace.
-    const bool all = maps.all && maps.crease.empty();
+    const bool all = bool(maps.all);
     const unsigned globalMask = all ? 7u : maps.global ? maps.globalPaths : 0u;
     for (size_t i = 0; i < photons.size(); ++i)
-      if (((globalMask >> photons[i].path) & 1u) && !(all && lastHit[i])) contents->global.push_back(photons[i]);
+      if (((globalMask >> photons[i].path) & 1u) && !(all && hitsLeft[i] == 0)) contents->global.push_back(photons[i]);
     if (maps.caustics) {
       for (const Photon& p : r.projection && !causticPhotons.empty() ? causticPhotons : photons)
         if (p.path == kCausticPhoton) contents->caustic.push_back(p);
     }
   }
+  // What a final gather at every vertex leaves out is lost (the few vertices
+  // handed over to it in the k-nearest mode read the rest in full).
+  if (gather) ts.lostPower += ts.lastHitPower, ts.lostRGB += ts.lastHitRGB;
+  else ts.lostPower += ts.lastHitCutPower, ts.lostRGB += ts.lastHitCutRGB;
   Timer queryTimer;
-  PhotonEstimate e = estimateAtVertices(r, maps, progress.sub(0.55, 1.0));
+  HandOver ho;
+  PhotonEstimate e = estimateAtVertices(r, maps, photons, surface, hitsLeft, crease, ho, progress.sub(0.55, 1.0));
   st.add("trace_seconds", traceSeconds);
-  st.add("kdtree_build_seconds", buildSeconds);
-  st.add("query_seconds", queryTimer.seconds());
+  st.add("kdtree_build_seconds", buildSeconds + ho.buildSeconds);
+  st.add("query_seconds", queryTimer.seconds() - ho.buildSeconds);
   st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
   size_t globalCount = 0;
   for (const Photon& p : photons) globalCount += (maps.globalPaths >> p.path) & 1u;
@@ -367,11 +269,20 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   st.add("photon_memory_mb", maps.bytes / 1048576.0);
   if (!r.specular) st.note("no caustic map: the scene has no mirror, glass or glossy faces");
   else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
-  if (maps.all && maps.crease.empty())
+  if (gather) {
     st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
-  else if (maps.all)
-    st.note(std::to_string(creaseCount) + " vertices at creases gather the photon map (" +
-            std::to_string(opt.gatherRays) + " rays each): there a density estimate reads the faces on both sides");
+  } else if (ho.crease + ho.otherSheet > 0) {
+    st.add("vertices_gathered_at_creases", double(ho.crease));
+    st.add("vertices_gathered_beside_other_sheets", double(ho.otherSheet));
+    st.note(std::to_string(ho.crease + ho.otherSheet) + " vertices gather the photon map (" +
+            std::to_string(opt.gatherRays) + " rays each) where a density estimate tells another quantity: " +
+            std::to_string(ho.crease) + " at creases (it reads the faces on both sides), " +
+            std::to_string(ho.otherSheet) +
+            " with another object within its radius (an object standing on the surface, a lamp just below "
+            "a ceiling: the sphere counts what the vertex does not see)");
+  }
+  if (ho.at.size() && (gather || ho.crease + ho.otherSheet > 0))
+    st.add("gather_near_hits_relit", double(ho.nearHits));
   return e;
 }
 

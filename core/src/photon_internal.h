@@ -3,12 +3,14 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "gi/direct.h"
 #include "gi/photon.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -20,6 +22,21 @@ inline glm::i8vec3 packNormal(const glm::vec3& n) {
   return glm::i8vec3(int8_t(std::lround(n.x * 127.f)), int8_t(std::lround(n.y * 127.f)), int8_t(std::lround(n.z * 127.f)));
 }
 inline glm::vec3 unpackNormal(const glm::i8vec3& n) { return glm::vec3(n) * (1.f / 127.f); }
+
+// What the estimators need to know of a run.
+struct PhotonRun {
+  const Scene& s;
+  const RayCaster& caster;
+  const PhotonOptions& opt;  // in local units
+  const VertexMaterial& mat;
+  const std::vector<glm::vec3>& origins;  // ray origins lifted off the vertices
+  float eps;
+  bool specular;          // the scene has mirror or glass faces
+  bool projection;        // caustic photons aimed at them
+  unsigned vertexPaths;   // the photon paths the vertex estimates read
+  float r2max;            // squared gather radius cap
+  const SkyOpenings& openings;  // the sky's openings (gi/sky.h; none without a sky)
+};
 
 // What a run's density estimates looked like, for the warnings below.
 struct PhotonGatherCheck {
@@ -67,15 +84,70 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 // photons, and paths cut at max_depth carrying much of the power.
 void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st);
 
+// A final-gather ray's diffuse hit: the face, the point, its unit normal,
+// the length of the ray's last leg and a key of its own (vertex, ray).
+struct PhotonGatherHit {
+  uint32_t face;
+  glm::vec3 point, normal;
+  float t;
+  uint32_t key;
+};
 // Final gather at every vertex through mirrors, glass and glossy faces:
 // cosine-weighted rays from origins[v] follow them (up to 16 interactions;
 // a glossy lobe by one sample of it) and, at the
-// first diffuse face, add value(face, point, its unit normal) if the ray hit its front (0 otherwise).
+// first diffuse face, add value(hit) if the ray hit its front (0 otherwise).
 // `only` (one flag per vertex, or null for all): the vertices to gather at; the others get 0.
-std::vector<glm::vec3> specularFinalGather(
-    const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
-    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value,
-    const std::vector<uint8_t>* only = nullptr);
+std::vector<glm::vec3> specularFinalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
+                                           const std::vector<glm::vec3>& origins, int rays, uint32_t key, float eps,
+                                           const std::function<glm::vec3(const PhotonGatherHit&)>& value,
+                                           const std::vector<uint8_t>* only = nullptr);
+
+// The photons' irradiance at the vertices.
+struct PhotonEstimate {
+  std::vector<glm::vec3> H;
+  std::vector<double> noise;  // Poisson standard error (luminance)
+  size_t verticesWithoutPhotons = 0;
+  PhotonGatherCheck check;
+  std::vector<glm::vec3> byPath[kPathKinds];  // H's terms by the photons' path kind (light_path_split, k nearest)
+};
+
+class PhotonMap;
+class GatherSurface;
+// The kd-trees of a k-nearest run over the traced photons (which must
+// outlive them): the global map read at the vertices, or, with a final
+// gather, `all` read where its rays land; and the caustic map.
+struct PhotonMaps {
+  std::unique_ptr<PhotonMap> global, caustics, all;
+  unsigned globalPaths = 7u;
+  size_t bytes = 0;  // the photons and the trees
+};
+
+// Where the k-nearest mode gathered instead, and why.
+struct HandOver {
+  std::vector<uint8_t> at;  // per vertex
+  size_t crease = 0, otherSheet = 0, nearHits = 0;
+  double buildSeconds = 0;
+};
+
+// Density estimates at the vertices: the global map there with k_nearest
+// photons (or the final gather reading `all` everywhere), plus the caustic
+// map with caustic_k. With the direct light apart, the k-nearest mode hands
+// a vertex over to the final gather where the density estimate tells
+// another quantity than the vertex's value (photon_gather.cpp); `all` is
+// built for them if needed.
+PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::vector<Photon>& photons,
+                                  const GatherSurface& surface, const std::vector<uint8_t>& hitsLeft,
+                                  const std::vector<uint8_t>& crease, HandOver& ho, const Progress& progress);
+// `all`: the photons a final gather reads (without each path's last allowed hit).
+std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const GatherSurface& surface,
+                                     const std::vector<uint8_t>& hitsLeft);
+
+// The final gather of `all` (the photons without each path's last allowed
+// hit) at the vertices `only` marks (null: all), its near hits relit
+// (photon_gather.cpp); count(photons) for each estimate read, *nearHits
+// the hits relit.
+std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
+                                       const std::function<void(int)>& count, size_t* nearHits);
 
 // A vertex at a crease: one of its diffuse faces turns more than
 // kCreaseDegrees from its (averaged) normal. There the k-nearest density

@@ -20,16 +20,25 @@ enum class PhotonKernel {
   Cone,     // Jensen 1996: w = 1 - d / (k r), k = 1.1, over int w dA  (pi r^2 (1 - 2 / (3 k)) on a plane)
 };
 
+// Which photons an estimate reads: their path kinds (bits 1 << PhotonPath)
+// and the fewest hits their paths had left (needs the map's hitsLeft).
+struct PhotonOnly {
+  unsigned paths = 7u;
+  int minHitsLeft = 0;
+};
+
 class PhotonMap {
  public:
   // Photons whose path kind has its bit set in `pathMask` (1 << PhotonPath),
-  // but for those `exclude` (if given, one flag per photon) marks.
-  // `surface` normalises the estimates (it must outlive the map).
+  // but for those whose path had no hits left (`hitsLeft`, if given, one
+  // count per photon as tracePhotons writes it: 0 at a path's last allowed
+  // hit). `surface` normalises the estimates (it must outlive the map, and
+  // so must `hitsLeft`).
   PhotonMap(const std::vector<Photon>& all, unsigned pathMask, const GatherSurface& surface,
-            const std::vector<uint8_t>* exclude = nullptr)
-      : surface_(surface), cloud_{all, {}} {
+            const std::vector<uint8_t>* hitsLeft = nullptr)
+      : surface_(surface), left_(hitsLeft), cloud_{all, {}} {
     for (uint32_t i = 0; i < all.size(); ++i)
-      if ((pathMask & (1u << all[i].path)) && !(exclude && (*exclude)[i])) cloud_.idx.push_back(i);
+      if ((pathMask & (1u << all[i].path)) && !(hitsLeft && (*hitsLeft)[i] == 0)) cloud_.idx.push_back(i);
     // Positions copied together: the build reads them many times over.
     cloud_.pts.resize(cloud_.idx.size());
     for (size_t k = 0; k < cloud_.idx.size(); ++k) cloud_.pts[k] = all[cloud_.idx[k]].p;
@@ -48,12 +57,16 @@ class PhotonMap {
   // gets the Poisson standard error, *photons the number of photons used;
   // byPath (3 entries, or null) gets the same estimate's terms added by the
   // photons' path kind (they sum to the result within float rounding).
+  // `only` narrows the photons read (their path kinds, the hits their paths
+  // had left); *radius gets the estimate's radius (0 without photons).
   glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max, PhotonKernel kernel,
-                       double* noise = nullptr, int* photons = nullptr, glm::vec3* byPath = nullptr) const {
+                       double* noise = nullptr, int* photons = nullptr, glm::vec3* byPath = nullptr,
+                       const PhotonOnly& only = PhotonOnly(), float* radius = nullptr) const {
     if (photons) *photons = 0;
+    if (radius) *radius = 0.f;
     if (size() == 0 || k < 1) return glm::vec3(0.f);
     Query q;
-    nearestSameSide(x, n, k, r2max, q);
+    nearestSameSide(x, n, k, r2max, q, only);
     if (photons) *photons = q.used;
     if (q.used == 0) return glm::vec3(0.f);
     float r2 = q.d2[q.used - 1];
@@ -65,6 +78,7 @@ class PhotonMap {
     }
     r2 = std::max(r2, 1e-30f);
     const float r = std::sqrt(r2);
+    if (radius) *radius = r;
     // When the k-th photon sets the radius it lies on the disk's edge, and
     // counting it gives k / (pi r_k^2) photons per unit area, whose mean is
     // k / (k - 1) times the density (pi r_k^2 times the density is Gamma(k)
@@ -116,7 +130,8 @@ class PhotonMap {
   // Candidates come from the kd-tree in any orientation: 2k first, then more
   // (up to kMaxQuery) while fewer than k (but some) lie on this side, as at a
   // crease or corner where most of the nearest photons are on the other faces.
-  void nearestSameSide(const glm::vec3& x, const glm::vec3& n, int k, float r2max, Query& q) const {
+  void nearestSameSide(const glm::vec3& x, const glm::vec3& n, int k, float r2max, Query& q,
+                       const PhotonOnly& only = PhotonOnly()) const {
     const float p[3] = {x.x, x.y, x.z};
     uint32_t idx[kMaxQuery];
     float d2[kMaxQuery];
@@ -127,8 +142,11 @@ class PhotonMap {
       bool pastCap = false;
       for (size_t m = 0; m < found && q.used < k; ++m) {
         if (d2[m] > r2max) { pastCap = true; break; }
-        const Photon& ph = cloud_.all[cloud_.idx[idx[m]]];
+        const uint32_t i = cloud_.idx[idx[m]];
+        const Photon& ph = cloud_.all[i];
         if (glm::dot(ph.normal(), n) < kSameSide) continue;  // other side or another surface
+        if (!((only.paths >> ph.path) & 1u) || (only.minHitsLeft > 0 && left_ && (*left_)[i] < only.minHitsLeft))
+          continue;
         q.ph[q.used] = &ph;
         q.d2[q.used] = d2[m];
         ++q.used;
@@ -143,6 +161,7 @@ class PhotonMap {
     }
   }
   const GatherSurface& surface_;
+  const std::vector<uint8_t>* left_;
   struct Cloud {
     const std::vector<Photon>& all;
     std::vector<uint32_t> idx;

@@ -183,7 +183,7 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
-    uint32_t key, float eps, const std::function<glm::vec3(uint32_t, const glm::vec3&, const glm::vec3&)>& value,
+    uint32_t key, float eps, const std::function<glm::vec3(const PhotonGatherHit&)>& value,
     const std::vector<uint8_t>* only) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
@@ -206,7 +206,7 @@ std::vector<glm::vec3> specularFinalGather(
           const glm::vec3 y = ray.o + ray.d * h.t;
           const Material m = s.faceMaterial(h.face);
           if (m == Material::Diffuse) {
-            if (glm::dot(ray.d, ng) < 0.f) sum += glm::dvec3(weight * value(h.face, y, ng));
+            if (glm::dot(ray.d, ng) < 0.f) sum += glm::dvec3(weight * value({h.face, y, ng, h.t, hash3(uint32_t(v), key ^ 0x9e3779b9u, uint32_t(k))}));
             break;
           }
           if (m == Material::Glossy) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "gi/photon.h"
 #include "gi/specular.h"
@@ -66,14 +67,51 @@ double triangleBallArea(const glm::dvec3& a, const glm::dvec3& b, const glm::dve
   return std::clamp(std::abs(s), 0.0, 0.5 * twice);
 }
 
+// Per vertex, the sheet of usable faces (corners shared by position) it
+// lies on, as the smallest index of a vertex at a position in it.
+static std::vector<uint32_t> vertexSheets(const Scene& s, const std::vector<uint8_t>& ok) {
+  const size_t nv = s.vertexCount();
+  // Vertices at one position share the first one's index.
+  std::vector<uint32_t> order(nv), same(nv);
+  for (uint32_t i = 0; i < nv; ++i) order[i] = i;
+  const auto& P = s.positions;
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+    return std::tie(P[a].x, P[a].y, P[a].z, a) < std::tie(P[b].x, P[b].y, P[b].z, b);
+  });
+  for (size_t k = 0; k < nv; ++k) same[order[k]] = k > 0 && P[order[k]] == P[order[k - 1]] ? same[order[k - 1]] : order[k];
+  // Union-find over those, joined by the faces.
+  std::vector<uint32_t> up(nv);
+  for (uint32_t i = 0; i < nv; ++i) up[i] = i;
+  const auto find = [&](uint32_t a) {
+    while (up[a] != a) a = up[a] = up[up[a]];
+    return a;
+  };
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!ok[f]) continue;
+    const auto& t = s.triangles[f];
+    const uint32_t a = find(same[t.x]);
+    for (const uint32_t v : {t.y, t.z}) {
+      const uint32_t b = find(same[v]);
+      if (a != b) up[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  std::vector<uint32_t> sheet(nv, GatherSurface::kNoSheet);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) sheet[s.triangles[f][k]] = find(same[s.triangles[f][k]]);
+  return sheet;
+}
+
 GatherSurface::GatherSurface(const Scene& s) {
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  vertexSheet_ = vertexSheets(s, ok);
   std::vector<glm::vec3> centroid;
   for (size_t f = 0; f < s.faceCount(); ++f) {
     // Photons are stored on diffuse faces only.
     if (!ok[f] || isCausticSurface(s.faceMaterial(f))) continue;
     const auto& t = s.triangles[f];
+    sheet_.push_back(vertexSheet_[t.x]);
     a_.push_back(s.positions[t.x]);
     b_.push_back(s.positions[t.y]);
     c_.push_back(s.positions[t.z]);
@@ -121,6 +159,10 @@ uint32_t GatherSurface::build(uint32_t begin, uint32_t end, std::vector<glm::vec
   }
   nodes_[id].plane = planar && m != glm::vec3(0.f) ? plane : glm::vec3(0.f);
   nodes_[id].d = d;
+  uint32_t sheet = sheet_[f0];
+  for (uint32_t i = begin; i < end; ++i)
+    if (sheet_[order_[i]] != sheet) sheet = kNoSheet;
+  nodes_[id].sheet = sheet;
   if (end - begin <= 4) {
     double area = 0.0;
     for (uint32_t i = begin; i < end; ++i) area += faceArea_[order_[i]];
@@ -194,6 +236,35 @@ double GatherSurface::area(const glm::vec3& x, const glm::vec3& n, float r, bool
     }
   }
   return A;
+}
+
+bool GatherSurface::otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet,
+                                       float cosTurn) const {
+  if (nodes_.empty() || !(r > 0.f)) return false;
+  const float r2 = r * r;
+  const glm::dvec3 xd(x);
+  uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const uint32_t id = stack[--top];
+    const Node& node = nodes_[id];
+    const bool same = node.sheet == sheet && node.m != glm::vec3(0.f) && glm::dot(node.m, n) >= cosTurn;
+    if (same || !sphereMeetsBox(x, r2, node.lo, node.hi)) continue;
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = id + 1;
+      continue;
+    }
+    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+      const uint32_t f = order_[i];
+      if (sheet_[f] == sheet && glm::dot(n_[f], n) >= cosTurn) continue;
+      const float dc = glm::length(glm::vec3(bound_[f]) - x);
+      if (dc - bound_[f].w >= r) continue;
+      if (dc + bound_[f].w <= r || triangleBallArea(a_[f], b_[f], c_[f], xd, r) > 0.0) return true;
+    }
+  }
+  return false;
 }
 
 double GatherSurface::coneArea(const glm::vec3& x, const glm::vec3& n, float r, float k) const {

@@ -35,6 +35,22 @@ class GatherSurface {
   // at once where the whole disk lies on one plane through x.
   double coneArea(const glm::vec3& x, const glm::vec3& n, float r, float k) const;
 
+  // The sheets: the usable faces joined where they share a corner (by
+  // position, so that a welded room and a triangle soup of it are one sheet).
+  // The sheet of vertex v (kNoSheet for one no usable face holds).
+  static constexpr uint32_t kNoSheet = 0xffffffffu;
+  uint32_t vertexSheet(size_t v) const { return v < vertexSheet_.size() ? vertexSheet_[v] : kNoSheet; }
+  // Whether a counted face (diffuse, any orientation) within r of x belongs
+  // to another sheet than `sheet` (an object standing on the surface, a lamp
+  // just below a ceiling) or turns more than acos(cosTurn) from n (a wall
+  // meeting the floor, welded or not). There the density estimate's premise,
+  // the irradiance even over the surface inside the sphere, fails: the
+  // other surface hides part of the sky from points near it (the light
+  // falls steeply towards the edge, and the point may be in a contact
+  // shadow the sphere averages away), the floor hidden under a block counts
+  // as area, a lamp's photons as the ceiling's.
+  bool otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet, float cosTurn) const;
+
  private:
   // A bounding-volume hierarchy over the faces. A node wholly inside the ball
   // whose faces share one normal adds its area at once: on the planar walls
@@ -46,6 +62,7 @@ class GatherSurface {
     float d;
     double area;            // of the faces below
     uint32_t first, count;  // leaf: faces order_[first, first + count); inner: count = 0, children index + 1 and first
+    uint32_t sheet;         // the faces' common sheet, or kNoSheet if they differ
   };
   uint32_t build(uint32_t begin, uint32_t end, std::vector<glm::vec3>& centroid);
   std::vector<glm::vec3> a_, b_, c_, m_, n_;  // per counted face: corners, quantised and exact unit normals
@@ -53,6 +70,8 @@ class GatherSurface {
   std::vector<glm::vec4> bound_;  // per face: a bounding sphere (centre, radius)
   std::vector<uint32_t> order_;
   std::vector<Node> nodes_;
+  std::vector<uint32_t> sheet_;        // per counted face
+  std::vector<uint32_t> vertexSheet_;  // per vertex
 };
 
 }  // namespace gi

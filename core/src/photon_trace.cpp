@@ -300,9 +300,9 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
             // The gather's map leaves it out: its light is missing as a cut
             // path's is (but for a caustic, which the caustic map keeps), and
             // the path's own cut power below is part of it.
-            lastBlocks[b].push_back(depth == opt.maxDepth);
+            lastBlocks[b].push_back(uint8_t(std::min(opt.maxDepth - depth, 255)));
             flaggedLast = depth == opt.maxDepth && path != kCausticPhoton;
-            if (flaggedLast) st.lostPower += luminance(power), st.lostRGB += glm::dvec3(power);
+            if (flaggedLast) st.lastHitPower += luminance(power), st.lastHitRGB += glm::dvec3(power);
           }
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
@@ -320,6 +320,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         if (depth == hits) {
           ++st.lostAtMaxDepth;
           if (!flaggedLast) st.lostPower += luminance(power), st.lostRGB += glm::dvec3(power);
+          else st.lastHitCutPower += luminance(power), st.lastHitCutRGB += glm::dvec3(power);
         }
       }
       budget.add(out.size(), end - b * kBlock);
@@ -352,6 +353,10 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
     stats.storedPower += t.storedPower;
     stats.lostPower += t.lostPower;
     stats.lostRGB += t.lostRGB;
+    stats.lastHitPower += t.lastHitPower;
+    stats.lastHitRGB += t.lastHitRGB;
+    stats.lastHitCutPower += t.lastHitCutPower;
+    stats.lastHitCutRGB += t.lastHitCutRGB;
     stats.emittedRGB += t.emittedRGB;
   }
   stats.stored = stats.direct + stats.caustic + stats.indirect;

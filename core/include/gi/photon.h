@@ -110,14 +110,22 @@ struct PhotonTraceStats {
   // closed room, where the luminance's share understates a colour that
   // reflects more (lostPower: 5% where the result was 16.5% dark).
   glm::dvec3 lostRGB{0.0}, emittedRGB{0.0};
+  // Where the hits left were asked for, lostPower leaves out the paths
+  // whose last allowed hit stored a photon (but a caustic): what a final
+  // gather loses of them is that photon's power (lastHit), what a density
+  // estimate loses the power the path still carried after it (lastHitCut).
+  double lastHitPower = 0.0, lastHitCutPower = 0.0;
+  glm::dvec3 lastHitRGB{0.0}, lastHitCutRGB{0.0};
 };
 
 // Traces photons `first` .. `first + count - 1` of the seed's sequence (each
 // carrying 1/count of the power); deterministic for any thread count. A
 // path stores photons at its hits 0 .. max_depth (a photon at hit i brings
-// light of i reflections). `lastHit`, if given, gets one flag per photon:
-// 1 where it was stored at hit max_depth (the final gather's map leaves
-// those out: its rays add the last reflection).
+// light of i reflections). `lastHit`, if given, gets the hits each photon's
+// path had left, min(max_depth - i, 255): 0 where it was stored at hit
+// max_depth (the final gather's map leaves those out: its rays add the last
+// reflection; a near hit relit by one more ray reads only photons with 2 or
+// more left).
 std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                  size_t count, const Progress& progress, PhotonTraceStats& stats,
                                  std::vector<uint8_t>* lastHit = nullptr);

@@ -1,0 +1,177 @@
+// The final gather of the photon map (Jensen 1996) with its near hits relit,
+// and the vertices where the k-nearest estimate hands over to it.
+//
+// The gather's estimate at a vertex x with normal n is the mean over N
+// cosine-weighted rays of the reflected radiosity rho(y) H(y) where they land,
+//   H_indirect(x) ~ (1/N) sum_j rho(y_j) H(y_j),
+// H(y) the density estimate of the photon map at y (all photons but those of
+// each path's last allowed hit: the gather adds that reflection). That
+// estimate spreads what lands on y's surface over the sphere of radius r(y)
+// around y: where the ray is shorter than r(y) the vertex itself lies in the
+// region the estimate blurs, and it reads its own surroundings' average,
+// not the point's. At the foot of a block, a floor point's sphere reaches
+// under the block, where no photon lands: it reads too dark, and a vertex
+// there (half of whose rays land within a few centimetres) read 35-42% low
+// in the Cornell box. So at such a near hit (t < r(y)) the hit is relit, as
+// the radiosity filter's final gather relights its near hits
+// (radiosity_vertices.cpp):
+//   H(y) = H_direct(y) + H_caustic(y) + rho(z) H(z),
+// the direct light by light sampling at y itself (the area lights, the point
+// or spot light, the sky and the sun), the caustic photons read at y, and
+// the rest from one cosine ray from y to z, read from the photons with two
+// or more hits left (one reflection at z, one at y, one at x: max_depth
+// stays exact). One ray a near hit is enough: a vertex averages many.
+#include <atomic>
+
+#include "gi/color.h"
+#include "gi/emitters.h"
+#include "gi/sampling.h"
+#include "gi/scene_setup.h"
+#include "photon_internal.h"
+#include "photon_map.h"
+#include "photon_surface.h"
+
+namespace gi {
+
+std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const GatherSurface& surface,
+                                     const std::vector<uint8_t>& hitsLeft) {
+  return std::make_unique<PhotonMap>(photons, 7u, surface, &hitsLeft);
+}
+
+std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
+                                       const std::function<void(int)>& count, size_t* nearHits) {
+  const Scene& s = r.s;
+  const PhotonOptions& opt = r.opt;
+  const DirectLightAt directAt(s, r.caster, 4);
+  const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  std::atomic<size_t> relit{0};
+  PhotonOnly caustic, twoLeft;
+  caustic.paths = 1u << kCausticPhoton;
+  caustic.minHitsLeft = 1;
+  twoLeft.minHitsLeft = 2;
+  const auto read = [&](const glm::vec3& y, const glm::vec3& n, const PhotonOnly& o, float* radius, int* used) {
+    return all.irradiance(y, n, opt.kNearest, r.r2max, PhotonKernel::Uniform, nullptr, used, nullptr, o, radius);
+  };
+  const auto value = [&](const PhotonGatherHit& g) -> glm::vec3 {
+    int used = 0;
+    float radius = 0.f;
+    const glm::vec3 H = read(g.point, g.normal, PhotonOnly(), &radius, &used);
+    count(used);
+    // A far hit, or max_depth 0 (no reflection may be added at y).
+    if (!(g.t < radius) || opt.maxDepth < 1) return s.faceRho(g.face) * H;
+    relit.fetch_add(1, std::memory_order_relaxed);
+    const glm::vec3 o = g.point + g.normal * r.eps;
+    glm::vec3 Hy = directAt(g.point, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, o, g.normal) +
+                   skySunIrradianceAt(opt.outside, r.caster, o, g.normal, 4, g.key);
+    if (r.specular) Hy += read(g.point, g.normal, caustic, nullptr, nullptr);
+    Rng rng(hash3(g.key, 0x6eu, 0x2bu));
+    Ray ray;
+    ray.o = o;
+    ray.d = Frame(g.normal).toWorld(cosineHemisphere({rng.next(), rng.next()}));
+    const Hit h = r.caster.intersect(ray);
+    if (h.valid() && s.faceMaterial(h.face) == Material::Diffuse && glm::dot(ray.d, faceN[h.face]) < 0.f)
+      Hy += s.faceRho(h.face) * read(ray.o + ray.d * h.t, faceN[h.face], twoLeft, nullptr, nullptr);
+    return s.faceRho(g.face) * Hy;
+  };
+  std::vector<glm::vec3> H =
+      specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps, value, only);
+  if (nearHits) *nearHits = relit.load();
+  return H;
+}
+
+
+// Density estimates at the vertices: the global map there with k_nearest
+// photons (or the final gather reading `all` everywhere), plus the caustic
+// map with caustic_k; counts the estimates that held some or only a few
+// photons. With the direct light apart, the k-nearest mode hands a vertex
+// over to the final gather where the density estimate tells another
+// quantity than the vertex's value: at a crease (creaseVertices), and
+// where a face of another sheet comes within the estimate's radius
+// (GatherSurface::otherSheetWithin). `all` is built for them if needed.
+PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::vector<Photon>& photons,
+                                  const GatherSurface& surface, const std::vector<uint8_t>& hitsLeft,
+                                  const std::vector<uint8_t>& crease, HandOver& ho, const Progress& progress) {
+  const Scene& s = r.s;
+  const PhotonOptions& opt = r.opt;
+  const size_t nv = s.vertexCount();
+  PhotonEstimate e;
+  e.H.assign(nv, glm::vec3(0.f));
+  e.noise.assign(nv, 0.0);
+  const bool split = opt.lightPathSplit;
+  if (split)
+    for (auto& h : e.byPath) h.assign(nv, glm::vec3(0.f));
+  std::atomic<size_t> some{0}, few{0};
+  auto count = [&](int used) {
+    if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
+    if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
+  };
+  const bool gatherAll = !m.global;
+  const bool handOver = !gatherAll && opt.directLight;
+  ho.at.assign(nv, gatherAll ? 1 : 0);
+  std::vector<glm::vec3> fromGlobal(handOver ? nv : 0, glm::vec3(0.f));
+  std::atomic<size_t> creases{0}, sheets{0};
+  const float cosCrease = float(std::cos(kCreaseDegrees * M_PI / 180.0));
+  parallelBlocks(nv, progress.sub(0.0, gatherAll ? 0.1 : 0.6), "density estimation", [&](size_t b, size_t end) {
+    for (size_t i = b; i < end; ++i) {
+      if (!r.mat.valid[i]) continue;
+      double e1 = 0, e2 = 0;
+      // The terms by path kind: a final gather's photons lie one diffuse
+      // bounce beyond the vertex (all indirect); a map's by their tag.
+      glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
+      glm::vec3* byPath = split ? parts : nullptr;
+      glm::vec3 H(0.f);
+      if (!gatherAll) {
+        int used = 0;
+        float radius = 0.f;
+        H = m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max, PhotonKernel::Uniform, &e1,
+                                 &used, byPath, PhotonOnly(), &radius);
+        if (handOver) {
+          const bool atCrease = !crease.empty() && crease[i];
+          const bool other = !atCrease && surface.otherSurfaceWithin(s.positions[i], r.mat.n[i], radius,
+                                                                        surface.vertexSheet(i), cosCrease);
+          if (atCrease || other) {
+            ho.at[i] = 1;
+            (atCrease ? creases : sheets).fetch_add(1, std::memory_order_relaxed);
+            fromGlobal[i] = H;
+            e1 = 0;
+          } else {
+            count(used);
+          }
+        } else {
+          count(used);
+        }
+      }
+      if (m.caustics)
+        H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2,
+                                    nullptr, byPath);
+      if (split)
+        for (int k = 0; k < kPathKinds; ++k) e.byPath[k][i] = parts[k];
+      e.H[i] = H;
+      e.noise[i] = std::sqrt(e1 * e1 + e2 * e2);
+    }
+  });
+  ho.crease = creases.load();
+  ho.otherSheet = sheets.load();
+  if (gatherAll || ho.crease + ho.otherSheet > 0) {
+    Timer bt;
+    if (!m.all) {
+      m.all = gatherMap(photons, surface, hitsLeft);
+      m.bytes += m.all->memoryBytes();
+    }
+    ho.buildSeconds = bt.seconds();
+    const std::vector<glm::vec3> gathered = gatherPhotonMap(r, *m.all, &ho.at, count, &ho.nearHits);
+    for (size_t i = 0; i < nv; ++i) {
+      if (!ho.at[i] || !r.mat.valid[i]) continue;
+      // The global map's photons (all indirect with the direct light apart) give way to the gather's.
+      e.H[i] += gathered[i] - (handOver ? fromGlobal[i] : glm::vec3(0.f));
+      if (split) e.byPath[kPathIndirect][i] = gathered[i];
+    }
+  }
+  for (size_t i = 0; i < nv; ++i)
+    if (r.mat.valid[i] && luminance(e.H[i]) <= 0.f) ++e.verticesWithoutPhotons;
+  e.check.estimates = some.load();
+  e.check.fewEstimates = few.load();
+  return e;
+}
+
+}  // namespace gi
