@@ -190,6 +190,27 @@ uint32_t GatherSurface::build(uint32_t begin, uint32_t end, std::vector<glm::vec
   return id;
 }
 
+// Depth first over the nodes the ball (x, r2) meets: skip(node) true
+// leaves the node and what lies below it; leaf(node) visits a leaf's faces
+// and returns true to end the walk.
+template <class Skip, class Leaf>
+void GatherSurface::walk(const glm::vec3& x, float r2, Skip skip, Leaf leaf) const {
+  uint32_t stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const uint32_t id = stack[--top];
+    const Node& node = nodes_[id];
+    if (!sphereMeetsBox(x, r2, node.lo, node.hi) || skip(node)) continue;
+    if (node.count == 0) {
+      stack[top++] = node.first;
+      stack[top++] = id + 1;
+      continue;
+    }
+    if (leaf(node)) return;
+  }
+}
+
 double GatherSurface::area(const glm::vec3& x, const glm::vec3& n, float r, bool* flat) const {
   if (flat) *flat = true;
   if (nodes_.empty() || !(r > 0.f)) return 0.0;
@@ -203,38 +224,35 @@ double GatherSurface::area(const glm::vec3& x, const glm::vec3& n, float r, bool
     else if (glm::dot(ref, normal) < 1.f - 1e-6f) *flat = false;
   };
   double A = 0.0;
-  uint32_t stack[64];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const uint32_t id = stack[--top];
-    const Node& node = nodes_[id];
-    if (!sphereMeetsBox(x, r2, node.lo, node.hi)) continue;
+  const auto boxInside = [&](const Node& node) {
     const glm::vec3 far = glm::max(glm::abs(x - node.lo), glm::abs(x - node.hi));
-    const bool inside = glm::dot(far, far) <= r2;  // the whole box, hence every face below, within the ball
-    if (inside && node.m != glm::vec3(0.f)) {
-      if (glm::dot(node.m, n) >= kSameSide) {
-        A += node.area;
-        if (flat) onePlane(node.plane, node.plane != glm::vec3(0.f) && std::abs(glm::dot(node.plane, x) - node.d) <= tol);
-      }
-      continue;
-    }
-    if (node.count == 0) {
-      stack[top++] = node.first;
-      stack[top++] = id + 1;
-      continue;
-    }
-    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-      const uint32_t f = order_[i];
-      if (glm::dot(m_[f], n) < kSameSide) continue;
-      // The face's bounding sphere wholly inside the ball, or apart from it: no clipping.
-      const float dc = glm::length(glm::vec3(bound_[f]) - x);
-      if (!inside && dc - bound_[f].w >= r) continue;
-      const double a = inside || dc + bound_[f].w <= r ? faceArea_[f] : triangleBallArea(a_[f], b_[f], c_[f], xd, r);
-      A += a;
-      if (flat && a > 0.0) onePlane(n_[f], std::abs(glm::dot(n_[f], x - a_[f])) <= tol);
-    }
-  }
+    return glm::dot(far, far) <= r2;  // the whole box, hence every face below, within the ball
+  };
+  walk(x, r2,
+       [&](const Node& node) {
+         if (!(node.m != glm::vec3(0.f) && boxInside(node))) return false;
+         if (glm::dot(node.m, n) >= kSameSide) {
+           A += node.area;
+           if (flat)
+             onePlane(node.plane, node.plane != glm::vec3(0.f) && std::abs(glm::dot(node.plane, x) - node.d) <= tol);
+         }
+         return true;
+       },
+       [&](const Node& node) {
+         const bool inside = boxInside(node);
+         for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+           const uint32_t f = order_[i];
+           if (glm::dot(m_[f], n) < kSameSide) continue;
+           // The face's bounding sphere wholly inside the ball, or apart from it: no clipping.
+           const float dc = glm::length(glm::vec3(bound_[f]) - x);
+           if (!inside && dc - bound_[f].w >= r) continue;
+           const double a =
+               inside || dc + bound_[f].w <= r ? faceArea_[f] : triangleBallArea(a_[f], b_[f], c_[f], xd, r);
+           A += a;
+           if (flat && a > 0.0) onePlane(n_[f], std::abs(glm::dot(n_[f], x - a_[f])) <= tol);
+         }
+         return false;
+       });
   return A;
 }
 
@@ -243,28 +261,22 @@ bool GatherSurface::otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, f
   if (nodes_.empty() || !(r > 0.f)) return false;
   const float r2 = r * r;
   const glm::dvec3 xd(x);
-  uint32_t stack[64];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const uint32_t id = stack[--top];
-    const Node& node = nodes_[id];
-    const bool same = node.sheet == sheet && node.m != glm::vec3(0.f) && glm::dot(node.m, n) >= cosTurn;
-    if (same || !sphereMeetsBox(x, r2, node.lo, node.hi)) continue;
-    if (node.count == 0) {
-      stack[top++] = node.first;
-      stack[top++] = id + 1;
-      continue;
-    }
-    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
-      const uint32_t f = order_[i];
-      if (sheet_[f] == sheet && glm::dot(n_[f], n) >= cosTurn) continue;
-      const float dc = glm::length(glm::vec3(bound_[f]) - x);
-      if (dc - bound_[f].w >= r) continue;
-      if (dc + bound_[f].w <= r || triangleBallArea(a_[f], b_[f], c_[f], xd, r) > 0.0) return true;
-    }
-  }
-  return false;
+  bool found = false;
+  walk(x, r2,
+       [&](const Node& node) {
+         return node.sheet == sheet && node.m != glm::vec3(0.f) && glm::dot(node.m, n) >= cosTurn;
+       },
+       [&](const Node& node) {
+         for (uint32_t i = node.first; i < node.first + node.count && !found; ++i) {
+           const uint32_t f = order_[i];
+           if (sheet_[f] == sheet && glm::dot(n_[f], n) >= cosTurn) continue;
+           const float dc = glm::length(glm::vec3(bound_[f]) - x);
+           if (dc - bound_[f].w >= r) continue;
+           found = dc + bound_[f].w <= r || triangleBallArea(a_[f], b_[f], c_[f], xd, r) > 0.0;
+         }
+         return found;
+       });
+  return found;
 }
 
 double GatherSurface::coneArea(const glm::vec3& x, const glm::vec3& n, float r, float k) const {

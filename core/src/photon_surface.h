@@ -65,6 +65,8 @@ class GatherSurface {
     uint32_t sheet;         // the faces' common sheet, or kNoSheet if they differ
   };
   uint32_t build(uint32_t begin, uint32_t end, std::vector<glm::vec3>& centroid);
+  template <class Skip, class Leaf>
+  void walk(const glm::vec3& x, float r2, Skip skip, Leaf leaf) const;
   std::vector<glm::vec3> a_, b_, c_, m_, n_;  // per counted face: corners, quantised and exact unit normals
   std::vector<double> faceArea_;
   std::vector<glm::vec4> bound_;  // per face: a bounding sphere (centre, radius)
