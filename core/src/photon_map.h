@@ -25,6 +25,7 @@ enum class PhotonKernel {
 struct PhotonOnly {
   unsigned paths = 7u;
   int minHitsLeft = 0;
+  bool widen = true;  // search past the 2k nearest while fewer than k are on this side
 };
 
 class PhotonMap {
@@ -46,6 +47,8 @@ class PhotonMap {
     tree_->buildIndex();
   }
   size_t size() const { return cloud_.idx.size(); }
+  // The map's i-th photon (i < size()).
+  const Photon& photon(size_t i) const { return cloud_.all[cloud_.idx[i]]; }
   // Index and tree; the photons themselves belong to the caller's vector.
   size_t memoryBytes() const {
     return cloud_.idx.capacity() * sizeof(uint32_t) + cloud_.pts.capacity() * sizeof(glm::vec3) + tree_->usedMemory(*tree_);
@@ -58,10 +61,13 @@ class PhotonMap {
   // byPath (3 entries, or null) gets the same estimate's terms added by the
   // photons' path kind (they sum to the result within float rounding).
   // `only` narrows the photons read (their path kinds, the hits their paths
-  // had left); *radius gets the estimate's radius (0 without photons).
+  // had left); *radius gets the estimate's radius (0 without photons),
+  // *twoLeft (needs hitsLeft) the part of the estimate from the photons
+  // whose paths had two or more hits left.
   glm::vec3 irradiance(const glm::vec3& x, const glm::vec3& n, int k, float r2max, PhotonKernel kernel,
                        double* noise = nullptr, int* photons = nullptr, glm::vec3* byPath = nullptr,
-                       const PhotonOnly& only = PhotonOnly(), float* radius = nullptr) const {
+                       const PhotonOnly& only = PhotonOnly(), float* radius = nullptr,
+                       glm::vec3* twoLeft = nullptr) const {
     if (photons) *photons = 0;
     if (radius) *radius = 0.f;
     if (size() == 0 || k < 1) return glm::vec3(0.f);
@@ -89,13 +95,15 @@ class PhotonMap {
     // check: a closed box's reflected light 1.33 times too high at k = 4.
     // k = 1 keeps its one photon (no estimate of that form has a mean).
     const int counted = q.used == k && k >= 2 ? q.used - 1 : q.used;
-    glm::dvec3 sum(0.0);
+    glm::dvec3 sum(0.0), sumTwo(0.0);
     glm::dvec3 sumPath[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
     double sumL2 = 0.0;
     for (int m = 0; m < counted; ++m) {
       const float w = kernel == PhotonKernel::Cone ? std::max(0.f, 1.f - std::sqrt(q.d2[m]) / (kCone * r)) : 1.f;
       sum += double(w) * glm::dvec3(q.ph[m]->power);
       if (byPath) sumPath[q.ph[m]->path] += double(w) * glm::dvec3(q.ph[m]->power);
+      if (twoLeft && left_ && (*left_)[size_t(q.ph[m] - cloud_.all.data())] >= 2)
+        sumTwo += double(w) * glm::dvec3(q.ph[m]->power);
       const double l = double(w) * luminance(q.ph[m]->power);
       sumL2 += l * l;
     }
@@ -105,6 +113,7 @@ class PhotonMap {
     if (noise) *noise = std::sqrt(sumL2) / area;
     if (byPath)
       for (int p = 0; p < 3; ++p) byPath[p] += glm::vec3(sumPath[p] / area);
+    if (twoLeft) *twoLeft = glm::vec3(sumTwo / area);
     return glm::vec3(sum / area);
   }
 
@@ -155,7 +164,8 @@ class PhotonMap {
       q.exhausted = found < want || pastCap || (found && d2[found - 1] > r2max);
       // None on this side among 2k: this side holds (next to) none here, as
       // on a wall beside a caustic; the estimate is 0 without a wider search.
-      if (q.used >= k || q.used == 0 || q.exhausted || want >= std::min<size_t>(size(), kMaxQuery)) return;
+      if (q.used >= k || q.used == 0 || q.exhausted || !only.widen || want >= std::min<size_t>(size(), kMaxQuery))
+        return;
       // Enough candidates for k on this side at the share seen, with a margin.
       want = std::min<size_t>({size(), std::max(want * 2, want * size_t(k) * 5 / (size_t(q.used) * 4)), kMaxQuery});
     }

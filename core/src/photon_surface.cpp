@@ -259,17 +259,28 @@ double GatherSurface::area(const glm::vec3& x, const glm::vec3& n, float r, bool
 bool GatherSurface::otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet,
                                        float cosTurn) const {
   if (nodes_.empty() || !(r > 0.f)) return false;
-  const float r2 = r * r;
+  const float r2 = r * r, rise = 1e-4f * r, ownRise = 0.1f * r;
   const glm::dvec3 xd(x);
   bool found = false;
   walk(x, r2,
        [&](const Node& node) {
-         return node.sheet == sheet && node.m != glm::vec3(0.f) && glm::dot(node.m, n) >= cosTurn;
+         // The box's highest point above the plane: below the rise needed, nothing in it counts.
+         const glm::vec3 c = 0.5f * (node.lo + node.hi), h = 0.5f * (node.hi - node.lo);
+         const float top = glm::dot(n, c - x) + glm::dot(glm::abs(n), h);
+         const bool same = node.sheet == sheet;
+         return top <= rise || (same && top <= ownRise) ||
+                (same && node.m != glm::vec3(0.f) && glm::dot(node.m, n) >= cosTurn);
        },
        [&](const Node& node) {
          for (uint32_t i = node.first; i < node.first + node.count && !found; ++i) {
            const uint32_t f = order_[i];
-           if (sheet_[f] == sheet && glm::dot(n_[f], n) >= cosTurn) continue;
+           const bool own = sheet_[f] == sheet;
+           if (own && glm::dot(n_[f], n) >= cosTurn) continue;
+           // Only a face that rises above x's tangent plane can hide sky from
+           // it: another object's by any amount, the surface's own by a
+           // tenth of the radius (a wall, not a gentle hollow).
+           const float above = std::max({glm::dot(n, a_[f] - x), glm::dot(n, b_[f] - x), glm::dot(n, c_[f] - x)});
+           if (!(above > (own ? ownRise : rise))) continue;
            const float dc = glm::length(glm::vec3(bound_[f]) - x);
            if (dc - bound_[f].w >= r) continue;
            found = dc + bound_[f].w <= r || triangleBallArea(a_[f], b_[f], c_[f], xd, r) > 0.0;

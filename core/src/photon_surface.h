@@ -40,10 +40,12 @@ class GatherSurface {
   // The sheet of vertex v (kNoSheet for one no usable face holds).
   static constexpr uint32_t kNoSheet = 0xffffffffu;
   uint32_t vertexSheet(size_t v) const { return v < vertexSheet_.size() ? vertexSheet_[v] : kNoSheet; }
-  // Whether a counted face (diffuse, any orientation) within r of x belongs
-  // to another sheet than `sheet` (an object standing on the surface, a lamp
-  // just below a ceiling) or turns more than acos(cosTurn) from n (a wall
-  // meeting the floor, welded or not). There the density estimate's premise,
+  // Whether a counted face (diffuse, any orientation) within r of x rises
+  // above x's tangent plane (on n's side) and belongs to another sheet than
+  // `sheet` (an object standing on the surface, a lamp just below a ceiling:
+  // by more than 1e-4 r) or turns more than acos(cosTurn) from n (a wall
+  // meeting the floor, welded or not: by more than r / 10; a convex surface
+  // curving away from the plane, or a gentle hollow, does not count). There the density estimate's premise,
   // the irradiance even over the surface inside the sphere, fails: the
   // other surface hides part of the sky from points near it (the light
   // falls steeply towards the edge, and the point may be in a contact
