@@ -52,7 +52,7 @@ struct Group {
 // before the change (the default seed, against a cached reference of the
 // same tracer): the lamp's border +62.6% (worst 111%), the blocks' sides at
 // the floor -21.1% with the final gather and a worst of 74% at k nearest;
-// after: +0.5%, +2.0%, the worst 20%.
+// after: -0.3%, +2.1%, the worst 23%.
 TEST(PhotonContact, LampBorderAndBlockFeetMatchTheReference) {
   io::LoadedMesh mesh = io::loadMesh(std::string(GI_TEST_MESHES) + "/cornell_box.ply");
   Scene s = mesh.scene;
