@@ -133,7 +133,8 @@ class SiteIrradiance {
 }  // namespace
 
 std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
-                                       const std::function<void(int)>& count, size_t* nearHits) {
+                                       const std::function<void(int)>& count, size_t* nearHits,
+                                       const Progress& progress) {
   const Scene& s = r.s;
   const PhotonOptions& opt = r.opt;
   const DirectLightAt directAt(s, r.caster, 4);
@@ -171,7 +172,7 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
     return s.faceRho(g.face) * Hy;
   };
   std::vector<glm::vec3> H =
-      specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps, value, only);
+      specularFinalGather(s, r.caster, r.mat, r.origins, opt.gatherRays, opt.seed ^ 0x6au, r.eps, value, only, progress);
   if (nearHits) *nearHits = relit.load();
   return H;
 }
@@ -256,7 +257,8 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
       m.bytes += m.all->memoryBytes();
     }
     ho.buildSeconds = bt.seconds();
-    const std::vector<glm::vec3> gathered = gatherPhotonMap(r, *m.all, &ho.at, count, &ho.nearHits);
+    const std::vector<glm::vec3> gathered =
+        gatherPhotonMap(r, *m.all, &ho.at, count, &ho.nearHits, progress.sub(gatherAll ? 0.1 : 0.6, 1.0));
     for (size_t i = 0; i < nv; ++i) {
       if (!ho.at[i] || !r.mat.valid[i]) continue;
       // The global map's photons (all indirect with the direct light apart) give way to the gather's.

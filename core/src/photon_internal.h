@@ -100,7 +100,8 @@ struct PhotonGatherHit {
 std::vector<glm::vec3> specularFinalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
                                            const std::vector<glm::vec3>& origins, int rays, uint32_t key, float eps,
                                            const std::function<glm::vec3(const PhotonGatherHit&)>& value,
-                                           const std::vector<uint8_t>* only = nullptr);
+                                           const std::vector<uint8_t>* only = nullptr,
+                                           const Progress& progress = Progress(nullptr));
 
 // The photons' irradiance at the vertices.
 struct PhotonEstimate {
@@ -147,7 +148,8 @@ std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const G
 // (photon_gather.cpp); count(photons) for each estimate read, *nearHits
 // the hits relit.
 std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
-                                       const std::function<void(int)>& count, size_t* nearHits);
+                                       const std::function<void(int)>& count, size_t* nearHits,
+                                       const Progress& progress);
 
 // A vertex at a crease: one of its diffuse faces turns more than
 // kCreaseDegrees from its (averaged) normal. There the k-nearest density

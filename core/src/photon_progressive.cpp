@@ -184,10 +184,10 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
     uint32_t key, float eps, const std::function<glm::vec3(const PhotonGatherHit&)>& value,
-    const std::vector<uint8_t>* only) {
+    const std::vector<uint8_t>* only, const Progress& progress) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
-  parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+  parallelBlocks(s.vertexCount(), progress, "final gather", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
       if (!mat.valid[v] || (only && !(*only)[v])) continue;
       SobolOwenStream seq(hash3(uint32_t(v), key, 0xf9u));
