@@ -27,8 +27,6 @@
 #include <memory>
 #include <optional>
 
-#include <nanoflann.hpp>
-
 #include "gi/color.h"
 #include "gi/emitters.h"
 #include "gi/sampling.h"
@@ -36,6 +34,7 @@
 #include "photon_internal.h"
 #include "photon_map.h"
 #include "photon_surface.h"
+#include "point_cloud.h"
 
 namespace gi {
 
@@ -77,7 +76,7 @@ class SiteIrradiance {
       normal_[i] = ph.n;
       state_[i].store(0, std::memory_order_relaxed);
     }
-    tree_ = std::make_unique<Tree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    tree_ = std::make_unique<PointTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree_->buildIndex();
   }
   // The estimate at site i, computed at its first reading (a site no ray
@@ -116,18 +115,11 @@ class SiteIrradiance {
   int k_;
   float r2max_;
   size_t stride_;
-  struct Cloud {
-    std::vector<glm::vec3> pts;
-    size_t kdtree_get_point_count() const { return pts.size(); }
-    float kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
-    template <class B> bool kdtree_get_bbox(B&) const { return false; }
-  };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
-  Cloud cloud_;
+  PointCloud cloud_;
   std::vector<glm::i8vec3> normal_;
   mutable std::vector<Site> sites_;
   std::unique_ptr<std::atomic<uint8_t>[]> state_;  // 0 not computed, 1 being stored, 2 stored
-  std::unique_ptr<Tree> tree_;
+  std::unique_ptr<PointTree> tree_;
 };
 
 }  // namespace

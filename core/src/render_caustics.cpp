@@ -11,31 +11,23 @@
 #include <algorithm>
 #include <cmath>
 
-#include <nanoflann.hpp>
-
 #include "gi/color.h"
+#include "point_cloud.h"
 #include "render_internal.h"
 
 namespace gi::eye {
 
 struct CausticMap::Impl {
-  struct Cloud {
-    std::vector<glm::vec3> pts;
-    size_t kdtree_get_point_count() const { return pts.size(); }
-    float kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
-    template <class B> bool kdtree_get_bbox(B&) const { return false; }
-  };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
   std::vector<Photon> photons;
-  Cloud cloud;
-  std::unique_ptr<Tree> tree;
+  PointCloud cloud;
+  std::unique_ptr<PointTree> tree;
 };
 
 CausticMap::CausticMap(std::vector<Photon> photons) : impl_(std::make_unique<Impl>()) {
   impl_->photons = std::move(photons);
   impl_->cloud.pts.reserve(impl_->photons.size());
   for (const Photon& p : impl_->photons) impl_->cloud.pts.push_back(p.p);
-  impl_->tree = std::make_unique<Impl::Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  impl_->tree = std::make_unique<PointTree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   impl_->tree->buildIndex();
 }
 
