@@ -148,7 +148,6 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
   return H;
 }
 
-
 // Direct light by light sampling at every vertex (area emitters, the point
 // or spot light, the sky and the sun), or none when the photons carry it.
 // The sky through the mesh's openings (a window) is sampled through them as
@@ -179,7 +178,6 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
   for (int k = 0; k < kPathKinds; ++k) e.byPath[k] = std::move(pr.byPath[k]);
   return e;
 }
-
 
 PhotonMaps buildMaps(const PhotonRun& r, const std::vector<Photon>& photons, const std::vector<Photon>& causticPhotons,
                      const GatherSurface& surface, const PhotonTraceStats& ts, const std::vector<uint8_t>& hitsLeft) {
@@ -271,17 +269,17 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
   if (gather) {
     st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
-  } else if (ho.crease + ho.otherSheet > 0) {
+  } else if (ho.crease + ho.otherSurface > 0) {
     st.add("vertices_gathered_at_creases", double(ho.crease));
-    st.add("vertices_gathered_beside_other_sheets", double(ho.otherSheet));
-    st.note(std::to_string(ho.crease + ho.otherSheet) + " vertices gather the photon map (" +
+    st.add("vertices_gathered_beside_other_surfaces", double(ho.otherSurface));
+    st.note(std::to_string(ho.crease + ho.otherSurface) + " vertices gather the photon map (" +
             std::to_string(opt.gatherRays) + " rays each) where a density estimate tells another quantity: " +
             std::to_string(ho.crease) + " at creases (it reads the faces on both sides), " +
-            std::to_string(ho.otherSheet) +
-            " with another object within its radius (an object standing on the surface, a lamp just below "
-            "a ceiling: the sphere counts what the vertex does not see)");
+            std::to_string(ho.otherSurface) +
+            " where another surface rises inside its radius (an object standing on the surface, a lamp "
+            "just below a ceiling, a wall: the sphere counts what the vertex does not see)");
   }
-  if (ho.at.size() && (gather || ho.crease + ho.otherSheet > 0))
+  if (ho.at.size() && (gather || ho.crease + ho.otherSurface > 0))
     st.add("gather_near_hits_relit", double(ho.nearHits));
   return e;
 }

@@ -176,8 +176,8 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
 // photons. With the direct light apart, the k-nearest mode hands a vertex
 // over to the final gather where the density estimate tells another
 // quantity than the vertex's value: at a crease (creaseVertices), and
-// where a face of another sheet comes within the estimate's radius
-// (GatherSurface::otherSheetWithin). `all` is built for them if needed.
+// where another surface rises inside the estimate's radius
+// (GatherSurface::otherSurfaceWithin). `all` is built for them if needed.
 PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::vector<Photon>& photons,
                                   const GatherSurface& surface, const std::vector<uint8_t>& hitsLeft,
                                   const std::vector<uint8_t>& crease, HandOver& ho, const Progress& progress) {
@@ -199,7 +199,7 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
   const bool handOver = !gatherAll && opt.directLight;
   ho.at.assign(nv, gatherAll ? 1 : 0);
   std::vector<glm::vec3> fromGlobal(handOver ? nv : 0, glm::vec3(0.f));
-  std::atomic<size_t> creases{0}, sheets{0};
+  std::atomic<size_t> creases{0}, others{0};
   const float cosCrease = float(std::cos(kCreaseDegrees * M_PI / 180.0));
   parallelBlocks(nv, progress.sub(0.0, gatherAll ? 0.1 : 0.6), "density estimation", [&](size_t b, size_t end) {
     for (size_t i = b; i < end; ++i) {
@@ -221,7 +221,7 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
                                                                         surface.vertexSheet(i), cosCrease);
           if (atCrease || other) {
             ho.at[i] = 1;
-            (atCrease ? creases : sheets).fetch_add(1, std::memory_order_relaxed);
+            (atCrease ? creases : others).fetch_add(1, std::memory_order_relaxed);
             fromGlobal[i] = H;
             e1 = 0;
           } else {
@@ -241,8 +241,8 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
     }
   });
   ho.crease = creases.load();
-  ho.otherSheet = sheets.load();
-  if (gatherAll || ho.crease + ho.otherSheet > 0) {
+  ho.otherSurface = others.load();
+  if (gatherAll || ho.crease + ho.otherSurface > 0) {
     Timer bt;
     if (!m.all) {
       m.all = gatherMap(photons, surface, hitsLeft);

@@ -126,7 +126,7 @@ struct PhotonMaps {
 // Where the k-nearest mode gathered instead, and why.
 struct HandOver {
   std::vector<uint8_t> at;  // per vertex
-  size_t crease = 0, otherSheet = 0, nearHits = 0;
+  size_t crease = 0, otherSurface = 0, nearHits = 0;
   double buildSeconds = 0;
 };
 

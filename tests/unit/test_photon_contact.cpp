@@ -114,7 +114,7 @@ TEST(PhotonContact, LampBorderAndBlockFeetMatchTheReference) {
     o.finalGather = finalGather;
     const VertexRadiometry r = computePhotonMap(s, *caster, o);
     if (!finalGather) {
-      EXPECT_GT(r.stats.get("vertices_gathered_beside_other_sheets", 0.0), 0.0);
+      EXPECT_GT(r.stats.get("vertices_gathered_beside_other_surfaces", 0.0), 0.0);
       EXPECT_GT(r.stats.get("gather_near_hits_relit", 0.0), 0.0);
     }
     for (const Group* g : {&lamp, &foot, &floor}) {
