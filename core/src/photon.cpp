@@ -253,6 +253,7 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   st.add("trace_seconds", traceSeconds);
   st.add("kdtree_build_seconds", buildSeconds + ho.buildSeconds);
   st.add("query_seconds", queryTimer.seconds() - ho.buildSeconds);
+  if (ho.gatherSeconds > 0) st.add("final_gather_seconds", ho.gatherSeconds);
   st.add("photons_per_second", traceSeconds > 0 ? opt.photons / traceSeconds : 0.0);
   size_t globalCount = 0;
   for (const Photon& p : photons) globalCount += (maps.globalPaths >> p.path) & 1u;

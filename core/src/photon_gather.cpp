@@ -249,8 +249,10 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
       m.bytes += m.all->memoryBytes();
     }
     ho.buildSeconds = bt.seconds();
+    Timer gt;
     const std::vector<glm::vec3> gathered =
         gatherPhotonMap(r, *m.all, &ho.at, count, &ho.nearHits, progress.sub(gatherAll ? 0.1 : 0.6, 1.0));
+    ho.gatherSeconds = gt.seconds();
     for (size_t i = 0; i < nv; ++i) {
       if (!ho.at[i] || !r.mat.valid[i]) continue;
       // The global map's photons (all indirect with the direct light apart) give way to the gather's.

@@ -127,7 +127,7 @@ struct PhotonMaps {
 struct HandOver {
   std::vector<uint8_t> at;  // per vertex
   size_t crease = 0, otherSurface = 0, nearHits = 0;
-  double buildSeconds = 0;
+  double buildSeconds = 0, gatherSeconds = 0;
 };
 
 // Density estimates at the vertices: the global map there with k_nearest
