@@ -169,7 +169,6 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
   return H;
 }
 
-
 // Density estimates at the vertices: the global map there with k_nearest
 // photons (or the final gather reading `all` everywhere), plus the caustic
 // map with caustic_k; counts the estimates that held some or only a few
