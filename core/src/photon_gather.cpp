@@ -201,7 +201,6 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
   const bool gatherAll = !m.global;
   const bool handOver = !gatherAll && opt.directLight;
   ho.at.assign(nv, gatherAll ? 1 : 0);
-  std::vector<glm::vec3> fromGlobal(handOver ? nv : 0, glm::vec3(0.f));
   std::atomic<size_t> creases{0}, others{0};
   const float cosCrease = float(std::cos(kCreaseDegrees * M_PI / 180.0));
   parallelBlocks(nv, progress.sub(0.0, gatherAll ? 0.1 : 0.6), "density estimation", [&](size_t b, size_t end) {
@@ -225,7 +224,9 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
           if (atCrease || other) {
             ho.at[i] = 1;
             (atCrease ? creases : others).fetch_add(1, std::memory_order_relaxed);
-            fromGlobal[i] = H;
+            // The gather's light takes the global map's place (all indirect with the direct light apart).
+            H = glm::vec3(0.f);
+            parts[kPathIndirect] = glm::vec3(0.f);
             e1 = 0;
           } else {
             count(used);
@@ -258,8 +259,7 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
     ho.gatherSeconds = gt.seconds();
     for (size_t i = 0; i < nv; ++i) {
       if (!ho.at[i] || !r.mat.valid[i]) continue;
-      // The global map's photons (all indirect with the direct light apart) give way to the gather's.
-      e.H[i] += gathered[i] - (handOver ? fromGlobal[i] : glm::vec3(0.f));
+      e.H[i] += gathered[i];
       if (split) e.byPath[kPathIndirect][i] = gathered[i];
     }
   }

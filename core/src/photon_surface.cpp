@@ -6,6 +6,8 @@
 #include <cmath>
 #include <tuple>
 
+#include <tbb/parallel_sort.h>
+
 #include "gi/photon.h"
 #include "gi/specular.h"
 #include "photon_internal.h"
@@ -71,14 +73,24 @@ double triangleBallArea(const glm::dvec3& a, const glm::dvec3& b, const glm::dve
 // lies on, as the smallest index of a vertex at a position in it.
 static std::vector<uint32_t> vertexSheets(const Scene& s, const std::vector<uint8_t>& ok) {
   const size_t nv = s.vertexCount();
-  // Vertices at one position share the first one's index.
-  std::vector<uint32_t> order(nv), same(nv);
-  for (uint32_t i = 0; i < nv; ++i) order[i] = i;
+  // Vertices at one position share the first one's index. Only the usable
+  // faces' vertices are sorted: a vertex no face uses may be NaN, which no
+  // order can hold.
+  std::vector<uint8_t> used(nv, 0);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) used[s.triangles[f][k]] = 1;
+  std::vector<uint32_t> order, same(nv);
+  for (uint32_t i = 0; i < nv; ++i) {
+    same[i] = i;
+    if (used[i]) order.push_back(i);
+  }
   const auto& P = s.positions;
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+  tbb::parallel_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
     return std::tie(P[a].x, P[a].y, P[a].z, a) < std::tie(P[b].x, P[b].y, P[b].z, b);
   });
-  for (size_t k = 0; k < nv; ++k) same[order[k]] = k > 0 && P[order[k]] == P[order[k - 1]] ? same[order[k - 1]] : order[k];
+  for (size_t k = 1; k < order.size(); ++k)
+    if (P[order[k]] == P[order[k - 1]]) same[order[k]] = same[order[k - 1]];
   // Union-find over those, joined by the faces.
   std::vector<uint32_t> up(nv);
   for (uint32_t i = 0; i < nv; ++i) up[i] = i;
