@@ -82,7 +82,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        .help = "Shoot the photons in passes and keep, per vertex, a gather radius and the flux found in it; after "
                "each pass the radius shrinks so that a fraction alpha = 2/3 of the new photons is kept (Hachisuka, "
                "Ogaki and Jensen 2008). Bias and noise both go to zero as passes grow, with memory for one pass "
-               "only. Replaces the k-nearest estimates and the final gather.",
+               "only. Replaces the k-nearest estimates and the final gather, but where a density estimate tells "
+               "another quantity (at a crease, beside another surface: see k_nearest): with the direct light "
+               "apart, those vertices take a final gather of the first passes' photons (200,000 paths).",
        .type = ParamType::Bool, .def = false},
       {.name = "passes", .label = "Progressive passes",
        .help = "Passes of 'Photons emitted' photons each (progressive mode).",
@@ -163,9 +165,22 @@ std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& prog
   return Hd;
 }
 
+// The log's account of the vertices handed over to the final gather (none: nothing).
+void reportHandOver(const PhotonOptions& opt, const HandOver& ho, const std::string& map, RunStats& st) {
+  if (ho.crease + ho.otherSurface == 0) return;
+  st.add("vertices_gathered_at_creases", double(ho.crease));
+  st.add("vertices_gathered_beside_other_surfaces", double(ho.otherSurface));
+  st.add("gather_near_hits_relit", double(ho.nearHits));
+  st.note(std::to_string(ho.crease + ho.otherSurface) + " vertices gather " + map + " (" +
+          std::to_string(opt.gatherRays) + " rays each) where a density estimate tells another quantity: " +
+          std::to_string(ho.crease) + " at creases (it reads the faces on both sides), " +
+          std::to_string(ho.otherSurface) +
+          " where another surface rises inside its radius (an object standing on the surface, a lamp "
+          "just below a ceiling, a wall: the sphere counts what the vertex does not see)");
+}
+
 PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress, PhotonTraceStats& ts, RunStats& st) {
-  ProgressiveResult pr =
-      progressivePhotonMap(r.s, r.caster, r.opt, r.mat, r.vertexPaths, r.projection, progress.sub(0.15, 1.0), ts);
+  ProgressiveResult pr = progressivePhotonMap(r, progress.sub(0.15, 1.0), ts);
   st.add("ppm_passes", double(r.opt.passes));
   st.add("ppm_mean_final_radius", pr.meanRadius * r.s.unit);
   st.add("ppm_mean_photons_per_vertex", pr.meanCount);
@@ -173,7 +188,14 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
   st.add("query_seconds", pr.querySeconds);
   st.add("trace_seconds", pr.traceSeconds);
   st.add("photon_memory_mb", pr.peakBytes / 1048576.0);
-  if (r.opt.finalGather) st.note("final gather not used: progressive photon mapping estimates all photon light");
+  if (r.opt.finalGather)
+    st.note("final gather not used: progressive photon mapping estimates the photon light (but where it hands over)");
+  if (pr.ho.gatherSeconds > 0) st.add("final_gather_seconds", pr.ho.gatherSeconds);
+  if (pr.gatherPasses > 0)
+    reportHandOver(r.opt, pr.ho,
+                   "a map of the first " + std::to_string(pr.gatherPasses) + " passes' photons, their power / " +
+                       std::to_string(pr.gatherPasses),
+                   st);
   PhotonEstimate e{std::move(pr.H), std::move(pr.noise), pr.verticesWithoutPhotons, pr.check};
   for (int k = 0; k < kPathKinds; ++k) e.byPath[k] = std::move(pr.byPath[k]);
   return e;
@@ -270,18 +292,10 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   else if (!opt.directLight) st.note("caustic photons read with the others (one map: the direct light is not apart)");
   if (gather) {
     st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
-  } else if (ho.crease + ho.otherSurface > 0) {
-    st.add("vertices_gathered_at_creases", double(ho.crease));
-    st.add("vertices_gathered_beside_other_surfaces", double(ho.otherSurface));
-    st.note(std::to_string(ho.crease + ho.otherSurface) + " vertices gather the photon map (" +
-            std::to_string(opt.gatherRays) + " rays each) where a density estimate tells another quantity: " +
-            std::to_string(ho.crease) + " at creases (it reads the faces on both sides), " +
-            std::to_string(ho.otherSurface) +
-            " where another surface rises inside its radius (an object standing on the surface, a lamp "
-            "just below a ceiling, a wall: the sphere counts what the vertex does not see)");
-  }
-  if (ho.at.size() && (gather || ho.crease + ho.otherSurface > 0))
     st.add("gather_near_hits_relit", double(ho.nearHits));
+  } else {
+    reportHandOver(opt, ho, "the photon map", st);
+  }
   return e;
 }
 

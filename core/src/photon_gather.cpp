@@ -173,6 +173,14 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
   return H;
 }
 
+bool handsOver(const PhotonRun& r, const GatherSurface& surface, const std::vector<uint8_t>& crease, size_t i,
+               float radius, bool& atCrease) {
+  const float cosCrease = float(std::cos(kCreaseDegrees * M_PI / 180.0));
+  atCrease = !crease.empty() && crease[i];
+  return atCrease ||
+         surface.otherSurfaceWithin(r.s.positions[i], r.mat.n[i], radius, surface.vertexSheet(i), cosCrease);
+}
+
 // Density estimates at the vertices: the global map there with k_nearest
 // photons (or the final gather reading `all` everywhere), plus the caustic
 // map with caustic_k; counts the estimates that held some or only a few
@@ -202,7 +210,6 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
   const bool handOver = !gatherAll && opt.directLight;
   ho.at.assign(nv, gatherAll ? 1 : 0);
   std::atomic<size_t> creases{0}, others{0};
-  const float cosCrease = float(std::cos(kCreaseDegrees * M_PI / 180.0));
   parallelBlocks(nv, progress.sub(0.0, gatherAll ? 0.1 : 0.6), "density estimation", [&](size_t b, size_t end) {
     for (size_t i = b; i < end; ++i) {
       if (!r.mat.valid[i]) continue;
@@ -217,11 +224,9 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
         float radius = 0.f;
         H = m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max, PhotonKernel::Uniform, &e1,
                                  &used, byPath, PhotonOnly(), &radius);
+        bool atCrease = false;
         if (handOver) {
-          const bool atCrease = !crease.empty() && crease[i];
-          const bool other = !atCrease && surface.otherSurfaceWithin(s.positions[i], r.mat.n[i], radius,
-                                                                        surface.vertexSheet(i), cosCrease);
-          if (atCrease || other) {
+          if (handsOver(r, surface, crease, i, radius, atCrease)) {
             ho.at[i] = 1;
             (atCrease ? creases : others).fetch_add(1, std::memory_order_relaxed);
             // The gather's light takes the global map's place (all indirect with the direct light apart).

@@ -39,9 +39,10 @@ class PhotonGrid {
     return photons_.capacity() * sizeof(Photon) + keys_.capacity() * sizeof(uint64_t) + starts_.capacity() * sizeof(uint32_t);
   }
   // Flux and count of the photons within sqrt(r2) of x that arrived on n's
-  // side; byPath (3 entries, or null) gets the flux by the photons' path kind.
+  // side and whose path kind is in `paths` (bits 1 << PhotonPath); byPath
+  // (3 entries, or null) gets the flux by the photons' path kind.
   void gather(const glm::vec3& x, const glm::vec3& n, float r2, glm::dvec3& flux, size_t& count,
-              glm::dvec3* byPath = nullptr) const {
+              glm::dvec3* byPath = nullptr, unsigned paths = 7u) const {
     if (byPath)
       for (int k = 0; k < 3; ++k) byPath[k] = glm::dvec3(0.0);
     flux = glm::dvec3(0.0);
@@ -58,7 +59,7 @@ class PhotonGrid {
           for (uint32_t m = starts_[c]; m < starts_[c + 1]; ++m) {
             const Photon& p = photons_[m];
             const glm::vec3 d = p.p - x;
-            if (glm::dot(d, d) > r2 || glm::dot(p.normal(), n) < kSameSide) continue;
+            if (glm::dot(d, d) > r2 || glm::dot(p.normal(), n) < kSameSide || !((paths >> p.path) & 1u)) continue;
             flux += glm::dvec3(p.power);
             if (byPath) byPath[p.path] += glm::dvec3(p.power);
             ++count;

@@ -54,30 +54,6 @@ struct PhotonGatherCheck {
 // A handful: below it an estimate's relative noise exceeds 1 / sqrt(4) = 50%.
 constexpr int kFewPhotons = 4;
 
-// Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
-// vertices as the measurement points: per vertex a radius R, an accumulated
-// photon count N and flux tau. After each pass of M new photons within R,
-//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) A(R') / A(R),
-// and H = tau / (A(R) passes) (each pass's photons carry the full power / count),
-// with A(R) the area of the counted surface within R (photon_surface.h): pi R^2
-// on a plane, where the flux ratio is Hachisuka's R'^2 / R^2.
-// The first radius is the distance to the k-th nearest photon of the first pass.
-// With `projection`, each pass's caustic photons come from traceCausticPhotons
-// (those of the global pass are dropped).
-struct ProgressiveResult {
-  std::vector<glm::vec3> H;
-  std::vector<double> noise;  // Poisson error estimate per vertex (luminance)
-  size_t verticesWithoutPhotons = 0;
-  double meanRadius = 0, meanCount = 0;
-  double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;
-  double peakBytes = 0;
-  PhotonGatherCheck check;  // surface, photons over all passes, vertices with few photons
-  std::vector<glm::vec3> byPath[3];  // H's terms by the photons' path kind (opt.lightPathSplit)
-};
-ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
-                                       const Progress& progress, PhotonTraceStats& stats);
-
 // Warnings (RunStats::warn) for parameters that make the result meaningless:
 // a gather radius cap below the photon spacing, estimates of a handful of
 // photons, k below 3 (no finite mean or variance), k above the map's
@@ -130,6 +106,13 @@ struct HandOver {
   double buildSeconds = 0, gatherSeconds = 0;
 };
 
+// Whether vertex i takes a final gather instead of its density estimate
+// (of the given radius): at a crease (`crease`, from creaseVertices, or
+// empty for none; *atCrease says so), or where another surface rises inside
+// the radius (GatherSurface::otherSurfaceWithin).
+bool handsOver(const PhotonRun& r, const GatherSurface& surface, const std::vector<uint8_t>& crease, size_t i,
+               float radius, bool& atCrease);
+
 // Density estimates at the vertices: the global map there with k_nearest
 // photons (or the final gather reading `all` everywhere), plus the caustic
 // map with caustic_k. With the direct light apart, the k-nearest mode hands
@@ -150,6 +133,38 @@ std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const G
 std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
                                        const std::function<void(int)>& count, size_t* nearHits,
                                        const Progress& progress);
+
+// Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
+// vertices as the measurement points: per vertex a radius R, an accumulated
+// photon count N and flux tau. After each pass of M new photons within R,
+//   N' = N + alpha M,   R'^2 = R^2 (N + alpha M) / (N + M),   tau' = (tau + Phi_M) A(R') / A(R),
+// and H = tau / (A(R) passes) (each pass's photons carry the full power / count),
+// with A(R) the area of the counted surface within R (photon_surface.h): pi R^2
+// on a plane, where the flux ratio is Hachisuka's R'^2 / R^2.
+// The first radius is the distance to the k-th nearest photon of the first pass.
+// With `projection`, each pass's caustic photons come from traceCausticPhotons
+// (those of the global pass are dropped). With the direct light apart, the
+// vertices where a density estimate tells another quantity than the
+// vertex's value (a crease, another surface inside the first radius: as in
+// the k-nearest mode, photon_gather.cpp) keep only their caustic photons
+// and take a final gather of the first passes' photons for the rest: as
+// many passes as kPpmGatherPaths paths need (the default photons of the
+// k-nearest mode; on the Cornell box 1 to 10 passes of 200,000 gave the
+// same errors, the gather's own noise dominating, at 0.3 to 2.3 s more).
+struct ProgressiveResult {
+  std::vector<glm::vec3> H;
+  std::vector<double> noise;  // Poisson error estimate per vertex (luminance)
+  size_t verticesWithoutPhotons = 0;
+  double meanRadius = 0, meanCount = 0;
+  double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;
+  double peakBytes = 0;
+  PhotonGatherCheck check;  // surface, photons over all passes, vertices with few photons
+  std::vector<glm::vec3> byPath[3];  // H's terms by the photons' path kind (opt.lightPathSplit)
+  HandOver ho;                       // the vertices that gathered, and why
+  int gatherPasses = 0;              // passes whose photons the gather read
+};
+constexpr size_t kPpmGatherPaths = 200000;
+ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progress, PhotonTraceStats& stats);
 
 // A vertex at a crease: one of its diffuse faces turns more than
 // kCreaseDegrees from its (averaged) normal. There the k-nearest density

@@ -1,5 +1,6 @@
 // Progressive photon mapping and the specular-aware final gather.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -37,15 +38,32 @@ struct PpmVertices {
 };
 
 // The photons of one pass; with projection, its caustic photons are the
-// aimed ones (those of the global pass dropped).
-std::vector<Photon> tracePass(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, int pass,
-                              bool projection, const Progress& pp, PhotonTraceStats& stats) {
+// aimed ones (those of the global pass dropped). With `keep`, the global
+// trace's photons (all kinds) are appended to it with their power times
+// keepScale, and the hits their paths had left to keep->left.
+struct KeptPhotons {
+  std::vector<Photon> photons;
+  std::vector<uint8_t> left;
+  size_t bytes() const { return photons.capacity() * sizeof(Photon) + left.capacity(); }
+};
+std::vector<Photon> tracePass(const PhotonRun& r, int pass, const Progress& pp, PhotonTraceStats& stats,
+                              KeptPhotons* keep, float keepScale) {
+  const PhotonOptions& opt = r.opt;
   const size_t count = size_t(opt.photons);
-  std::vector<Photon> photons = tracePhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats);
-  if (projection) {
+  // The hits left are asked for whenever the direct light is apart, so the
+  // lost-power account is the same in every pass (progressivePhotonMap).
+  std::vector<uint8_t> left;
+  std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats,
+                                             opt.directLight ? &left : nullptr);
+  if (keep) {
+    keep->photons.reserve(keep->photons.size() + photons.size());
+    for (const Photon& p : photons) keep->photons.push_back({p.p, p.power * keepScale, p.n, p.path});
+    keep->left.insert(keep->left.end(), left.begin(), left.end());
+  }
+  if (r.projection) {
     auto caustic = [](const Photon& p) { return p.path == kCausticPhoton; };
     photons.erase(std::remove_if(photons.begin(), photons.end(), caustic), photons.end());
-    const auto c = traceCausticPhotons(s, caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
+    const auto c = traceCausticPhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
     photons.insert(photons.end(), c.begin(), c.end());
   }
   return photons;
@@ -84,15 +102,19 @@ float gridCell(const VertexMaterial& mat, const PpmVertices& v, float r2fallback
 
 // One pass's update at every vertex: M new photons within R give
 // N' = N + alpha M, R'^2 = R^2 (N + alpha M) / (N + M), tau' = (tau + Phi_M) A(R') / A(R).
+// The vertices `caustic` marks (handed over to the final gather) count
+// only their caustic photons.
 void updateVertices(const Scene& s, const VertexMaterial& mat, const PhotonGrid& grid, const GatherSurface& surface,
-                    double alpha, const Progress& progress, const std::string& what, PpmVertices& v) {
+                    double alpha, const std::vector<uint8_t>& caustic, const Progress& progress,
+                    const std::string& what, PpmVertices& v) {
   parallelBlocks(s.vertexCount(), progress, what, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!mat.valid[i]) continue;
       glm::dvec3 flux, fluxPath[3];
       size_t M = 0;
       const bool split = !v.tauPath[0].empty();
-      grid.gather(s.positions[i], mat.n[i], v.R2[i], flux, M, split ? fluxPath : nullptr);
+      grid.gather(s.positions[i], mat.n[i], v.R2[i], flux, M, split ? fluxPath : nullptr,
+                  caustic[i] ? 1u << kCausticPhoton : 7u);
       if (M == 0) continue;
       v.seen[i] += M;
       const double ratio = (v.N[i] + alpha * double(M)) / (v.N[i] + double(M));
@@ -111,8 +133,10 @@ void updateVertices(const Scene& s, const VertexMaterial& mat, const PhotonGrid&
 }
 
 // H = tau / (A(R) passes) per vertex, its Poisson noise, and the counts the
-// warnings and the log need.
-void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, ProgressiveResult& r) {
+// warnings and the log need (a vertex that gathers is without photons only
+// if its gather finds none either).
+void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, const std::vector<uint8_t>& gathers,
+               ProgressiveResult& r) {
   const size_t nv = v.R2.size();
   r.H.assign(nv, glm::vec3(0.f));
   r.noise.assign(nv, 0.0);
@@ -130,7 +154,10 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, Prog
     }
     sumR += std::sqrt(double(v.R2[i]));
     sumN += v.N[i];
-    if (v.N[i] <= 0.0) { ++r.verticesWithoutPhotons; continue; }
+    if (v.N[i] <= 0.0) {
+      r.verticesWithoutPhotons += gathers[i] ? 0 : 1;
+      continue;
+    }
     const double area = v.A[i] > 0.0 ? v.A[i] : M_PI * double(v.R2[i]);
     const glm::dvec3 H = v.tau[i] / (area * passes);
     r.H[i] = glm::vec3(H);
@@ -143,12 +170,57 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, Prog
   r.meanCount = valid ? sumN / double(valid) : 0.0;
 }
 
+// The vertices that take a final gather (photon_gather.cpp's test with the
+// first radius), counted by reason.
+void decideHandOver(const PhotonRun& r, const GatherSurface& surface, const PpmVertices& v, HandOver& ho) {
+  const std::vector<uint8_t> crease = creaseVertices(r.s, r.mat);
+  ho.at.assign(r.s.vertexCount(), 0);
+  std::atomic<size_t> creases{0}, others{0};
+  parallelBlocks(r.s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      bool atCrease = false;
+      if (!r.mat.valid[i] || !handsOver(r, surface, crease, i, std::sqrt(v.R2[i]), atCrease)) continue;
+      ho.at[i] = 1;
+      (atCrease ? creases : others).fetch_add(1, std::memory_order_relaxed);
+    }
+  });
+  ho.crease = creases.load();
+  ho.otherSurface = others.load();
+}
+
+// The final gather at the vertices handed over, from the kept photons'
+// map, added to their (caustic) estimates.
+void gatherHandedOver(const PhotonRun& r, const GatherSurface& surface, const KeptPhotons& kept,
+                      const Progress& progress, ProgressiveResult& out) {
+  Timer bt;
+  const std::unique_ptr<PhotonMap> all = gatherMap(kept.photons, surface, kept.left);
+  out.buildSeconds += bt.seconds();
+  out.peakBytes = std::max(out.peakBytes, double(kept.bytes() + all->memoryBytes()));
+  std::atomic<size_t> some{0}, few{0};
+  const auto count = [&](int used) {
+    if (used > 0) some.fetch_add(1, std::memory_order_relaxed);
+    if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
+  };
+  Timer gt;
+  const std::vector<glm::vec3> H = gatherPhotonMap(r, *all, &out.ho.at, count, &out.ho.nearHits, progress);
+  out.ho.gatherSeconds = gt.seconds();
+  out.check.estimates += some.load();
+  out.check.fewEstimates += few.load();
+  for (size_t i = 0; i < H.size(); ++i) {
+    if (!out.ho.at[i] || !r.mat.valid[i]) continue;
+    out.H[i] += H[i];
+    if (!out.byPath[kPathIndirect].empty()) out.byPath[kPathIndirect][i] = H[i];
+    if (luminance(out.H[i]) <= 0.f) ++out.verticesWithoutPhotons;
+  }
+}
+
 }  // namespace
 
-ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
-                                       const VertexMaterial& mat, unsigned pathMask, bool projection,
-                                       const Progress& progress, PhotonTraceStats& stats) {
-  ProgressiveResult r;
+ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progress, PhotonTraceStats& stats) {
+  const Scene& s = r.s;
+  const PhotonOptions& opt = r.opt;
+  const VertexMaterial& mat = r.mat;
+  ProgressiveResult out;
   PpmVertices v(s.vertexCount(), opt.lightPathSplit);
   const GatherSurface surface(s);
   const float r2cap = opt.maxRadius > 0 ? float(opt.maxRadius * opt.maxRadius) : HUGE_VALF;
@@ -156,29 +228,54 @@ ProgressiveResult progressivePhotonMap(const Scene& s, const RayCaster& caster, 
   // start at the cap, or at 1% of the diagonal without one.
   const float diag = float(sceneScale(s).diagonal);
   const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
+  // With the direct light apart, the photons of the first passes (up to
+  // kPpmGatherPaths paths) are kept for the final gather of the vertices
+  // handed over to it (dropped after the first pass if there are none).
+  int keepPasses = 0;
+  if (opt.directLight) {
+    const size_t paths = size_t(opt.photons);
+    keepPasses = int(std::min<size_t>((kPpmGatherPaths + paths - 1) / paths, size_t(opt.passes)));
+  }
+  KeptPhotons kept;
+  out.ho.at.assign(s.vertexCount(), 0);
+  const double gatherShare = opt.directLight ? 0.1 : 0.0;
   for (int pass = 0; pass < opt.passes; ++pass) {
-    const Progress pp = progress.sub(double(pass) / opt.passes, double(pass + 1) / opt.passes);
+    const Progress pp = progress.sub((1.0 - gatherShare) * pass / opt.passes, (1.0 - gatherShare) * (pass + 1) / opt.passes);
     Timer tt;
-    std::vector<Photon> photons = tracePass(s, caster, opt, pass, projection, pp, stats);
-    r.traceSeconds += tt.seconds();
+    std::vector<Photon> photons =
+        tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr, 1.f / float(std::max(keepPasses, 1)));
+    out.traceSeconds += tt.seconds();
     Timer bt;
     std::unique_ptr<PhotonMap> map;
-    if (pass == 0) map = firstRadii(s, opt, mat, photons, pathMask, surface, r2cap, r2fallback, v);
-    const PhotonGrid grid(photons, pathMask, gridCell(mat, v, r2fallback, diag));
-    r.check.mapPhotons += grid.size();
-    r.buildSeconds += bt.seconds();
-    r.peakBytes = std::max(r.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
-                                               (map ? map->memoryBytes() : 0)));
+    if (pass == 0) {
+      map = firstRadii(s, opt, mat, photons, r.vertexPaths, surface, r2cap, r2fallback, v);
+      if (opt.directLight) decideHandOver(r, surface, v, out.ho);
+      if (out.ho.crease + out.ho.otherSurface == 0) {
+        keepPasses = 0;
+        kept = KeptPhotons();
+      }
+    }
+    const PhotonGrid grid(photons, r.vertexPaths, gridCell(mat, v, r2fallback, diag));
+    out.check.mapPhotons += grid.size();
+    out.buildSeconds += bt.seconds();
+    out.peakBytes = std::max(out.peakBytes, double(photons.capacity() * sizeof(Photon) + grid.memoryBytes() +
+                                                   (map ? map->memoryBytes() : 0) + kept.bytes()));
     map.reset();
     std::vector<Photon>().swap(photons);
     Timer qt;
-    updateVertices(s, mat, grid, surface, opt.alpha, pp.sub(0.7, 1.0), "progressive pass " + std::to_string(pass + 1),
-                   v);
-    r.querySeconds += qt.seconds();
+    updateVertices(s, mat, grid, surface, opt.alpha, out.ho.at, pp.sub(0.7, 1.0),
+                   "progressive pass " + std::to_string(pass + 1), v);
+    out.querySeconds += qt.seconds();
   }
-  estimates(mat, v, opt.passes, r);
-  r.check.surfaceArea = surface.totalArea();
-  return r;
+  // The density estimates lose the power of the paths cut at max_depth, the
+  // photon at their last hit apart (tracePhotons' account with the hits left).
+  stats.lostPower += stats.lastHitCutPower;
+  stats.lostRGB += stats.lastHitCutRGB;
+  estimates(mat, v, opt.passes, out.ho.at, out);
+  out.gatherPasses = keepPasses;
+  if (keepPasses > 0) gatherHandedOver(r, surface, kept, progress.sub(1.0 - gatherShare, 1.0), out);
+  out.check.surfaceArea = surface.totalArea();
+  return out;
 }
 
 std::vector<glm::vec3> specularFinalGather(
