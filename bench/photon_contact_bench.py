@@ -4,8 +4,9 @@
 The k-nearest density estimate counts what a vertex does not see where another surface rises inside its
 sphere (the Cornell box's lamp 0.1 mm below the ceiling, its blocks on a floor that goes on under them, the
 objects and walls of a scan room); since 5 December 2026 such vertices take a final gather, whose near hits
-are relit. This measures it: `gi photonmap` (default settings, and with `final_gather` on the box) against
-`gi reference` (cached under bench/results/refs), over
+are relit; since 6 December progressive photon mapping hands the same vertices over. This measures it:
+`gi photonmap` (default settings; with `final_gather` on the box; `progressive` at its default 16 passes of
+200,000 paths on both) against `gi reference` (cached under bench/results/refs), over
 
   - the Cornell box: all vertices (relative RMS), the ceiling vertices on the lamp's border, the blocks'
     sides at the floor and the floor within 30 mm of a block (sum of differences over sum of reference);
@@ -123,7 +124,9 @@ def main():
         binaries["before"] = a.before
     cases = [("cornell_box", box, ["--emitter_source", "1"]),
              ("cornell_box, final_gather", box, ["--emitter_source", "1", "--final_gather", "true"]),
-             ("scan room 100k", room, [])]
+             ("cornell_box, progressive", box, ["--emitter_source", "1", "--progressive", "true"]),
+             ("scan room 100k", room, []),
+             ("scan room 100k, progressive", room, ["--progressive", "true"])]
     refs = {"cornell_box": reference(gi, box, cache, ["--emitter_source", "1", "--target_relative_error", "0.01"]),
             "scan room 100k": reference(gi, room, cache, ["--traced_vertices", "4000", "--samples_per_vertex", "16384",
                                                            "--traced_vertex_seed", "7"])}

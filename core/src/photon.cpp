@@ -193,8 +193,9 @@ PhotonEstimate progressiveEstimate(const PhotonRun& r, const Progress& progress,
   if (pr.ho.gatherSeconds > 0) st.add("final_gather_seconds", pr.ho.gatherSeconds);
   if (pr.gatherPasses > 0)
     reportHandOver(r.opt, pr.ho,
-                   "a map of the first " + std::to_string(pr.gatherPasses) + " passes' photons, their power / " +
-                       std::to_string(pr.gatherPasses),
+                   pr.gatherStride > 1
+                       ? "a map of every " + std::to_string(pr.gatherStride) + "th photon of the first pass"
+                       : "a map of the first " + std::to_string(pr.gatherPasses) + " pass(es)' photons",
                    st);
   PhotonEstimate e{std::move(pr.H), std::move(pr.noise), pr.verticesWithoutPhotons, pr.check};
   for (int k = 0; k < kPathKinds; ++k) e.byPath[k] = std::move(pr.byPath[k]);

@@ -148,7 +148,8 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
 // vertex's value (a crease, another surface inside the first radius: as in
 // the k-nearest mode, photon_gather.cpp) keep only their caustic photons
 // and take a final gather of the first passes' photons for the rest: as
-// many passes as kPpmGatherPaths paths need (the default photons of the
+// many passes as kPpmGatherPaths paths need, or a share of the first pass's
+// photons where it has more paths (the default photons of the
 // k-nearest mode; on the Cornell box 1 to 10 passes of 200,000 gave the
 // same errors, the gather's own noise dominating, at 0.3 to 2.3 s more).
 struct ProgressiveResult {
@@ -162,6 +163,7 @@ struct ProgressiveResult {
   std::vector<glm::vec3> byPath[3];  // H's terms by the photons' path kind (opt.lightPathSplit)
   HandOver ho;                       // the vertices that gathered, and why
   int gatherPasses = 0;              // passes whose photons the gather read
+  size_t gatherStride = 1;           // every gatherStride-th of them (a pass of more than kPpmGatherPaths paths)
 };
 constexpr size_t kPpmGatherPaths = 200000;
 ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progress, PhotonTraceStats& stats);

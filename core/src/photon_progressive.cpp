@@ -38,16 +38,18 @@ struct PpmVertices {
 };
 
 // The photons of one pass; with projection, its caustic photons are the
-// aimed ones (those of the global pass dropped). With `keep`, the global
-// trace's photons (all kinds) are appended to it with their power times
-// keepScale, and the hits their paths had left to keep->left.
+// aimed ones (those of the global pass dropped). With `keep`, every
+// stride-th photon of the global trace (all kinds) is appended to it with
+// its power times `scale`, and the hits its path had left to keep->left.
 struct KeptPhotons {
   std::vector<Photon> photons;
   std::vector<uint8_t> left;
+  size_t stride = 1;
+  float scale = 1.f;
   size_t bytes() const { return photons.capacity() * sizeof(Photon) + left.capacity(); }
 };
 std::vector<Photon> tracePass(const PhotonRun& r, int pass, const Progress& pp, PhotonTraceStats& stats,
-                              KeptPhotons* keep, float keepScale) {
+                              KeptPhotons* keep) {
   const PhotonOptions& opt = r.opt;
   const size_t count = size_t(opt.photons);
   // The hits left are asked for whenever the direct light is apart, so the
@@ -56,9 +58,12 @@ std::vector<Photon> tracePass(const PhotonRun& r, int pass, const Progress& pp, 
   std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats,
                                              opt.directLight ? &left : nullptr);
   if (keep) {
-    keep->photons.reserve(keep->photons.size() + photons.size());
-    for (const Photon& p : photons) keep->photons.push_back({p.p, p.power * keepScale, p.n, p.path});
-    keep->left.insert(keep->left.end(), left.begin(), left.end());
+    keep->photons.reserve(keep->photons.size() + photons.size() / keep->stride + 1);
+    for (size_t i = 0; i < photons.size(); i += keep->stride) {
+      const Photon& p = photons[i];
+      keep->photons.push_back({p.p, p.power * keep->scale, p.n, p.path});
+      keep->left.push_back(left[i]);
+    }
   }
   if (r.projection) {
     auto caustic = [](const Photon& p) { return p.path == kCausticPhoton; };
@@ -228,22 +233,26 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
   // start at the cap, or at 1% of the diagonal without one.
   const float diag = float(sceneScale(s).diagonal);
   const float r2fallback = std::min(r2cap, 1e-4f * diag * diag);
-  // With the direct light apart, the photons of the first passes (up to
+  // With the direct light apart, the photons of the first passes (those of
   // kPpmGatherPaths paths) are kept for the final gather of the vertices
-  // handed over to it (dropped after the first pass if there are none).
+  // handed over to it (dropped after the first pass if there are none). A
+  // pass of more paths keeps every stride-th photon, its power times the
+  // stride (each photon kept with probability 1 / stride: the same density).
   int keepPasses = 0;
+  KeptPhotons kept;
   if (opt.directLight) {
     const size_t paths = size_t(opt.photons);
     keepPasses = int(std::min<size_t>((kPpmGatherPaths + paths - 1) / paths, size_t(opt.passes)));
+    kept.stride = (paths + kPpmGatherPaths - 1) / kPpmGatherPaths;
+    kept.scale = float(kept.stride) / float(keepPasses);
   }
-  KeptPhotons kept;
   out.ho.at.assign(s.vertexCount(), 0);
   const double gatherShare = opt.directLight ? 0.1 : 0.0;
   for (int pass = 0; pass < opt.passes; ++pass) {
     const Progress pp = progress.sub((1.0 - gatherShare) * pass / opt.passes, (1.0 - gatherShare) * (pass + 1) / opt.passes);
     Timer tt;
     std::vector<Photon> photons =
-        tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr, 1.f / float(std::max(keepPasses, 1)));
+        tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr);
     out.traceSeconds += tt.seconds();
     Timer bt;
     std::unique_ptr<PhotonMap> map;
@@ -273,6 +282,7 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
   stats.lostRGB += stats.lastHitCutRGB;
   estimates(mat, v, opt.passes, out.ho.at, out);
   out.gatherPasses = keepPasses;
+  out.gatherStride = kept.stride;
   if (keepPasses > 0) gatherHandedOver(r, surface, kept, progress.sub(1.0 - gatherShare, 1.0), out);
   out.check.surfaceArea = surface.totalArea();
   return out;
