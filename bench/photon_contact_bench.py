@@ -4,7 +4,7 @@
 The k-nearest density estimate counts what a vertex does not see where another surface rises inside its
 sphere (the Cornell box's lamp 0.1 mm below the ceiling, its blocks on a floor that goes on under them, the
 objects and walls of a scan room); since 5 December 2026 such vertices take a final gather, whose near hits
-are relit; since 6 December progressive photon mapping hands the same vertices over. This measures it:
+are relit; later that day progressive photon mapping hands the same vertices over. This measures it:
 `gi photonmap` (default settings; with `final_gather` on the box; `progressive` at its default 16 passes of
 200,000 paths on both) against `gi reference` (cached under bench/results/refs), over
 

@@ -10,7 +10,7 @@
 // (half of their rays land within a few centimetres, on floor whose
 // estimate has the same fault). Now the k-nearest mode hands such vertices
 // to the final gather, and the gather relights its near hits. Progressive
-// photon mapping read the lamp's border +57% (worst +124%) until 6 December
+// photon mapping read the lamp's border +57% (worst +124%) until 5 December
 // 2026; it now hands over the same vertices.
 #include <gtest/gtest.h>
 

@@ -172,7 +172,7 @@ TEST(PhotonMap, FurnaceBoxCreasesAndCorners) {
 // cannot pass by its spread). Measured: +0.75% (standard error 0.54%);
 // reading the density estimate as before, -7.7% (2.6%): fails both; since
 // the near hits are relit (5 December 2026) +0.5% (0.7%). Progressive
-// photon mapping hands the same vertices over since 6 December 2026 (4
+// photon mapping hands the same vertices over since 5 December 2026 (4
 // passes of 500,000 paths, the gather reading the first): +1.0% (0.5%);
 // with its hand-over switched off, -9.0% (1.3%).
 TEST(PhotonMap, WeldedRoomEdgesMatchTheReference) {
