@@ -52,26 +52,37 @@ namespace {
 // made a final gather cost about 2.6 ms a vertex at 64 rays (a 100k-triangle
 // scan room) where the sites cost one estimate each, once. With k photons an
 // estimate's disk holds about k / stride sites, so the nearest lies well
-// inside the radius over which the estimate is already an average. Sites
-// lie where photons do, so the nearest one is more often on the brighter
-// side: on the scan room the gathered vertices read +0.3% with a search per
-// ray (56 s), +0.7% with a site every k/8 photons (5 to 6 s), +1.3% every k/4.
+// inside the radius over which the estimate is already an average.
+// The estimates count only the photons that are not sites, their power
+// times stride / (stride - 1) (stride >= 2). Choosing the site nearest to
+// a ray's hit says that no site lies in the ball between them, and a site
+// there is a photon missing near the site: counting the sites made the
+// estimates (k - 1) / k times the density, -25% at k = 4, with the site's
+// own photon counted on top (k - 1) / (k - 2) times it less that, and
+// infinite at k = 1 (a photon at distance 0; found 5 December 2026). The
+// photons that are not sites are independent of where the sites lie (the
+// sites are every stride-th photon of the map, in the order of their
+// paths, not of their places), so their estimate has no such bias: a
+// furnace's gathered light within 0.5% at k = 4 and 8
+// (PhotonMap.SmallKHasNoBias).
 class SiteIrradiance {
  public:
   struct Site {
-    glm::vec3 H, caustic, two;  // all photons, the caustic ones, those with 2 or more hits left
-    float radius;
-    int used;  // photons the estimate read
+    glm::vec3 H{0.f}, caustic{0.f}, two{0.f};  // all photons, the caustic ones, those with 2 or more hits left
+    float radius = 0.f;
+    int used = 0;  // photons the estimate read
   };
+  // Sites every `stride`-th photon (at least every second).
   SiteIrradiance(const PhotonMap& all, int k, float r2max, size_t stride)
-      : all_(all), k_(k), r2max_(r2max), stride_(stride) {
-    const size_t n = (all.size() + stride - 1) / stride;
+      : all_(all), k_(k), r2max_(r2max), stride_(std::max<size_t>(stride, 2)),
+        scale_(float(stride_) / float(stride_ - 1)) {
+    const size_t n = (all.size() + stride_ - 1) / stride_;
     cloud_.pts.resize(n);
     normal_.resize(n);
     sites_.resize(n);
     state_ = std::make_unique<std::atomic<uint8_t>[]>(n);
     for (size_t i = 0; i < n; ++i) {
-      const Photon& ph = all.photon(i * stride);
+      const Photon& ph = all.photon(i * stride_);
       cloud_.pts[i] = ph.p;
       normal_[i] = ph.n;
       state_[i].store(0, std::memory_order_relaxed);
@@ -84,11 +95,7 @@ class SiteIrradiance {
   Site site(size_t i) const {
     if (state_[i].load(std::memory_order_acquire) == 2) return sites_[i];
     const Photon& ph = all_.photon(i * stride_);
-    Site st;
-    glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
-    st.H = all_.irradiance(ph.p, ph.normal(), k_, r2max_, PhotonKernel::Uniform, nullptr, &st.used, parts,
-                           PhotonOnly(), &st.radius, &st.two);
-    st.caustic = parts[kCausticPhoton];
+    const Site st = estimate(ph.p, ph.normal(), true);
     uint8_t empty = 0;
     if (state_[i].compare_exchange_strong(empty, 1, std::memory_order_acq_rel)) {
       sites_[i] = st;
@@ -97,6 +104,20 @@ class SiteIrradiance {
     return st;
   }
   size_t size() const { return sites_.size(); }
+  // The estimate at y (normal n) from the photons that are not sites;
+  // `widen`: search past the 2k nearest while fewer than k are on n's side.
+  Site estimate(const glm::vec3& y, const glm::vec3& n, bool widen) const {
+    Site st;
+    glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
+    PhotonOnly rest;
+    rest.widen = widen;
+    rest.skipEvery = uint32_t(stride_);
+    st.H = scale_ * all_.irradiance(y, n, k_, r2max_, PhotonKernel::Uniform, nullptr, &st.used, parts, rest,
+                                    &st.radius, &st.two);
+    st.caustic = scale_ * parts[kCausticPhoton];
+    st.two *= scale_;
+    return st;
+  }
   // The nearest site to y whose photon arrived within 60 degrees of n, among
   // the 16 nearest; none if none.
   std::optional<Site> nearest(const glm::vec3& y, const glm::vec3& n) const {
@@ -119,6 +140,7 @@ class SiteIrradiance {
   int k_;
   float r2max_;
   size_t stride_;
+  float scale_;
   PointCloud cloud_;
   std::vector<glm::i8vec3> normal_;
   mutable std::vector<Site> sites_;
@@ -140,14 +162,7 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
   // A point's estimate: the nearest site's, or (none on this side near it) its own.
   const auto at = [&](const glm::vec3& y, const glm::vec3& n) {
     if (const std::optional<SiteIrradiance::Site> site = sites.nearest(y, n)) return *site;
-    SiteIrradiance::Site own;
-    glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
-    PhotonOnly near;
-    near.widen = false;
-    own.H = all.irradiance(y, n, opt.kNearest, r.r2max, PhotonKernel::Uniform, nullptr, &own.used, parts, near,
-                           &own.radius, &own.two);
-    own.caustic = parts[kCausticPhoton];
-    return own;
+    return sites.estimate(y, n, false);
   };
   const auto value = [&](const PhotonGatherHit& g) -> glm::vec3 {
     const SiteIrradiance::Site e = at(g.point, g.normal);

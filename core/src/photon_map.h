@@ -25,7 +25,8 @@ enum class PhotonKernel {
 struct PhotonOnly {
   unsigned paths = 7u;
   int minHitsLeft = 0;
-  bool widen = true;  // search past the 2k nearest while fewer than k are on this side
+  bool widen = true;      // search past the 2k nearest while fewer than k are on this side
+  uint32_t skipEvery = 0;  // if > 0: the map's photons i (photon(i)) with i % skipEvery == 0 left out
 };
 
 class PhotonMap {
@@ -70,6 +71,7 @@ class PhotonMap {
                        glm::vec3* twoLeft = nullptr) const {
     if (photons) *photons = 0;
     if (radius) *radius = 0.f;
+    if (twoLeft) *twoLeft = glm::vec3(0.f);
     if (size() == 0 || k < 1) return glm::vec3(0.f);
     Query q;
     nearestSameSide(x, n, k, r2max, q, only);
@@ -154,6 +156,7 @@ class PhotonMap {
         const uint32_t i = cloud_.idx[idx[m]];
         const Photon& ph = cloud_.all[i];
         if (glm::dot(ph.normal(), n) < kSameSide) continue;  // other side or another surface
+        if (only.skipEvery && idx[m] % only.skipEvery == 0) continue;
         if (!((only.paths >> ph.path) & 1u) || (only.minHitsLeft > 0 && left_ && (*left_)[i] < only.minHitsLeft))
           continue;
         q.ph[q.used] = &ph;
