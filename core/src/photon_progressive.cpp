@@ -249,10 +249,10 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
   out.ho.at.assign(s.vertexCount(), 0);
   const double gatherShare = opt.directLight ? 0.1 : 0.0;
   for (int pass = 0; pass < opt.passes; ++pass) {
-    const Progress pp = progress.sub((1.0 - gatherShare) * pass / opt.passes, (1.0 - gatherShare) * (pass + 1) / opt.passes);
+    const double passShare = (1.0 - gatherShare) / opt.passes;
+    const Progress pp = progress.sub(passShare * pass, passShare * (pass + 1));
     Timer tt;
-    std::vector<Photon> photons =
-        tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr);
+    std::vector<Photon> photons = tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr);
     out.traceSeconds += tt.seconds();
     Timer bt;
     std::unique_ptr<PhotonMap> map;

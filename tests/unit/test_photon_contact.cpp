@@ -145,9 +145,10 @@ TEST(PhotonContact, LampBorderAndBlockFeetMatchTheReference) {
         }
         for (size_t i : g->vertices)
           if (luminance(ref.B[i]) > 0.f)
-            worst = std::max(worst, std::abs(double(luminance(r.B[i])) - double(luminance(ref.B[i]))) * double(n) / sumRef);
-        std::printf("max_depth %d, %s, %s: %zu vertices, (photon map - reference) / reference: mean %+.4f, worst %.4f of "
-                    "the mean\n",
+            worst = std::max(worst, std::abs(double(luminance(r.B[i])) - double(luminance(ref.B[i]))) * double(n) /
+                                        sumRef);
+        std::printf("max_depth %d, %s, %s: %zu vertices, (photon map - reference) / reference: mean %+.4f, worst "
+                    "%.4f of the mean\n",
                     maxDepth, mode, g->name, n, diff / sumRef, worst);
         EXPECT_LT(std::abs(diff / sumRef), 0.06) << g->name << ", max_depth " << maxDepth << ", " << mode;
         EXPECT_LT(worst, 0.4) << g->name << ", max_depth " << maxDepth << ", " << mode;

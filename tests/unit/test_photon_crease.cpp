@@ -212,7 +212,8 @@ TEST(PhotonMap, WeldedRoomEdgesMatchTheReference) {
     }
     ASSERT_EQ(n, 4 * 7);
     const double mean = sum / n, sem = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1));
-    std::printf("welded room, ceiling edge, %s: %d vertices, photon map / reference - 1 = %+.4f (standard error %.4f)\n",
+    std::printf("welded room, ceiling edge, %s: %d vertices, photon map / reference - 1 = %+.4f (standard error "
+                "%.4f)\n",
                 progressive ? "progressive (4 passes of 500k)" : "k nearest", n, mean, sem);
     EXPECT_LT(sem, 0.01);
     EXPECT_LT(std::fabs(mean), 0.03);
