@@ -48,11 +48,19 @@ Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& 
       eps_(float(sceneScale(s).rayEpsilon)) {
   hasSky_ = luminance(L_.skyRadiance) > 0.f;
   hasSun_ = luminance(L_.sunIrradiance) > 0.f;
-  sunDisk_ = hasSun_ && L_.sunAngularRadiusDeg > 0.f;
-  sunCos_ = std::cos(glm::radians(L_.sunAngularRadiusDeg));
-  const float omega = 2.f * float(M_PI) * (1.f - sunCos_);
-  sunPdf_ = sunDisk_ ? 1.f / omega : 0.f;
-  sunL_ = sunDisk_ ? L_.sunIrradiance * (sunDiskScale(L_.sunAngularRadiusDeg) / omega) : glm::vec3(0.f);  // E / (pi sin^2 a)
+  // The disk's solid angle 2 pi (1 - cos a) = 4 pi sin^2(a / 2), in double:
+  // in single precision 1 - cos a is 0 below a = 0.014 degrees (and off by
+  // 0.5% at the real sun's 0.27), which made the radiance and the density
+  // infinite and every path's value NaN (a reference of zeros; found 5
+  // December 2026). Below 1e-12 sr (a = 3.2e-5 degrees) the sun is taken
+  // as the point it then is: one shadow ray, its radiance's limit.
+  const double halfAngle = 0.5 * double(L_.sunAngularRadiusDeg) * M_PI / 180.0;
+  const double omega = 4.0 * M_PI * std::sin(halfAngle) * std::sin(halfAngle);
+  sunDisk_ = hasSun_ && omega > 1e-12;
+  sunCos_ = float(std::cos(2.0 * halfAngle));
+  sunPdf_ = sunDisk_ ? float(1.0 / omega) : 0.f;
+  sunL_ = sunDisk_ ? L_.sunIrradiance * float(double(sunDiskScale(L_.sunAngularRadiusDeg)) / omega)
+                   : glm::vec3(0.f);  // E / (pi sin^2 a)
   hasPoint_ = L_.point.on();
 }
 

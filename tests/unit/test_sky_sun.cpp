@@ -157,6 +157,29 @@ TEST(SkySun, LargeSunGivesItsIrradianceFacingIt) {
   EXPECT_NEAR(pm, kRho * 3.0, 0.03 * kRho * 3.0);
 }
 
+// A sun disk too small for single precision: the path tracer divided by its
+// solid angle 2 pi (1 - cos a), 0 in floats below a = 0.014 degrees, and
+// every path was NaN (a reference of zeros and a render of dropped samples;
+// found 5 December 2026). From a point sun up to the real sun's 0.27
+// degrees, the open plane at 60 degrees from the sun gets E_sun cos 60 at
+// every vertex (64 paths on the one surface: each path's value differs only
+// by the disk's sampled direction, whose cosine spans 0.8% at 0.27 degrees;
+// 0.5% allowed, 0.15% seen).
+TEST(SkySun, TinySunDiskIsThePointSun) {
+  const Scene s = openPlane();
+  auto caster = makeEmbreeCaster(s);
+  for (float radius : {0.f, 1e-30f, 1e-6f, 1e-3f, 0.01f, 0.27f}) {
+    const SkySun o = sunOnly(3.f, 60.f, radius);
+    PathTraceOptions po;
+    po.samplesPerVertex = 64;
+    po.sunIrradiance = o.sunIrradiance;
+    po.sunDirection = o.sunDirection;
+    po.sunAngularRadiusDeg = radius;
+    const auto ref = pathTrace(s, *caster, po);
+    for (const glm::vec3& B : ref.B) EXPECT_NEAR(B.g, kRho * 1.5, 5e-3 * kRho * 1.5) << "sun_angular_radius " << radius;
+  }
+}
+
 // No emitter, no sky, no sun: refused with the reason.
 TEST(SkySun, NoLightIsRefused) {
   const Scene s = openPlane();
