@@ -316,6 +316,9 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
   if (ts.glossyBounces) st.add("glossy_bounces", double(ts.glossyBounces));
   st.add("total_internal_reflections", double(ts.totalInternal));
   st.add("emitted_power_W", ts.emittedPower * r.s.unit * r.s.unit);
+  if (ts.pointOnSurface)
+    st.note("the point light lies on a surface (within the ray epsilon): its light towards the surface's back is "
+            "absorbed there, the rest leaves from past it");
   if (ts.lostAtMaxDepth)
     st.note(std::to_string(ts.lostAtMaxDepth) + " paths cut at max_depth, carrying " +
             std::to_string(ts.emittedPower > 0 ? 100.0 * ts.lostPower / double(ts.passes) / ts.emittedPower : 0.0) +

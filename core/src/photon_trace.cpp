@@ -62,6 +62,29 @@ bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::v
   return true;
 }
 
+// The point of triangle abc nearest to p (Ericson 2005, "Real-Time
+// Collision Detection", 5.1.5: by the Voronoi regions of its corners and
+// edges).
+glm::vec3 closestOnTriangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+  if (d1 <= 0.f && d2 <= 0.f) return a;
+  const glm::vec3 bp = p - b;
+  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+  if (d3 >= 0.f && d4 <= d3) return b;
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.f && d1 >= 0.f && d3 <= 0.f) return a + ab * (d1 / (d1 - d3));
+  const glm::vec3 cp = p - c;
+  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+  if (d6 >= 0.f && d5 <= d6) return c;
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.f && d2 >= 0.f && d6 <= 0.f) return a + ac * (d2 / (d2 - d6));
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0.f && (d4 - d3) >= 0.f && (d5 - d6) >= 0.f) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const float denom = 1.f / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
 // The lights photons leave from: the area emitters, an optional point or
 // spot light, the sky and the sun, chosen in proportion to their (luminance)
 // power; the sky's and the sun's is what crosses the disk of the bounding
@@ -102,7 +125,35 @@ class PhotonLights {
     inner_ = area_.totalPower() + pointPower_;
     total_ = inner_ + skyPower_ + sunPower_;
     spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
+    // The faces the point light lies on (within the ray epsilon): the
+    // default position is the box's corner, a lamp may be put on a wall.
+    if (pointPower_ > 0.0) {
+      const float eps = float(sceneScale(s).rayEpsilon);
+      const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+      const std::vector<uint8_t> ok = usableFaceMask(s);
+      for (size_t f = 0; f < s.faceCount(); ++f) {
+        if (!ok[f]) continue;
+        const glm::uvec3& t = s.triangles[f];
+        const glm::vec3 q = closestOnTriangle(o.point.position, s.positions[t.x], s.positions[t.y], s.positions[t.z]);
+        if (glm::length(q - o.point.position) <= eps) pointOn_.push_back(faceN[f]);
+      }
+    }
   }
+  // A point light on a surface (within the ray epsilon): its light towards
+  // the back of a face it lies on is absorbed there (true for d), and the
+  // rest leaves from past those faces (rays from it start at
+  // pointStart()). Traced from the light itself, the rays hit those faces at
+  // t ~ 0 in every direction (the origin lies on them): on their back (all
+  // absorbed, the light dark) or their front (photons stored at the light,
+  // read 1e30 times too bright by a vertex there; an outside sweep, 5
+  // December 2026).
+  bool pointBlocked(const glm::vec3& d) const {
+    for (const glm::vec3& n : pointOn_)
+      if (glm::dot(d, n) <= 0.f) return true;
+    return false;
+  }
+  float pointStart(float eps) const { return pointOn_.empty() ? 0.f : 2.f * eps; }
+  bool pointOnSurface() const { return !pointOn_.empty(); }
   bool empty() const { return !(total_ > 0.0); }
   double totalPower() const { return total_; }
   // A point on an area emitter or the point light (the caustic projection
@@ -125,6 +176,7 @@ class PhotonLights {
 
   struct Emission {
     glm::vec3 o, d, power, n;
+    bool point = false;  // from the point or spot light
   };
   // The global photons: cosine-distributed from area emitters, uniform in the
   // spot's cone; photon power for `count` photons in total.
@@ -136,6 +188,7 @@ class PhotonLights {
     lp.pdf *= float(1.0 - pOut);
     Emission e{lp.o, {}, {}, lp.n};
     if (lp.point) {
+      e.point = true;
       // Flux per photon: I * solid angle / (p_choice * count).
       e.d = Frame(spotFrame_).toWorld(uniformCone(u1, float(cosSpot_)));
       e.power = lp.L * float(2.0 * M_PI * (1.0 - cosSpot_)) / float(lp.pdf * count);
@@ -181,6 +234,7 @@ class PhotonLights {
   double pointPower_ = 0.0, total_ = 0.0, cosSpot_ = -1.0;
   double sunScale_ = 1.0;
   glm::vec3 spotFrame_;
+  std::vector<glm::vec3> pointOn_;  // unit normals of the faces the point light lies on
 };
 
 // What one stored photon costs at the peak of a run: the photon (28 bytes),
@@ -264,10 +318,12 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
         const auto em = lights.sample(sobolOwen2D(k.index, k.pos), sobolOwen2D(k.index, k.dir), double(count));
         glm::vec3 power = em.power;
         st.emittedRGB += glm::dvec3(power);
+        if (em.point && lights.pointBlocked(em.d)) continue;  // into the surface the light lies on
         Rng rng(hash3(k.index, k.rng, 0x7u));
         Ray ray;
         ray.o = em.o + em.n * eps;
         ray.d = em.d;
+        if (em.point) ray.tnear = lights.pointStart(eps);
         int diffuse = 0;
         bool viaSpecular = false;
         int depth = 0;
@@ -361,6 +417,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   }
   stats.stored = stats.direct + stats.caustic + stats.indirect;
   stats.emitted += count;
+  stats.pointOnSurface = lights.pointOnSurface();
   stats.emittedPower = lights.totalPower();
   ++stats.passes;
   return all;
@@ -478,7 +535,9 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
           if (c <= 0.f) continue;
           power = lp.L * c / (lp.pdf * pdfW * float(count));
         }
+        if (lp.point && lights.pointBlocked(d)) continue;  // into the surface the light lies on
         ray.d = d;
+        if (lp.point) ray.tnear = lights.pointStart(eps);
         Rng rng(hash3(k.index, k.rng, 0xc5u));
         bool viaSpecular = false;
         // Stored at the diffuse hit after at most max_depth specular bounces.

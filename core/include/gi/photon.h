@@ -102,6 +102,7 @@ struct PhotonTraceStats {
   size_t lostAtMaxDepth = 0, escaped = 0;
   size_t causticEmitted = 0, causticStored = 0, causticMissed = 0;  // the projection pass
   size_t passes = 0;                             // calls of tracePhotons summed here
+  bool pointOnSurface = false;                   // the point light lies on a surface (within the ray epsilon)
   double storedPower = 0.0;                      // luminance, W, summed over passes
   double emittedPower = 0.0;                     // luminance power of the lights, W
   double lostPower = 0.0;  // luminance still carried by paths cut at max depth, and by the photons lastHit flags (caustics apart)
