@@ -164,7 +164,12 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     st.note("no relative RMS error: the reference is 0 at every vertex and the value is not");
   st.add("max_abs_error", maxAbs);
   st.add("mean_error", used ? sumD / double(used) : 0.0);
-  if (measure == ErrorMeasure::ZScore) {
+  if (measure == ErrorMeasure::ZScore && zCount == 0 && undefined > 0) {
+    // rms_z 0 would read as a perfect agreement (a reference of one path a
+    // vertex writes error bars of 0: an outside sweep, 5 December 2026).
+    st.warn("no vertex has an error bar (all are 0 or missing): no z-score is defined and none is reported; "
+            "rms_error and max_abs_error still are");
+  } else if (measure == ErrorMeasure::ZScore) {
     st.add("rms_z", zCount ? std::sqrt(sumZ2 / double(zCount)) : 0.0);
     st.add("fraction_abs_z_above_3", zCount ? double(beyond3) / double(zCount) : 0.0);
     st.note("|z| > 3 at " + std::to_string(beyond3) + " of " + std::to_string(zCount) +
@@ -293,6 +298,9 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   res.stats.notes.insert(res.stats.notes.begin(), "value " + o.value + " against the reference " + from +
                                                       (sr.empty() ? "" : ", its error bar " + o.referenceError));
   for (std::string& n : e.stats.notes) res.stats.notes.push_back(std::move(n));
+  // The estimate's own warnings (errors beyond single precision, no z-score
+  // defined) were dropped here until 5 December 2026.
+  for (std::string& w : e.stats.warnings) res.stats.warnings.push_back(std::move(w));
 }
 
 }  // namespace gi

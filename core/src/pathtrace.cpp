@@ -420,6 +420,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("paths_cut_at_max_depth", totalCut);
   if (adaptive) st.add("adaptive_rounds", rounds);
   depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
+  if (!adaptive && opt.samplesPerVertex < 2 && valid > 0)
+    st.warn("one path per vertex gives no error estimate: StdError and StdErrorH are written as 0 (unknown, not "
+            "exact); an error map's z-scores need 2 or more");
   if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
   if (opt.tracedSelected)
     st.note("traced the " + std::to_string(std::count(part.subset->begin(), part.subset->end(), uint8_t(1))) +

@@ -238,6 +238,16 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   bool said = false;
   for (const auto& n : negative.stats.notes) said |= n.find("1 vertices with no defined") != std::string::npos;
   EXPECT_TRUE(said);
+  // Error bars of 0 everywhere (a reference of one path a vertex): no
+  // z-score anywhere, said by a warning of the filter (its estimate's
+  // warnings never reached the filter's log until 5 December 2026), and no
+  // rms_z of 0 that would read as a perfect agreement.
+  const std::vector<VertexAttribute> noBars = {{kQualityAttribute, 1, value}, {"Reference", 1, refv},
+                                               {"Zero", 1, std::vector<float>(nv, 0.f)}};
+  const FilterResult none = errorMapOf(sf, noBars, {{"reference_error", "Zero"}, {"error_measure", "2"}});
+  ASSERT_EQ(none.stats.warnings.size(), 1u);
+  EXPECT_NE(none.stats.warnings[0].find("no z-score is defined"), std::string::npos);
+  EXPECT_TRUE(std::isnan(none.stats.get("rms_z", std::nan(""))));
   const std::vector<VertexAttribute> zero = {{kQualityAttribute, 1, value}, {"Reference", 1, std::vector<float>(nv, 0.f)}};
   const FilterResult r0 = errorMapOf(sf, zero, {});
   EXPECT_TRUE(std::isnan(r0.stats.get("relative_rms_error", std::nan(""))));

@@ -43,6 +43,19 @@ TEST(PathTracer, FurnaceSphere) {
   }
 }
 
+// One path a vertex gives no error estimate: the error bars are written as
+// 0 (unknown), and a warning says so (an error map's z-scores read them as
+// exact, rms_z 0; an outside sweep, 5 December 2026). Two paths: none.
+TEST(PathTracer, OnePathAVertexSaysItHasNoErrorBars) {
+  auto sf = scenes::sphere(1.0, 1, true);
+  scenes::setUniform(sf, glm::vec3(0.5f), glm::vec3(1.f));
+  const auto one = trace(sf.scene, 1);
+  ASSERT_EQ(one.stats.warnings.size(), 1u);
+  EXPECT_NE(one.stats.warnings[0].find("no error estimate"), std::string::npos);
+  for (float e : one.stdError) EXPECT_EQ(e, 0.f);
+  EXPECT_TRUE(trace(sf.scene, 2).stats.warnings.empty());
+}
+
 // A uniform white sky with rho = 0: H = E_sky AO. Floor vertices at distance d
 // from a wall of height 1: AO = 1/2 + d / (2 sqrt(d^2 + 1)). 2048 paths: each
 // within 4 reported standard errors plus 0.005 (the wall's finite width).
