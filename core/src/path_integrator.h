@@ -33,6 +33,7 @@
 #include "gi/light_paths.h"
 #include "gi/sky.h"
 #include "gi/raycaster.h"
+#include "gi/run.h"
 #include "gi/sampling.h"
 #include "gi/scene.h"
 
@@ -111,6 +112,12 @@ struct LightSettings {
 // then hit a point exactly, which no sampled direction does; pbrt and every
 // unidirectional path tracer miss it too). Photon mapping finds it.
 std::string unsampledLightPaths(const Scene& s, const LightSettings& lights);
+
+// Warns (st) where paths cut at the depth limit (maxDepth, -1 = none but
+// `cap`) may miss more light than the mean relative error: `cut` of `paths`;
+// `remedy` ends the warning.
+void depthWarnings(const Scene& s, int maxDepth, int cap, double paths, double cut, double relErr,
+                   const char* remedy, RunStats& st);
 
 struct PathRules {
   int maxDepth = 32;            // events that continue a path (see the top of this file)

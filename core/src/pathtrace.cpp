@@ -104,37 +104,6 @@ using reference::RingVariance;
 // (which Russian roulette never ends) stops here.
 constexpr int kDepthCap = 100000;
 
-// Paths the depth limit ended while they would have gone on: their further
-// light is missing, a bias outside the error bars. No limit (-1): only paths
-// caught between perfect mirrors reach the cap. A limit k: in a closed room
-// of reflectance rho_max the light of more than k bounces is a share
-// rho_max^(k+1) of B; warn when that may exceed the mean relative error.
-void depthWarnings(const Scene& s, const PathTraceOptions& opt, double paths, double cut, double relErr,
-                   RunStats& st) {
-  if (!(cut > 0) || !(paths > 0)) return;
-  char b[400];
-  if (opt.maxDepth < 0) {
-    std::snprintf(b, sizeof b,
-                  "%.0f of %.0f paths (%.3g%%) were still going after %d bounces (caught between perfect mirrors?) "
-                  "and were cut: their further light is missing",
-                  cut, paths, 100.0 * cut / paths, kDepthCap);
-    st.warn(b);
-    return;
-  }
-  float rhoMax = 0.f;
-  const auto ok = usableFaceMask(s);
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f]) rhoMax = std::max({rhoMax, s.faceRho(f).r, s.faceRho(f).g, s.faceRho(f).b});
-  const double share = std::pow(std::min(1.0, double(rhoMax)), double(opt.maxDepth) + 1.0);
-  if (share <= relErr) return;
-  std::snprintf(b, sizeof b,
-                "max_depth = %d cut %.0f of %.0f paths: the light of more bounces is missing (in a closed room of "
-                "the largest reflectance here, %.4g, a share %.3g%% of B), more than the mean relative error "
-                "%.3g%%, and is not in the error bars (-1 = no limit, unbiased)",
-                opt.maxDepth, cut, paths, rhoMax, 100.0 * share, 100.0 * relErr);
-  st.warn(b);
-}
-
 struct Accum {
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
   Cov sumHH{};  // H's channel products (as Cov)
@@ -419,7 +388,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);
   st.add("paths_cut_at_max_depth", totalCut);
   if (adaptive) st.add("adaptive_rounds", rounds);
-  depthWarnings(s, opt, samples, totalCut, valid ? rel / double(valid) : 0.0, st);
+  paths::depthWarnings(s, opt.maxDepth < 0 ? -1 : opt.maxDepth, kDepthCap, samples, totalCut,
+                       valid ? rel / double(valid) : 0.0, "-1 = no limit, unbiased", st);
   if (!adaptive && opt.samplesPerVertex < 2 && valid > 0)
     st.warn("one path per vertex gives no error estimate: StdError and StdErrorH are written as 0 (unknown, not "
             "exact); an error map's z-scores need 2 or more");

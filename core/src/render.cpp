@@ -282,6 +282,9 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
               "away from the scene?)");
     st.add("rms_std_error", std::sqrt(err2 / double(n)));
     st.add("mean_relative_std_error", relN ? rel / double(relN) : 0.0);
+    if (o.mode == RenderMode::PathTraced)
+      paths::depthWarnings(s, o.maxDepth, o.maxDepth, double(n) * o.samplesPerPixel, double(c.cutAtMaxDepth),
+                           relN ? rel / double(relN) : 0.0, "raise max_depth, up to 100,000", st);
   }
   st.note(std::string("mode ") + renderModeName(o.mode));
   if (o.mode == RenderMode::PathTraced && o.samplesPerPixel < 2) st.warn("one sample per pixel gives no error estimate");

@@ -223,6 +223,27 @@ TEST(RenderModes, BlackImageIsSaid) {
   }
 }
 
+// Paths cut at max_depth in the path-traced view: inside a furnace box of
+// reflectance 0.99 (E = 1, L = 1 / (pi (1 - rho)) = 31.8) the default 32
+// bounces keep 1 - 0.99^33 = 28% of the radiance, which the view only noted
+// (an outside sweep, 5 December 2026: 26% of it, no warning). Now a warning
+// says so; at rho 0.5 (0.5^33 of B missing) none.
+TEST(RenderModes, PathsCutAtMaxDepthAreWarned) {
+  for (const float rho : {0.99f, 0.5f}) {
+    SceneBuilder b;
+    b.box({-2, -2, -2}, {2, 2, 2}, glm::vec3(rho), glm::vec3(1.f), Material::Diffuse, true, 2);
+    const Scene s = b.build();
+    RenderOptions o;
+    o.camera = Camera::lookAt({0, 0, -1}, {0, 0, 1}, {0, 1, 0}, 60, 8, 8);
+    o.mode = RenderMode::PathTraced;
+    o.samplesPerPixel = 16;
+    const RenderResult r = run(s, o);
+    const bool warned = std::any_of(r.stats.warnings.begin(), r.stats.warnings.end(),
+                                    [](const std::string& w) { return w.find("max_depth = 32 cut") == 0; });
+    EXPECT_EQ(warned, rho > 0.9f) << "rho " << rho;
+  }
+}
+
 // A glossy floor reflecting a small square emitter near its mirror
 // direction, where light sampling and lobe sampling both matter (their
 // densities are comparable over the emitter): the expected radiance of each
