@@ -325,6 +325,10 @@ TEST(PathWarnings, PointLightCausticsMissingIsSaid) {
     r.point = p;
     const bool view = warned(render(s, *caster, r).stats, "point light's light reflected or refracted");
     EXPECT_EQ(ref, view);
+    // The distributed view too (its shadow rays stop at glass; it said
+    // nothing until 5 December 2026).
+    r.mode = RenderMode::Distributed;
+    EXPECT_EQ(ref, warned(render(s, *caster, r).stats, "point light's light reflected or refracted"));
     return ref;
   };
   EXPECT_TRUE(warnedAbout(caustic, L));
