@@ -276,6 +276,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   };
   Timer traceTimer;
   int rounds = 0;
+  double unmet = 0;  // adaptive: vertices that stopped at max_samples above the target
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
@@ -332,6 +333,15 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
         break;
       }
     }
+    const std::vector<double> var = pooled().B;
+    std::vector<double> stopped(1, 0.0);
+    for (size_t i = 0; i < nv; ++i) {
+      if (!traceable[i] || !part.contains(i, nv) || acc[i].n == 0) continue;
+      const double goal = opt.targetRelativeError * std::max(luminance(mat.E[i]) + acc[i].sumL / acc[i].n, floorB);
+      stopped[0] += var[i] > goal * goal * acc[i].n ? 1.0 : 0.0;
+    }
+    if (!part.all()) part.sumOverParts(stopped);
+    unmet = stopped[0];
   }
   const double traceSeconds = traceTimer.seconds();
   PathTraceResult res;
@@ -390,6 +400,17 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   if (adaptive) st.add("adaptive_rounds", rounds);
   paths::depthWarnings(s, opt.maxDepth < 0 ? -1 : opt.maxDepth, kDepthCap, samples, totalCut,
                        valid ? rel / double(valid) : 0.0, "-1 = no limit, unbiased", st);
+  if (unmet > 0) {
+    // Said as ambient occlusion and the sky say it (an outside sweep, 5
+    // December 2026: a target of 1e-6 ran every vertex to max_samples in
+    // silence).
+    char b[300];
+    std::snprintf(b, sizeof b,
+                  "%.0f of %zu traced vertices stopped at max_samples (%d paths) with their error above "
+                  "target_relative_error %.3g: raise max_samples or the target",
+                  unmet, valid, opt.maxSamples, opt.targetRelativeError);
+    st.warn(b);
+  }
   if (!adaptive && opt.samplesPerVertex < 2 && valid > 0)
     st.warn("one path per vertex gives no error estimate: StdError and StdErrorH are written as 0 (unknown, not "
             "exact); an error map's z-scores need 2 or more");
