@@ -93,6 +93,13 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
     if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors, glass or glossy faces");
+    // As photon mapping warns (photon_checks.cpp); the view said nothing
+    // until 5 December 2026 (caustic_photons 1: the brightest pixel 4 times
+    // too bright).
+    if (stored && stored < size_t(o.causticK))
+      stats.warn("caustic_k " + std::to_string(o.causticK) + " exceeds the " + std::to_string(stored) +
+                 " photons of the caustic map: every estimate spans them all (one blurred average); raise "
+                 "caustic_photons");
   } else if (wantCaustics) {
     stats.note("no caustic map: the scene has no mirror, glass or glossy faces");
   }

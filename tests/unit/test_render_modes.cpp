@@ -577,4 +577,15 @@ TEST(RenderModes, TwoPassCausticPhotonsKeepMaxDepth) {
   EXPECT_EQ(run(s, o).stats.get("caustic_photons_stored", -1), 0.0);
   o.maxDepth = 1;
   EXPECT_GT(run(s, o).stats.get("caustic_photons_stored", -1), 100.0);
+  // Fewer caustic photons than caustic_k (128): warned, as photon mapping
+  // warns it (the view said nothing until 5 December 2026).
+  const auto kWarned = [](const RenderResult& r) {
+    return std::any_of(r.stats.warnings.begin(), r.stats.warnings.end(),
+                       [](const std::string& w) { return w.rfind("caustic_k 128 exceeds the", 0) == 0; });
+  };
+  EXPECT_FALSE(kWarned(run(s, o)));
+  o.causticPhotons = 50;
+  const RenderResult few = run(s, o);
+  EXPECT_GT(few.stats.get("caustic_photons_stored", -1), 0.0);
+  EXPECT_TRUE(kWarned(few));
 }
