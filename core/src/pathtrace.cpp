@@ -276,7 +276,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   };
   Timer traceTimer;
   int rounds = 0;
-  double unmet = 0;  // adaptive: vertices that stopped at max_samples above the target
+  double floorB = 0;  // adaptive: the error target's floor, a tenth of the pilot's mean B
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
@@ -299,7 +299,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     for (size_t i = 0; i < nv; ++i)
       if (traceable[i] && part.inSubset(i)) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
-    const double floorB = 0.1 * meanB;
+    floorB = 0.1 * meanB;
     // Rounds: every vertex whose error bar (its ring's pooled variance, as
     // reported) is above the target traces the paths that variance predicts
     // it needs, at least 32 and at most as many as it has; then the pools
@@ -333,15 +333,6 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
         break;
       }
     }
-    const std::vector<double> var = pooled().B;
-    std::vector<double> stopped(1, 0.0);
-    for (size_t i = 0; i < nv; ++i) {
-      if (!traceable[i] || !part.contains(i, nv) || acc[i].n == 0) continue;
-      const double goal = opt.targetRelativeError * std::max(luminance(mat.E[i]) + acc[i].sumL / acc[i].n, floorB);
-      stopped[0] += var[i] > goal * goal * acc[i].n ? 1.0 : 0.0;
-    }
-    if (!part.all()) part.sumOverParts(stopped);
-    unmet = stopped[0];
   }
   const double traceSeconds = traceTimer.seconds();
   PathTraceResult res;
@@ -358,7 +349,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   size_t isolated = 0;
   for (size_t i = 0; i < nv; ++i) isolated += part.contains(i, nv) && var.vertices[i] == 1;
   double totalRays = 0, samples = 0, lum = 0, rel = 0, err2 = 0, totalCut = 0;
-  size_t valid = 0;
+  size_t valid = 0, unmet = 0;  // unmet (adaptive): vertices that stopped at max_samples above the target
   for (size_t i = 0; i < nv; ++i) {
     totalRays += double(counts[i].rays());
     totalCut += double(counts[i].cutAtMaxDepth);
@@ -376,6 +367,10 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       res.split.indirect[i] = rho * glm::vec3(acc[i].sumPart[kPathIndirect] / acc[i].n);
     }
     res.stdError[i] = float(std::sqrt(var.B[i] / acc[i].n));
+    if (adaptive) {  // the rounds' own test, on the variance reported
+      const double goal = opt.targetRelativeError * std::max(luminance(mat.E[i]) + acc[i].sumL / acc[i].n, floorB);
+      unmet += var.B[i] > goal * goal * acc[i].n;
+    }
     res.stdErrorH[i] = float(std::sqrt(var.H[i] / acc[i].n));
     res.samples[i] = int(acc[i].n) * (twoSided ? 2 : 1);
     res.traced[i] = 1;
@@ -406,7 +401,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     // silence).
     char b[300];
     std::snprintf(b, sizeof b,
-                  "%.0f of %zu traced vertices stopped at max_samples (%d paths) with their error above "
+                  "%zu of %zu traced vertices stopped at max_samples (%d paths) with their error above "
                   "target_relative_error %.3g: raise max_samples or the target",
                   unmet, valid, opt.maxSamples, opt.targetRelativeError);
     st.warn(b);

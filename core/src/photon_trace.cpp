@@ -125,17 +125,29 @@ class PhotonLights {
     inner_ = area_.totalPower() + pointPower_;
     total_ = inner_ + skyPower_ + sunPower_;
     spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
-    // The faces the point light lies on (within the ray epsilon): the
-    // default position is the box's corner, a lamp may be put on a wall.
+    // The faces the point light lies on (within the ray epsilon; the default
+    // position is the box's corner): per pass, so boxes first, masks if near.
     if (pointPower_ > 0.0) {
       const float eps = float(sceneScale(s).rayEpsilon);
-      const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-      const std::vector<uint8_t> ok = usableFaceMask(s);
+      const glm::vec3& L = o.point.position;
+      const size_t nv = s.positions.size();
+      std::vector<uint32_t> near;
       for (size_t f = 0; f < s.faceCount(); ++f) {
-        if (!ok[f]) continue;
         const glm::uvec3& t = s.triangles[f];
-        const glm::vec3 q = closestOnTriangle(o.point.position, s.positions[t.x], s.positions[t.y], s.positions[t.z]);
-        if (glm::length(q - o.point.position) <= eps) pointOn_.push_back(faceN[f]);
+        if (t.x >= nv || t.y >= nv || t.z >= nv) continue;  // usableFaceMask refuses it below
+        const glm::vec3 &a = s.positions[t.x], &b = s.positions[t.y], &c = s.positions[t.z];
+        const glm::vec3 lo = glm::min(glm::min(a, b), c) - eps, hi = glm::max(glm::max(a, b), c) + eps;
+        if (L.x >= lo.x && L.x <= hi.x && L.y >= lo.y && L.y <= hi.y && L.z >= lo.z && L.z <= hi.z)
+          near.push_back(uint32_t(f));
+      }
+      if (!near.empty()) {
+        const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+        const std::vector<uint8_t> ok = usableFaceMask(s);
+        for (uint32_t f : near) {
+          const glm::uvec3& t = s.triangles[f];
+          if (ok[f] && glm::length(closestOnTriangle(L, s.positions[t.x], s.positions[t.y], s.positions[t.z]) - L) <= eps)
+            pointOn_.push_back(faceN[f]);
+        }
       }
     }
   }

@@ -90,10 +90,13 @@ Params budget(gi::FilterKind kind, Bytes& in) {
     case gi::FilterKind::PhotonMapping:
       return {{"photons", "500"}, {"gather_rays", "2"}, {"final_gather", a & 1 ? "true" : "false"},
               {"progressive", a & 2 ? "true" : "false"}, {"passes", "2"}, {"sky_irradiance", "1"},
-              {"photon_layer", "true"}, {"photon_layer_max", "100"}, {"light_samples", "2"}};
+              {"photon_layer", "true"}, {"photon_layer_max", "100"}, {"light_samples", "2"},
+              // A point light at the origin, a grid point of most inputs: on or near their faces.
+              {"point_intensity", a & 4 ? "1" : "0"}};
     case gi::FilterKind::PathTracedReference:
       return {{"samples_per_vertex", "4"}, {"min_samples", "4"}, {"max_samples", "8"}, {"max_depth", "3"},
-              {"sky_irradiance", "1"}};
+              {"sky_irradiance", "1"}, {"sun_irradiance", a & 1 ? "1" : "0"},
+              {"sun_angular_radius", a & 2 ? "1e-6" : "0.27"}};
     case gi::FilterKind::FormFactorsOfFace:
       return {{"face_index", std::to_string(a % 4)}, {"form_factor_method", std::to_string(b % 3)},
               {"rays_per_patch", "16"}, {"hemicube_resolution", "16"}};
