@@ -87,6 +87,16 @@ Ray Integrator::spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d
   return r;
 }
 
+Ray Integrator::shadowRay(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, const glm::vec3& y, float lift,
+                          float stop) const {
+  Ray r = spawn(x, n, d, lift);
+  const glm::vec3 w = y - r.o;
+  const float len = glm::length(w);
+  if (len > 0.f) r.d = w / len;
+  r.tfar = len * (1.f - 1e-4f) - stop;
+  return r;
+}
+
 glm::vec3 Integrator::escaped(const glm::vec3& d, bool delta, float pdfPrev, float nLPrev) const {
   glm::vec3 L = L_.skyRadiance;
   if (sunDisk_ && glm::dot(d, L_.sunDirection) >= sunCos_)
@@ -126,8 +136,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
         const float cx = glm::dot(n, w), ce = -glm::dot(e.n, w);
         const glm::vec3 f = cx > 0.f && ce > 0.f ? b.f(w) : glm::vec3(0.f);
         if (positive(f)) {
-          Ray ray = spawn(x, n, w, lift);
-          ray.tfar = r * (1.f - 1e-4f) - eps_;
+          const Ray ray = shadowRay(x, n, w, e.p, lift, eps_);
           const bool cast = ray.tfar > 0.f;  // else the emitter point is closer than the offset: visible
           c.shadow += cast;
           if (!cast || !caster_.occluded(ray)) {
@@ -166,8 +175,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
       const float cx = glm::dot(n, w);
       const glm::vec3 f = cx > 0.f && L_.point.shinesTowards(-w) ? b.f(w) : glm::vec3(0.f);
       if (positive(f)) {
-        Ray ray = spawn(x, n, w, lift);
-        ray.tfar = r * (1.f - 1e-4f);
+        const Ray ray = shadowRay(x, n, w, L_.point.position, lift, 0.f);
         ++c.shadow;
         if (!caster_.occluded(ray)) L += f * L_.point.intensity * (cx / r2);
       }

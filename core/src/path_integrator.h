@@ -190,6 +190,13 @@ class Integrator {
   // A ray leaving x (normal n) in direction d, lifted by `lift` to d's side.
   Ray spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, float lift) const;
   Ray spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d) const { return spawn(x, n, d, eps_); }
+  // A shadow ray from x (lifted by `lift` to d's side) to the light point y,
+  // aimed from the lifted origin: aimed from x, a ray lifted off a surface
+  // that sees the light at a grazing angle meets the light's own plane
+  // before y (by up to lift / cos at the light). It stops `stop` before y
+  // (and 1e-4 of the way); tfar <= 0 means y is nearer than that.
+  Ray shadowRay(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, const glm::vec3& y, float lift,
+                float stop) const;
   Bsdf bsdfAt(const SurfacePoint& sp, const glm::vec3& wo) const;
   // Sky and sun disk seen along d; MIS-weighted against a sun sample unless
   // the direction came from a delta event.

@@ -151,7 +151,15 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
   const size_t nv = s.vertexCount();
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-  const std::vector<glm::vec3> vn = vertexNormalsForRays(s);
+  std::vector<glm::vec3> vn = vertexNormalsForRays(s);
+  for (glm::vec3& n : vn)
+    if (glm::dot(n, n) > 0.f) n = glm::normalize(n);
+  // Each vertex's eye ray arrives at the point the per-vertex filters start
+  // their rays from, less its lift along the normal (which the paths add):
+  // pulled into its faces by the ray offset, so that at a border vertex
+  // (a wall's edge beside another wall) the light from the other wall is not
+  // lost through the seam.
+  const std::vector<glm::vec3> lifted = vertexRayOrigins(s, vn, ctx.eps());
   std::vector<uint32_t> start(nv + 1, 0), faces;
   for (size_t f = 0; f < s.faceCount(); ++f)
     if (ok[f])
@@ -174,9 +182,9 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
       for (uint32_t j = start[v]; j < start[v + 1]; ++j)
         if (glm::dot(faceN[faces[j]], toCam) > glm::dot(faceN[best], toCam)) best = faces[j];
       SurfacePoint sp;
-      sp.x = s.positions[v];
+      sp.x = lifted[v] - ctx.eps() * vn[v];
       sp.face = best;
-      sp.n = glm::dot(vn[v], faceN[best]) > 0.5f ? glm::normalize(vn[v]) : faceN[best];
+      sp.n = glm::dot(vn[v], faceN[best]) > 0.5f ? vn[v] : faceN[best];
       // Facing away: nothing leaves it towards the camera on its outer side
       // (a glass vertex would start an eye ray inside the glass, beyond the
       // critical angle where no light can come from).

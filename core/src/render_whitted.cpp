@@ -88,8 +88,7 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
     const float r = glm::length(w);
     if (!(r > 0.f)) continue;
     w /= r;
-    Ray ray = spawn(x, n, w);
-    ray.tfar = r * (1.f - 1e-4f) - eps_;
+    const Ray ray = shadowRay(x, n, w, glm::vec3(centre), eps(), eps());
     if (ray.tfar > 0.f) H += glm::vec3(Hl) * whittedTransmittance(ray, c);
     else H += glm::vec3(Hl);
   }
@@ -105,8 +104,7 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
       w /= r;
       const float cx = glm::dot(n, w);
       if (cx > 0.f && o_.point.shinesTowards(-w)) {
-        Ray ray = spawn(x, n, w);
-        ray.tfar = r * (1.f - 1e-4f);
+        const Ray ray = shadowRay(x, n, w, o_.point.position, eps(), 0.f);
         H += o_.point.intensity * (cx / r2) * whittedTransmittance(ray, c);
       }
     }
