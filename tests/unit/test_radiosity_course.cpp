@@ -152,8 +152,10 @@ TEST(RadiosityCourse, AmbientTermOnTheCornellBox) {
 // 0.9 everywhere: B = 10) stopped at 0.5 and 0.1 of its power unshot: the
 // patches' mean is exact with the term; the vertices' mean, interpolated,
 // -0.02% and 0.00% (before: +4.5% and +0.9%), bound 0.5%; with the final
-// gather +3.4% and +0.7% (before: +7.9% and +1.6%; its near hits, relit,
-// count one more bounce of the unshot light), bounds 4% and 1%.
+// gather +4.2% and +0.85% (before: +7.9% and +1.6%; its near hits, relit,
+// count more bounces of the unshot light: +3.4% and +0.7% with two levels
+// of them, before the converged solution's near hits went on by Russian
+// roulette), bounds 5% and 1%.
 TEST(RadiosityCourse, AmbientTermAtTheVerticesCountsEachBounceOnce) {
   auto sf = scenes::closedBox(1.0, 4, true);
   scenes::setUniform(sf, glm::vec3(0.9f), glm::vec3(1.f));
@@ -172,7 +174,7 @@ TEST(RadiosityCourse, AmbientTermAtTheVerticesCountsEachBounceOnce) {
       std::printf("ambient term, %.0f%% unshot, %s: patches %+.3f%%, vertices %+.3f%%\n", 100 * tol,
                   kRadiosityVertexOutputs.logName(mode), 100 * (patches / 10 - 1), 100 * (vertices / 10 - 1));
       EXPECT_NEAR(patches / 10, 1.0, 1e-3);
-      const double allowed = mode == RadiosityVertexOutput::InterpolatedIndirect ? 0.005 : tol > 0.2 ? 0.04 : 0.01;
+      const double allowed = mode == RadiosityVertexOutput::InterpolatedIndirect ? 0.005 : tol > 0.2 ? 0.05 : 0.01;
       EXPECT_NEAR(vertices / 10, 1.0, allowed) << kRadiosityVertexOutputs.logName(mode) << ", tolerance " << tol;
     }
 }
