@@ -325,7 +325,8 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
       if (!unoccluded_) {
         ++rays;
         const glm::vec3 from = glm::vec3(centroid_[i]) + normal_[i] * eps_;
-        if (!visibleToRandomPoint(caster_, from, s_.positions[tj.x], s_.positions[tj.y], s_.positions[tj.z], rng, eps_))
+        if (!visibleByFormFactorKernel(caster_, from, normal_[i], s_.positions[tj.x], s_.positions[tj.y],
+                                       s_.positions[tj.z], rng, eps_))
           continue;
       }
       r.j.push_back(j);
@@ -344,11 +345,13 @@ FormFactorRow FormFactors::analyticRow(uint32_t i) const {
       const double f =
           near ? refine(base[k], w, wg[k], g, &target, &splitBudget, kMaxRefine + kEdgeLevels, tolPerShare) : wg[k];
       if (f <= 0) continue;
-      // Visibility: one ray per base point to a random point of j, for all of
-      // that base sub-triangle's refined quarters (as many rays as before refinement).
+      // Visibility: one ray per base point to a point of j drawn by the
+      // form factor's kernel, for all of that base sub-triangle's refined
+      // quarters (as many rays as before refinement).
       if (!unoccluded_) {
         ++rays;
-        if (!visibleToRandomPoint(caster_, lifted[k], s_.positions[tj.x], s_.positions[tj.y], s_.positions[tj.z], rng, eps_))
+        if (!visibleByFormFactorKernel(caster_, lifted[k], normal_[i], s_.positions[tj.x], s_.positions[tj.y],
+                                       s_.positions[tj.z], rng, eps_))
           continue;
       }
       F += f;

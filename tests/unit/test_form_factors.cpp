@@ -294,3 +294,42 @@ TEST(FormFactors, CoaxialDisksMatchClosedForm) {
   const auto rows = allRows(u, 4096, 0, FormFactorMethod::Analytic, 16);
   EXPECT_NEAR(plateToPlate(u, rows, split, true), closed(1, 0.5, 1), 0.003);
 }
+
+// A small square on the floor and a long triangle standing beside it, whose
+// upper part (up to 3 m) a plate at 0.3 m hides: most of the triangle's
+// area is hidden, most of its factor is not. The analytic method's one
+// visibility ray a base point must aim by the form factor's kernel; aimed at
+// a point uniform by area it converged to the unoccluded factor times the
+// visible share of the area (0.174 at 4 points, 0.069 at 1,024 against
+// 0.3625; an outside audit). Analytic at 1,024 points, 8 seeds (the
+// mean's standard error from their spread), against Monte Carlo with 2M
+// rays (standard error sqrt(F (1 - F) / N)): within 4 combined standard
+// errors. Measured: 0.3618 (0.0010) against 0.3622 (aimed by area: 0.0712).
+TEST(FormFactors, AnalyticVisibilityWeighsByTheKernel) {
+  const std::vector<glm::dvec3> pts = {{0, 0, 0},        {0.1, 0, 0},  {0, 0.1, 0},     {0.1, 0.1, 0},
+                                       {0.12, -0.1, 0},  {0.12, 0.05, 3}, {0.12, 0.2, 0}, {0, -1, 0.3},
+                                       {0, 1, 0.3},      {0.119, -1, 0.3}, {0.119, 1, 0.3}};
+  const std::vector<glm::uvec3> tris = {{0, 1, 3}, {0, 3, 2}, {4, 5, 6}, {7, 8, 10}, {7, 10, 9}};
+  const Scene s = Scene::fromAbsolute(pts, tris);
+  auto caster = makeEmbreeCaster(s);
+  auto factor = [&](const FormFactors& ff) {
+    const FormFactorRow r = ff.row(0);
+    for (size_t k = 0; k < r.j.size(); ++k)
+      if (r.j[k] == 2) return double(r.F[k]);
+    return 0.0;
+  };
+  const int rays = 1 << 21;
+  const double mc = factor(FormFactors(s, *caster, FormFactors::Settings{FormFactorMethod::MonteCarlo, rays, 4, 128, 7}));
+  double sum = 0, sum2 = 0;
+  const int seeds = 8;
+  for (int seed = 0; seed < seeds; ++seed) {
+    const double f = factor(FormFactors(s, *caster, FormFactors::Settings{FormFactorMethod::Analytic, 0, 1024, 128, uint32_t(seed)}));
+    sum += f;
+    sum2 += f * f;
+  }
+  const double mean = sum / seeds, sem = std::sqrt((sum2 / seeds - mean * mean) / (seeds - 1));
+  const double seMc = std::sqrt(mc * (1 - mc) / rays);
+  std::printf("square -> long triangle: analytic %.4f (standard error %.4f), Monte Carlo %.4f (%.4f)\n", mean, sem, mc, seMc);
+  EXPECT_GT(mc, 0.3);
+  EXPECT_NEAR(mean, mc, 4 * std::sqrt(sem * sem + seMc * seMc));
+}

@@ -60,10 +60,16 @@ class RayCaster {
 };
 
 struct Rng;
-// Whether x sees a uniformly random point of triangle (a, b, c): one shadow
-// ray stopping short of the point (eps and a relative margin).
-bool visibleToRandomPoint(const RayCaster& caster, const glm::vec3& x, const glm::vec3& a, const glm::vec3& b,
-                          const glm::vec3& c, Rng& rng, float eps);
+// Whether x (normal n) sees a random point of triangle (a, b, c) drawn with
+// the density of the point-to-triangle form factor's kernel, cos(theta_x)
+// over the solid angle (a direction uniform in the spherical triangle, Arvo
+// 1995, kept with probability cos(theta_x)): its mean is the kernel-weighted
+// visibility, so that F x it is the occluded factor (a point uniform by
+// area weighs the triangle's far, hidden part as much as its near, bright
+// one: a long triangle half hidden read 52% low at 4 points a patch and 81%
+// at 1,024). One shadow ray stopping short of the triangle's plane.
+bool visibleByFormFactorKernel(const RayCaster& caster, const glm::vec3& x, const glm::vec3& n, const glm::vec3& a,
+                               const glm::vec3& b, const glm::vec3& c, Rng& rng, float eps);
 
 enum class BatchMode { Single, Packet8, Stream };  // how batches reach Embree
 
