@@ -111,3 +111,43 @@ TEST(HierarchicalRadiosity, ThinPartitionStopsTheLight) {
     EXPECT_NEAR(ratio, 1.0, 0.05) << partition;
   }
 }
+
+// A small square on the floor (4 x 4 cells) beside a long triangle standing
+// up to 3 m, whose upper part a black plate at 0.3 m hides from the square;
+// a lamp lights the triangle. Nearly all of the triangle's factor from the
+// square is its near, visible part, while most of its area is hidden: a
+// link's visible share counted by point pairs passed a fraction of the
+// light (the square's power 46% low at 4 link rays, 73% at 64; an outside
+// audit), counted by the pairs' kernel it is the share of the factor.
+// Against the flat solution (Gauss-Seidel, analytic factors: it agrees with
+// Monte Carlo and the hemicube within 0.3% there): within 10% at 4 and 64
+// link rays. Measured: +6.9% and -6.4% (the rest is the link's 16 x 16 point
+// quadrature of a kernel that falls as r^-4 along the triangle).
+TEST(HierarchicalRadiosity, LongHalfHiddenSourceWeighsItsVisiblePartByTheKernel) {
+  test::SceneBuilder b;
+  grid(b, {0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, 4, 4, glm::vec3(0.5f));  // the square, facing up
+  b.tri({0.12, -0.1, 0}, {0.12, 0.05, 3}, {0.12, 0.2, 0}, glm::vec3(0.95f), glm::vec3(0.f), Material::Diffuse);
+  b.quad({0, -1, 0.3}, {0, 1, 0.3}, {0.119, 1, 0.3}, {0.119, -1, 0.3}, glm::vec3(0.f));  // facing down
+  b.quad({0, 0, 1.4}, {0, 0.2, 1.4}, {0, 0.2, 1.6}, {0, 0, 1.6}, glm::vec3(0.f), glm::vec3(1.f));  // facing +x
+  const Scene s = b.build();
+  auto caster = makeEmbreeCaster(s);
+  auto squarePower = [&](const RadiosityResult& r) {
+    double sum = 0;
+    for (size_t f = 0; f < 32; ++f) sum += faceArea(s, f) * luminance(r.B[f]);
+    return sum;
+  };
+  RadiosityOptions o;
+  o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+  o.tolerance = 1e-6;
+  o.solver = RadiositySolver::GaussSeidel;
+  o.formFactors.method = FormFactorMethod::Analytic;
+  const double flat = squarePower(solveRadiosity(s, *caster, o));
+  ASSERT_GT(flat, 0);
+  o.solver = RadiositySolver::Hierarchical;
+  for (int rays : {4, 64}) {
+    o.linkRays = rays;
+    const double ratio = squarePower(solveRadiosity(s, *caster, o)) / flat;
+    std::printf("%d link rays: the square's power, hierarchical / flat %.4f\n", rays, ratio);
+    EXPECT_NEAR(ratio, 1.0, 0.1) << rays << " link rays";
+  }
+}
