@@ -56,14 +56,16 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   for (const char* shown : kResultAttributes)
     if (in.attrs.vertexColorShows.empty() && in.attribute(shown)) in.attrs.vertexColorShows = shown;
   if (v.has("reflectance_source"))
-    if (auto err =
-            applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog, &res.setupWarnings))
+    if (auto err = applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog))
       throw std::invalid_argument(*err);
   if (v.has("mirror_layers")) {
     std::string log;
     if (auto err = applyMaterials(in.scene, in.layers, v, &log)) throw std::invalid_argument(*err);
     res.setupLog += (res.setupLog.empty() ? "" : "; ") + log;
   }
+  // After the materials: a mirror's or glass layer's faces take the specular colour.
+  if (v.has("reflectance_source"))
+    if (auto w = whiteReflectanceWarning(in.scene)) res.setupWarnings.push_back(*w);
   res.report = analyzeScene(in.scene);
   if (res.report.usableFaces() == 0)
     throw std::invalid_argument("the mesh has no usable triangles (" + res.report.summary() + ")");

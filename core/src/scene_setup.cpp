@@ -212,8 +212,7 @@ namespace {
 // rho per face from the chosen source, *msg the log's part ("reflectance
 // from ..."), *warnings (if given) the clamp of rho >= 1; the error sentence
 // when the mesh lacks that source.
-std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg,
-                                          std::vector<std::string>* warnings) {
+std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg) {
   const size_t nf = s.faceCount(), nv = s.vertexCount();
   auto src = kReflectanceSources.get(v, "reflectance_source");
   const glm::vec3 constant = v.getVec("reflectance");
@@ -269,13 +268,7 @@ std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, con
   if (resultColors)
     *msg += " (the vertex colours display an earlier filter's result, " + a.vertexColorShows +
             ", not a reflectance: choose 'Vertex color' to use them anyway)";
-  if (clamped) {
-    *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
-    if (warnings)
-      warnings->push_back(std::to_string(clamped) + " reflectance channels at or above 1 (white colours) limited to "
-                          "0.999: rho = 1 returns all the light it receives, and a closed room never converges; at "
-                          "0.999 B there reaches about 1000 times the emission (choose a reflectance below 1)");
-  }
+  if (clamped) *msg += " (" + std::to_string(clamped) + " channels of white colours limited to 0.999)";
   return std::nullopt;
 }
 
@@ -347,10 +340,26 @@ std::string setEmission(Scene& s, const MeshAttributes& a, const ParamValues& v)
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
                                                  bool withEmitters, std::string* log, std::vector<std::string>* warnings) {
   std::string msg;
-  if (auto err = setReflectance(s, a, v, &msg, warnings)) return err;
+  if (auto err = setReflectance(s, a, v, &msg)) return err;
   if (withEmitters) msg += setEmission(s, a, v);
   if (log) *log = msg;
+  if (warnings)
+    if (auto w = whiteReflectanceWarning(s)) warnings->push_back(*w);
   return std::nullopt;
+}
+
+std::optional<std::string> whiteReflectanceWarning(const Scene& s) {
+  size_t clamped = 0;
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    if (!s.material.empty() && s.material[f] != Material::Diffuse) continue;  // a specular colour may be 1
+    const glm::vec3 r = s.faceRho(f);
+    for (int k = 0; k < 3; ++k) clamped += r[k] >= 0.999f ? 1 : 0;
+  }
+  if (!clamped) return std::nullopt;
+  return std::to_string(clamped) +
+         " reflectance channels of diffuse faces at or above 1 (white colours) limited to 0.999: rho = 1 returns all "
+         "the light it receives, and a closed room never converges; at 0.999 B there reaches about 1000 times the "
+         "emission (choose a reflectance below 1)";
 }
 
 std::vector<Rgb8> VertexOutput::displayColors() const {

@@ -429,6 +429,32 @@ TEST(RadiosityWarnings, WhiteReflectanceLimitedIsWarned) {
   }
 }
 
+// A mirror's or a glass layer's faces take the specular colour (white: a
+// perfect mirror), so white colours there are not limited: the warning
+// counts the diffuse faces' channels only (it counted every face's, the
+// mirror's among them; an outside audit), and says nothing when every
+// face is a mirror.
+TEST(SceneWarnings, WhiteColoursOnAMirrorLayerAreNotCounted) {
+  for (const char* mirrors : {"mirror", "*"}) {
+    FilterInput in = test::filterInput(FilterKind::PathTracedReference, scenes::closedBox(1.0, 2, true));
+    const size_t nf = in.scene.faceCount();
+    ASSERT_EQ(nf, 48u);
+    in.layers = {{"walls", 0, 40}, {"mirror", 40, 8}};
+    const auto specs = filterSpecs(FilterKind::PathTracedReference);
+    const double diag = analyzeScene(in.scene).diagonal;
+    for (const auto& [k, v] : {std::pair<const char*, const char*>{"reflectance_source", "Constant"},
+                               {"reflectance", "255,255,255"}, {"emitter_source", "None"},
+                               {"point_position", "0.5,0.5,0.5"}, {"point_intensity", "1"},
+                               {"samples_per_vertex", "4"}, {"mirror_layers", mirrors}, {"max_depth", "2"}})
+      in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+    const FilterResult r = runFilter(FilterKind::PathTracedReference, in);
+    if (mirrors[0] == '*')
+      EXPECT_FALSE(warned(r.stats, "limited to 0.999")) << all(r.stats);
+    else
+      EXPECT_TRUE(warned(r.stats, "120 reflectance channels of diffuse faces")) << all(r.stats);
+  }
+}
+
 // A face repeated (same corners, same turn) shadows its copy at random: the
 // run warns, as the scene line already noted; the box without it says
 // nothing.
