@@ -8,6 +8,7 @@
 #include <iterator>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -367,6 +368,17 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   if (vertexColor.empty()) check(attrs.vertexColor.size(), nv, "vertex colours");
   for (const VertexAttribute& a : extras.attributes) check(a.values.size(), nv * size_t(a.components), a.name.c_str());
   if (nv > uint32_t(INT32_MAX)) failWrite(path, "too many vertices for int indices");
+  // Every property a name the reader takes back: one token, no name twice.
+  std::set<std::string> names = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "quality"};
+  for (const VertexAttribute& a : extras.attributes) {
+    const bool token = !a.name.empty() && std::all_of(a.name.begin(), a.name.end(), [](unsigned char c) {
+      return c > 0x20 && c < 0x7f;
+    });
+    if (!token) failWrite(path, "an attribute's name is not one word of printable characters");
+    for (const std::string& n : a.components == 1 ? std::vector<std::string>{a.name}
+                                                  : std::vector<std::string>{a.name + "_x", a.name + "_y", a.name + "_z"})
+      if (!names.insert(n).second) failWrite(path, "the property '" + n + "' would be written twice");
+  }
 
   const bool hasN = !extras.normals.empty(), hasQ = !vertexQuality.empty();
   const bool hasC = !vertexColor.empty() || !attrs.vertexColor.empty();

@@ -1,6 +1,8 @@
 #include "result_file.h"
 
 #include <algorithm>
+#include <cctype>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -31,7 +33,13 @@ std::vector<uint8_t> flatColors(const std::vector<Rgb8>& c) {
 }
 
 std::vector<Rgb8> colors(const json& j) {
-  const auto f = j.get<std::vector<uint8_t>>();
+  if (!j.is_array()) throw std::runtime_error("a colour array is not an array");
+  std::vector<uint8_t> f;
+  f.reserve(j.size());
+  for (const json& v : j) {
+    if (!v.is_number_unsigned() || v.get<uint64_t>() > 255) throw std::runtime_error("a colour is not an integer 0..255");
+    f.push_back(uint8_t(v.get<unsigned>()));
+  }
   if (f.size() % 3) throw std::runtime_error("a colour array is not a multiple of 3 long");
   std::vector<Rgb8> c(f.size() / 3);
   for (size_t i = 0; i < c.size(); ++i) c[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
@@ -43,6 +51,15 @@ std::vector<float> flatVectors(const std::vector<glm::vec3>& v) {
   f.reserve(v.size() * 3);
   for (const glm::vec3& x : v) f.insert(f.end(), {x.x, x.y, x.z});
   return f;
+}
+
+// A per-vertex attribute's name as a PLY property: a letter, then letters,
+// digits and underscores, and none of the properties the writer puts there itself.
+bool plyAttributeName(const std::string& name) {
+  static const char* taken[] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "quality"};
+  if (name.empty() || name.size() > 64 || !std::isalpha(static_cast<unsigned char>(name[0]))) return false;
+  if (!std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; })) return false;
+  return std::none_of(std::begin(taken), std::end(taken), [&](const char* t) { return name == t; });
 }
 
 }  // namespace
@@ -86,11 +103,15 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
   try {
     const json j = json::parse(text);
     if (j.at("format") != "gi-result" || j.at("version") != 1) throw std::runtime_error("not a gi result file (version 1)");
-    ResultKey key{j.at("filter"), j.at("file"), std::stoull(j.at("scene_hash").get<std::string>(), nullptr, 16),
-                  j.at("parameters")};
+    const std::string hash = j.at("scene_hash").get<std::string>();
+    if (hash.empty() || hash.size() > 16 ||
+        !std::all_of(hash.begin(), hash.end(), [](unsigned char c) { return std::isxdigit(c) != 0; }))
+      throw std::runtime_error("its scene hash is not 1 to 16 hex digits");
+    ResultKey key{j.at("filter"), j.at("file"), std::stoull(hash, nullptr, 16), j.at("parameters")};
     r.vertexQuality = j.at("vertex_quality").get<std::vector<float>>();
     r.vertexColor = colors(j.at("vertex_color"));
     const auto n = j.at("vertex_normal").get<std::vector<float>>();
+    if (n.size() % 3) throw std::runtime_error("vertex_normal is not a multiple of 3 long");
     r.vertexNormal.resize(n.size() / 3);
     for (size_t i = 0; i < r.vertexNormal.size(); ++i) r.vertexNormal[i] = {n[3 * i], n[3 * i + 1], n[3 * i + 2]};
     r.faceQuality = j.at("face_quality").get<std::vector<float>>();
@@ -98,12 +119,15 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
     r.attributes.clear();
     const size_t nv = j.at("vertices");
     for (const auto& [name, a] : j.at("attributes").items()) {
+      if (!plyAttributeName(name)) throw std::runtime_error("attribute '" + name + "' is not a PLY property name of its own");
+      if (!a.at("components").is_number_integer()) throw std::runtime_error("attribute " + name + ": components is not 1 or 3");
       VertexAttribute x{name, a.at("components"), a.at("values").get<std::vector<float>>()};
       if ((x.components != 1 && x.components != 3) || x.values.size() != nv * size_t(x.components))
         throw std::runtime_error("attribute " + name + " does not match the vertex count");
       r.attributes.push_back(std::move(x));
     }
-    if (r.vertexQuality.size() != nv || (!r.vertexColor.empty() && r.vertexColor.size() != nv))
+    if (r.vertexQuality.size() != nv || (!r.vertexColor.empty() && r.vertexColor.size() != nv) ||
+        (!r.vertexNormal.empty() && r.vertexNormal.size() != nv))
       throw std::runtime_error("array sizes do not match the vertex count");
     // JSON numbers beyond float range become infinities: no result holds one.
     auto finite = [](const std::vector<float>& v) {
@@ -121,7 +145,10 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
     r.stats.warnings = j.at("warnings").get<std::vector<std::string>>();
     return key;
   } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read " + path + ": " + e.what());
+    // The JSON library's messages begin "[json.exception.type_error.302] ": said without it.
+    std::string what = e.what();
+    if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos) what = what.substr(what.find("] ") + 2);
+    throw std::runtime_error("cannot read " + path + ": " + what);
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -88,6 +89,7 @@ Texts parameterPairs(const std::vector<std::string>& w, size_t from, const std::
     else throw std::invalid_argument(where + "--" + k + " needs a value");
     const ParamSpec* p = findSpec(specs, k);
     if (!p || p->meshlabOnly) throw std::invalid_argument(where + "'" + filter + "' has no parameter --" + k);
+    if (out.count(k)) throw std::invalid_argument(where + "--" + k + " is given twice");
     out[k] = v;
   }
   return out;
@@ -104,6 +106,8 @@ std::pair<std::string, Texts> readParamsFile(const std::string& path) {
     throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
   }
   if (!j.is_object()) throw std::invalid_argument("the parameter file " + path + " must hold a JSON object");
+  if (j.contains("filter") && !j["filter"].is_string())
+    throw std::invalid_argument("\"filter\" in " + path + " must be a string");
   std::string filter = j.value("filter", "");
   Texts t;
   const json p = j.value("parameters", json::object());
@@ -175,8 +179,11 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
   long long i = 0, n = 1;
   if (!text.empty()) {
     char slash = 0, rest = 0;
+    errno = 0;
     if (std::sscanf(text.c_str(), "%lld %c %lld %c", &i, &slash, &n, &rest) != 3 || slash != '/')
       throw std::invalid_argument("--shard '" + text + "': expected I/N, e.g. 0/16");
+    if (errno == ERANGE || n > (1LL << 40) || i > (1LL << 40))
+      throw std::invalid_argument("--shard '" + text + "': I and N must be below 2^40");
   } else if (std::getenv("SLURM_ARRAY_TASK_COUNT")) {
     // Each variable an integer (a garbled one must not make every task shard 0).
     auto num = [](const char* name, long long fallback) {
@@ -410,19 +417,31 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     const std::string hash = jobHash(d.cliName, params, job.input);
     const fs::path ply = fs::path(a.outDir) / (job.stem + ".ply"), sum = fs::path(a.outDir) / (job.stem + ".json");
     const json old = readJson(sum);
-    const bool same = old.is_object() && old.value("params_hash", "") == hash;
+    // A summary's fields read only with the type they are written with (a
+    // hand-edited one of other types counts as missing: recomputed).
+    const auto text = [&](const char* field) {
+      const auto it = old.is_object() ? old.find(field) : old.end();
+      return it != old.end() && it->is_string() ? it->get<std::string>() : std::string();
+    };
+    const auto number = [&](const char* field) {
+      const auto it = old.is_object() ? old.find(field) : old.end();
+      return it != old.end() && it->is_number() && std::isfinite(it->get<double>()) && it->get<double>() >= 0
+                 ? it->get<double>()
+                 : 0.0;
+    };
+    const bool same = text("params_hash") == hash;
     const std::string tag = "[" + std::to_string(k + 1) + "/" + std::to_string(jobs.size()) + "] " + job.input + ": ";
-    if (same && old.value("status", "") == "ok" && fs::exists(ply)) {
+    if (same && text("status") == "ok" && fs::exists(ply)) {
       ++before;
-      raysAll += old.value("rays", 0.0);
-      computeAll += old.value("seconds", 0.0);
+      raysAll += number("rays");
+      computeAll += number("seconds");
       if (!a.quiet && !a.reportOnly) std::cerr << tag << "done before\n";
       continue;
     }
     if (a.reportOnly) {
-      if (same && old.value("status", "") == "failed") {
+      if (same && text("status") == "failed") {
         ++failed;
-        failures.push_back({{"input", job.input}, {"error", old.value("error", "")}});
+        failures.push_back({{"input", job.input}, {"error", text("error")}});
       } else {
         ++missing;
       }

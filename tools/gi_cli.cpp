@@ -238,17 +238,30 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
   bool reused = false;
   std::error_code noFile;
+  std::string damaged;
   if (!cached.empty() && std::filesystem::exists(cached, noFile)) {
     FilterResult stored = r;
-    const io::ResultKey k = io::readResultFile(cached, stored);
+    io::ResultKey k;
+    // A damaged cache file is computed again (and rewritten); one that is
+    // not a regular file (a pipe, a device) stops the run, as before.
+    const bool regular = std::filesystem::is_regular_file(cached, noFile);
+    try {
+      k = io::readResultFile(cached, stored);
+    } catch (const std::runtime_error& e) {
+      if (!regular) throw;
+      damaged = e.what();
+    }
     // The text files a result rewrites are those its parameters name, and
     // no others (a cache file is not trusted to choose where to write).
     const FilterFiles plan = filterFiles(kind, in.values);
     const bool filesNamed = std::all_of(stored.files.begin(), stored.files.end(), [&](const FilterFile& f) {
       return std::any_of(plan.writes.begin(), plan.writes.end(), [&](const NamedFile& w) { return w.path == f.path; });
     });
-    reused = k.filter == key.filter && k.sceneHash == key.sceneHash && k.parameters == key.parameters &&
-             stored.vertexQuality.size() == in.scene.vertexCount() && filesNamed;
+    const size_t nf = in.scene.faceCount();
+    reused = damaged.empty() && k.filter == key.filter && k.sceneHash == key.sceneHash &&
+             k.parameters == key.parameters && stored.vertexQuality.size() == in.scene.vertexCount() &&
+             (stored.faceQuality.empty() || stored.faceQuality.size() == nf) &&
+             (stored.faceColor.empty() || stored.faceColor.size() == nf) && filesNamed;
     if (reused) {
       r = std::move(stored);
       r.stats.note("reused the cached result " + cached);
@@ -261,6 +274,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   if (!reused) {
     cluster::compute(kind, in, r, progress, a.split);
     if (!writer) return 0;
+    if (!damaged.empty()) r.stats.warn("the cached result could not be used, so it was computed again: " + damaged);
   }
   const bool caching = !reused && !cached.empty() && !r.refined && r.layers.empty();  // a cached result holds no geometry
   // The files the result names, checked as the plan was before anything is written.
@@ -476,6 +490,7 @@ int runCli(int argc, char** argv) {
         else if (i + 1 < extras.size()) val = extras[++i];
         else throw std::invalid_argument("--" + k + " needs a value");
         if (!findSpec(specs, k)) throw std::invalid_argument("'" + d->cliName + "' has no parameter --" + k);
+        if (a.raw.count(k)) throw std::invalid_argument("--" + k + " is given twice");
         a.raw[k] = val;
       }
       return writeScript({d->kind}, a);
