@@ -295,7 +295,10 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
     st.note("final gather of the photon map (" + std::to_string(opt.gatherRays) + " rays per vertex)");
     st.add("gather_near_hits_relit", double(ho.nearHits));
   } else {
-    reportHandOver(opt, ho, "the photon map", st);
+    reportHandOver(opt, ho,
+                   maps.thinnedStride > 1 ? "a map of every " + std::to_string(maps.thinnedStride) + "th photon"
+                                          : std::string("the photon map"),
+                   st);
   }
   return e;
 }

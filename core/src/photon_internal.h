@@ -73,11 +73,15 @@ struct PhotonGatherHit {
 // a glossy lobe by one sample of it) and, at the
 // first diffuse face, add value(hit) if the ray hit its front (0 otherwise).
 // `only` (one flag per vertex, or null for all): the vertices to gather at; the others get 0.
+// *variance (if given): per vertex, the variance of the mean of the rays'
+// luminance (their sample variance over the ray count; an upper bound for
+// the stratified rays), 0 where nothing was gathered.
 std::vector<glm::vec3> specularFinalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
                                            const std::vector<glm::vec3>& origins, int rays, uint32_t key, float eps,
                                            const std::function<glm::vec3(const PhotonGatherHit&)>& value,
                                            const std::vector<uint8_t>* only = nullptr,
-                                           const Progress& progress = Progress(nullptr));
+                                           const Progress& progress = Progress(nullptr),
+                                           std::vector<double>* variance = nullptr);
 
 // The photons' irradiance at the vertices.
 struct PhotonEstimate {
@@ -97,6 +101,11 @@ struct PhotonMaps {
   std::unique_ptr<PhotonMap> global, caustics, all;
   unsigned globalPaths = 7u;
   size_t bytes = 0;  // the photons and the trees
+  // The photons `all` reads when it is a thinned copy (the hand-over's map
+  // of a run of more than kPpmGatherPaths paths), with their hits left.
+  std::vector<Photon> thinned;
+  std::vector<uint8_t> thinnedLeft;
+  size_t thinnedStride = 1;
 };
 
 // Where the k-nearest mode gathered instead, and why.
@@ -132,7 +141,7 @@ std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const G
 // the hits relit.
 std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all, const std::vector<uint8_t>* only,
                                        const std::function<void(int)>& count, size_t* nearHits,
-                                       const Progress& progress);
+                                       const Progress& progress, std::vector<double>* variance = nullptr);
 
 // Progressive photon mapping (Hachisuka, Ogaki and Jensen 2008) with the
 // vertices as the measurement points: per vertex a radius R, an accumulated

@@ -207,13 +207,15 @@ void gatherHandedOver(const PhotonRun& r, const GatherSurface& surface, const Ke
     if (used > 0 && used < kFewPhotons) few.fetch_add(1, std::memory_order_relaxed);
   };
   Timer gt;
-  const std::vector<glm::vec3> H = gatherPhotonMap(r, *all, &out.ho.at, count, &out.ho.nearHits, progress);
+  std::vector<double> variance;
+  const std::vector<glm::vec3> H = gatherPhotonMap(r, *all, &out.ho.at, count, &out.ho.nearHits, progress, &variance);
   out.ho.gatherSeconds = gt.seconds();
   out.check.estimates += some.load();
   out.check.fewEstimates += few.load();
   for (size_t i = 0; i < H.size(); ++i) {
     if (!out.ho.at[i] || !r.mat.valid[i]) continue;
     out.H[i] += H[i];
+    out.noise[i] = std::sqrt(out.noise[i] * out.noise[i] + variance[i]);  // the caustic part's and the gather's
     if (!out.byPath[kPathIndirect].empty()) out.byPath[kPathIndirect][i] = H[i];
     if (luminance(out.H[i]) <= 0.f) ++out.verticesWithoutPhotons;
   }
@@ -291,9 +293,10 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
 std::vector<glm::vec3> specularFinalGather(
     const Scene& s, const RayCaster& caster, const VertexMaterial& mat, const std::vector<glm::vec3>& origins, int rays,
     uint32_t key, float eps, const std::function<glm::vec3(const PhotonGatherHit&)>& value,
-    const std::vector<uint8_t>* only, const Progress& progress) {
+    const std::vector<uint8_t>* only, const Progress& progress, std::vector<double>* variance) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
+  if (variance) variance->assign(s.vertexCount(), 0.0);
   parallelBlocks(s.vertexCount(), progress, "final gather", [&](size_t b, size_t e) {
     for (size_t v = b; v < e; ++v) {
       if (!mat.valid[v] || (only && !(*only)[v])) continue;
@@ -301,7 +304,9 @@ std::vector<glm::vec3> specularFinalGather(
       Rng rng(hash3(uint32_t(v), key, 0xfau));
       const Frame frame(mat.n[v]);
       glm::dvec3 sum(0.0);
+      double sumL2 = 0;
       for (int k = 0; k < rays; ++k) {
+        const glm::dvec3 before = sum;
         Ray ray;
         ray.o = origins[v];
         ray.d = frame.toWorld(cosineHemisphere(seq.next()));
@@ -338,8 +343,14 @@ std::vector<glm::vec3> specularFinalGather(
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
         }
+        const double l = luminance(glm::vec3(sum - before));
+        sumL2 += l * l;
       }
       H[v] = glm::vec3(sum / double(rays));
+      if (variance && rays > 1) {
+        const double m = luminance(H[v]);
+        (*variance)[v] = std::max(0.0, (sumL2 / rays - m * m) / (rays - 1));
+      }
     }
   });
   return H;
