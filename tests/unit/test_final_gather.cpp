@@ -78,6 +78,19 @@ PathTraceResult edgeReference(const Scene& s, const RayCaster& caster, std::shar
   return pathTrace(s, caster, po);
 }
 
+// The converged solution of `solver` gathered with `rays` rays a vertex,
+// against the reference at the marked vertices; printed as `what`.
+EdgeError convergedAgainst(const Scene& s, const RayCaster& caster, const std::vector<uint8_t>& marked,
+                           const PathTraceResult& ref, RadiositySolver solver, int rays, const char* what) {
+  RadiosityOptions o;
+  o.solver = solver;
+  o.gatherRays = rays;
+  const EdgeError e = edgeError(marked, ref, solveRadiosity(s, caster, o).Bvertex);
+  std::printf("%s: %d %s vertices, mean %+.4f (standard error %.4f), RMS %.4f\n",
+              solver == RadiositySolver::GaussSeidel ? "flat" : "hierarchical", e.n, what, e.mean, e.sem, e.rms);
+  return e;
+}
+
 void expectWithinTheReference(const EdgeError& e, double bias = 0) {
   EXPECT_GT(e.n, 150);
   EXPECT_LT(std::fabs(e.mean), 4 * e.sem + bias);
@@ -108,15 +121,8 @@ TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
   auto caster = makeEmbreeCaster(s);
   auto edge = std::make_shared<std::vector<uint8_t>>(roomEdgeVertices(s));
   const PathTraceResult ref = edgeReference(s, *caster, edge, -1);
-  for (RadiositySolver solver : {RadiositySolver::GaussSeidel, RadiositySolver::Hierarchical}) {
-    RadiosityOptions o;
-    o.solver = solver;
-    o.gatherRays = 2048;
-    const EdgeError e = edgeError(*edge, ref, solveRadiosity(s, *caster, o).Bvertex);
-    std::printf("%s: %d edge vertices, mean %+.4f (standard error %.4f), RMS %.4f\n",
-                solver == RadiositySolver::GaussSeidel ? "flat" : "hierarchical", e.n, e.mean, e.sem, e.rms);
-    expectWithinTheReference(e, 0.005);
-  }
+  for (RadiositySolver solver : {RadiositySolver::GaussSeidel, RadiositySolver::Hierarchical})
+    expectWithinTheReference(convergedAgainst(s, *caster, *edge, ref, solver, 2048, "edge"), 0.005);
 }
 
 // A fixed bounce count (the course's images, one bounce the classic one):
@@ -175,12 +181,7 @@ TEST(FinalGather, RoomCornerVerticesMatchTheReference) {
   std::fill(corners->begin(), corners->begin() + 24, 1);  // the walls' vertices
   const PathTraceResult ref = edgeReference(s, *caster, corners, -1);
   for (RadiositySolver solver : {RadiositySolver::GaussSeidel, RadiositySolver::Hierarchical}) {
-    RadiosityOptions o;
-    o.solver = solver;
-    o.gatherRays = 4096;
-    const EdgeError e = edgeError(*corners, ref, solveRadiosity(s, *caster, o).Bvertex);
-    std::printf("%s: %d corner vertices, mean %+.4f (standard error %.4f), RMS %.4f\n",
-                solver == RadiositySolver::GaussSeidel ? "flat" : "hierarchical", e.n, e.mean, e.sem, e.rms);
+    const EdgeError e = convergedAgainst(s, *caster, *corners, ref, solver, 4096, "corner");
     EXPECT_EQ(e.n, 24);
     EXPECT_LT(std::fabs(e.mean), 4 * e.sem);
     EXPECT_LT(std::fabs(e.mean), 0.015);
