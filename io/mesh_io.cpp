@@ -350,6 +350,11 @@ LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const st
   return parse(bytes, format, name, "");
 }
 
+bool plyVertexPropertyOfItsOwn(const std::string& name) {
+  static const char* own[] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "quality"};
+  return std::any_of(std::begin(own), std::end(own), [&](const char* o) { return name == o; });
+}
+
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
               const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,
               const PlyExtras& extras) {
@@ -369,7 +374,7 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   for (const VertexAttribute& a : extras.attributes) check(a.values.size(), nv * size_t(a.components), a.name.c_str());
   if (nv > uint32_t(INT32_MAX)) failWrite(path, "too many vertices for int indices");
   // Every property a name the reader takes back: one token, no name twice.
-  std::set<std::string> names = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "quality"};
+  std::set<std::string> names;
   for (const VertexAttribute& a : extras.attributes) {
     const bool token = !a.name.empty() && std::all_of(a.name.begin(), a.name.end(), [](unsigned char c) {
       return c > 0x20 && c < 0x7f;
@@ -377,7 +382,8 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
     if (!token) failWrite(path, "an attribute's name is not one word of printable characters");
     for (const std::string& n : a.components == 1 ? std::vector<std::string>{a.name}
                                                   : std::vector<std::string>{a.name + "_x", a.name + "_y", a.name + "_z"})
-      if (!names.insert(n).second) failWrite(path, "the property '" + n + "' would be written twice");
+      if (plyVertexPropertyOfItsOwn(n) || !names.insert(n).second)
+        failWrite(path, "the property '" + n + "' would be written twice");
   }
 
   const bool hasN = !extras.normals.empty(), hasQ = !vertexQuality.empty();

@@ -60,5 +60,8 @@ struct PlyExtras {
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
               const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,
               const PlyExtras& extras = {});
+// Whether writePly writes a vertex property of this name itself (x, y, z,
+// the normal, the colour, quality): an attribute may not take it.
+bool plyVertexPropertyOfItsOwn(const std::string& name);
 
 }  // namespace gi::io

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -11,6 +10,7 @@
 
 #include "atomic_file.h"
 #include "json_text.h"
+#include "mesh_io.h"
 #include "output_files.h"
 
 namespace gi::io {
@@ -56,10 +56,9 @@ std::vector<float> flatVectors(const std::vector<glm::vec3>& v) {
 // A per-vertex attribute's name as a PLY property: a letter, then letters,
 // digits and underscores, and none of the properties the writer puts there itself.
 bool plyAttributeName(const std::string& name) {
-  static const char* taken[] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "quality"};
   if (name.empty() || name.size() > 64 || !std::isalpha(static_cast<unsigned char>(name[0]))) return false;
   if (!std::all_of(name.begin(), name.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; })) return false;
-  return std::none_of(std::begin(taken), std::end(taken), [&](const char* t) { return name == t; });
+  return !plyVertexPropertyOfItsOwn(name);
 }
 
 }  // namespace

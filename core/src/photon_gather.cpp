@@ -43,6 +43,17 @@ std::unique_ptr<PhotonMap> gatherMap(const std::vector<Photon>& photons, const G
   return std::make_unique<PhotonMap>(photons, 7u, surface, &hitsLeft);
 }
 
+void appendEveryNth(const std::vector<Photon>& photons, const std::vector<uint8_t>& left, size_t stride, float scale,
+                    std::vector<Photon>& out, std::vector<uint8_t>& outLeft) {
+  out.reserve(out.size() + photons.size() / stride + 1);
+  outLeft.reserve(outLeft.size() + photons.size() / stride + 1);
+  for (size_t i = 0; i < photons.size(); i += stride) {
+    const Photon& p = photons[i];
+    out.push_back({p.p, p.power * scale, p.n, p.path});
+    outLeft.push_back(left[i]);
+  }
+}
+
 namespace {
 
 // Irradiance kept at every `stride`-th photon of the map (precomputed in
@@ -289,16 +300,10 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
       // times the photons), and a map of every photon of a large run cost
       // as much again as the run's own map (3M paths on the Cornell box:
       // 4.8 s of kd-trees against 1.7 s).
-      const size_t stride = (size_t(opt.photons) + kPpmGatherPaths - 1) / kPpmGatherPaths;
+      const size_t stride = gatherMapStride(size_t(opt.photons));
       if (stride > 1) {
         m.thinnedStride = stride;
-        m.thinned.reserve(photons.size() / stride + 1);
-        m.thinnedLeft.reserve(photons.size() / stride + 1);
-        for (size_t i = 0; i < photons.size(); i += stride) {
-          const Photon& p = photons[i];
-          m.thinned.push_back({p.p, p.power * float(stride), p.n, p.path});
-          m.thinnedLeft.push_back(hitsLeft[i]);
-        }
+        appendEveryNth(photons, hitsLeft, stride, float(stride), m.thinned, m.thinnedLeft);
         m.all = gatherMap(m.thinned, surface, m.thinnedLeft);
         m.bytes += m.thinned.capacity() * sizeof(Photon) + m.thinnedLeft.capacity();
       } else {

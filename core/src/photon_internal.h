@@ -175,6 +175,14 @@ struct ProgressiveResult {
   size_t gatherStride = 1;           // every gatherStride-th of them (a pass of more than kPpmGatherPaths paths)
 };
 constexpr size_t kPpmGatherPaths = 200000;
+// The stride that thins the photons of `paths` paths to a map of about
+// kPpmGatherPaths paths' worth (1: keep them all).
+inline size_t gatherMapStride(size_t paths) { return (paths + kPpmGatherPaths - 1) / kPpmGatherPaths; }
+// Appends every stride-th photon (with its path's hits left) at `scale`
+// times its power: each kept with probability 1 / stride, the same density
+// when scale is the stride.
+void appendEveryNth(const std::vector<Photon>& photons, const std::vector<uint8_t>& left, size_t stride, float scale,
+                    std::vector<Photon>& out, std::vector<uint8_t>& outLeft);
 ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progress, PhotonTraceStats& stats);
 
 // A vertex at a crease: one of its diffuse faces turns more than

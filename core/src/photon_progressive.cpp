@@ -57,14 +57,7 @@ std::vector<Photon> tracePass(const PhotonRun& r, int pass, const Progress& pp, 
   std::vector<uint8_t> left;
   std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats,
                                              opt.directLight ? &left : nullptr);
-  if (keep) {
-    keep->photons.reserve(keep->photons.size() + photons.size() / keep->stride + 1);
-    for (size_t i = 0; i < photons.size(); i += keep->stride) {
-      const Photon& p = photons[i];
-      keep->photons.push_back({p.p, p.power * keep->scale, p.n, p.path});
-      keep->left.push_back(left[i]);
-    }
-  }
+  if (keep) appendEveryNth(photons, left, keep->stride, keep->scale, keep->photons, keep->left);
   if (r.projection) {
     auto caustic = [](const Photon& p) { return p.path == kCausticPhoton; };
     photons.erase(std::remove_if(photons.begin(), photons.end(), caustic), photons.end());
@@ -245,7 +238,7 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
   if (opt.directLight) {
     const size_t paths = size_t(opt.photons);
     keepPasses = int(std::min<size_t>((kPpmGatherPaths + paths - 1) / paths, size_t(opt.passes)));
-    kept.stride = (paths + kPpmGatherPaths - 1) / kPpmGatherPaths;
+    kept.stride = gatherMapStride(paths);
     kept.scale = float(kept.stride) / float(keepPasses);
   }
   out.ho.at.assign(s.vertexCount(), 0);

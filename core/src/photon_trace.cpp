@@ -62,29 +62,6 @@ bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::v
   return true;
 }
 
-// The point of triangle abc nearest to p (Ericson 2005, "Real-Time
-// Collision Detection", 5.1.5: by the Voronoi regions of its corners and
-// edges).
-glm::vec3 closestOnTriangle(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
-  const glm::vec3 ab = b - a, ac = c - a, ap = p - a;
-  const float d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0.f && d2 <= 0.f) return a;
-  const glm::vec3 bp = p - b;
-  const float d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0.f && d4 <= d3) return b;
-  const float vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.f && d1 >= 0.f && d3 <= 0.f) return a + ab * (d1 / (d1 - d3));
-  const glm::vec3 cp = p - c;
-  const float d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0.f && d5 <= d6) return c;
-  const float vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.f && d2 >= 0.f && d6 <= 0.f) return a + ac * (d2 / (d2 - d6));
-  const float va = d3 * d6 - d5 * d4;
-  if (va <= 0.f && (d4 - d3) >= 0.f && (d5 - d6) >= 0.f) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const float denom = 1.f / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
 // The lights photons leave from: the area emitters, an optional point or
 // spot light, the sky and the sun, chosen in proportion to their (luminance)
 // power; the sky's and the sun's is what crosses the disk of the bounding
@@ -143,10 +120,12 @@ class PhotonLights {
       if (!near.empty()) {
         const std::vector<glm::vec3> faceN = unitFaceNormals(s);
         const std::vector<uint8_t> ok = usableFaceMask(s);
+        const glm::dvec3 Ld(L);
         for (uint32_t f : near) {
           const glm::uvec3& t = s.triangles[f];
-          if (ok[f] && glm::length(closestOnTriangle(L, s.positions[t.x], s.positions[t.y], s.positions[t.z]) - L) <= eps)
-            pointOn_.push_back(faceN[f]);
+          const glm::dvec3 q = closestPointOnTriangle(Ld, glm::dvec3(s.positions[t.x]), glm::dvec3(s.positions[t.y]),
+                                                      glm::dvec3(s.positions[t.z]));
+          if (ok[f] && glm::length(q - Ld) <= double(eps)) pointOn_.push_back(faceN[f]);
         }
       }
     }

@@ -209,9 +209,9 @@ std::vector<ParamSpec> displaySpecs() {
 
 namespace {
 
-// rho per face from the chosen source, *msg the log's part ("reflectance
-// from ..."), *warnings (if given) the clamp of rho >= 1; the error sentence
-// when the mesh lacks that source.
+// rho per face from the chosen source (rho >= 1 limited to 0.999), *msg the
+// log's part ("reflectance from ..."); the error sentence when the mesh lacks
+// that source.
 std::optional<std::string> setReflectance(Scene& s, const MeshAttributes& a, const ParamValues& v, std::string* msg) {
   const size_t nf = s.faceCount(), nv = s.vertexCount();
   auto src = kReflectanceSources.get(v, "reflectance_source");
@@ -338,13 +338,11 @@ std::string setEmission(Scene& s, const MeshAttributes& a, const ParamValues& v)
 }  // namespace
 
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
-                                                 bool withEmitters, std::string* log, std::vector<std::string>* warnings) {
+                                                 bool withEmitters, std::string* log) {
   std::string msg;
   if (auto err = setReflectance(s, a, v, &msg)) return err;
   if (withEmitters) msg += setEmission(s, a, v);
   if (log) *log = msg;
-  if (warnings)
-    if (auto w = whiteReflectanceWarning(s)) warnings->push_back(*w);
   return std::nullopt;
 }
 

@@ -7,6 +7,7 @@
 
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
+#include "gi/scene.h"
 
 namespace gi {
 
@@ -84,30 +85,6 @@ double largestCosine(const glm::dvec3& n, const glm::dvec3 (&p)[3]) {
   return insideOther ? 1.0 : std::min(1.0, best);
 }
 
-// The squared distance from p to triangle (a, b, c): Ericson 2005,
-// "Real-Time Collision Detection", section 5.1.5 (the point's Voronoi
-// region of the triangle's corners, edges and face).
-double distance2ToTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  auto d2to = [&](const glm::dvec3& q) { return glm::dot(p - q, p - q); };
-  if (d1 <= 0 && d2 <= 0) return d2to(a);
-  const glm::dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return d2to(b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return d2to(a + ab * (d1 / (d1 - d3)));
-  const glm::dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return d2to(c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return d2to(a + ac * (d2 / (d2 - d6)));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return d2to(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
-  const double den = 1 / (va + vb + vc);
-  return d2to(a + ab * (vb * den) + ac * (vc * den));
-}
-
 }  // namespace
 
 bool visibleByFormFactorKernel(const RayCaster& caster, const glm::vec3& x, const glm::vec3& n, const glm::vec3& a,
@@ -128,7 +105,8 @@ bool visibleByFormFactorKernel(const RayCaster& caster, const glm::vec3& x, cons
   if (!(ln > 0)) return true;
   const double h = std::fabs(glm::dot(nt, da)) / ln;
   const double lmax = std::max(glm::dot(N, da), std::max(glm::dot(N, db), glm::dot(N, dc)));
-  const double r2min = distance2ToTriangle(X, pa, pb, pc);
+  const glm::dvec3 nearest = closestPointOnTriangle(X, pa, pb, pc) - X;
+  const double r2min = glm::dot(nearest, nearest);
   if (h > 0 && lmax > 0 && r2min > 0) {
     const double kmax = lmax * h / (r2min * r2min);
     for (int k = 0; k < 4; ++k) {

@@ -359,7 +359,7 @@ TEST(ScenesIo, LayersKeepTheirOwnReflectanceRule) {
     v.set("reflectance", glm::vec3(float(std::atof(constant)) / 255.f));
     gi::Scene s = m.scene;
     std::string log;
-    EXPECT_FALSE(gi::applySceneConventions(s, m.attrs, v, false, &log, nullptr).has_value());
+    EXPECT_FALSE(gi::applySceneConventions(s, m.attrs, v, false, &log).has_value());
     return std::make_pair(s.rho, log);
   };
   auto lin = [](int a, int b, int c) { return gi::srgb8ToLinear(uint8_t(a), uint8_t(b), uint8_t(c)); };

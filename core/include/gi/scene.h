@@ -116,6 +116,9 @@ inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.
 std::vector<uint8_t> usableFaceMask(const Scene& s);
 // All three components finite (no NaN, no Inf).
 inline bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+// The point of triangle (a, b, c) nearest to p (Ericson 2005, "Real-Time
+// Collision Detection", 5.1.5: by the Voronoi regions of its corners and edges).
+glm::dvec3 closestPointOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
 // For the functions that take the mask from a caller who already has it:
 // *known if given, else usableFaceMask(s) computed into `own`.
 const std::vector<uint8_t>& usableFaces(const Scene& s, const std::vector<uint8_t>* known, std::vector<uint8_t>& own);

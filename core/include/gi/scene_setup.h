@@ -78,14 +78,12 @@ std::vector<ParamSpec> geometrySceneSpecs();
 std::vector<ParamSpec> displaySpecs();
 
 // Sets rho (and, if withEmitters, emission) of `s` from its attributes.
-// Returns an error sentence when the result cannot be used; *warnings gets
-// what the run's log must warn of (whiteReflectanceWarning, as the scene's
-// materials stand: call that again after applyMaterials).
+// Returns an error sentence when the result cannot be used.
 std::optional<std::string> applySceneConventions(Scene& s, const MeshAttributes& a, const ParamValues& v,
-                                                 bool withEmitters, std::string* log = nullptr,
-                                                 std::vector<std::string>* warnings = nullptr);
+                                                 bool withEmitters, std::string* log = nullptr);
 // White colours (rho >= 1, limited to 0.999) on the diffuse faces, said as a
-// warning; mirror, glass and glossy faces take their own colours, which may be 1.
+// warning; mirror, glass and glossy faces take their own colours, which may
+// be 1 (so: after applyMaterials).
 std::optional<std::string> whiteReflectanceWarning(const Scene& s);
 
 // Mirror and glass (photon mapping and the reference): which layers are
