@@ -48,7 +48,7 @@ namespace gi {
 
 struct PathTraceOptions {
   int samplesPerVertex = 256;      // fixed count when targetRelativeError == 0
-  double targetRelativeError = 0;  // adaptive: stop when stderr(B) / B is below this
+  double targetRelativeError = 0;  // adaptive: counts sized by a pilot (left out) for stderr(B) / B below this
   int minSamples = 64, maxSamples = 65536;
   int maxDepth = -1;               // scattering events (diffuse, glossy, mirror, glass) that continue a
                                    // path (0 = direct light only); -1: no fixed limit (Russian roulette
