@@ -131,3 +131,4 @@ TEST(WindowRoom, AdaptiveReferenceIsUnbiased) {
     EXPECT_GT(r.stats.get("pilot_paths"), 0.0);
   }
 }
+
