@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace gi {
@@ -317,13 +318,21 @@ StrataEstimate strataOcclusion(const RayCaster& caster, uint32_t key, const glm:
   return s.estimate();
 }
 
-StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, const glm::vec3& org,
-                                       const Frame& frame, float tfar, const StrataTarget& t) {
+namespace {
+
+// Rounds of nested grids from strataOcclusion's (key, a grid of about
+// minRays strata): at most maxRounds after the first, stopping early where
+// the variance is at most stopVariance (> 0) or the next round would not fit
+// in budget rays. rounds: the rounds run after the first.
+StrataEstimate nestedRounds(const RayCaster& caster, uint32_t key, const glm::vec3& org, const Frame& frame,
+                            float tfar, int minRays, int maxRounds, double stopVariance, int budget, int& rounds) {
   Strata& s = threadStrata();
   // Round 0 is strataOcclusion's own grid and jitter; later rounds jitter their new rays afresh.
-  StrataEstimate e = strataOcclusion(caster, key, org, frame, tfar, StrataGrid::forRays(t.minRays));
+  StrataEstimate e = strataOcclusion(caster, key, org, frame, tfar, StrataGrid::forRays(minRays));
   int rays = e.rays;
-  for (uint32_t k = 1; e.variance > t.target * t.target && nextRoundFits(rays, s.n, int64_t(s.qdirs.size()), t.maxRays);
+  rounds = 0;
+  for (uint32_t k = 1; int(k) <= maxRounds && !(e.variance <= stopVariance) &&
+                       nextRoundFits(rays, s.n, int64_t(s.qdirs.size()), budget);
        ++k) {
     const uint32_t roundKey = hash3(key, k, 0x52u);
     s.refine();
@@ -331,8 +340,41 @@ StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, co
     s.castSplits(caster, roundKey, org, frame, tfar);
     e = s.estimate();
     rays += e.rays;
+    rounds = int(k);
   }
   e.rays = rays;
+  return e;
+}
+
+// The rounds the result's grid takes: the pilot's, and more where its
+// standard error is above the target over sqrt(kPilotMargin), each round
+// taken to divide it by 4^0.75 (one jittered ray per stratum of a step
+// function: variance as n^-1.5, Mitchell 1996, "Consequences of stratified
+// sampling in graphics", SIGGRAPH).
+int resultRounds(int pilotRounds, double pilotStdError, double target) {
+  const double want = target / std::sqrt(kPilotMargin);
+  if (!(pilotStdError > want)) return pilotRounds;
+  return pilotRounds + int(std::ceil(std::log(pilotStdError / want) / std::log(std::pow(4.0, 0.75))));
+}
+
+}  // namespace
+
+StrataEstimate strataOcclusionToTarget(const RayCaster& caster, uint32_t key, const glm::vec3& org,
+                                       const Frame& frame, float tfar, const StrataTarget& t) {
+  // The pilot: rounds to kPilotLooseness times the target on a key of its
+  // own, within a quarter of max_rays (its first round always); left out.
+  int pilotRounds = 0, rounds = 0;
+  const double loose = kPilotLooseness * t.target;
+  const StrataEstimate pilot = nestedRounds(caster, hash3(key, 0x9170u, 0x50u), org, frame, tfar, t.minRays,
+                                            std::numeric_limits<int>::max(), loose * loose, t.maxRays / 4,
+                                            pilotRounds);
+  // The result: the rounds the pilot predicts, on the vertex's own key, none
+  // stopped by its own estimate (only a round that would pass what max_rays
+  // leaves is not run).
+  const int wanted = resultRounds(pilotRounds, std::sqrt(pilot.variance), t.target);
+  StrataEstimate e = nestedRounds(caster, key, org, frame, tfar, t.minRays, wanted, -1.0, t.maxRays - pilot.rays, rounds);
+  e.rays += pilot.rays;
+  e.capped = rounds < wanted;
   return e;
 }
 
@@ -348,15 +390,25 @@ int strataRaysWhenOpen(StrataGrid grid) { return grid.strata() + 3 * grid.cols; 
 
 int strataRaysWhenOpen(const StrataTarget& t) {
   // Every round: the horizon row split (3 rays a column), the variance at
-  // estimate()'s floor, 0.25 / n^2.
-  StrataGrid g = StrataGrid::forRays(t.minRays);
-  int64_t n = g.strata(), cols = g.cols, rays = n + 3 * cols;
-  while (0.25 / (double(n) * double(n)) > t.target * t.target && nextRoundFits(rays, n, 3 * cols, t.maxRays)) {
-    rays += (3 * n - 3 * cols) + 3 * (2 * cols);
-    n *= 4;
-    cols *= 2;
-  }
-  return int(rays);
+  // estimate()'s floor, 0.25 / n^2; the pilot's rounds, then the result's.
+  const StrataGrid g = StrataGrid::forRays(t.minRays);
+  auto rounds = [&](int maxRounds, double stopStdError, int budget, int& run, double& stdError) {
+    int64_t n = g.strata(), cols = g.cols, rays = n + 3 * cols;
+    run = 0;
+    while (run < maxRounds && !(0.5 / double(n) <= stopStdError) && nextRoundFits(rays, n, 3 * cols, budget)) {
+      rays += (3 * n - 3 * cols) + 3 * (2 * cols);
+      n *= 4;
+      cols *= 2;
+      ++run;
+    }
+    stdError = 0.5 / double(n);
+    return rays;
+  };
+  int pilotRounds = 0, run = 0;
+  double pilotError = 0, error = 0;
+  const int64_t pilot = rounds(std::numeric_limits<int>::max(), kPilotLooseness * t.target, t.maxRays / 4,
+                               pilotRounds, pilotError);
+  return int(pilot + rounds(resultRounds(pilotRounds, pilotError, t.target), -1.0, t.maxRays - int(pilot), run, error));
 }
 
 }  // namespace gi

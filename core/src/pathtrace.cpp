@@ -108,12 +108,6 @@ using reference::RingVariance;
 // (which Russian roulette never ends) stops here.
 constexpr int kDepthCap = 100000;
 
-// Adaptive: a vertex's count is its pilot's predicted need times this, for
-// the error of the pilot's variance.
-constexpr double kPilotMargin = 1.25;
-// Adaptive: the pilot runs to this many times the target.
-constexpr double kPilotLooseness = 2.0;
-
 struct Accum {
   uint32_t first = 0;  // the index of the first path counted here (after a discarded pilot)
   double n = 0, sumL = 0, sumL2 = 0, sumHL = 0, sumHL2 = 0;
@@ -302,14 +296,10 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     });
   } else {
     // A pilot, left out of the estimate, then each vertex's count, traced
-    // afresh. A count decided from the paths it keeps biases the mean: a
-    // vertex whose paths came out high meets a relative target early, one
-    // whose paths all missed a small opening reads no variance and stops
-    // dark (a room lit through a window, 6 seeds: +9.7% at a target of 0.3
-    // with 64-path pilots, -12.5% at 0.2 with 16). Here the count is fixed
-    // before the paths it keeps are traced, so their mean is unbiased
-    // whatever the pilot read (Stein's two-stage procedure, the first stage
-    // left out of the estimate: Stein 1945, Ann. Math. Statist. 16(3)).
+    // afresh (gi/sampling.h, kPilotMargin): the rounds that stopped when the
+    // kept paths' own error bar met the target biased the mean (a room lit
+    // through a window, 6 seeds: +9.7% at a target of 0.3 with 64-path
+    // pilots, -12.5% at 0.2 with 16).
     // The pilot: min_samples paths, then rounds to kPilotLooseness times the
     // target (about a quarter of the paths), each vertex at most a quarter
     // of max_samples: its B and variance then size the count well.

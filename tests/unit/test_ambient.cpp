@@ -157,9 +157,14 @@ TEST(AmbientOcclusion, BatchModesGiveIdenticalResults) {
   EXPECT_EQ(a.value, c.value);
 }
 
-// Adaptive sampling: per-vertex stopping at a target standard error of 0.01;
-// the true RMS error (vs 16384 rays) stays below 0.015 and fewer rays are cast
-// than at the fixed maximum.
+// Adaptive sampling to a target standard error of 0.01: a pilot left out of
+// the result sizes each vertex's count (gi/sampling.h), so the target holds
+// at most vertices (measured: the reported error over the target has a
+// median of 0.89, a 90th percentile of 0.92; bounds 1 and 1.25); the true
+// RMS error (against 16,384 rays) stays below 0.015 (measured 0.0017; 0.0020
+// when the rounds stopped on their own estimate, at 1,697 rays a vertex
+// where the pilot and the count cast 2,537) and fewer rays are cast than at
+// the fixed maximum.
 TEST(AmbientOcclusion, AdaptiveMeetsTargetError) {
   auto sf = scenes::floorWithWall(2.0, 1.0, 8);
   auto caster = makeEmbreeCaster(sf.scene);
@@ -169,13 +174,16 @@ TEST(AmbientOcclusion, AdaptiveMeetsTargetError) {
   o.maxRays = 4096;
   const AmbientResult r = computeAmbient(sf.scene, *caster, o);
   const AmbientResult ref = runAO(sf.scene, 16384, 0.0, 99);
+  std::printf("RMS error %.5f with %.1f rays a vertex\n", test::rms(r.value, ref.value),
+              r.stats.get("rays") / double(sf.scene.vertexCount()));
   EXPECT_LT(test::rms(r.value, ref.value), 0.015);
-  EXPECT_LT(r.stats.get("rays"), 0.5 * 4096.0 * double(sf.scene.vertexCount()));
-  for (size_t i = 0; i < r.value.size(); ++i) {
-    if (r.rays[i] < 4096) {
-      EXPECT_LE(r.stdError[i], 0.01);
-    }
-  }
+  EXPECT_LT(r.stats.get("rays"), 0.75 * 4096.0 * double(sf.scene.vertexCount()));
+  std::vector<double> ratio;
+  for (size_t i = 0; i < r.value.size(); ++i)
+    if (r.rays[i] > 0) ratio.push_back(r.stdError[i] / 0.01);
+  const test::OverTarget over = test::overTarget(ratio);
+  EXPECT_LT(over.median, 1.0);
+  EXPECT_LT(over.p90, 1.25);
 }
 
 // With a finite max distance, vertices with nothing above them within reach are
@@ -351,9 +359,8 @@ TEST(SkyLighting, MaxDistanceLimitsTheSunsShadowsToo) {
 // light in W/m^2 (it was of the sky fraction: at a sky of 100 W/m^2 a target
 // of 0.01 gave errors of 0.97 W/m^2). At 100 times the sky, 100 times the
 // target stops every vertex where the plain one did; the plain target there
-// needs 10,000 times the rays, which max_rays (4,096) cuts short: every
-// vertex still stops either below the target or at max_rays, and the log
-// says the target is not met (it said nothing, as an audit found).
+// needs 10,000 times the rays, which max_rays (4,096) cuts short, and the
+// log says the target is not met (it said nothing, as an audit found).
 TEST(SkyLighting, TargetErrorIsInWattsPerSquareMetre) {
   auto sf = scenes::floorWithWall(2.0, 1.0, 8);
   auto caster = makeEmbreeCaster(sf.scene);
@@ -369,13 +376,17 @@ TEST(SkyLighting, TargetErrorIsInWattsPerSquareMetre) {
   };
   const AmbientResult one = run(1.f, 0.02), hundred = run(100.f, 2.0), strict = run(100.f, 0.02);
   double rays1 = 0, raysStrict = 0;
+  std::vector<double> ratio;
   for (size_t i = 0; i < one.value.size(); ++i) {
     if (one.rays[i] == 0) continue;
     EXPECT_EQ(one.rays[i], hundred.rays[i]) << "vertex " << i;
-    if (hundred.rays[i] < o.maxRays) { EXPECT_LE(hundred.stdError[i], 2.f) << "vertex " << i; }
-    if (strict.rays[i] < o.maxRays) { EXPECT_LE(strict.stdError[i], 0.02f) << "vertex " << i; }
+    ratio.push_back(hundred.stdError[i] / 2.0);
     rays1 += one.rays[i], raysStrict += strict.rays[i];
   }
+  // Counts sized by a pilot (gi/sampling.h): the target holds at most vertices.
+  const test::OverTarget over = test::overTarget(ratio);
+  EXPECT_LT(over.median, 1.0);
+  EXPECT_LT(over.p90, 1.25);
   std::printf("sky rays: %.0f at 0.02 of a sky of 1 W/m^2, %.0f at 0.02 of 100 W/m^2\n", rays1, raysStrict);
   EXPECT_GT(raysStrict, 5 * rays1);
   EXPECT_TRUE(hundred.stats.warnings.empty()) << hundred.stats.line("sky");

@@ -218,25 +218,30 @@ TEST(AOStrata, BentNormalsLeanAwayFromTheWall) {
   EXPECT_GT(glm::dot(r.bentNormal[v], q.bentNormal[v]), 0.999f);  // within 2.6 degrees
 }
 
-// To a target standard error (rounds of ever finer grids, gi/ao_strata.h), in
-// every region of the test scene at targets 0.02 and 0.01: every vertex that
-// cast rays reports meeting the target (the default max_rays, 4096, is not
-// reached there), the mean (error / reported standard error)^2 is at most
-// 1.2 as at fixed counts (the reference's variance in the denominator; the
-// stop reads the estimates, so this is what checks that stopping early did
-// not leave errors the reports miss) and the RMS error is below the target.
-// Measured: mean z^2 0.22 to 0.34 by region at 0.02, 0.12 to 0.36 at 0.01.
+// To a target standard error (a pilot's rounds size the result's grid,
+// gi/ao_strata.h), in every region of the test scene at targets 0.02 and
+// 0.01: the pilot misreads some vertices, so the target holds at most of
+// them, not all (the reported error over the target: median 0.78 and 0.55,
+// 90th percentile 0.90 and 0.87, 99th 1.61 and 1.11; bounds 1, 1.25, 2);
+// the mean (error / reported standard error)^2 is at most 1.2 as at fixed
+// counts (the reference's variance in the denominator) and the RMS error is
+// below the target. Measured: mean z^2 0.22 to 0.34 by region at 0.02, 0.12
+// to 0.36 at 0.01 (with the rounds that stopped on their own estimate).
 TEST(AOStrata, TargetHoldsEverywhereAgainstTheReference) {
   const TestScene& t = scene();
   const AmbientResult& ref = reference(t.s);
   for (double target : {0.02, 0.01}) {
     const AmbientResult a = run(t.s, strataTarget(target));
+    std::vector<double> ratio;
+    for (size_t i = 0; i < t.end; ++i)
+      if (a.rays[i] > 0) ratio.push_back(a.stdError[i] / target);
+    const test::OverTarget over = test::overTarget(ratio);
+    EXPECT_LT(over.median, 1.0) << target;
+    EXPECT_LT(over.p90, 1.25) << target;
+    EXPECT_LT(over.p99, 2.0) << target;
     for (const Region& r : regions(t)) {
       double sq = 0;
-      for (size_t i : r.v) {
-        if (a.rays[i] > 0) { ASSERT_LE(a.stdError[i], target) << r.name << " vertex " << i; }
-        sq += (double(a.value[i]) - ref.value[i]) * (double(a.value[i]) - ref.value[i]);
-      }
+      for (size_t i : r.v) sq += (double(a.value[i]) - ref.value[i]) * (double(a.value[i]) - ref.value[i]);
       const Cover c = coverOf(a, ref, r.v);
       ASSERT_GE(c.counted, 300u) << r.name;
       RecordProperty("z2_" + std::to_string(target) + "_" + r.name.substr(0, 12), std::to_string(c.meanZ2));
@@ -252,9 +257,11 @@ TEST(AOStrata, TargetHoldsEverywhereAgainstTheReference) {
 // twice the rays of the vertices whose AO is above 0.99, which stop after
 // the second round as open ones do: measured 469 against 180); an open
 // plane, its rays cast, gives exactly 1 with the rays the schedule predicts
-// (4 x 8 strata and the horizon row's splits, 56 rays, a standard error of
-// 1/64 above 0.01; then 8 x 16, whose 128 strata keep those 56 rays and
-// cast 72, and its horizon row's splits, 48: 176 rays, error 0.5/128); and
+// (the pilot: 4 x 8 strata and the horizon row's splits, 56 rays, a
+// standard error of 1/64, within twice 0.01; so the result takes one round
+// more: its own 4 x 8 strata, 56 rays, then 8 x 16, whose 128 strata keep
+// those 56 rays and cast 72, and its horizon row's splits, 48: 176 rays,
+// error 0.5/128; 232 in all, as strataRaysWhenOpen says); and
 // max_rays bounds every vertex's rays, with a warning where the target is
 // then missed.
 TEST(AOStrata, TargetRoundsAdaptAndStayWithinMaxRays) {
@@ -281,7 +288,8 @@ TEST(AOStrata, TargetRoundsAdaptAndStayWithinMaxRays) {
   const AmbientResult p = run(scenes::openPlane(1.0, 8).scene, open);
   for (size_t i = 0; i < p.value.size(); ++i) {
     EXPECT_EQ(p.value[i], 1.f);
-    EXPECT_EQ(p.rays[i], 176);
+    EXPECT_EQ(p.rays[i], 56 + 176);
+    EXPECT_EQ(p.rays[i], strataRaysWhenOpen(StrataTarget{0.01, 32, 4096}));
     EXPECT_NEAR(p.stdError[i], 0.5 / 128.0, 1e-6);
   }
 
@@ -334,7 +342,7 @@ TEST(AOStrata, RefinedGridsKeepEachRayInItsStratum) {
     StrataTarget t;
     t.target = 1e-4;
     t.minRays = 8;
-    t.maxRays = rounds == 1 ? 32 : rounds == 2 ? 300 : 1000;  // the next round would not fit
+    t.maxRays = rounds == 1 ? 64 : rounds == 2 ? 600 : 2000;  // the next round would not fit
     const StrataEstimate e = strataOcclusionToTarget(*caster, 77u, org, frame, std::numeric_limits<float>::infinity(), t);
     const StrataGridView g = lastStrataGrid();
     EXPECT_EQ(g.rows * g.cols, 8 << (2 * (rounds - 1))) << rounds << " rounds";
@@ -370,14 +378,14 @@ TEST(AOStrata, RefusesWhatItCannotEstimate) {
   o.maxDistance = 0.5;
   EXPECT_THROW(computeAmbient(s, *caster, o), std::invalid_argument);
   o = strataTarget(0.01);
-  o.maxRays = 127;  // the first round, 4 x 8 strata, may cast 128 with every stratum split
+  o.maxRays = 255;  // the first round, 4 x 8 strata, cast twice, may cast 256 with every stratum split
   try {
     computeAmbient(s, *caster, o);
     ADD_FAILURE() << "a max_rays below the first round's worst case was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("above max_rays 127"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("above max_rays 255"), std::string::npos) << e.what();
   }
-  o.maxRays = 128;
+  o.maxRays = 256;
   EXPECT_NO_THROW(computeAmbient(s, *caster, o));
   o = strata(64);
   o.useCone = true;

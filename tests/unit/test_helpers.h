@@ -1,6 +1,7 @@
 // Small helpers shared by the engine tests.
 #pragma once
 #include <cmath>
+#include <cstdio>
 #include <algorithm>
 #include <array>
 #include <functional>
@@ -91,6 +92,27 @@ inline TwoSidedMesh twoSided(const Scene& one) {
   m.tris = one.triangles;
   for (const glm::uvec3& t : one.triangles) m.tris.push_back({t.x, t.z, t.y});
   return m;
+}
+
+// Adaptive runs whose counts a pilot sized (gi/sampling.h, kPilotMargin):
+// the quantiles of each vertex's reported error over its target.
+struct OverTarget {
+  double median = 0, p90 = 0, p99 = 0, largest = 0;
+  size_t above = 0;  // ratios above 1
+};
+inline OverTarget overTarget(std::vector<double> ratio) {
+  OverTarget o;
+  if (ratio.empty()) return o;
+  std::sort(ratio.begin(), ratio.end());
+  const size_t n = ratio.size();
+  o.median = ratio[n / 2];
+  o.p90 = ratio[n * 9 / 10];
+  o.p99 = ratio[n * 99 / 100];
+  o.largest = ratio.back();
+  o.above = size_t(ratio.end() - std::upper_bound(ratio.begin(), ratio.end(), 1.0));
+  std::printf("reported error over the target: median %.3f, 90th percentile %.3f, 99th %.3f, largest %.3f; %zu of %zu "
+              "above\n", o.median, o.p90, o.p99, o.largest, o.above, n);
+  return o;
 }
 
 }  // namespace gi::test

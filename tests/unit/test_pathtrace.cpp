@@ -401,23 +401,18 @@ TEST(PathTracer, AdaptiveReachesTarget) {
   o.maxSamples = 4096;
   const auto r = pathTrace(sf.scene, *caster, o);
   const double floorB = 0.1 * r.stats.get("mean_luminance_B");
-  std::vector<double> q;
-  size_t above = 0, stopped = 0;
+  std::vector<double> ratio;
+  size_t stopped = 0;
   for (size_t i = 0; i < r.B.size(); ++i) {
-    const double ratio = r.stdError[i] / (0.05 * std::max(double(luminance(r.B[i])), floorB));
-    if (r.samples[i] >= o.maxSamples) {
-      stopped += ratio > 1;
-      continue;
-    }
-    q.push_back(ratio);
-    above += ratio > 1;
+    const double q = r.stdError[i] / (0.05 * std::max(double(luminance(r.B[i])), floorB));
+    if (r.samples[i] >= o.maxSamples) stopped += q > 1;
+    else ratio.push_back(q);
   }
-  std::sort(q.begin(), q.end());
-  std::printf("error bar over target: median %.3f, 90th percentile %.3f, largest %.3f; %zu above, %zu at max_samples\n",
-              q[q.size() / 2], q[q.size() * 9 / 10], q.back(), above, stopped);
-  EXPECT_LT(q[q.size() / 2], 1.0);
-  EXPECT_LT(q[q.size() * 9 / 10], 1.25);
-  EXPECT_LT(q.back(), 2.0);
+  const test::OverTarget over = test::overTarget(ratio);
+  const size_t above = over.above;
+  EXPECT_LT(over.median, 1.0);
+  EXPECT_LT(over.p90, 1.25);
+  EXPECT_LT(over.largest, 2.0);
   EXPECT_LT(r.stats.get("mean_relative_std_error"), 0.06);
   EXPECT_EQ(r.stats.get("vertices_above_target"), double(above));
   EXPECT_GE(r.stats.get("pilot_paths"), 64.0 * double(r.B.size()));

@@ -47,12 +47,16 @@
 // Still unbiased: a kept ray, given the quarter it lies in, is uniform in
 // it; the empty quarters get fresh ones; so every stratum of the new grid
 // holds one uniform ray independent of the others', and its split is again
-// decided by its neighbours' rays only. The rounds stop at the first whose
-// standard error is at most the target (sequential sampling: the stop
-// reads the estimates, as the per-vertex estimator's does), or before a
-// round that, with every new stratum split, would take the vertex past
-// max_rays (the first round must fit: computeAmbient refuses a max_rays
-// below its worst case, 4 rays a stratum).
+// decided by its neighbours' rays only. How many rounds: a pilot, rounds on
+// a key of its own until its standard error is at most twice the target
+// (within a quarter of max_rays), predicts them, each round taken to divide
+// the error by 4^0.75; the result's rounds run on the vertex's key without
+// reading their own estimates, and the pilot is left out (gi/sampling.h,
+// kPilotMargin: rounds that stopped at the first grid meeting the target
+// biased the mean low where light comes through a small opening). A round
+// runs only if, with every new stratum split, it fits in what max_rays
+// leaves (computeAmbient refuses a max_rays below twice the first round's
+// worst case, 4 rays a stratum).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -74,6 +78,7 @@ struct StrataGrid {
 struct StrataEstimate {
   double value = 0.0, variance = 0.0;
   int rays = 0;                    // rays cast
+  bool capped = false;             // to a target: a round the pilot asked for would have passed max_rays
   glm::vec3 bent{0.f};             // sum of the open samples' directions times their cells' areas
 };
 

@@ -7,6 +7,18 @@
 
 namespace gi {
 
+// Counts to a target error from a pilot left out of the estimate (Stein's
+// two-stage procedure with the first stage dropped: Stein 1945, Ann. Math.
+// Statist. 16(3)): a count decided from the samples it keeps biases their
+// mean (a vertex whose samples came out high meets a relative target early;
+// one whose samples all missed a small opening reads no variance and stops
+// dark), while one fixed before they are drawn leaves them unbiased. The
+// pilot runs to kPilotLooseness times the target (about a quarter of the
+// samples); the count is its prediction times kPilotMargin, for the pilot's
+// own error. The reference, ambient occlusion and the sky use it.
+inline constexpr double kPilotLooseness = 2.0;
+inline constexpr double kPilotMargin = 1.25;
+
 constexpr uint32_t reverseBits(uint32_t x) {
   x = __builtin_bswap32(x);  // bytes reversed; then the bits within each byte
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
