@@ -358,17 +358,28 @@ void depthWarnings(const Scene& s, int maxDepth, int cap, double paths, double c
     st.warn(b);
     return;
   }
-  float rhoMax = 0.f;
+  // The share of B that more bounces would add in a closed room of the
+  // scene's mean reflectance (area-weighted, each face's largest channel,
+  // mirrors and glass at their tint): rho^(k+1), the tail of the
+  // interreflection series sum rho^n. The largest reflectance read 100% as
+  // soon as one white mirror was in the scene (an outside audit).
+  double rhoArea = 0, area = 0;
   const auto ok = usableFaceMask(s);
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (ok[f]) rhoMax = std::max({rhoMax, s.faceRho(f).r, s.faceRho(f).g, s.faceRho(f).b});
-  const double share = std::pow(std::min(1.0, double(rhoMax)), double(maxDepth) + 1.0);
+    if (ok[f]) {
+      const glm::vec3 r = s.faceRho(f);
+      const double a = faceArea(s, f);
+      rhoArea += a * std::max({r.r, r.g, r.b});
+      area += a;
+    }
+  const double rhoMean = area > 0 ? std::min(1.0, rhoArea / area) : 0.0;
+  const double share = std::pow(rhoMean, double(maxDepth) + 1.0);
   if (share <= relErr) return;
   std::snprintf(b, sizeof b,
                 "max_depth = %d cut %.0f of %.0f paths: the light of more bounces is missing (in a closed room of "
-                "the largest reflectance here, %.4g, a share %.3g%% of B), more than the mean relative error "
+                "the mean reflectance here, %.4g, a share %.3g%% of B), more than the mean relative error "
                 "%.3g%%, and is not in the error bars (%s)",
-                maxDepth, cut, paths, rhoMax, 100.0 * share, 100.0 * relErr, remedy);
+                maxDepth, cut, paths, rhoMean, 100.0 * share, 100.0 * relErr, remedy);
   st.warn(b);
 }
 

@@ -581,6 +581,28 @@ TEST(PathTracer, DepthLimitThatTruncatesWarns) {
   o.maxDepth = 0;
   const auto d = trace(sf.scene, 4, o);
   EXPECT_TRUE(d.stats.warnings.empty()) << d.stats.line("reference");
+  // A grey room (0.5) with one white mirror wall at 8 bounces misses about
+  // 0.58^9 = 0.7% of B, below the run's error: no warning. The share was
+  // the largest reflectance's, 1^9 = 100%, whenever a white mirror was in
+  // the scene (an outside audit, 5 December 2026).
+  scenes::setUniform(sf, glm::vec3(0.5f), glm::vec3(1.f));
+  sf.scene.material.assign(sf.scene.faceCount(), Material::Diffuse);
+  size_t mirrors = 0;
+  for (size_t f = 0; f < sf.scene.faceCount(); ++f)
+    if (sf.scene.toWorld(sf.scene.positions[sf.scene.triangles[f].x]).x > 0.499 &&
+        sf.scene.toWorld(sf.scene.positions[sf.scene.triangles[f].y]).x > 0.499 &&
+        sf.scene.toWorld(sf.scene.positions[sf.scene.triangles[f].z]).x > 0.499) {
+      sf.scene.material[f] = Material::Mirror;
+      sf.scene.rho[f] = glm::vec3(1.f);
+      sf.scene.emission[f] = glm::vec3(0.f);
+      ++mirrors;
+    }
+  ASSERT_GT(mirrors, 0u);
+  o.maxDepth = 8;
+  const auto m = trace(sf.scene, 16, o);
+  EXPECT_GT(m.stats.get("paths_cut_at_max_depth"), 0.0);
+  EXPECT_LT(m.stats.get("mean_relative_std_error"), 0.5);
+  EXPECT_FALSE(warned(m.stats, "max_depth = 8 cut")) << m.stats.line("reference");
 }
 
 // No limit, yet a path caught between perfect mirrors (which Russian roulette
