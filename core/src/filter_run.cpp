@@ -31,6 +31,7 @@ namespace {
 
 using detail::scalarAttribute;
 using detail::vectorAttribute;
+using detail::firstPassCausticsAttribute;
 
 // Validation, the scene conventions and the scene report: steps 1 and 2.
 void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
@@ -222,6 +223,7 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   PathTraceResult r = pathTrace(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
+  res.attributes.push_back(firstPassCausticsAttribute(in.scene.vertexCount(), true));
   res.attributes.push_back(vectorAttribute("Irradiance", r.H));
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
@@ -273,6 +275,7 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
   // from a run on a machine with more memory.
   if (capped) res.stats.warn(lowered + " (the solve's memory plan follows it)");
   res.attributes.push_back(vectorAttribute("Radiosity", r.Bvertex));
+  res.attributes.push_back(firstPassCausticsAttribute(r.Bvertex.size(), false));
   // Its direct part, for a two-pass view (as photon mapping leaves it).
   if (r.Bdirect.size() == r.Bvertex.size()) res.attributes.push_back(vectorAttribute("RadiosityDirect", r.Bdirect));
   if (in.values.getBool("face_output")) res.faceRadiometry = std::move(r.B);
@@ -327,6 +330,7 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   else if (in.values.getInt("photon_layer_max") != 1000000)
     res.stats.warn("photon_layer_max is not used: photon_layer is off");
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
+  res.attributes.push_back(firstPassCausticsAttribute(r.B.size(), true));
   radiometric(res, in.scene, in.values.getFloat("exposure"), "Radiosity");
   // Its direct part, for a two-pass view (which then need not estimate it again).
   if (r.Bdirect.size() == r.B.size()) res.attributes.push_back(vectorAttribute("RadiosityDirect", r.Bdirect));

@@ -1,6 +1,9 @@
 #include "filter_views.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <string>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -94,6 +97,7 @@ void runHemicube(FilterInput& in, FilterResult& res) {
 void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
   const ParamValues& v = in.values;
   RenderOptions opt = RenderOptions::fromParams(v, in.scene, in.layerCamera ? &*in.layerCamera : nullptr);
+  std::string firstPassNote;
   auto perVertex = [&](const char* name, std::vector<glm::vec3>& out) {
     const VertexAttribute* a = in.attribute(name);
     if (!a || a->components != 3 || opt.mode != RenderMode::TwoPass) return;
@@ -103,9 +107,23 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
   };
   perVertex("Radiosity", opt.firstPassB);
   perVertex("RadiosityDirect", opt.firstPassBdirect);  // the first pass's direct part, if it left one
+  // Whether the first pass holds caustics, as it says (first_pass_caustics
+  // only for a Radiosity left by another tool): it defaulted to yes, and
+  // after radiosity the caustic map was taken out of light without caustics.
+  if (const VertexAttribute* c = in.attribute("RadiosityCaustics");
+      c && c->components == 1 && !c->values.empty() && opt.mode == RenderMode::TwoPass) {
+    const bool has = std::count_if(c->values.begin(), c->values.end(), [](float x) { return x > 0.5f; }) * 2 >
+                     std::ptrdiff_t(c->values.size());
+    if (has != opt.firstPassHasCaustics)
+      firstPassNote = std::string("the first pass ") + (has ? "holds" : "holds no") +
+                      " caustics (its RadiosityCaustics attribute): first_pass_caustics " +
+                      (opt.firstPassHasCaustics ? "true" : "false") + " not used";
+    opt.firstPassHasCaustics = has;
+  }
   const auto caster = makeEmbreeCaster(in.scene);
   RenderResult r = render(in.scene, *caster, opt, progress);
   res.stats = std::move(r.stats);
+  if (!firstPassNote.empty()) res.stats.note(firstPassNote);
   FilterImage img;
   img.name = std::string(renderModeName(opt.mode)) + " view";
   img.exposure = imageExposure(r.image, v.getFloat("exposure"), r.seesEmitter);

@@ -10,6 +10,12 @@
 namespace gi::detail {
 
 inline VertexAttribute scalarAttribute(const std::string& name, const std::vector<float>& v) { return {name, 1, v}; }
+// Beside a lighting filter's Radiosity: 1 where it holds caustics (photon
+// mapping, the reference), 0 where not (radiosity); the two-pass view reads
+// it to know whether to take the first pass's caustics out.
+inline VertexAttribute firstPassCausticsAttribute(size_t nv, bool caustics) {
+  return scalarAttribute("RadiosityCaustics", std::vector<float>(nv, caustics ? 1.f : 0.f));
+}
 
 inline VertexAttribute vectorAttribute(const std::string& name, const std::vector<glm::vec3>& v) {
   VertexAttribute a{name, 3, {}};

@@ -109,9 +109,11 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .type = ParamType::Enum, .def = kTwoPassDiffuse.index(TwoPassDiffuse::Caustics),
                .choices = kTwoPassDiffuse.choices()});
   s.push_back({.name = "first_pass_caustics", .label = "First pass has caustics",
-               .help = "Whether the stored first pass includes caustics (photon mapping: yes; radiosity: no). If so, "
-                       "and the caustic map is used, they are taken out of the stored indirect light so as not to "
-                       "count twice.",
+               .help = "Whether the stored first pass includes caustics (photon mapping and the reference: yes; "
+                       "radiosity: no). If so, and the caustic map is used, they are taken out of the stored "
+                       "indirect light so as not to count twice. The filters of this suite say it themselves (the "
+                       "per-vertex attribute RadiosityCaustics beside Radiosity), and then this is not used: it is "
+                       "for a Radiosity attribute left by another tool.",
                .type = ParamType::Bool, .def = true});
   s.push_back({.name = "caustic_photons", .label = "Caustic photons",
                .help = "Photons aimed at the mirrors and glass for the caustic map (two-pass). More: sharper and "

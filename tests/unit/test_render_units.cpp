@@ -180,3 +180,60 @@ TEST(RenderUnits, PathTracedViewGivesItsErrorBarsPerPixel) {
   EXPECT_EQ(runFilter(FilterKind::RayTracedView, in).images.size(), 1u);  // distributed
   EXPECT_EQ(filterFiles(FilterKind::RayTracedView, in.values).writes.size(), 2u);  // the PNG and the PFM
 }
+
+// The two-pass view takes the first pass's caustics out of its stored light
+// (to add the caustic map's) only where the first pass holds caustics. The
+// parameter first_pass_caustics defaulted to yes, so after radiosity (no
+// caustics) the caustics were taken out of light that never held them (an
+// outside audit, 5 December 2026). Now the lighting filters say it with the
+// attribute RadiosityCaustics (radiosity 0, photon mapping and the
+// reference 1), which the view follows, with a note when it overrides the
+// parameter. A floor under the sky and a lamp with a glass block between,
+// so the caustic map holds photons.
+TEST(RenderUnits, TwoPassTakesOutOnlyCausticsTheFirstPassHolds) {
+  auto withGlass = [](FilterKind kind) {
+    FilterInput in = skyFloor(kind);
+    SceneBuilder b;
+    b.quad({-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}, glm::vec3(0.f), glm::vec3(0.f), Material::Diffuse, 4);
+    b.quad({-0.3, -0.3, 3}, {-0.3, 0.3, 3}, {0.3, 0.3, 3}, {0.3, -0.3, 3}, glm::vec3(0.f), glm::vec3(0.f),
+           Material::Diffuse, 1);  // the lamp, facing down
+    const size_t floorFaces = 34;
+    b.box({-0.5, -0.5, 1.0}, {0.5, 0.5, 1.5}, glm::vec3(1.f), glm::vec3(0.f), Material::Glass, false);
+    in.scene = b.build();
+    in.layers.push_back({"floor", 0, floorFaces});
+    in.layers.push_back({"glass", floorFaces, in.scene.faceCount() - floorFaces});  // glass_layers '*glass*'
+    in.attrs.faceSelected.assign(in.scene.faceCount(), 0);
+    in.attrs.faceSelected[32] = in.attrs.faceSelected[33] = 1;
+    in.values.set("emitter_source", kEmitterSources.index(EmitterSource::SelectedFaces));
+    return in;
+  };
+  for (const FilterKind first : {FilterKind::Radiosity, FilterKind::PhotonMapping}) {
+    FilterInput in = withGlass(first);
+    if (first == FilterKind::PhotonMapping) in.values.set("photons", 20000);
+    const FilterResult r = runFilter(first, in);
+    const VertexAttribute* c = r.attribute("RadiosityCaustics");
+    ASSERT_NE(c, nullptr);
+    ASSERT_EQ(c->values.size(), in.scene.vertexCount());
+    const bool holds = first == FilterKind::PhotonMapping;
+    EXPECT_EQ(c->values[0], holds ? 1.f : 0.f);
+    FilterInput view = withGlass(FilterKind::RayTracedView);
+    view.attributes = r.attributes;
+    view.values.set("mode", kRenderModes.index(RenderMode::TwoPass));
+    view.values.set("two_pass_diffuse", kTwoPassDiffuse.index(TwoPassDiffuse::Caustics));
+    view.values.set("caustic_photons", 20000);
+    view.values.set("camera", 1);  // Look at
+    view.values.set("eye", glm::vec3(0.f, 0.f, 3.f));
+    view.values.set("target", glm::vec3(0.f));
+    view.values.set("width", 8);
+    view.values.set("height", 8);
+    view.values.set("samples_per_pixel", 1);
+    for (const bool parameter : {true, false}) {
+      view.values.set("first_pass_caustics", parameter);
+      const FilterResult v = runFilter(FilterKind::RayTracedView, view);
+      const std::string line = v.stats.line("view");
+      EXPECT_GT(v.stats.get("caustic_photons_stored"), 0.0) << line;
+      EXPECT_EQ(line.find("the first pass's caustics replaced") != std::string::npos, holds) << line;
+      EXPECT_EQ(line.find("RadiosityCaustics attribute") != std::string::npos, parameter != holds) << line;
+    }
+  }
+}
