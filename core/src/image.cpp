@@ -60,6 +60,10 @@ float imageExposure(const Image& img, double exposureParam, const std::vector<ui
   lum.reserve(img.px.size());
   for (size_t i = 0; i < img.px.size(); ++i)
     if (mask.size() != img.px.size() || !mask[i]) lum.push_back(luminance(img.px[i]));
+  // Every pixel shows an emitter (inside a furnace, where every face emits):
+  // all of them, rather than the exposure of 1 an empty list gives.
+  if (lum.empty())
+    for (const glm::vec3& p : img.px) lum.push_back(luminance(p));
   return autoExposure(lum.data(), lum.size());
 }
 

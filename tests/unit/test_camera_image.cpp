@@ -194,6 +194,11 @@ TEST(Image, PngAndExposure) {
   const float e = imageExposure(img, 0.0, mask);
   EXPECT_NEAR(1.f / e, 0.98f, 0.011f);  // percentile of 0.01 .. 0.99
   EXPECT_EQ(imageExposure(img, 2.5), 2.5f);
+  // Every pixel an emitter (inside a furnace): their own percentile, not 1
+  // (which an outside audit found: an exposure left at 1 whatever the light).
+  Image furnace(4, 4);
+  for (glm::vec3& p : furnace.px) p = glm::vec3(50.f);
+  EXPECT_FLOAT_EQ(imageExposure(furnace, 0.0, std::vector<uint8_t>(furnace.px.size(), 1)), 1.f / 50.f);
   const auto bytes = toSrgb8(img, 1.f);
   EXPECT_EQ(bytes[3 * 99], 255);         // clamped
   EXPECT_EQ(bytes[3 * 49], uint8_t(std::lround(linearToSrgb(0.5f) * 255.f)));

@@ -24,7 +24,8 @@ struct Image {
 
 // The exposure for display: exposureParam > 0 is used as is; otherwise the
 // 99th percentile of the luminance of the pixels not masked out (mask[i] = 1:
-// the pixel shows an emitter, which would darken everything else) maps to 1.
+// the pixel shows an emitter, which would darken everything else) maps to 1;
+// where every pixel is masked, the percentile of all of them.
 float imageExposure(const Image& img, double exposureParam, const std::vector<uint8_t>& mask = {});
 
 // Display bytes (sRGB, RGB interleaved, row 0 at the top).
