@@ -38,10 +38,14 @@ Camera Camera::lookAt(const glm::dvec3& eye, const glm::dvec3& target, const glm
   Camera c;
   c.eye_ = eye;
   c.fwd_ = d / len;
-  const glm::dvec3 r = glm::cross(c.fwd_, up);
+  // Only the up direction counts, not its length: a tiny one is as good
+  // (it was called parallel to the view, an outside audit found).
+  const double upLen = glm::length(up);
+  if (!(upLen > 0.0) || !std::isfinite(upLen))
+    throw std::invalid_argument("the camera's up direction must be a finite, non-zero vector");
+  const glm::dvec3 r = glm::cross(c.fwd_, up / upLen);
   const double rl = glm::length(r);
-  if (!(rl > 1e-9 * std::max(1.0, glm::length(up))))
-    throw std::invalid_argument("the camera's up direction must not be parallel to its view direction");
+  if (!(rl > 1e-9)) throw std::invalid_argument("the camera's up direction must not be parallel to its view direction");
   c.right_ = r / rl;
   c.up_ = glm::cross(c.right_, c.fwd_);
   c.width_ = width;

@@ -1,6 +1,7 @@
 #include "gi/params.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -71,6 +72,14 @@ static std::string num(double x) {
   return b;
 }
 
+// The shortest text that reads back as x (a range message rounded to six
+// digits said "0.5 is outside [0, 0.5]" of 0.5000001, an outside audit).
+static std::string exact(double x) {
+  char b[64];
+  const auto r = std::to_chars(b, b + sizeof b, x);
+  return std::string(b, r.ptr);
+}
+
 std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal) {
   for (const auto& s : specs) {
     if (!v.has(s.name)) return "parameter '" + s.name + "' is missing";
@@ -80,7 +89,7 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
         case ParamType::Int: {
           int x = v.getInt(s.name);
           if (x < s.min || x > s.max)
-            return "parameter '" + s.name + "' = " + std::to_string(x) + " is outside [" + num(s.min) + ", " + num(s.max) + "]";
+            return "parameter '" + s.name + "' = " + std::to_string(x) + " is outside [" + exact(s.min) + ", " + exact(s.max) + "]";
           break;
         }
         case ParamType::Float: {
@@ -90,15 +99,15 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           // (1e-12 arrives as 9.99999996e-13).
           const bool below = x < s.min && float(x) < float(s.min), above = x > s.max && float(x) > float(s.max);
           if (!std::isfinite(x) || below || above)
-            return "parameter '" + s.name + "' = " + num(x) + " is outside [" + num(s.min) + ", " + num(s.max) + "]";
+            return "parameter '" + s.name + "' = " + exact(x) + " is outside [" + exact(s.min) + ", " + exact(s.max) + "]";
           break;
         }
         case ParamType::Distance: {
           double x = v.getFloat(s.name);
           if (!std::isfinite(x) || x < 0.0)
-            return "parameter '" + s.name + "' = " + num(x) + " must be a finite distance >= 0";
+            return "parameter '" + s.name + "' = " + exact(x) + " must be a finite distance >= 0";
           if (s.max > 0.0 && diagonal > 0.0 && x > s.max * diagonal * (1.0 + 1e-6))
-            return "parameter '" + s.name + "' = " + num(x) + " exceeds " + num(s.max) + " x the bbox diagonal (" + num(diagonal) + ")";
+            return "parameter '" + s.name + "' = " + exact(x) + " exceeds " + exact(s.max) + " x the bbox diagonal (" + exact(diagonal) + ")";
           break;
         }
         case ParamType::Enum: {

@@ -153,6 +153,17 @@ TEST(Camera, RejectsDegenerateViews) {
   EXPECT_THROW(Camera::lookAt({0, 0, 0}, {0, 1, 0}, {0, 1, 0}, 40, 10, 10), std::invalid_argument);
   EXPECT_THROW(Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 180, 10, 10), std::invalid_argument);
   EXPECT_THROW(Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 40, 0, 10), std::invalid_argument);
+  // Only the up vector's direction counts: a tiny one gives the same view
+  // (it was called parallel to the view); a zero one is said as such.
+  const Camera tiny = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1e-30, 0}, 40, 10, 10);
+  const Camera unit = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 40, 10, 10);
+  EXPECT_EQ(tiny.up(), unit.up());
+  try {
+    Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 0, 0}, 40, 10, 10);
+    ADD_FAILURE() << "a zero up vector was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("non-zero"), std::string::npos) << e.what();
+  }
   ShotData s;
   EXPECT_THROW(Camera::fromShot(s, 10, 10), std::invalid_argument);  // no intrinsics
   Camera c = Camera::lookAt({0, 0, 0}, {0, 0, 3}, {0, 1, 0}, 40, 10, 10);

@@ -202,6 +202,12 @@ TEST(Params, FloatBoundsSurviveSinglePrecision) {
     v.set("tol", x);
     EXPECT_TRUE(gi::validate(specs, v, kDiag).has_value()) << x;
   }
+  // The message gives the value as it reads back (six digits said
+  // "0.300001 is outside [1e-12, 0.3]" of 0.3000012, and 0.5000001 read 0.5).
+  v.set("tol", 0.3000012);
+  const auto why = gi::validate(specs, v, kDiag);
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("0.3000012 is outside [1e-12, 0.3]"), std::string::npos) << *why;
 }
 
 TEST(Params, ParseValueEveryType) {
