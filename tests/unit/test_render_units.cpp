@@ -81,17 +81,24 @@ FilterInput skyFloor(FilterKind kind) {
   return in;
 }
 
-double floorRadianceInTwoPass(const std::vector<VertexAttribute>& firstPass, TwoPassDiffuse diffuse) {
-  FilterInput in = skyFloor(FilterKind::RayTracedView);
+// The two-pass view of a first pass's attributes, looking down at the floor
+// from 3 above, size x size pixels.
+void twoPassFromAbove(FilterInput& in, const std::vector<VertexAttribute>& firstPass, TwoPassDiffuse diffuse,
+                      int size, int samplesPerPixel) {
   in.attributes = firstPass;
   in.values.set("mode", kRenderModes.index(RenderMode::TwoPass));
   in.values.set("two_pass_diffuse", kTwoPassDiffuse.index(diffuse));
   in.values.set("camera", 1);  // Look at
   in.values.set("eye", glm::vec3(0.f, 0.f, 3.f));
   in.values.set("target", glm::vec3(0.f));
-  in.values.set("width", 16);
-  in.values.set("height", 16);
-  in.values.set("samples_per_pixel", 4);
+  in.values.set("width", size);
+  in.values.set("height", size);
+  in.values.set("samples_per_pixel", samplesPerPixel);
+}
+
+double floorRadianceInTwoPass(const std::vector<VertexAttribute>& firstPass, TwoPassDiffuse diffuse) {
+  FilterInput in = skyFloor(FilterKind::RayTracedView);
+  twoPassFromAbove(in, firstPass, diffuse, 16, 4);
   const FilterResult r = runFilter(FilterKind::RayTracedView, in);
   EXPECT_EQ(r.images.size(), 1u);
   return r.images.empty() ? 0.0 : gi::test::meanLuminance(r.images[0].image);
@@ -217,16 +224,8 @@ TEST(RenderUnits, TwoPassTakesOutOnlyCausticsTheFirstPassHolds) {
     const bool holds = first == FilterKind::PhotonMapping;
     EXPECT_EQ(c->values[0], holds ? 1.f : 0.f);
     FilterInput view = withGlass(FilterKind::RayTracedView);
-    view.attributes = r.attributes;
-    view.values.set("mode", kRenderModes.index(RenderMode::TwoPass));
-    view.values.set("two_pass_diffuse", kTwoPassDiffuse.index(TwoPassDiffuse::Caustics));
+    twoPassFromAbove(view, r.attributes, TwoPassDiffuse::Caustics, 8, 1);
     view.values.set("caustic_photons", 20000);
-    view.values.set("camera", 1);  // Look at
-    view.values.set("eye", glm::vec3(0.f, 0.f, 3.f));
-    view.values.set("target", glm::vec3(0.f));
-    view.values.set("width", 8);
-    view.values.set("height", 8);
-    view.values.set("samples_per_pixel", 1);
     for (const bool parameter : {true, false}) {
       view.values.set("first_pass_caustics", parameter);
       const FilterResult v = runFilter(FilterKind::RayTracedView, view);
