@@ -222,7 +222,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   const bool strata = strataRuns(opt);
   const int openVertexRays =
       strata ? (opt.targetError > 0.0 ? strataRaysWhenOpen(strataTargetOf(opt)) : strataRaysWhenOpen(firstStrataGrid(opt)))
-             : opt.targetError > 0.0 ? std::max(opt.minRays, kRound)
+             : opt.targetError > 0.0 ? (opt.estimator == AOEstimator::Shared ? std::max(opt.minRays, kRound)
+                                                                         : perVertexRaysWhenOpen(opt))
                                      : opt.raysPerVertex;
   const bool openWithin = opt.skipOpenVertices && hemisphereRays && opt.maxDistance > 0.0;
   const bool openEverywhere = opt.skipOpenVertices && hemisphereRays && !(opt.maxDistance > 0.0) &&

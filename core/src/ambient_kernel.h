@@ -30,6 +30,26 @@ inline StrataGrid firstStrataGrid(const AmbientOptions& o) {
   return StrataGrid::forRays(o.targetError > 0.0 ? o.minRays : o.raysPerVertex);
 }
 
+// The rays a vertex whose every ray is open casts with the per-vertex
+// estimator to a target (AmbientKernel::run): the pilot's rounds until the
+// Laplace bound of n agreeing rays, sqrt(p (1 - p) / n) with p = (n + 1) /
+// (n + 2), is within twice the target, then the count it predicts. The
+// open-vertex proofs pay where this is large.
+inline int perVertexRaysWhenOpen(const AmbientOptions& o) {
+  auto laplace = [](int n) {
+    const double p = (n + 1.0) / (n + 2.0);
+    return std::sqrt(p * (1.0 - p) / n);
+  };
+  const int pilotMax = std::max(o.minRays, o.maxRays / 4);
+  int n = 0;
+  while (n < pilotMax) {
+    n += std::min(kRound, pilotMax - n);
+    if (n >= o.minRays && laplace(n) <= kPilotLooseness * o.targetError) break;
+  }
+  const double want = std::ceil(n * laplace(n) * std::sqrt(kPilotMargin) / o.targetError);
+  return n + int(std::clamp(want, double(o.minRays), double(std::max(o.minRays, o.maxRays - n))));
+}
+
 // A bent normal: the mean open direction, or the normal where none was open.
 inline glm::vec3 bentOrNormal(const glm::vec3& sum, const glm::vec3& n) {
   return glm::length(sum) > 0.f ? glm::normalize(sum) : n;
@@ -93,7 +113,7 @@ class AmbientKernel {
     // fixed-count rays, are the result, and the pilot is left out of it.
     // Stopping on the kept rays biased the mean low where light comes
     // through a small opening: a room lit through a window, -0.19 target
-    // units at a target of 0.005.
+    // units at a target of 0.005 (4 seeds).
     const int pilotMax = std::max(o_.minRays, o_.maxRays / 4);
     const VertexOut pilot = cast(hash3(vi, o_.seed, 0x4cu), pilotMax, kPilotLooseness * target_, org, frame);
     // Rays whose error bar falls as 1/sqrt(n) (their variance per ray), or,

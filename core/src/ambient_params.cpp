@@ -17,29 +17,31 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                .help = mode == AmbientMode::Sky
                            ? "Adaptive sampling: if > 0, a pilot (sky rays of its own, in rounds of 32 until the "
                              "estimated standard error of its sky light (W/m^2) is below twice this value, at most "
-                             "a quarter of max_rays) predicts the rays each vertex needs for this value, and the "
-                             "vertex casts that many. The pilot is left out of the result: a count decided from the "
-                             "rays it keeps biases the mean low where the sky is seen through small openings. So the "
-                             "target holds at most vertices, not all. The sun's shadow rays are a fixed count "
-                             "(sun_rays). 0 = fixed ray count."
+                             "min_rays or a quarter of max_rays, whichever is more) predicts the rays each vertex "
+                             "needs for this value, and the vertex casts that many. The pilot is left out of the "
+                             "result: a count decided from the rays it keeps biases the mean low where the sky is "
+                             "seen through small openings. So the target holds at most vertices, not all. The sun's "
+                             "shadow rays are a fixed count (sun_rays). 0 = fixed ray count."
                            : "Adaptive sampling: if > 0, a pilot (rays of its own, in rounds of 32 until its "
-                             "estimated standard error is below twice this value, at most a quarter of max_rays) "
-                             "predicts the rays each vertex needs for this value, and the vertex casts that many "
-                             "(adaptive strata: the pilot's grids, the first of about min_rays strata, each next with "
-                             "every stratum cut into four, predict how many such rounds the result's grids take). "
-                             "The pilot is left out of the result: a count decided from the rays it keeps biases the "
-                             "mean low where light comes through small openings. So the target holds at most "
-                             "vertices, not all. The shared estimator instead doubles the rays of the vertices whose "
-                             "pooled error is above the target, round by round. 0 = fixed ray count.",
+                             "estimated standard error is below twice this value, at most min_rays or a quarter of "
+                             "max_rays, whichever is more) predicts the rays each vertex needs for this value, and "
+                             "the vertex casts that many (adaptive strata: the pilot's grids, the first of about "
+                             "min_rays strata, each next with every stratum cut into four, predict how many such "
+                             "rounds the result's grids take). The pilot is left out of the result: a count decided "
+                             "from the rays it keeps biases the mean low where light comes through small openings. "
+                             "So the target holds at most vertices, not all. The shared estimator instead doubles the "
+                             "rays of the vertices whose pooled error is above the target, round by round. 0 = fixed "
+                             "ray count.",
                .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = mode == AmbientMode::Sky ? 1e9 : 0.5});
   s.push_back({.name = "min_rays", .label = "Minimum rays (adaptive)",
                .help = "Adaptive sampling: the fewest rays of the pilot and of the result.",
                .type = ParamType::Int, .def = 32, .min = 1, .max = 1 << 20});
   s.push_back({.name = "max_rays", .label = "Maximum rays (adaptive)",
-               .help = "Adaptive sampling never casts more than this many rays a vertex, the pilot's included, "
-                       "where it is at least twice min_rays (adaptive strata: a round starts only if it stays within "
-                       "this count with every stratum split; the first round, cast for the pilot and the result, "
-                       "must fit twice).",
+               .help = "Adaptive sampling never casts more than this many rays from a vertex's side, the pilot's "
+                       "included, where it is at least twice min_rays (the pilot and the result cast min_rays each "
+                       "at least; a two-sided surface casts from both sides, sky lighting adds sun_rays; adaptive "
+                       "strata: a round starts only if it stays within this count with every stratum split; the "
+                       "first round, cast for the pilot and the result, must fit twice).",
                .type = ParamType::Int, .def = 4096, .min = 1, .max = 1 << 22});
   const bool obscurance = mode == AmbientMode::Obscurance;
   s.push_back({.name = "max_distance", .label = obscurance ? "Maximum distance" : "Maximum ray distance",

@@ -341,9 +341,9 @@ std::string unsampledLightPaths(const Scene& s, const LightSettings& lights) {
 // Paths the depth limit ended while they would have gone on: their further
 // light is missing, a bias outside the error bars. No limit (maxDepth -1):
 // only paths caught between perfect mirrors reach `cap`. A limit k: in a
-// closed room of reflectance rho_max the light of more than k bounces is a
-// share rho_max^(k+1) of B; warn when that may exceed the mean relative
-// error (the reference and the path-traced view; the view only noted the
+// closed room of the scene's mean reflectance rho the light of more than k
+// bounces is a share rho^(k+1) of B; warn when that may exceed the mean
+// relative error (the reference and the path-traced view; the view only noted the
 // cut paths until 5 December 2026, when a white furnace's image read 26% of
 // its radiance at max_depth 32 without a warning).
 void depthWarnings(const Scene& s, int maxDepth, int cap, double paths, double cut, double relErr,

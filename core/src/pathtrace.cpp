@@ -30,17 +30,19 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
       {.name = "target_relative_error", .label = "Target relative error",
        .help = "If > 0, each vertex traces as many paths as a pilot predicts it needs for a standard error of its "
                "radiosity below this fraction of it (or of a tenth of the scene's mean, for dark vertices), at most "
-               "max_samples. The pilot (min_samples paths, then rounds to twice the target, at most a quarter of "
-               "max_samples) is left out of the result: a count decided from the paths it keeps would bias the "
-               "mean (a vertex whose paths came out bright would stop early). So the target holds at most vertices "
-               "(those above it are counted in the log, with honest error bars) and costs about 1.3 to 1.5 times "
-               "the paths.",
+               "max_samples. The pilot (min_samples paths, then rounds to twice the target, each vertex at most "
+               "min_samples or a quarter of max_samples, whichever is more) is left out of the result: a count "
+               "decided from the paths it keeps would bias the mean (a vertex whose paths came out bright would "
+               "stop early). So the target holds at most vertices (those above it are counted in the log, with "
+               "honest error bars) and costs about 1.5 times the paths. With max_samples = min_samples "
+               "there is no pilot: every vertex keeps min_samples paths.",
        .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1.0},
       {.name = "min_samples", .label = "Minimum paths (adaptive)",
        .help = "Adaptive sampling: the pilot's first paths, and the fewest a vertex keeps.",
        .type = ParamType::Int, .def = 64, .min = 2, .max = 1 << 24},
       {.name = "max_samples", .label = "Maximum paths (adaptive)",
-       .help = "Adaptive sampling: the most paths a vertex keeps (its pilot traces at most a quarter as many more).",
+       .help = "Adaptive sampling: the most paths a vertex keeps (its pilot traces at most min_samples or a quarter "
+               "as many, whichever is more, besides).",
        .type = ParamType::Int, .def = 65536, .min = 2, .max = 1 << 26},
       {.name = "max_depth", .label = "Maximum bounces",
        .help = "-1 (the default): no fixed limit, so the reference is unbiased: Russian roulette (survival = the "
@@ -246,29 +248,24 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   // (ringVariance): the error bars' variances.
   struct PooledVariance {
     std::vector<double> B, H;
-    std::vector<double> ringB;  // luminance of E + rho times the ring's mean H: the adaptive count's goal
     std::vector<uint32_t> vertices;
   };
   auto pooled = [&]() {
-    // Only the covariances and means of H and the path counts are exchanged.
-    std::vector<double> all(10 * nv, 0.0);
+    // Only the covariances of H and the path counts are exchanged.
+    std::vector<double> all(7 * nv, 0.0);
     for (size_t i = 0; i < nv; ++i)
       if (acc[i].n >= 2 && part.contains(i, nv)) {
         const Cov c = sampleCov(acc[i]);
         for (int k = 0; k < 6; ++k) all[6 * i + size_t(k)] = c[size_t(k)];
         all[6 * nv + i] = acc[i].n;
-        for (int k = 0; k < 3; ++k) all[7 * nv + 3 * i + size_t(k)] = acc[i].sumH[k] / acc[i].n;
       }
     if (!part.all()) part.sumOverParts(all);
-    const std::vector<double> paths(all.begin() + 6 * nv, all.begin() + 7 * nv);
-    std::vector<glm::dvec3> meanH(nv);
-    for (size_t i = 0; i < nv; ++i) meanH[i] = {all[7 * nv + 3 * i], all[7 * nv + 3 * i + 1], all[7 * nv + 3 * i + 2]};
-    RingVariance ring = ringVariance(graph, all.data(), paths, &meanH);
+    const std::vector<double> paths(all.begin() + 6 * nv, all.end());
+    RingVariance ring = ringVariance(graph, all.data(), paths);
     const glm::dvec3& lum = kLuminanceWeights;
     PooledVariance p;
     p.B.assign(nv, 0.0);
     p.H.assign(nv, 0.0);
-    p.ringB.assign(nv, 0.0);
     for (size_t i = 0; i < nv; ++i) {
       if (!(acc[i].n >= 2) || !part.contains(i, nv)) continue;
       p.H[i] = std::max(sampleVar(acc[i], true), quadratic(ring.mean[i], lum));
@@ -280,7 +277,6 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
           if (acc[i].sumH[c] > 0) rho[c] = acc[i].sumRH[c] / acc[i].sumH[c];
       const double own = sampleVar(acc[i], false), pool = quadratic(ring.mean[i], rho * lum);
       p.B[i] = ring.vertices[i] > 1 ? std::max(own, pool) : own;
-      p.ringB[i] = luminance(mat.E[i]) + glm::dot(rho * ring.meanH[i], lum);
     }
     p.vertices = std::move(ring.vertices);
     return p;
@@ -289,6 +285,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   int rounds = 0;         // adaptive: the pilot's rounds
   double floorB = 0;      // adaptive: the error target's floor, a tenth of the pilot's mean B
   double pilotPaths = 0;  // adaptive: the pilot's paths, traced and left out
+  double pilotRays = 0;   // and their rays
   if (!adaptive) {
     parallelBlocks(nv, progress, "tracing paths", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
@@ -303,8 +300,6 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     // The pilot: min_samples paths, then rounds to kPilotLooseness times the
     // target (about a quarter of the paths), each vertex at most a quarter
     // of max_samples: its B and variance then size the count well.
-    const double pilotTarget = kPilotLooseness * opt.targetRelativeError;
-    const double pilotCap = std::max(double(opt.minSamples), std::floor(0.25 * opt.maxSamples));
     parallelBlocks(nv, progress.sub(0.0, 0.05), "tracing paths (pilot)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (traceable[i] && part.contains(i, nv)) trace(i, opt.minSamples);
@@ -321,6 +316,12 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       if (traceable[i] && part.inSubset(i)) { meanB += pilot[i]; ++valid; }
     meanB = valid ? meanB / double(valid) : 0.0;
     floorB = 0.1 * meanB;
+  }
+  // With max_samples = min_samples the count cannot vary: the first pass's
+  // paths are the result, fixed in advance (no pilot to leave out).
+  if (adaptive && opt.maxSamples > opt.minSamples) {
+    const double pilotTarget = kPilotLooseness * opt.targetRelativeError;
+    const double pilotCap = std::max(double(opt.minSamples), std::floor(0.25 * opt.maxSamples));
     // The pilot's rounds: every vertex whose error bar (its ring's pooled
     // variance, as reported) is above the loose target traces what that
     // error bar predicts it needs, at least 32 and at most as many as it has,
@@ -361,9 +362,15 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       if (!traceable[i] || !part.contains(i, nv)) continue;
       const double B = luminance(mat.E[i]) + acc[i].sumL / acc[i].n;
       const double goal = opt.targetRelativeError * std::max(B, floorB);
-      const double n = goal > 0 ? std::ceil(kPilotMargin * var[i] / (goal * goal)) : double(opt.maxSamples);
+      // No variance (no light reached the pilot's paths, nor its ring's):
+      // min_samples, as a vertex that meets the target at once.
+      const double n = !(var[i] > 0) ? double(opt.minSamples)
+                       : goal > 0    ? std::ceil(kPilotMargin * var[i] / (goal * goal))
+                                     : double(opt.maxSamples);
       count[i] = int(std::clamp(n, double(opt.minSamples), double(opt.maxSamples)));
       pilotPaths += acc[i].n * (sides.slot[i] >= 0 ? 2.0 : 1.0);
+      pilotRays += double(counts[i].rays());
+      counts[i] = paths::Counts{};  // the log's paths cut at max_depth are the kept paths'
       Accum fresh;
       fresh.first = uint32_t(acc[i].n);
       acc[i] = fresh;
@@ -427,9 +434,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   st.add("vertices", double(nv));
   st.add("traced_vertices", double(valid));
   st.add("paths", samples);
-  st.add("rays", totalRays);
+  st.add("rays", totalRays + pilotRays);
   st.add("seconds", timer.seconds());
-  st.add("rays_per_second", traceSeconds > 0 ? totalRays / traceSeconds : 0.0);
+  st.add("rays_per_second", traceSeconds > 0 ? (totalRays + pilotRays) / traceSeconds : 0.0);
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_std_error", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.add("mean_relative_std_error", valid ? rel / double(valid) : 0.0);

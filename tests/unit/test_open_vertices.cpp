@@ -307,3 +307,21 @@ TEST(AmbientOcclusion, OpenProofRunsWhereItPays) {
   EXPECT_GE(high.sampled, 256u);
   EXPECT_NEAR(high.share, on.stats.get("skipped_open") / double(bunny.vertexCount()), 0.06);
 }
+
+// To a target, the per-vertex estimator's open vertex casts a pilot and the
+// count it predicts (perVertexRaysWhenOpen): at 0.005 on an open plane,
+// 350 rays (a pilot of 128, whose Laplace bound 0.0077 is within twice the
+// target, then 1.25^0.5 x 128 x 0.0077 / 0.005 = 222), where the plan took
+// 32 (min_rays)
+// and so never proved the plane's vertices open (an outside review). Now
+// they are, with the rays' value, 1.
+TEST(AmbientOcclusion, OpenProofCountsThePilotsRays) {
+  const Scene s = scenes::openPlane(1.0, 16).scene;
+  auto caster = makeEmbreeCaster(s);
+  AmbientOptions o;
+  o.targetError = 0.005;
+  const auto [on, off] = withAndWithoutProof(s, o);
+  EXPECT_EQ(on.stats.get("skipped_open"), double(s.vertexCount()));
+  EXPECT_EQ(on.value, off.value);
+  for (size_t i = 0; i < s.vertexCount(); ++i) EXPECT_EQ(off.rays[i], 350) << i;
+}

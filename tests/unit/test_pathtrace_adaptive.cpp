@@ -68,3 +68,42 @@ TEST(PathTracer, AdaptiveReachesTarget) {
             0u)
       << unmet.stats.warnings[0];
 }
+
+// Found by an outside review of the pilot (5 December 2026): a vertex whose
+// pilot and ring saw no light (a closed box under the sky) has no variance
+// and keeps min_samples paths (it took max_samples: 4,096 a vertex, 256
+// times the cost); the paths cut at max_depth and the depth warning count
+// the kept paths only, as "paths" does (the pilot's were counted too: "cut
+// 36248 of 19672 paths"); and with max_samples = min_samples there is no
+// pilot (the count cannot vary).
+TEST(PathTracer, AdaptivePilotEdgeCases) {
+  auto box = scenes::closedBox(1.0, 3, true);
+  scenes::setUniform(box, glm::vec3(0.5f), glm::vec3(0.f));
+  auto caster = makeEmbreeCaster(box.scene);
+  PathTraceOptions o;
+  o.skyRadiance = glm::vec3(1.f);
+  o.targetRelativeError = 0.1;
+  o.minSamples = 16;
+  o.maxSamples = 4096;
+  const PathTraceResult dark = pathTrace(box.scene, *caster, o);
+  const double nv = double(box.scene.vertexCount());
+  EXPECT_EQ(dark.stats.get("paths"), 16.0 * nv);
+  EXPECT_EQ(dark.stats.get("pilot_paths"), 16.0 * nv);
+  for (const glm::vec3& b : dark.B) EXPECT_EQ(b, glm::vec3(0.f));
+
+  auto sf = scenes::cornellBox(150.0);
+  auto cc = makeEmbreeCaster(sf.scene);
+  PathTraceOptions d;
+  d.maxDepth = 0;
+  d.targetRelativeError = 0.2;
+  d.minSamples = 16;
+  d.maxSamples = 256;
+  const PathTraceResult cut = pathTrace(sf.scene, *cc, d);
+  EXPECT_GT(cut.stats.get("paths_cut_at_max_depth"), 0.0);
+  EXPECT_LE(cut.stats.get("paths_cut_at_max_depth"), cut.stats.get("paths"));
+
+  d.minSamples = d.maxSamples = 64;
+  const PathTraceResult fixed = pathTrace(sf.scene, *cc, d);
+  EXPECT_EQ(fixed.stats.get("pilot_paths"), 0.0);
+  EXPECT_EQ(fixed.stats.get("paths"), 64.0 * double(sf.scene.vertexCount()));
+}
