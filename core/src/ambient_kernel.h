@@ -30,6 +30,21 @@ inline StrataGrid firstStrataGrid(const AmbientOptions& o) {
   return StrataGrid::forRays(o.targetError > 0.0 ? o.minRays : o.raysPerVertex);
 }
 
+// The per-vertex estimator's count to a target (per-ray units) from its
+// pilot (pilotRays rays, their standard error): rays whose error bar falls as
+// 1/sqrt(n) (their variance per ray), or, where all the pilot's rays agreed,
+// as the Laplace bound's 1/n; within [min_rays, what max_rays leaves]
+// (capped: the prediction was cut there).
+inline int perVertexCount(const AmbientOptions& o, double target, int pilotRays, double pilotStdError, bool agreed,
+                          bool* capped = nullptr) {
+  const double goal = target / std::sqrt(kPilotMargin);
+  const double ratio = goal > 0.0 ? pilotStdError / goal : 0.0;
+  const double want = std::ceil(agreed ? pilotRays * ratio : pilotRays * ratio * ratio);
+  const int most = std::max(o.minRays, o.maxRays - pilotRays);
+  if (capped) *capped = want > most;
+  return int(std::clamp(want, double(o.minRays), double(most)));
+}
+
 // The rays a vertex whose every ray is open casts with the per-vertex
 // estimator to a target (AmbientKernel::run): the pilot's rounds until the
 // Laplace bound of n agreeing rays, sqrt(p (1 - p) / n) with p = (n + 1) /
@@ -46,8 +61,7 @@ inline int perVertexRaysWhenOpen(const AmbientOptions& o) {
     n += std::min(kRound, pilotMax - n);
     if (n >= o.minRays && laplace(n) <= kPilotLooseness * o.targetError) break;
   }
-  const double want = std::ceil(n * laplace(n) * std::sqrt(kPilotMargin) / o.targetError);
-  return n + int(std::clamp(want, double(o.minRays), double(std::max(o.minRays, o.maxRays - n))));
+  return n + perVertexCount(o, o.targetError, n, laplace(n), true);
 }
 
 // A bent normal: the mean open direction, or the normal where none was open.
@@ -108,7 +122,8 @@ class AmbientKernel {
     }
     if (!(o_.targetError > 0.0)) return finish(cast(hash3(vi, o_.seed, 0x41u), o_.raysPerVertex, 0.0, org, frame), vi, n, org);
     // To a target: a pilot on numbers of its own, rounds of kRound rays to
-    // kPilotLooseness times the target (at most a quarter of max_rays),
+    // kPilotLooseness times the target (at most min_rays or a quarter of
+    // max_rays, whichever is more),
     // sizes the count (gi/sampling.h); the count's rays, the vertex's
     // fixed-count rays, are the result, and the pilot is left out of it.
     // Stopping on the kept rays biased the mean low where light comes
@@ -116,15 +131,10 @@ class AmbientKernel {
     // units at a target of 0.005 (4 seeds).
     const int pilotMax = std::max(o_.minRays, o_.maxRays / 4);
     const VertexOut pilot = cast(hash3(vi, o_.seed, 0x4cu), pilotMax, kPilotLooseness * target_, org, frame);
-    // Rays whose error bar falls as 1/sqrt(n) (their variance per ray), or,
-    // where all the pilot's rays agreed, as the Laplace bound's 1/n.
-    const double goal = target_ / std::sqrt(kPilotMargin);
-    const double ratio = goal > 0.0 ? double(pilot.stdError) / goal : 0.0;
-    const double want = std::ceil(pilot.agreed ? pilot.rays * ratio : pilot.rays * ratio * ratio);
-    const int most = std::max(o_.minRays, o_.maxRays - pilot.rays);
-    VertexOut out = cast(hash3(vi, o_.seed, 0x41u), int(std::clamp(want, double(o_.minRays), double(most))), 0.0,
-                         org, frame);
-    out.capped = want > most;
+    bool capped = false;
+    const int count = perVertexCount(o_, target_, pilot.rays, pilot.stdError, pilot.agreed, &capped);
+    VertexOut out = cast(hash3(vi, o_.seed, 0x41u), count, 0.0, org, frame);
+    out.capped = capped;
     out.rays += pilot.rays;
     return finish(out, vi, n, org);
   }

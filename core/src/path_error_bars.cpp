@@ -10,13 +10,11 @@
 namespace gi::reference {
 
 // cov: 6 numbers per vertex (as Cov); paths: nv counts.
-RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths,
-                          const std::vector<glm::dvec3>* meanH) {
+RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths) {
   const size_t nv = paths.size();
   RingVariance out;
   out.mean.assign(nv, Cov{});
   out.vertices.assign(nv, 0);
-  if (meanH) out.meanH.assign(nv, glm::dvec3(0.0));
   // Each level's new vertices: the frontier's neighbours, sorted and made
   // unique, less those already in the ring (kept sorted: binary searches),
   // so a vertex of high valence (a fan's hub) costs R log R, not R^2.
@@ -45,16 +43,13 @@ RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::ve
       }
       // The ring is sorted: sums in vertex order, the same bits in any thread.
       Cov sum{};
-      glm::dvec3 sumH(0.0);
       uint32_t n = 0;
       for (uint32_t j : ring)
         if (paths[j] >= 2) {
           for (int c = 0; c < 6; ++c) sum[size_t(c)] += cov[6 * size_t(j) + size_t(c)];
-          if (meanH) sumH += (*meanH)[j];
           ++n;
         }
       for (int c = 0; c < 6; ++c) out.mean[i][size_t(c)] = sum[size_t(c)] / double(n);  // n >= 1: the vertex itself
-      if (meanH) out.meanH[i] = sumH / double(n);
       out.vertices[i] = n;
     }
   });

@@ -44,13 +44,10 @@ using Cov = std::array<double, 6>;
 struct RingVariance {
   std::vector<Cov> mean;           // mean covariance over the traced vertices of the ring (the vertex's own included)
   std::vector<uint32_t> vertices;  // how many (1: the vertex alone)
-  std::vector<glm::dvec3> meanH;   // with meanH given: the mean of the ring's means of H
 };
 
-// cov: 6 numbers per vertex (as Cov); paths: nv counts; meanH (optional):
-// each vertex's mean H, pooled over the same ring.
-RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths,
-                          const std::vector<glm::dvec3>* meanH = nullptr);
+// cov: 6 numbers per vertex (as Cov); paths: nv counts.
+RingVariance ringVariance(const VertexGraph& g, const double* cov, const std::vector<double>& paths);
 
 // w^T C w for the symmetric 3 x 3 matrix C: the variance of w . H.
 double quadratic(const Cov& C, const glm::dvec3& w);

@@ -298,8 +298,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     // through a window, 6 seeds: +9.7% at a target of 0.3 with 64-path
     // pilots, -12.5% at 0.2 with 16).
     // The pilot: min_samples paths, then rounds to kPilotLooseness times the
-    // target (about a quarter of the paths), each vertex at most a quarter
-    // of max_samples: its B and variance then size the count well.
+    // target (about a quarter of the paths), each vertex at most min_samples
+    // or a quarter of max_samples, whichever is more: its B and variance then
+    // size the count well.
     parallelBlocks(nv, progress.sub(0.0, 0.05), "tracing paths (pilot)", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (traceable[i] && part.contains(i, nv)) trace(i, opt.minSamples);
