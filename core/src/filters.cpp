@@ -44,7 +44,8 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       s.push_back({.name = "face_output", .label = "Also write per-face results",
                    .help = "Besides the per-vertex result (area-weighted mean of the incident patches), write each "
                            "patch's radiosity to face quality and face colour: the flat-shaded look of the course's "
-                           "images.",
+                           "images (a patch partly buried under another surface shows the radiosity of the part the "
+                           "scene sees).",
                    .type = ParamType::Bool, .def = false});
       add(displaySpecs());
       break;

@@ -63,13 +63,39 @@ double FormFactors::rowScratchBytes() const {
   return 8.0 * n;
 }
 
+namespace {
+
+// The row of the seen share a of a patch: its buried points' rays met back
+// faces only, so the mean over the seen points is F / a; capped where the
+// row would sum above 1 (a share estimated a little low must not create
+// light). escaped stays 1 - the row's sum, as each method defines it.
+FormFactorRow seenPart(FormFactorRow r, float a) {
+  if (!(a > 0.f)) return FormFactorRow{{}, {}, 1.f};
+  double sum = 0;
+  for (float f : r.F) sum += f;
+  const double g = sum * a > 1.0 ? 1.0 / sum : 1.0 / a;
+  for (float& f : r.F) f = float(f * g);
+  r.escaped = float(std::clamp(1.0 - sum * g, 0.0, 1.0));
+  return r;
+}
+
+}  // namespace
+
+void FormFactors::useSeenParts(std::vector<float> a) {
+  if (a.size() != area_.size()) throw std::logic_error("seen parts: one share per patch");
+  if (set_.method == FormFactorMethod::Hemicube && set_.hemicubePoints <= 1) return;
+  seen_ = std::move(a);
+}
+
 FormFactorRow FormFactors::row(uint32_t i) const {
   if (!ok_[i]) return {};
+  FormFactorRow r;
   switch (set_.method) {
-    case FormFactorMethod::Analytic: return analyticRow(i);
-    case FormFactorMethod::Hemicube: return hemicubeRow(i);
-    default: return monteCarloRow(i);
+    case FormFactorMethod::Analytic: r = analyticRow(i); break;
+    case FormFactorMethod::Hemicube: r = hemicubeRow(i); break;
+    default: r = monteCarloRow(i); break;
   }
+  return seen_.empty() || seen_[i] >= 1.f ? r : seenPart(std::move(r), seen_[i]);
 }
 
 FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,

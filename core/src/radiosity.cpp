@@ -16,6 +16,7 @@
 #include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/form_factor_analytic.h"
+#include "gi/patch_seen.h"
 #include "gi/sampling.h"
 #include "radiosity_course.h"
 #include "radiosity_solvers.h"
@@ -286,6 +287,36 @@ MemoryPlan planMemory(size_t n, const FormFactors& ff, const RadiosityOptions& o
 
 std::string megabytes(double bytes) { return std::to_string(int(bytes / 1048576.0 + 0.5)); }
 
+// The flat solvers work with the seen part of each patch (gi/patch_seen.h):
+// its area a A, its direct irradiance H / a and its row F / a (the last in
+// `ff`). A patch no one sees keeps no area and no light.
+void useSeenParts(const PatchSeen& seen, Setup& u, FormFactors& ff) {
+  if (!seen.any()) return;
+  for (size_t i = 0; i < u.n; ++i) {
+    const float a = seen.fraction[i];
+    if (a >= 1.f) continue;
+    u.A[i] *= a;
+    u.Hd[i] = a > 0.f ? u.Hd[i] / a : glm::vec3(0.f);
+  }
+  ff.useSeenParts(seen.fraction);
+}
+
+void reportSeenParts(const PatchSeen& seen, const FormFactors& ff, RunStats& st) {
+  st.add("seen_part_rays", double(seen.rays));
+  if (!seen.any()) return;
+  st.add("patches_partly_buried", double(seen.partial));
+  st.add("patches_buried", double(seen.buried));
+  char b[420];
+  std::snprintf(b, sizeof b,
+                "%zu patches partly and %zu wholly buried under other surfaces (%.2g%% of the surface, where no ray "
+                "can reach): their radiosity is that of the part the scene sees%s",
+                seen.partial, seen.buried, 100.0 * seen.buriedArea / seen.area,
+                ff.method() == FormFactorMethod::Hemicube && ff.hemicubePoints() <= 1
+                    ? " (direct light; a hemicube at the centre gives the centre's row)"
+                    : "");
+  st.note(b);
+}
+
 // The whole sparse matrix computed first (in parallel) and kept for the solve.
 RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors& ff, const MemoryPlan& mem,
                               RadiositySolver solver, const RadiosityOptions& opt, const Progress& progress) {
@@ -446,9 +477,13 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     return res;
   }
   Timer timer;
-  const FormFactors ff(s, caster, ffs);
+  FormFactors ff(s, caster, ffs);
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
-  const DirectSetup direct = directSetup(s, caster, opt, ffs.seed, progress.sub(0.0, 0.05), progress.sub(0.05, 0.1));
+  DirectSetup direct = directSetup(s, caster, opt, ffs.seed, progress.sub(0.0, 0.05), progress.sub(0.05, 0.1));
+  Timer seenTimer;
+  const PatchSeen seen = patchSeenFractions(s, caster, ffs.seed);
+  useSeenParts(seen, direct.u, ff);
+  const double seenSeconds = seenTimer.seconds();
   const Setup& u = direct.u;
   RadiositySolver solver = opt.solver;
   if (solver == RadiositySolver::Auto) solver = mem.fits ? RadiositySolver::GaussSeidel : RadiositySolver::Progressive;
@@ -468,9 +503,12 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     res.stats.note(std::to_string(ff.farPairsByOnePoint()) +
                    " far pairs (F < 1e-7 proved by distance) by one point and one ray each, not refined");
   res.stats.add("patches", double(u.n));
+  reportSeenParts(seen, ff, res.stats);
+  res.stats.add("seen_part_seconds", seenSeconds);
+  if (seen.any()) res.seenShare = seen.fraction;
   if (slow) res.stats.warn(*slow);
   res.stats.add("memory_estimate_MB", (mem.rest + (mem.fits ? mem.matrix : 0.0)) / 1048576.0);
-  res.stats.add("rays", double(ff.raysCast()));
+  res.stats.add("rays", double(ff.raysCast() + seen.rays));
   res.stats.add("seconds", timer.seconds());
   if (const auto w = emitterOrientationWarning(s, caster, opt.outside.any())) res.stats.warn(*w);
   return res;

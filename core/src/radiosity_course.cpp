@@ -41,7 +41,8 @@ std::vector<ParamSpec> radiosityCourseSpecs() {
                "PREFIX_rho.mtx, PREFIX_Esys.mtx (E + rho (H_direct - F E): with it the system has the filter's "
                "exact direct light), PREFIX_B.mtx (the filter's patch radiosity, to check against; without the "
                "ambient term, which only the display adds) and "
-               "PREFIX_area.mtx. Needs the form-factor matrix in memory (memory budget).",
+               "PREFIX_area.mtx (of the part the scene sees, where a patch is partly buried under another "
+               "surface). Needs the form-factor matrix in memory (memory budget).",
        .type = ParamType::String, .defText = ""},
   };
 }

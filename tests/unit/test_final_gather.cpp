@@ -105,16 +105,14 @@ void expectWithinTheReference(const EdgeError& e, double bias = 0) {
 // that the gather's own noise is small; the reference traces 16,384 paths
 // at each edge vertex (about 1.2% standard error each). d = (B - ref) / ref
 // per vertex; its mean must lie within 4 standard errors of the mean (from
-// the spread of d itself, which holds both noises) and 0.5% of 0 and below
-// 1%, and its RMS below 2.5%. Measured: flat mean -0.42% (standard error
-// 0.12%), RMS 1.5%; hierarchical -0.79% (0.12%), RMS 1.7%. With the near
-// hits read at the patch's mean after two levels (until 5 December 2026):
-// -0.03% and -0.30%, where that mean's excess (+6% at the room's corners,
-// test below) offset the rest; the rest, about -0.4%, is not from the
-// patch values read at far hits (relighting hits within 4 patch edges
-// instead of 2 gives the same means) and is bounded here, not explained.
-// Reading the patch means at every near hit: flat +3.1% (7.8 standard
-// errors), RMS 6.0%; hierarchical +3.4%, RMS 6.8%: the test fails.
+// the spread of d itself, which holds both noises) of 0 and below 1%, and
+// its RMS below 2.5%. Measured: flat mean +0.09% (standard error
+// 0.11%), RMS 1.5%; hierarchical -0.79% (0.12%), RMS 1.7%, which is allowed
+// 0.5% besides: the floor's patches partly under the blocks send the light
+// of their whole area's mean, not of the part the scene sees (the flat
+// solvers' seen parts, test_patch_seen.cpp; before them the flat mean was
+// -0.42%). Reading the patch means at every near hit: flat +3.1% (7.8
+// standard errors), RMS 6.0%; hierarchical +3.4%, RMS 6.8%: the test fails.
 TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
   auto sf = scenes::cornellBox(50.0);
   const Scene& s = sf.scene;
@@ -122,7 +120,8 @@ TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
   auto edge = std::make_shared<std::vector<uint8_t>>(roomEdgeVertices(s));
   const PathTraceResult ref = edgeReference(s, *caster, edge, -1);
   for (RadiositySolver solver : {RadiositySolver::GaussSeidel, RadiositySolver::Hierarchical})
-    expectWithinTheReference(convergedAgainst(s, *caster, *edge, ref, solver, 2048, "edge"), 0.005);
+    expectWithinTheReference(convergedAgainst(s, *caster, *edge, ref, solver, 2048, "edge"),
+                             solver == RadiositySolver::Hierarchical ? 0.005 : 0.0);
 }
 
 // A fixed bounce count (the course's images, one bounce the classic one):

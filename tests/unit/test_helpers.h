@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/color.h"
 #include "gi/scene.h"
 
 namespace gi::test {
@@ -36,6 +37,15 @@ inline Scene transformed(const Scene& s, double scale, const glm::dvec3& offset)
   Scene t = Scene::fromAbsolute(pts, s.triangles);
   t.rho = s.rho; t.emission = s.emission; t.material = s.material;
   return t;
+}
+
+// A radiosity result's face f as the mean over the whole face (luminance):
+// B is the radiosity of the part the scene sees, and a buried part (under
+// a block) has none (gi/patch_seen.h). What a path tracer's vertices
+// average to over the face.
+template <class RadiosityResult>
+double wholePatchMean(const RadiosityResult& r, size_t f) {
+  return double(luminance(r.B[f])) * (r.seenShare.empty() ? 1.0 : double(r.seenShare[f]));
 }
 
 inline double rms(const std::vector<float>& a, const std::vector<float>& b) {

@@ -262,7 +262,7 @@ TEST(PathTracer, AgreesWithRadiosityOnCornellBox) {
   const auto rad = solveRadiosity(s, *caster, ro);
   const auto pt = trace(s, 256);
   const auto groups = test::wallSums(
-      s, [&](size_t f) { return double(luminance(rad.B[f])); },
+      s, [&](size_t f) { return test::wholePatchMean(rad, f); },
       [&](size_t f) {
         double ptB = 0;
         for (int k = 0; k < 3; ++k) ptB += luminance(pt.B[s.triangles[f][k]]) / 3;

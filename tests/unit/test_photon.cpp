@@ -353,7 +353,7 @@ TEST(PhotonMap, DiffuseCornellBoxAgreesWithRadiosityAndPathTracer) {
   int compared = 0;
   for (const auto& [name, reference] : {std::pair<std::string, int>{"radiosity", 0}, {"path tracer", 1}}) {
     const auto groups = test::wallSums(
-        s, reference == 0 ? std::function<double(size_t)>([&](size_t f) { return double(luminance(rad.B[f])); })
+        s, reference == 0 ? std::function<double(size_t)>([&](size_t f) { return test::wholePatchMean(rad, f); })
                           : std::function<double(size_t)>(faceMean(pt.B)),
         faceMean(pm.B));
     for (const auto& [k, g] : groups) {

@@ -91,6 +91,10 @@ class FormFactors {
   FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
       : FormFactors(s, caster, Settings{FormFactorMethod::MonteCarlo, raysPerPatch, 4, 128, seed}) {}
   FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
+  // From now on row(i) is the row of the seen part of patch i, a share
+  // a[i] of its area (gi/patch_seen.h): F_ij / a_i, the row summing to at
+  // most 1. Not for one hemicube at the centre, which is a point's row.
+  void useSeenParts(std::vector<float> a);
   size_t patchCount() const { return area_.size(); }
   double area(uint32_t i) const { return area_[i]; }
   uint64_t raysCast() const;
@@ -102,6 +106,7 @@ class FormFactors {
   // one-view row computes it (the same F, bit for bit), with its cells.
   HemicubeCells hemicubeCells(uint32_t i) const;
   FormFactorMethod method() const { return set_.method; }  // never Auto
+  int hemicubePoints() const { return set_.hemicubePoints; }
   bool unoccluded() const { return unoccluded_; }            // visibility rays skipped
   // Upper bound of the bytes a full sparse matrix of these rows needs.
   double matrixBytesBound() const;
@@ -122,6 +127,7 @@ class FormFactors {
   std::vector<double> area_;
   std::vector<glm::vec3> normal_;
   std::vector<uint8_t> ok_;
+  std::vector<float> seen_;  // per patch, or empty: whole patches
   mutable std::vector<uint64_t> rays_;        // per patch, for the statistics
   mutable std::vector<uint64_t> farPairs_;  // per patch, for the statistics
   std::vector<glm::dvec3> centroid_;

@@ -85,7 +85,10 @@ struct RadiosityOptions {
 };
 
 struct RadiosityResult {
-  std::vector<glm::vec3> B;         // per face
+  // Per face: the radiosity of the part of the patch the scene sees (a flat
+  // solver's patches partly buried under other surfaces, gi/patch_seen.h).
+  std::vector<glm::vec3> B;
+  std::vector<float> seenShare;     // per face, that part's share of its area; empty: all of every face
   std::vector<glm::vec3> Bvertex;   // per vertex (see RadiosityOptions::vertexOutput)
   // Per vertex, its direct part E + rho H_direct (luminaires, point light,
   // sky and sun): at the vertex where the vertex values compute it there,

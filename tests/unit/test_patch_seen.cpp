@@ -1,0 +1,113 @@
+// Patches partly buried under other surfaces (gi/patch_seen.h): the share
+// each patch's seen part takes of its area, and the radiosity solution that
+// works with those parts, against the path-traced reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "gi/color.h"
+#include "gi/pathtrace.h"
+#include "gi/patch_seen.h"
+#include "gi/radiosity.h"
+#include "gi/raycaster.h"
+#include "gi/scenes.h"
+#include "render_test_helpers.h"
+
+using namespace gi;
+
+// A unit floor of two triangles (split along x = z) under a closed block
+// whose footprint is [0.2, 0.6]^2 (it goes 0.05 below the floor: no
+// coplanar faces), and a thin open wall standing on the floor elsewhere.
+// The footprint is symmetric about the diagonal, so each triangle has 0.08
+// of its 0.5 buried: a seen share of 0.84. 64 Sobol points a triangle:
+// within 3 binomial standard deviations (sqrt(0.84 x 0.16 / 64) = 0.046),
+// which the points' stratification beats (measured 0.844 and 0.844).
+// The wall and the block's faces above the floor are seen whole; the
+// block's sides below it (outside the room, rays leave the scene) too.
+TEST(PatchSeen, FloorUnderABlockKeepsTheShareAroundIt) {
+  test::SceneBuilder b;
+  b.quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}, glm::vec3(0.5f));  // facing +y
+  b.box({0.2, -0.05, 0.2}, {0.6, 0.3, 0.6}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, false);
+  b.quad({0.8, 0, 0.1}, {0.8, 0.5, 0.1}, {0.8, 0.5, 0.9}, {0.8, 0, 0.9}, glm::vec3(0.5f));  // one-sided wall
+  const Scene s = b.build();
+  auto caster = makeEmbreeCaster(s);
+  const PatchSeen seen = patchSeenFractions(s, *caster, 0);
+  std::printf("floor triangles seen %.4f and %.4f; %zu partly buried, %zu buried, %llu rays\n", seen.fraction[0],
+              seen.fraction[1], seen.partial, seen.buried, static_cast<unsigned long long>(seen.rays));
+  const double sd = std::sqrt(0.84 * 0.16 / PatchSeen::kPoints);
+  EXPECT_NEAR(seen.fraction[0], 0.84, 3 * sd);
+  EXPECT_NEAR(seen.fraction[1], 0.84, 3 * sd);
+  for (size_t f = 2; f < s.faceCount(); ++f) EXPECT_EQ(seen.fraction[f], 1.f) << f;
+  EXPECT_EQ(seen.partial, 2u);
+  EXPECT_EQ(seen.buried, 0u);
+  EXPECT_NEAR(seen.buriedArea, 0.16, 6 * sd);
+}
+
+// The same floor entirely under a larger block: buried, no area, no light;
+// and an open scene (a floor lit through a small solid angle, most rays
+// leaving the scene) is never taken for buried.
+TEST(PatchSeen, WhollyBuriedAndOpenScenes) {
+  {
+    test::SceneBuilder b;
+    b.quad({0.3, 0, 0.3}, {0.3, 0, 0.7}, {0.7, 0, 0.7}, {0.7, 0, 0.3}, glm::vec3(0.5f));
+    b.box({0, -0.05, 0}, {1, 0.3, 1}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, false);
+    const Scene s = b.build();
+    auto caster = makeEmbreeCaster(s);
+    const PatchSeen seen = patchSeenFractions(s, *caster, 0);
+    EXPECT_EQ(seen.fraction[0], 0.f);
+    EXPECT_EQ(seen.fraction[1], 0.f);
+    EXPECT_EQ(seen.buried, 2u);
+  }
+  {
+    test::SceneBuilder b;
+    b.quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}, glm::vec3(0.5f), glm::vec3(0.f), Material::Diffuse, 4);
+    b.quad({0.4, 3, 0.4}, {0.6, 3, 0.4}, {0.6, 3, 0.6}, {0.4, 3, 0.6}, glm::vec3(0.f), glm::vec3(10.f));
+    const Scene s = b.build();
+    auto caster = makeEmbreeCaster(s);
+    const PatchSeen seen = patchSeenFractions(s, *caster, 0);
+    EXPECT_FALSE(seen.any());
+  }
+}
+
+// The Cornell box's floor is cut into 50 mm patches without regard to the
+// blocks standing on it: 43 triangles partly under them, 22 wholly. Read at their whole
+// area's mean, they sent too little light, and the converged final gather's
+// vertices came out dark everywhere: against the reference (8,192 paths at
+// every vertex), by -0.60% (standard error 0.07%) at the vertices off the
+// room's walls (the blocks, the light's rim), -0.46% (0.05%) on the walls
+// and -0.42% (0.12%) on the room's edges, halving with the patch size
+// (100 mm: -0.9%, 25 mm: -0.3%). With the seen parts: +0.00%, -0.00% and
+// +0.09%. The mean of d = B / ref - 1 over the 988 lit vertices within 4 of
+// its standard errors of 0 and 0.2%. (The hierarchical solver does not
+// have the seen parts: README, Limitations.)
+TEST(PatchSeen, CornellBoxVerticesMatchTheReference) {
+  auto sf = scenes::cornellBox(50.0);
+  const Scene& s = sf.scene;
+  auto caster = makeEmbreeCaster(s);
+  PathTraceOptions po;
+  po.samplesPerVertex = 8192;
+  const PathTraceResult ref = pathTrace(s, *caster, po);
+  RadiosityOptions o;
+  o.solver = RadiositySolver::GaussSeidel;
+  o.gatherRays = 2048;
+  const RadiosityResult r = solveRadiosity(s, *caster, o);
+  EXPECT_GT(r.stats.get("patches_partly_buried"), 30);
+  std::printf("%.0f patches partly buried, %.0f buried\n", r.stats.get("patches_partly_buried"),
+              r.stats.get("patches_buried"));
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    const double q = luminance(ref.B[v]);
+    if (!(q > 0)) continue;
+    const double d = luminance(r.Bvertex[v]) / q - 1.0;
+    sum += d, sum2 += d * d, ++n;
+  }
+  const double mean = sum / n, sem = std::sqrt((sum2 / n - mean * mean) / (n - 1));
+  std::printf("%d vertices: mean %+.4f (standard error %.4f)\n", n, mean, sem);
+  EXPECT_GT(n, 900);
+  EXPECT_LT(std::fabs(mean), 4 * sem);
+  EXPECT_LT(std::fabs(mean), 0.002);
+}
