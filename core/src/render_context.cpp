@@ -55,6 +55,7 @@ Context::Context(const Scene& s, const RayCaster& c, const RenderOptions& o, con
     if (ok[f] && emits(uint32_t(f)))
       for (int k = 1; k < 3; ++k) parent[find(s.triangles[f][k])] = find(s.triangles[f][0]);
   std::vector<int> group(s.vertexCount(), -1);
+  lightOfFace_.assign(s.faceCount(), -1);
   for (size_t f = 0; f < s.faceCount(); ++f) {
     if (!ok[f] || !emits(uint32_t(f))) continue;
     const uint32_t root = find(s.triangles[f][0]);
@@ -63,6 +64,7 @@ Context::Context(const Scene& s, const RayCaster& c, const RenderOptions& o, con
       areaLights_.emplace_back();
     }
     areaLights_[size_t(group[root])].faces.push_back(uint32_t(f));
+    lightOfFace_[f] = group[root];
   }
   for (AreaLight& l : areaLights_) {
     std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge -> uses

@@ -84,8 +84,10 @@ class Context : public paths::Integrator, private paths::StoredLight {
   // Whitted: direct irradiance at x, exact area-light factors with one shadow ray each.
   glm::vec3 whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const;
   // Whitted: what reaches the end of a shadow ray: 0 past an opaque face,
-  // through glass the tint times 1 - F at each interface crossed.
-  glm::vec3 whittedTransmittance(Ray ray, Counts& c) const;
+  // through glass the tint times 1 - F at each interface crossed; a ray
+  // aimed at area light `light` that meets the front of one of its faces
+  // has reached it (a closed light's aim point lies inside it).
+  glm::vec3 whittedTransmittance(Ray ray, Counts& c, int light = -1) const;
 
   struct AreaLight {
     std::vector<uint32_t> faces;
@@ -103,6 +105,7 @@ class Context : public paths::Integrator, private paths::StoredLight {
   const RenderOptions& o_;
   const TwoPassData* tp_;
   std::vector<AreaLight> areaLights_;
+  std::vector<int> lightOfFace_;  // per face, its area light (-1: none)
 };
 
 }  // namespace eye

@@ -10,9 +10,13 @@
 //     unoccluded irradiance, sum over its faces of E_f F(x -> f) with Lambert's
 //     contour integral (gi/form_factor_analytic.h), times the visibility of
 //     ONE shadow ray aimed at the light's centre as seen from x (the
-//     F-weighted mean of its faces' centroids; its area centroid when all of
-//     it is in view, and then the sum is its boundary's contour integral):
-//     hard shadows without noise;
+//     F-weighted mean of the centroids of its faces' parts in front of x's
+//     tangent plane; its area centroid when all of it is in view, and then
+//     the sum is its boundary's contour integral): hard shadows without
+//     noise. The ray reaches the light when it meets the front of one of
+//     its faces first (a closed light, a sphere, has its centre inside);
+//     the centre is never behind x's plane (it once was, for a light partly
+//     behind it, and the ray then started inside the object under x);
 //   - the point or spot light and the sun's centre: one shadow ray each.
 // A shadow ray goes straight through glass, losing the Fresnel reflectance
 // F at each interface it crosses (and taking the glass's tint), as classical
@@ -45,12 +49,38 @@ struct Branch {
   bool lightOnly = false;  // past max_depth: it may only find a light (emission, sky, sun)
 };
 float maxChannel(const glm::vec3& v) { return std::max({v.r, v.g, v.b}); }
+
+// The area-weighted centroid of the part of triangle v in front of the plane
+// through x with normal n (Sutherland and Hodgman's clip against one plane);
+// false where no part of it is.
+bool frontCentroid(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3 (&v)[3], glm::dvec3& centroid) {
+  glm::dvec3 poly[4];
+  int m = 0;
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec3 &p = v[k], &q = v[(k + 1) % 3];
+    const double dp = glm::dot(n, p - x), dq = glm::dot(n, q - x);
+    if (dp > 0.0) poly[m++] = p;
+    if ((dp > 0.0) != (dq > 0.0)) poly[m++] = p + (q - p) * (dp / (dp - dq));
+  }
+  if (m < 3) return false;
+  glm::dvec3 sum(0.0);
+  double area = 0.0;
+  for (int k = 1; k + 1 < m; ++k) {
+    const double a = glm::length(glm::cross(poly[k] - poly[0], poly[k + 1] - poly[0]));
+    sum += a * (poly[0] + poly[k] + poly[k + 1]) / 3.0;
+    area += a;
+  }
+  if (!(area > 0.0)) return false;
+  centroid = sum / area;
+  return true;
+}
 }  // namespace
 
 glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const {
   glm::vec3 H(0.f);
   const glm::dvec3 xd(x), nd(n);
-  for (const AreaLight& light : areaLights_) {
+  for (size_t li = 0; li < areaLights_.size(); ++li) {
+    const AreaLight& light = areaLights_[li];
     glm::dvec3 Hl(0.0), centre(0.0);
     double wsum = 0.0;
     bool whole = light.uniform;  // no face clipped: its boundary's contour integral
@@ -77,9 +107,10 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
       const glm::dvec3 a(s_.positions[t.x]), b(s_.positions[t.y]), cc(s_.positions[t.z]);
       if (glm::dot(glm::dvec3(faceN_[f]), xd - a) <= double(eps_)) continue;  // behind (or in) the one-sided emitter
       const double F = pointToTriangleFormFactor(xd, nd, a, b, cc);
-      if (!(F > 0.0)) continue;
+      glm::dvec3 mid;
+      if (!(F > 0.0) || !frontCentroid(xd, nd, {a, b, cc}, mid)) continue;
       Hl += F * glm::dvec3(s_.faceEmission(f));
-      centre += F * (a + b + cc) / 3.0;
+      centre += F * mid;
       wsum += F;
     }
     if (!(wsum > 0.0)) continue;
@@ -89,7 +120,7 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
     if (!(r > 0.f)) continue;
     w /= r;
     const Ray ray = shadowRay(x, n, w, glm::vec3(centre), eps(), eps());
-    if (ray.tfar > 0.f) H += glm::vec3(Hl) * whittedTransmittance(ray, c);
+    if (ray.tfar > 0.f) H += glm::vec3(Hl) * whittedTransmittance(ray, c, int(li));
     else H += glm::vec3(Hl);
   }
   if (hasSun_) {
@@ -112,12 +143,13 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
   return H;
 }
 
-glm::vec3 Context::whittedTransmittance(Ray ray, Counts& c) const {
+glm::vec3 Context::whittedTransmittance(Ray ray, Counts& c, int light) const {
   glm::vec3 T(1.f);
   for (int crossings = 0;; ++crossings) {
     ++c.shadow;
     const Hit h = caster_.intersect(ray);
     if (!h.valid()) return T;
+    if (light >= 0 && lightOfFace_[h.face] == light && glm::dot(ray.d, faceN_[h.face]) < 0.f) return T;
     if (s_.faceMaterial(h.face) != Material::Glass || crossings >= 64) return glm::vec3(0.f);
     const float ior = s_.ior.empty() ? 1.5f : s_.ior[h.face];
     // F from the air side at either face: the straight line stands for the

@@ -21,8 +21,7 @@
 #include "render_test_helpers.h"
 
 using namespace gi;
-using gi::test::BlockSums;
-using gi::test::blockSums;
+using gi::test::expectBlocksAgree;
 using gi::test::SceneBuilder;
 
 namespace {
@@ -54,31 +53,6 @@ RenderOptions roomOptions(const Scene& s, RenderMode m, int spp, int w, int h) {
   o.point.position = glm::vec3(glm::dvec3(1, 1.5, -1) - s.origin);
   o.point.intensity = glm::vec3(2.f);
   return o;
-}
-
-// Block means of two images agree within 4 combined standard errors, each
-// block's from the per-pixel standard errors sqrt(sum sigma_p^2) / n (for
-// the QMC modes this spread of the pixel samples is an upper bound), and so
-// do the whole images' sums (a bias spread over the image: in the tests
-// below 4 sigma is 1.5% of the Whitted image, 0.6% of the distributed one).
-void expectBlocksAgree(const RenderResult& a, const RenderResult& b, int block, const char* what) {
-  const int W = a.image.width, H = a.image.height;
-  int blocks = 0;
-  double sa = 0, sb = 0, vsa = 0, vsb = 0;
-  for (int by = 0; by + block <= H; by += block)
-    for (int bx = 0; bx + block <= W; bx += block) {
-      const BlockSums s = blockSums(a, b, bx, by, block);
-      const double ma = s.a, mb = s.b, va = s.varA, vb = s.varB;
-      const double n = double(block) * block;
-      EXPECT_NEAR(ma / n, mb / n, 4 * std::sqrt(va + vb) / n + 1e-6) << what << " block " << bx << "," << by;
-      sa += ma;
-      sb += mb;
-      vsa += va;
-      vsb += vb;
-      ++blocks;
-    }
-  EXPECT_GT(blocks, 20);
-  EXPECT_NEAR(sa, sb, 4 * std::sqrt(vsa + vsb)) << what << ": whole image";
 }
 
 }  // namespace
