@@ -29,7 +29,7 @@ using paths::SurfacePoint;
 // Caustic photons and their density estimate (render_caustics.cpp).
 class CausticMap {
  public:
-  explicit CausticMap(std::vector<Photon> photons);
+  CausticMap(std::vector<Photon> photons, const Scene& s);
   ~CausticMap();
   size_t size() const;
   // Irradiance at x (unit normal n) from the k nearest photons on n's side within sqrt(r2max).

@@ -88,7 +88,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
     const size_t stored = photons.size();
     tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
-    if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons));
+    if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons), s);
     stats.add("caustic_photons_aimed", double(ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
