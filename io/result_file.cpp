@@ -100,7 +100,7 @@ ResultKey readResultFile(const std::string& path, FilterResult& r) {
     throw std::runtime_error(e.what());
   }
   try {
-    const json j = json::parse(text);
+    const json j = parseJson(text);
     if (j.at("format") != "gi-result" || j.at("version") != 1) throw std::runtime_error("not a gi result file (version 1)");
     const std::string hash = j.at("scene_hash").get<std::string>();
     if (hash.empty() || hash.size() > 16 ||

@@ -101,7 +101,7 @@ std::pair<std::string, Texts> readParamsFile(const std::string& path) {
   const std::string text = files::readTextFile(path, "parameter file", size_t(64) << 20);
   json j;
   try {
-    j = json::parse(text);
+    j = gi::io::parseJson(text);
   } catch (const std::exception& e) {
     throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
   }
@@ -234,7 +234,7 @@ std::string jobHash(const std::string& filter, const Texts& params, const std::s
 
 json readJson(const fs::path& p) {
   try {
-    return json::parse(files::readTextFile(p.string(), "summary"));
+    return gi::io::parseJson(files::readTextFile(p.string(), "summary"));
   } catch (const std::exception&) {  // missing, not a regular file, not JSON: no summary
     return nullptr;
   }
@@ -376,6 +376,10 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     common[k] = v;
   }
   for (const auto& [k, v] : parameterPairs(extras, 0, specs, d.cliName, "")) common[k] = v;
+  // Every mesh takes these: a value that cannot be read is said once, before
+  // any mesh is loaded (it failed each mesh in turn). Ranges that depend on
+  // the mesh (percentages of its diagonal) are checked per mesh.
+  for (const auto& [k, v] : common) (void)parseValue(*findSpec(specs, k), v, 1.0);
 
   if (a.manifest.empty() == a.dir.empty()) throw std::invalid_argument("give either --manifest FILE or --dir DIR");
   std::vector<Job> jobs = a.manifest.empty() ? readFolder(a.dir, a.glob) : readManifest(a.manifest, specs, d.cliName);

@@ -227,6 +227,17 @@ def case_inputs(a, tmp):
     with open(bad, "w") as f:
         f.write("# only a comment\n")
     one_line(["ao", "--manifest", bad, "-o", out], "lists no mesh", "a manifest that lists no mesh")
+    # A value no mesh can take is said once, before any mesh is loaded.
+    fresh = os.path.join(tmp, "never_written")
+    one_line(["ao", "--dir", meshes, "-o", fresh, "--rays_per_vertex", "nan"], "rays_per_vertex",
+             "a value no mesh can take")
+    check(not os.path.exists(os.path.join(fresh, "bowl.json")), "no per-mesh summary for a bad common value")
+    # A parameter file nested deeper than any of ours (it crashed the tool
+    # at 200,000 levels: nlohmann's copies recurse per level).
+    deep = os.path.join(tmp, "deep_params.json")
+    with open(deep, "w") as f:
+        f.write('{"filter": "ao", "parameters": {"rays_per_vertex": ' + "[" * 200000 + "]" * 200000 + "}}")
+    one_line(["--params", deep, "--dir", meshes, "-o", out], "nested deeper", "a parameter file nested 200,000 deep")
 
 
 CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs}
