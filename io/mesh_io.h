@@ -25,6 +25,9 @@ struct LoadedMesh {
   // records some that no longer match its faces (edited elsewhere, or
   // polygons): then the file is one layer.
   std::vector<std::pair<std::string, size_t>> layers;
+  // What the run's log should warn of: polygons no triangulation of ours
+  // could keep inside themselves.
+  std::vector<std::string> warnings;
 };
 
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure:

@@ -272,6 +272,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   in.attributes = std::move(mesh.attributes);
   in.readVertexFile = io::readVertexFile;
   FilterResult r = runFilter(d.kind, in);
+  for (const std::string& w : mesh.warnings) r.stats.warn(w);
   // The layers first: a result PLY that exists has its layers beside it. Each file is written whole or not at all.
   const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
   writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers);

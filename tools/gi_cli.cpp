@@ -276,6 +276,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     if (!writer) return 0;
     if (!damaged.empty()) r.stats.warn("the cached result could not be used, so it was computed again: " + damaged);
   }
+  for (const std::string& w : mesh.warnings) r.stats.warn(w);
   const bool caching = !reused && !cached.empty() && !r.refined && r.layers.empty();  // a cached result holds no geometry
   // The files the result names, checked as the plan was before anything is written.
   std::vector<files::Named> outputs = resultOutputs(a, r);

@@ -333,6 +333,44 @@ TEST(ScenesIo, ConcavePolygonsAreCutInsideThem) {
   }
 }
 
+// Ear clipping stops at 256 corners (its rounds are O(n^2)): a concave
+// star of 254 corners is cut inside itself, one of 258 is split as a fan
+// and the loader says so (an outside audit found a 258-corner comb's area
+// 22 times too large, a quarter of its triangles reversed, and no word).
+TEST(ScenesIo, LargeConcavePolygonsAreCutOrWarned) {
+  for (int n : {254, 258}) {
+    std::string ply = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                      "property list int int vertex_indices\nend_header\n";
+    std::string face = std::to_string(n);
+    double exact = 0;
+    std::vector<glm::dvec2> p;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2 * kPi * k / n, r = k % 2 ? 0.4 : 1.0;
+      p.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+    for (int k = 0; k < n; ++k) {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.17g %.17g 0\n", p[size_t(k)].x, p[size_t(k)].y);
+      ply += line;
+      face += " " + std::to_string(k);
+      const auto &a = p[size_t(k)], &b = p[size_t(k + 1) % p.size()];
+      exact += 0.5 * (a.x * b.y - b.x * a.y);
+    }
+    const auto m = gi::io::parseMesh(ply + face + "\n", "ply", "star.ply");
+    double area = 0;
+    for (size_t f = 0; f < m.scene.faceCount(); ++f) area += 0.5 * double(glm::length(gi::faceNormalUnnormalized(m.scene, f)));
+    if (n <= 256) {
+      EXPECT_TRUE(m.warnings.empty()) << n;
+      EXPECT_NEAR(area, exact, 1e-5 * exact) << n;
+    } else {
+      ASSERT_EQ(m.warnings.size(), 1u) << n;
+      EXPECT_NE(m.warnings[0].find("258"), std::string::npos) << m.warnings[0];
+      EXPECT_GT(area, 1.1 * exact) << "the fan covers area outside the star";
+    }
+  }
+}
+
 // Several layers keep each its own reflectance rule (an outside audit: a
 // layer without colours beside one with face colours took the filler grey,
 // not the constant; a layer's vertex colours gave way to another's face
