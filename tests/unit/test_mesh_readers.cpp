@@ -314,7 +314,17 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
   const std::string dir = tempPath("dir.ply"), empty = tempPath("empty.ply");
   fs::create_directories(dir);
   std::ofstream(empty).close();
+  // Large files of zeros (sparse: no disk space) are refused from their
+  // first bytes, before the rest is read (a 300 MB one took 503 MB).
+  const std::string zerosPly = tempPath("zeros.ply"), zerosObj = tempPath("zeros.obj"), zerosStl = tempPath("zeros.stl");
+  for (const std::string& z : {zerosPly, zerosObj, zerosStl}) {
+    std::ofstream(z).close();
+    fs::resize_file(z, size_t(1) << 30);
+  }
   for (const auto& [path, fragment] : {std::pair<std::string, std::string>{dir, "is a directory"},
+                                       {zerosPly, "not a PLY file"},
+                                       {zerosObj, "not a text file"},
+                                       {zerosStl, "does not match its 1073741824 bytes"},
                                        {empty, "empty (0 bytes)"},
                                        {tempPath("none.ply"), "no such file"},
                                        {"/dev/null", "not a regular file"}}) {
@@ -327,4 +337,5 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
   }
   fs::remove_all(dir);
   fs::remove(empty);
+  for (const std::string& z : {zerosPly, zerosObj, zerosStl}) fs::remove(z);
 }
