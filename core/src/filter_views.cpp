@@ -30,6 +30,8 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
   res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
   res.stats.add("seconds", rep.seconds);
   res.stats.note(out.summary);
+  if (const auto w = narrowPatchWarning(s, narrowPatch(s, face, sceneScale(s).rayEpsilon), "its form factors"))
+    res.stats.warn(*w);
 }
 
 // The hemicube of the chosen face as pictures; the faces take the pictures'

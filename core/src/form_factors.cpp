@@ -4,6 +4,7 @@
 #include <array>
 #include <map>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "gi/form_factor_analytic.h"
@@ -241,6 +242,33 @@ FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   }
   r.escaped = float(double(lost) / N);
   return r;
+}
+
+bool narrowPatch(const Scene& s, size_t f, double width) {
+  const auto& t = s.triangles[f];
+  const glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
+  const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+  return 2.0 * faceArea(s, f) < width * longest;
+}
+
+size_t narrowPatchCount(const Scene& s) {
+  const auto ok = usableFaceMask(s);
+  const double width = sceneScale(s).rayEpsilon;
+  size_t narrow = 0;
+  for (size_t f = 0; f < s.faceCount(); ++f) narrow += ok[f] && narrowPatch(s, f, width);
+  return narrow;
+}
+
+std::optional<std::string> narrowPatchWarning(const Scene& s, size_t narrow, const std::string& what) {
+  if (!narrow) return std::nullopt;
+  char b[480];
+  std::snprintf(b, sizeof b,
+                "%zu patch%s narrower than the ray offset (%.3g): rays from %s start within the offset of what "
+                "%s touch%s and miss its near part, so %s may read too little light there; merge such slivers into "
+                "their neighbours",
+                narrow, narrow == 1 ? " is" : "es are", sceneScale(s).rayEpsilon * s.unit,
+                narrow == 1 ? "it" : "them", narrow == 1 ? "it" : "they", narrow == 1 ? "es" : "", what.c_str());
+  return std::string(b);
 }
 
 bool pairwiseUnoccluded(const Scene& s) {

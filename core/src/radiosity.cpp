@@ -471,9 +471,12 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const FormFactors::Settings& ffs = opt.formFactors;
   if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   checkRadiosityMemory(s.faceCount(), opt);  // either solver: before any work
+  const std::optional<std::string> narrow =
+      narrowPatchWarning(s, narrowPatchCount(s), "their patch values (face output, patch averages)");
   if (usesHierarchy(s.faceCount(), opt)) {
     RadiosityResult res = solveHierarchicalRadiosity(s, caster, opt, progress);
     if (const auto w = emitterOrientationWarning(s, caster, opt.outside.any())) res.stats.warn(*w);
+    if (narrow) res.stats.warn(*narrow);
     return res;
   }
   Timer timer;
@@ -511,6 +514,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   res.stats.add("rays", double(ff.raysCast() + seen.rays));
   res.stats.add("seconds", timer.seconds());
   if (const auto w = emitterOrientationWarning(s, caster, opt.outside.any())) res.stats.warn(*w);
+  if (narrow) res.stats.warn(*narrow);
   return res;
 }
 

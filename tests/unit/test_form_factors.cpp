@@ -17,6 +17,7 @@
 #include "gi/radiosity.h"
 #include "gi/scenes.h"
 #include "form_factor_rows.h"
+#include "render_test_helpers.h"
 #include "test_helpers.h"
 
 using namespace gi;
@@ -332,4 +333,26 @@ TEST(FormFactors, AnalyticVisibilityWeighsByTheKernel) {
   std::printf("square -> long triangle: analytic %.4f (standard error %.4f), Monte Carlo %.4f (%.4f)\n", mean, sem, mc, seMc);
   EXPECT_GT(mc, 0.3);
   EXPECT_NEAR(mean, mc, 4 * std::sqrt(sem * sem + seMc * seMc));
+}
+
+// A floor strip of width w at the foot of an emitting wall (the scene's
+// diagonal 1.41, ray offset 1.41e-5): at w = 1e-5 every point of it lies
+// within the offset of the wall, and its patch value read 0.16 (Monte Carlo)
+// or 0 (analytic) of the 10.05 a strip of 2e-5 gets; the radiosity run
+// warns there and not at 2e-5 (an outside audit found no word).
+TEST(FormFactors, PatchesNarrowerThanTheRayOffsetAreWarned) {
+  for (double w : {1e-5, 2e-5}) {
+    test::SceneBuilder b;
+    b.quad({0, 0, 0}, {w, 0, 0}, {w, 1, 0}, {0, 1, 0}, glm::vec3(0.5f));  // the strip, facing +z
+    b.quad({0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}, glm::vec3(0.f), glm::vec3(10.f));  // the wall, facing +x
+    const Scene s = b.build();
+    EXPECT_EQ(narrowPatchCount(s), w < 1.4e-5 ? 2u : 0u) << w;
+    auto caster = makeEmbreeCaster(s);
+    RadiosityOptions o;
+    o.vertexOutput = RadiosityVertexOutput::PatchAverage;
+    const RadiosityResult r = solveRadiosity(s, *caster, o);
+    bool warned = false;
+    for (const std::string& m : r.stats.warnings) warned = warned || m.find("narrower than the ray offset") != std::string::npos;
+    EXPECT_EQ(warned, w < 1.4e-5) << w;
+  }
 }
