@@ -381,6 +381,16 @@ int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   if (!a.mesh.empty()) {
     diag = sceneDiagonal(io::loadMesh(a.mesh).scene);
   } else {
+    // A script stores absolute values: a share of a diagonal nobody gave
+    // would be written for a diagonal of 1 (10% became 0.1 mm on a box of
+    // 960 mm; an outside audit).
+    for (FilterKind k : kinds)
+      for (const auto& p : filterSpecs(k))
+        if (const auto it = a.raw.find(p.name);
+            p.type == ParamType::Distance && it != a.raw.end() && !it->second.empty() && it->second.back() == '%')
+          throw std::invalid_argument("--" + p.name + " " + it->second +
+                                      ": a share of the mesh's diagonal needs --mesh FILE (the script stores "
+                                      "absolute values)");
     for (FilterKind k : kinds)
       for (const auto& p : filterSpecs(k))
         if (p.type == ParamType::Distance && p.def > 0 && !a.raw.count(p.name))

@@ -196,6 +196,8 @@ CASES = [
     ("cli_save_result_no_folder", "--save-result into a missing folder", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
      ["reference", "FILE", "--save-result", "DIR/no/ref.json"], "does not exist"),
     ("cli_script_output_empty", "script -o ''", None, ["script", "ao", "-o", ""], "--output is empty"),
+    ("cli_script_share_without_mesh", "script --max_distance 10% without --mesh", None,
+     ["script", "ao", "--max_distance", "10%"], "needs --mesh"),
     ("cli_threads_negative", "--threads -1", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])}, ["ao", "FILE", "--threads", "-1"],
      "--threads"),
     ("cli_threads_zero", "--threads 0", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])}, ["ao", "FILE", "--threads", "0"],
