@@ -178,14 +178,16 @@ std::vector<ParamSpec> formFactorSpecs() {
 uint32_t chosenFace(int faceIndex, const std::vector<uint8_t>& selected, size_t faceCount) {
   if (faceIndex >= 0) {
     if (size_t(faceIndex) >= faceCount)
-      throw std::invalid_argument("face_index " + std::to_string(faceIndex) + " is beyond the " + std::to_string(faceCount) + " faces");
+      throw std::invalid_argument("face_index " + std::to_string(faceIndex) + " is beyond the " + std::to_string(faceCount) +
+                                  " triangles (a polygon counts as its triangles)");
     return uint32_t(faceIndex);
   }
   std::vector<uint32_t> sel;
   for (size_t f = 0; f < selected.size(); ++f)
     if (selected[f]) sel.push_back(uint32_t(f));
   if (sel.size() != 1)
-    throw std::invalid_argument("select exactly one face (" + std::to_string(sel.size()) + " are selected), or give face_index");
+    throw std::invalid_argument("select exactly one face (" + std::to_string(sel.size()) +
+                                " are selected; a selected polygon counts as its triangles), or give face_index");
   return sel[0];
 }
 

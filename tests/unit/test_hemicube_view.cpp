@@ -223,7 +223,7 @@ TEST(HemicubeView, RefusesNoSelectionSeveralAndBadFaces) {
   };
   FilterInput none = input(FilterKind::HemicubeOfFace, box());
   none.attrs.faceSelected.assign(none.scene.faceCount(), 0);
-  EXPECT_NE(message(none).find("select exactly one face (0 are selected)"), std::string::npos) << message(none);
+  EXPECT_NE(message(none).find("select exactly one face (0 are selected"), std::string::npos) << message(none);
   FilterInput two = none;
   two.attrs.faceSelected[3] = two.attrs.faceSelected[9] = 1;
   EXPECT_NE(message(two).find("(2 are selected)"), std::string::npos) << message(two);
