@@ -5,6 +5,7 @@
 #include <cfloat>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace gi::io::detail {
@@ -78,6 +79,12 @@ void checkPolygons(const Polygons& p, const std::string& name) {
     if (const uint32_t twice = repeatedIndex(face); twice != kNone)
       failRead(name, "face " + std::to_string(f) + " lists vertex " + std::to_string(twice) + " twice");
   }
+}
+
+std::string shortNumber(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
 }
 
 std::string quoted(std::string_view text) {

@@ -63,6 +63,8 @@ void checkPolygons(const Polygons& p, const std::string& name);
 // One "a b c" text in quotes for a message: control bytes shown as \xNN,
 // at most 60 characters.
 std::string quoted(std::string_view text);
+// A number for a message, as %g writes it (300, 0.5, 1e+30).
+std::string shortNumber(double v);
 
 // The readers (each in its own file). Every one throws std::runtime_error
 // with one sentence naming `name` on any defect.

@@ -293,8 +293,14 @@ struct BinarySource {
   bool finished() const { return pos == b.size(); }
 };
 
-uint8_t colourByte(Type t, double v) {
+// A colour channel as a byte: integers 0..255, floats 0..1; a value outside
+// (by more than rounding) is refused, as the OBJ reader refuses it (an int
+// 300 or a float 255 was clamped without a word; an outside audit).
+uint8_t colourByte(Type t, double v, const std::string& name, const std::string& where, const std::string& channel) {
   const double c = isInteger(t) ? v : v * 255.0;
+  if (!(c >= -0.5 && c < 255.5))
+    failRead(name, where + ": colour '" + channel + "' is " + shortNumber(v) + ", outside " +
+                       (isInteger(t) ? "0..255 (an integer colour)" : "0..1 (a floating-point colour)"));
   return uint8_t(std::clamp(std::lround(c), 0L, 255L));
 }
 
@@ -395,9 +401,9 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
           case Role::NX: if (normals) out.normals[k].x = float(v); break;
           case Role::NY: if (normals) out.normals[k].y = float(v); break;
           case Role::NZ: if (normals) out.normals[k].z = float(v); break;
-          case Role::R: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].r = colourByte(p.type, v); break;
-          case Role::G: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].g = colourByte(p.type, v); break;
-          case Role::B: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].b = colourByte(p.type, v); break;
+          case Role::R: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].r = colourByte(p.type, v, name, what(), p.name); break;
+          case Role::G: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].g = colourByte(p.type, v, name, what(), p.name); break;
+          case Role::B: if (colours) (isVertex ? out.vertexColor : out.faceColor)[k].b = colourByte(p.type, v, name, what(), p.name); break;
           case Role::Quality: out.faceQuality[k] = float(v); break;
           case Role::Flags: (isVertex ? out.vertexSelected : out.faceSelected)[k] = (int64_t(v) & 0x20) ? 1 : 0; break;
           default: break;

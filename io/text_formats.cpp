@@ -65,8 +65,11 @@ std::string_view restOfLine(std::string_view line, std::string_view keyword) {
   return m.substr(0, m.find_last_not_of(" \t") + 1);
 }
 
-// OFF colours: 3 or 4 numbers, 0..255 integers or 0..1 floats.
-bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3& c) {
+// OFF colours: 3 or 4 numbers, 0..255 integers or 0..1 floats, decided per
+// colour as Geomview's OFF specification has it ('1 1 1' is 1/255, '1.0 1.0
+// 1.0' is 1). A number outside its range is refused (it was clamped without
+// a word; an outside audit), as the OBJ and PLY readers refuse it.
+bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3& c, std::string& outside) {
   const size_t n = w.size() - first;
   if (n != 3 && n != 4) return false;
   const bool isFloat = std::any_of(w.begin() + long(first), w.begin() + long(first) + 3,
@@ -74,7 +77,13 @@ bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3
   for (int k = 0; k < 3; ++k) {
     double v = 0;
     if (!parseDouble(w[first + size_t(k)], v)) return false;
-    c[k] = uint8_t(std::clamp(isFloat ? std::lround(v * 255.0) : std::lround(v), 0L, 255L));
+    const double b = isFloat ? v * 255.0 : v;
+    if (!(b >= -0.5 && b < 255.5)) {
+      outside = "a colour channel of " + shortNumber(v) + ", outside " +
+                (isFloat ? "0..1 (a colour written with a point)" : "0..255 (an integer colour)");
+      return false;
+    }
+    c[k] = uint8_t(std::clamp(std::lround(b), 0L, 255L));
   }
   return true;
 }
@@ -118,7 +127,9 @@ Polygons readOff(std::string_view bytes, const std::string& name) {
     p.points.push_back({x[0], x[1], x[2]});
     if (hasN) p.normals.push_back({float(x[3]), float(x[4]), float(x[5])});
     glm::u8vec3 c(255);
-    if (hasC && !offColour(w, want, c)) failRead(name, in.at() + ": vertex " + std::to_string(i) + " has no valid colour");
+    std::string outside;
+    if (hasC && !offColour(w, want, c, outside))
+      failRead(name, in.at() + ": vertex " + std::to_string(i) + (outside.empty() ? " has no valid colour" : " has " + outside));
     if (hasC) p.vertexColor.push_back(c);
   }
   bool faceColours = true;
@@ -142,8 +153,10 @@ Polygons readOff(std::string_view bytes, const std::string& name) {
     p.index.insert(p.index.end(), face.begin(), face.end());
     p.faceStart.push_back(uint32_t(p.index.size()));
     glm::u8vec3 c(255);
+    std::string outside;
     if (w.size() == size_t(n) + 1) faceColours = false;
-    else if (!offColour(w, size_t(n) + 1, c)) failRead(name, in.at() + ": face " + std::to_string(f) + " has a malformed colour");
+    else if (!offColour(w, size_t(n) + 1, c, outside))
+      failRead(name, in.at() + ": face " + std::to_string(f) + (outside.empty() ? " has a malformed colour" : " has " + outside));
     p.faceColor.push_back(c);
   }
   if (!faceColours) p.faceColor.clear();  // only when every face has one

@@ -14,6 +14,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -338,4 +339,40 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
   fs::remove_all(dir);
   fs::remove(empty);
   for (const std::string& z : {zerosPly, zerosObj, zerosStl}) fs::remove(z);
+}
+
+// Colours outside their range are refused in PLY and OFF (as in OBJ)
+// rather than clamped (an int 300 or a float 128 came in as 255 without a
+// word; an outside audit). OFF decides integer or float per colour, as
+// Geomview's specification has it: '1 1 1' is 1/255, '1.0 1.0 1.0' is 1.
+TEST(MeshReaders, ColoursOutsideTheirRangeAreRefused) {
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  for (const auto& [props, values, fragment] :
+       {std::tuple<std::string, std::string, std::string>{"property int red\nproperty int green\nproperty int blue\n",
+                                                          "300 0 0", "'red' is 300, outside 0..255"},
+        {"property float red\nproperty float green\nproperty float blue\n", "0.5 128 0", "'green' is 128, outside 0..1"},
+        {"property int red\nproperty int green\nproperty int blue\n", "0 -20 0", "'green' is -20"}}) {
+    const std::string ply = head + props + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 " + values + "\n";
+    try {
+      gi::io::parseMesh(ply, "ply", "c.ply");
+      ADD_FAILURE() << values;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  }
+  const std::string ok = head + "property float red\nproperty float green\nproperty float blue\nend_header\n"
+                         "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1 0.5 0\n";
+  EXPECT_EQ(gi::io::parseMesh(ok, "ply", "c.ply").attrs.faceColor[0], glm::u8vec3(255, 128, 0));
+  const auto off = gi::io::parseMesh("COFF\n3 1 0\n0 0 0 0.5 0.5 0.5\n1 0 0 1 1 1\n0 1 0 0.25 0 1.0\n3 0 1 2\n", "off", "c.off");
+  ASSERT_EQ(off.attrs.vertexColor.size(), 3u);
+  EXPECT_EQ(off.attrs.vertexColor[1], glm::u8vec3(1, 1, 1));
+  EXPECT_EQ(off.attrs.vertexColor[2], glm::u8vec3(64, 0, 255));
+  try {
+    gi::io::parseMesh("COFF\n3 1 0\n0 0 0 0.5 0 0\n1 0 0 2.0 0 0\n0 1 0 0 0 1\n3 0 1 2\n", "off", "f.off");
+    ADD_FAILURE() << "a float colour of 2";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 1 has a colour channel of 2, outside 0..1"), std::string::npos)
+        << e.what();
+  }
 }
