@@ -59,11 +59,25 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     if (g.A[f] > 0) rhoMax = std::max({rhoMax, double(rho.r), double(rho.g), double(rho.b)});
     S[f] = g.A[f] > 0 ? rho * Hd[f] : glm::vec3(0.f);
   }
+  // The seen share of each triangle (1 where none is given), its seen area,
+  // and the direct light of its seen part.
+  const bool partSeen = !set.seen.empty();
+  if (partSeen && set.seen.size() != nf) throw std::logic_error("seen shares: one per triangle");
+  auto seenShare = [&](size_t f) { return partSeen ? double(set.seen[f]) : 1.0; };
+  if (partSeen)
+    for (size_t f = 0; f < nf; ++f) S[f] = seenShare(f) > 0 ? S[f] / float(seenShare(f)) : glm::vec3(0.f);
   P += set.enteringPower;
   HierarchicalSolution sol;
   progress.report(0.0, "cluster tree");  // serial stages: named, so a long one shows what runs
   const Tree t = buildTree(g);
   const size_t nn = t.nodes.size();
+  // Per node, the seen area under it and its share of the node's area.
+  std::vector<double> seenA(nn, 0.0), seenOf(nn, 1.0);
+  for (size_t k = nn; k-- > 0;) {
+    const Node& nd = t.nodes[k];
+    seenA[k] = nd.leaf() ? g.A[t.order[nd.first]] * seenShare(t.order[nd.first]) : seenA[nd.left] + seenA[nd.right];
+    seenOf[k] = nd.A > 0 ? seenA[k] / nd.A : 1.0;
+  }
   sol.R = S;
   sol.H.assign(nf, glm::vec3(0.f));
   if (nn == 0 || !(P > 0)) return sol;
@@ -123,8 +137,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
         Rbar[k] = glm::dvec3(R[f]);
         Rmax[k] = luminance(R[f]);
       } else {
-        const Node &l = t.nodes[nd.left], &r = t.nodes[nd.right];
-        Rbar[k] = (l.A * Rbar[nd.left] + r.A * Rbar[nd.right]) / nd.A;
+        // The mean over the seen part (rays from a receiver land there).
+        Rbar[k] = seenA[k] > 0 ? (seenA[nd.left] * Rbar[nd.left] + seenA[nd.right] * Rbar[nd.right]) / seenA[k]
+                               : glm::dvec3(0.0);
         Rmax[k] = std::max(Rmax[nd.left], Rmax[nd.right]);
       }
     }
@@ -141,7 +156,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     // Power relative to all the light leaving surfaces (emitted and reflected:
     // in a bright room the reflected power is many times the emitted).
     double leaving = P;
-    for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * luminance(Rcur[f]);
+    for (size_t f = 0; f < nf; ++f) leaving += g.A[f] * seenShare(f) * luminance(Rcur[f]);
     Refiner ref{g, t, Rmax, set.epsilon * leaving, maxLinks, next, &nextFresh, unoccluded ? nullptr : &probe};
     pr.report(0.0, "refining links");
     Timer rt;
@@ -231,7 +246,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
             h += double(l.F) * r;
           }
         }
-        Hg[k] = h;
+        // A link's factor is a mean over the whole receiver, whose buried
+        // points it never reaches: what it brings falls on the seen part.
+        Hg[k] = seenOf[k] > 0 ? h / seenOf[k] : glm::dvec3(0.0);
       }
     });
     for (size_t k = 0; k < nn; ++k) {  // preorder: parents first
@@ -331,7 +348,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
       double change = 0;
       for (size_t f = 0; f < nf; ++f) {
         Rn[f] = g.A[f] > 0 ? S[f] + s.faceRho(f) * H[f] : glm::vec3(0.f);
-        change += g.A[f] * std::fabs(luminance(Rn[f] - sol.R[f]));
+        change += g.A[f] * seenShare(f) * std::fabs(luminance(Rn[f] - sol.R[f]));
       }
       sol.R.swap(Rn);
       sol.residual = change / P;
@@ -394,9 +411,12 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   double absorbed = 0, reflected = 0, escaped = P;
   for (size_t f = 0; f < nf; ++f) {
     if (!(g.A[f] > 0)) continue;
-    absorbed += g.A[f] * luminance((glm::vec3(1.f) - s.faceRho(f)) * (Hd[f] + sol.H[f]));
-    reflected += g.A[f] * luminance(sol.R[f]);
-    escaped += g.A[f] * (luminance(sol.R[f]) * (1.0 - double(closure[f])) - luminance(Hd[f]));
+    const double As = g.A[f] * seenShare(f);  // the seen part's (Hd is the whole triangle's mean)
+    absorbed += luminance((glm::vec3(1.f) - s.faceRho(f)) * (float(g.A[f]) * Hd[f] + float(As) * sol.H[f]));
+    reflected += As * luminance(sol.R[f]);
+    // The closure rays from buried points met back faces: G of the seen part.
+    const double G = seenShare(f) > 0 ? std::min(1.0, double(closure[f]) / seenShare(f)) : 1.0;
+    escaped += As * luminance(sol.R[f]) * (1.0 - G) - g.A[f] * luminance(Hd[f]);
   }
   size_t leafLinks = 0;
   for (const Link& l : links) leafLinks += (t.nodes[l.p].leaf() && t.nodes[l.q].leaf()) ? 1 : 0;

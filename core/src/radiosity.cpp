@@ -301,7 +301,7 @@ void useSeenParts(const PatchSeen& seen, Setup& u, FormFactors& ff) {
   ff.useSeenParts(seen.fraction);
 }
 
-void reportSeenParts(const PatchSeen& seen, const FormFactors& ff, RunStats& st) {
+void reportSeenParts(const PatchSeen& seen, RunStats& st, const FormFactors* ff = nullptr) {
   st.add("seen_part_rays", double(seen.rays));
   if (!seen.any()) return;
   st.add("patches_partly_buried", double(seen.partial));
@@ -311,7 +311,7 @@ void reportSeenParts(const PatchSeen& seen, const FormFactors& ff, RunStats& st)
                 "%zu patches partly and %zu wholly buried under other surfaces (%.2g%% of the surface, where no ray "
                 "can reach): their radiosity is that of the part the scene sees%s",
                 seen.partial, seen.buried, 100.0 * seen.buriedArea / seen.area,
-                ff.method() == FormFactorMethod::Hemicube && ff.hemicubePoints() <= 1
+                ff && ff->method() == FormFactorMethod::Hemicube && ff->hemicubePoints() <= 1
                     ? " (direct light; a hemicube at the centre gives the centre's row)"
                     : "");
   st.note(b);
@@ -390,6 +390,10 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (opt.maxLinks > 0) hs.maxLinks = opt.maxLinks;
   hs.enteringPower = u.Pout;
   hs.seed = opt.formFactors.seed;
+  Timer seenTimer;
+  const PatchSeen seen = patchSeenFractions(s, caster, opt.formFactors.seed);
+  if (seen.any()) hs.seen = seen.fraction;
+  const double seenSeconds = seenTimer.seconds();
   // Progress: direct light 0-20%, the hierarchy to 70% (to 100% without per-vertex values), the vertices after.
   const bool vertices = opt.vertexOutput != RadiosityVertexOutput::PatchAverage;
   HierarchicalSolution h = solveHierarchical(s, caster, u.Hd, hs, opt.bounces, opt.tolerance, opt.maxIterations,
@@ -415,10 +419,18 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   if (opt.hierarchyEpsilon == 0 && n > 20000)
     res.stats.warn("hierarchy_epsilon = 0 links every pair of the " + std::to_string(n) +
                    " patches (the flat solution at quadratic cost); 1e-4 is the default");
-  if (vertices) radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &direct.openings);
-  else res.Bdirect = patchAverageDirect(s, u.E, u.rho, u.Hd);
+  if (vertices) {
+    radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &direct.openings);
+  } else {
+    std::vector<glm::vec3> Hd = u.Hd;  // of the seen parts, as B
+    for (size_t i = 0; i < Hd.size() && seen.any(); ++i) Hd[i] = seen.fraction[i] > 0 ? Hd[i] / seen.fraction[i] : glm::vec3(0.f);
+    res.Bdirect = patchAverageDirect(s, u.E, u.rho, Hd);
+  }
   direct.report(opt, res.stats);
   res.stats.add("patches", double(u.n));
+  reportSeenParts(seen, res.stats);
+  res.stats.add("seen_part_seconds", seenSeconds);
+  if (seen.any()) res.seenShare = seen.fraction;
   res.stats.add("memory_estimate_MB", double(n) * kSolverBytesPerPatch / 1048576.0 + res.stats.get("hierarchy_MB", 0.0));
   res.stats.add("seconds", timer.seconds());
   return res;
@@ -506,7 +518,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
     res.stats.note(std::to_string(ff.farPairsByOnePoint()) +
                    " far pairs (F < 1e-7 proved by distance) by one point and one ray each, not refined");
   res.stats.add("patches", double(u.n));
-  reportSeenParts(seen, ff, res.stats);
+  reportSeenParts(seen, res.stats, &ff);
   res.stats.add("seen_part_seconds", seenSeconds);
   if (seen.any()) res.seenShare = seen.fraction;
   if (slow) res.stats.warn(*slow);

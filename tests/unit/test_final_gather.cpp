@@ -106,12 +106,11 @@ void expectWithinTheReference(const EdgeError& e, double bias = 0) {
 // at each edge vertex (about 1.2% standard error each). d = (B - ref) / ref
 // per vertex; its mean must lie within 4 standard errors of the mean (from
 // the spread of d itself, which holds both noises) of 0 and below 1%, and
-// its RMS below 2.5%. Measured: flat mean +0.09% (standard error
-// 0.11%), RMS 1.5%; hierarchical -0.79% (0.12%), RMS 1.7%, which is allowed
-// 0.5% besides: the floor's patches partly under the blocks send the light
-// of their whole area's mean, not of the part the scene sees (the flat
-// solvers' seen parts, test_patch_seen.cpp; before them the flat mean was
-// -0.42%). Reading the patch means at every near hit: flat +3.1% (7.8
+// its RMS below 2.5%. Measured: flat mean +0.08% (standard error 0.11%),
+// RMS 1.4%; hierarchical -0.34% (0.11%), RMS 1.5%, which is allowed 0.5%
+// besides (README, Limitations). Before the solvers worked with the seen
+// parts of the floor's patches under the blocks (test_patch_seen.cpp):
+// flat -0.42%, hierarchical -0.79%. Reading the patch means at every near hit: flat +3.1% (7.8
 // standard errors), RMS 6.0%; hierarchical +3.4%, RMS 6.8%: the test fails.
 TEST(FinalGather, RoomEdgeVerticesMatchTheReference) {
   auto sf = scenes::cornellBox(50.0);

@@ -70,6 +70,11 @@ struct HierarchySettings {
   int closureRays = 64;       // rays per triangle counting what its row sums to (0: no closure, no energy balance;
                               // with occluders at most 8M in all, at least 4 a triangle: the energy account alone)
   uint32_t seed = 0;          // of those rays
+  // Per triangle, the share of its area the scene sees (gi/patch_seen.h);
+  // empty: all of every triangle. The solution is then the radiosity of
+  // the seen parts: a node's gathered light is spread over its seen part
+  // and a source's mean taken over its seen part.
+  std::vector<float> seen;
 };
 
 struct HierarchicalSolution {
