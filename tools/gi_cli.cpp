@@ -474,6 +474,13 @@ int runCli(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return cluster::rank() == 0 ? app.exit(e) : 0;  // --help: the help text, exit 0
+    // A first word that is no subcommand: say which (CLI11 says only that one is required).
+    if (argc > 1 && argv[1][0] != '-' && app.get_subcommands([&](CLI::App* c) { return c->check_name(argv[1]); }).empty()) {
+      std::string names;
+      for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; }))
+        names += (names.empty() ? "" : ", ") + c->get_name();
+      return cluster::abandon() ? failOneLine(std::string("unknown subcommand '") + argv[1] + "' (" + names + ")") : 1;
+    }
     return cluster::abandon() ? failOneLine(e.what()) : 1;
   }
   try {

@@ -198,6 +198,7 @@ CASES = [
     ("cli_script_output_empty", "script -o ''", None, ["script", "ao", "-o", ""], "--output is empty"),
     ("cli_script_share_without_mesh", "script --max_distance 10% without --mesh", None,
      ["script", "ao", "--max_distance", "10%"], "needs --mesh"),
+    ("cli_unknown_subcommand", "a first word that is no subcommand", None, ["nosuch"], "unknown subcommand 'nosuch'"),
     ("cli_ff_table_extreme_ratio", "formfactors-table of a strip 1e-20 wide", None,
      ["formfactors-table", "--perpendicular", "1e-20,1,1"], "more than 1e4 apart"),
     ("cli_ff_table_huge_length", "formfactors-table of 1e30", None,
