@@ -73,7 +73,7 @@ TEST(PatchSeen, WhollyBuriedAndOpenScenes) {
 }
 
 // The Cornell box's floor is cut into 50 mm patches without regard to the
-// blocks standing on it: 43 triangles partly under them, 22 wholly. Read at their whole
+// blocks standing on it: 42 triangles partly under them, 23 wholly. Read at their whole
 // area's mean, they sent too little light, and the converged final gather's
 // vertices came out dark everywhere: against the reference (8,192 paths at
 // every vertex), by -0.60% (standard error 0.07%) at the vertices off the

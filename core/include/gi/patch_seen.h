@@ -35,8 +35,8 @@
 namespace gi {
 
 struct PatchSeen {
-  static constexpr int kScreenPoints = 16;   // points tried on every patch
-  static constexpr int kPoints = 64;         // on a patch where one of them was buried
+  static constexpr int kScreenPoints = 16;   // points tried on every patch (all buried: the patch is)
+  static constexpr int kPoints = 64;         // on a patch where some of them were buried
   static constexpr int kRaysPerPoint = 32;   // at most, per point
   std::vector<float> fraction;  // per face: the share of its area seen (1 for emitters and unusable faces)
   size_t partial = 0;           // patches with 0 < share < 1
