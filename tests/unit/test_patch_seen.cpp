@@ -73,9 +73,9 @@ TEST(PatchSeen, WhollyBuriedAndOpenScenes) {
 }
 
 // The Cornell box's floor is cut into 50 mm patches without regard to the
-// blocks standing on it: 42 triangles partly under them, 23 wholly. Read at their whole
-// area's mean, they sent too little light, and the converged final gather's
-// vertices came out dark everywhere: against the reference (8,192 paths at
+// blocks standing on it: 42 triangles partly under them, 23 wholly. Read
+// at their whole area's mean, they sent too little light, and the
+// converged final gather's vertices came out dark everywhere: against the reference (8,192 paths at
 // every vertex), by -0.60% (standard error 0.07%) at the vertices off the
 // room's walls (the blocks, the light's rim), -0.46% (0.05%) on the walls
 // and -0.42% (0.12%) on the room's edges, halving with the patch size
