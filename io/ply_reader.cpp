@@ -297,7 +297,9 @@ struct BinarySource {
 // (by more than rounding) is refused, as the OBJ reader refuses it (an int
 // 300 or a float 255 was clamped without a word; an outside audit).
 uint8_t colourByte(Type t, double v, const std::string& name, const std::string& where, const std::string& channel) {
-  const double c = isInteger(t) ? v : v * 255.0;
+  // 16-bit colours (ushort, as some scanners write them) are 0..65535.
+  const bool wide = t == Type::U16;
+  const double c = wide ? v / 257.0 : isInteger(t) ? v : v * 255.0;
   if (!(c >= -0.5 && c < 255.5))
     failRead(name, where + ": colour '" + channel + "' is " + shortNumber(v) + ", outside " +
                        (isInteger(t) ? "0..255 (an integer colour)" : "0..1 (a floating-point colour)"));

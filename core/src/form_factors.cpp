@@ -69,12 +69,22 @@ namespace {
 // The row of the seen share a of a patch: its buried points' rays met back
 // faces only, so the mean over the seen points is F / a; capped where the
 // row would sum above 1 (a share estimated a little low must not create
-// light). escaped stays 1 - the row's sum, as each method defines it.
-FormFactorRow seenPart(FormFactorRow r, float a) {
-  if (!(a > 0.f)) return FormFactorRow{{}, {}, 1.f};
+// light). Entries to patches taken as wholly buried (their screening points
+// all buried: a sliver of under 1/16 may still be seen, and rays land
+// there) are dropped, as light that leaves: such a patch has no area to
+// receive it (a division by that area gave NaN; an outside review).
+// escaped stays 1 - the row's sum, as each method defines it.
+FormFactorRow seenPart(FormFactorRow r, const std::vector<float>& seen, uint32_t i, bool pointRow) {
+  const float a = pointRow ? 1.f : seen[i];  // one hemicube at the centre: that point's row
+  if (!(seen[i] > 0.f)) return FormFactorRow{{}, {}, 1.f};
+  size_t kept = 0;
+  for (size_t k = 0; k < r.j.size(); ++k)
+    if (seen[r.j[k]] > 0.f) r.j[kept] = r.j[k], r.F[kept++] = r.F[k];
+  r.j.resize(kept);
+  r.F.resize(kept);
   double sum = 0;
   for (float f : r.F) sum += f;
-  const double g = sum * a > 1.0 ? 1.0 / sum : 1.0 / a;
+  const double g = a >= 1.f ? 1.0 : sum * a > 1.0 ? 1.0 / sum : 1.0 / a;
   for (float& f : r.F) f = float(f * g);
   r.escaped = float(std::clamp(1.0 - sum * g, 0.0, 1.0));
   return r;
@@ -84,7 +94,6 @@ FormFactorRow seenPart(FormFactorRow r, float a) {
 
 void FormFactors::useSeenParts(std::vector<float> a) {
   if (a.size() != area_.size()) throw std::logic_error("seen parts: one share per patch");
-  if (set_.method == FormFactorMethod::Hemicube && set_.hemicubePoints <= 1) return;
   seen_ = std::move(a);
 }
 
@@ -96,7 +105,9 @@ FormFactorRow FormFactors::row(uint32_t i) const {
     case FormFactorMethod::Hemicube: r = hemicubeRow(i); break;
     default: r = monteCarloRow(i); break;
   }
-  return seen_.empty() || seen_[i] >= 1.f ? r : seenPart(std::move(r), seen_[i]);
+  return seen_.empty() ? r
+                       : seenPart(std::move(r), seen_, i,
+                                  set_.method == FormFactorMethod::Hemicube && set_.hemicubePoints <= 1);
 }
 
 FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,

@@ -254,7 +254,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     for (size_t k = 0; k < nn; ++k) {  // preorder: parents first
       const Node& nd = t.nodes[k];
       Hacc[k] = Hg[k] + (k ? Hacc[nd.parent] : glm::dvec3(0.0));
-      if (nd.leaf()) H[t.order[nd.first]] = glm::vec3(closedRoom ? Hacc[k] * rowScale[t.order[nd.first]] : Hacc[k]);
+      if (nd.leaf())  // a triangle taken as wholly buried receives nothing (as in the flat solvers)
+        H[t.order[nd.first]] = seenShare(t.order[nd.first]) > 0
+                                   ? glm::vec3(closedRoom ? Hacc[k] * rowScale[t.order[nd.first]] : Hacc[k])
+                                   : glm::vec3(0.f);
     }
   };
   // The links closed (gi/hierarchical.h) in a closed room without

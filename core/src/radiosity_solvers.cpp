@@ -188,7 +188,7 @@ void progressiveRefinement(const Setup& u, const RowFn& row, bool transpose, con
       const FormFactorRow& r = row(uint32_t(i));
       for (size_t k = 0; k < r.j.size(); ++k) {
         const uint32_t j = r.j[k];
-        if (u.rho[j] == glm::vec3(0.f)) continue;  // black receivers reflect nothing
+        if (u.rho[j] == glm::vec3(0.f) || !(u.A[j] > 0)) continue;  // black receivers reflect nothing
         receive(j, glm::dvec3(u.rho[j]) * shoot * (double(r.F[k]) * u.A[i] / u.A[j]));
       }
     }

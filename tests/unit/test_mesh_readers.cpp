@@ -339,6 +339,14 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
   fs::remove_all(dir);
   fs::remove(empty);
   for (const std::string& z : {zerosPly, zerosObj, zerosStl}) fs::remove(z);
+  // An ASCII STL whose 'solid' lies past the first 4 KiB is the reader's to
+  // judge (5,000 blank lines first were refused; an outside review).
+  const std::string late = tempPath("late.stl");
+  std::ofstream(late) << std::string(5000, '\n')
+                      << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                         "endloop\nendfacet\nendsolid t\n";
+  EXPECT_EQ(gi::io::loadMesh(late).scene.faceCount(), 1u);
+  fs::remove(late);
 }
 
 // Colours outside their range are refused in PLY and OFF (as in OBJ)
@@ -364,6 +372,10 @@ TEST(MeshReaders, ColoursOutsideTheirRangeAreRefused) {
   const std::string ok = head + "property float red\nproperty float green\nproperty float blue\nend_header\n"
                          "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1 0.5 0\n";
   EXPECT_EQ(gi::io::parseMesh(ok, "ply", "c.ply").attrs.faceColor[0], glm::u8vec3(255, 128, 0));
+  // 16-bit colours (ushort) are 0..65535.
+  const std::string wide = head + "property ushort red\nproperty ushort green\nproperty ushort blue\nend_header\n"
+                           "0 0 0\n1 0 0\n0 1 0\n3 0 1 2 65535 32896 0\n";
+  EXPECT_EQ(gi::io::parseMesh(wide, "ply", "w.ply").attrs.faceColor[0], glm::u8vec3(255, 128, 0));
   const auto off = gi::io::parseMesh("COFF\n3 1 0\n0 0 0 0.5 0.5 0.5\n1 0 0 1 1 1\n0 1 0 0.25 0 1.0\n3 0 1 2\n", "off", "c.off");
   ASSERT_EQ(off.attrs.vertexColor.size(), 3u);
   EXPECT_EQ(off.attrs.vertexColor[1], glm::u8vec3(1, 1, 1));

@@ -93,7 +93,8 @@ class FormFactors {
   FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
   // From now on row(i) is the row of the seen part of patch i, a share
   // a[i] of its area (gi/patch_seen.h): F_ij / a_i, the row summing to at
-  // most 1. Not for one hemicube at the centre, which is a point's row.
+  // most 1 (one hemicube at the centre keeps its point's row), without the
+  // patches of share 0 (light landing there leaves).
   void useSeenParts(std::vector<float> a);
   size_t patchCount() const { return area_.size(); }
   double area(uint32_t i) const { return area_[i]; }
