@@ -34,7 +34,7 @@ bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::v
 }  // namespace
 
 PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t seed,
-                             const Progress& progress) {
+                             const std::vector<glm::vec3>* direct, const Progress& progress) {
   const size_t n = s.faceCount();
   const auto ok = usableFaceMask(s);
   const float eps = float(sceneScale(s).rayEpsilon);
@@ -57,7 +57,8 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
       // Every screening point buried: the patch is taken as wholly buried
       // (a seen part under 1/16 of it goes with it), which spares a large
       // mesh's hidden inner faces the 64 points of 32 rays each.
-      if (buried == PatchSeen::kScreenPoints) {
+      const bool lit = direct && (*direct)[i] != glm::vec3(0.f);
+      if (buried == PatchSeen::kScreenPoints && !lit) {
         out.fraction[i] = 0.f;
         continue;
       }

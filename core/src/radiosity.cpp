@@ -391,7 +391,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   hs.enteringPower = u.Pout;
   hs.seed = opt.formFactors.seed;
   Timer seenTimer;
-  const PatchSeen seen = patchSeenFractions(s, caster, opt.formFactors.seed);
+  const PatchSeen seen = patchSeenFractions(s, caster, opt.formFactors.seed, &u.Hd);
   if (seen.any()) hs.seen = seen.fraction;
   const double seenSeconds = seenTimer.seconds();
   // Progress: direct light 0-20%, the hierarchy to 70% (to 100% without per-vertex values), the vertices after.
@@ -496,7 +496,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   const MemoryPlan mem = planMemory(s.faceCount(), ff, opt);  // refuses before the work if nothing fits
   DirectSetup direct = directSetup(s, caster, opt, ffs.seed, progress.sub(0.0, 0.05), progress.sub(0.05, 0.1));
   Timer seenTimer;
-  const PatchSeen seen = patchSeenFractions(s, caster, ffs.seed);
+  const PatchSeen seen = patchSeenFractions(s, caster, ffs.seed, &direct.u.Hd);
   useSeenParts(seen, direct.u, ff);
   const double seenSeconds = seenTimer.seconds();
   const Setup& u = direct.u;

@@ -48,7 +48,10 @@ struct PatchSeen {
 };
 
 // Every usable, non-emitting face. Deterministic per (face, seed).
+// `direct` (optional, per face): a face with direct light has a seen part,
+// so it is never taken as wholly buried from its screening points alone.
 PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t seed,
+                             const std::vector<glm::vec3>* direct = nullptr,
                              const Progress& progress = Progress(nullptr));
 
 }  // namespace gi
