@@ -423,7 +423,8 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
     radiosityVertexValues(s, caster, opt, res, progress.sub(0.7, 1.0), &direct.openings);
   } else {
     std::vector<glm::vec3> Hd = u.Hd;  // of the seen parts, as B
-    for (size_t i = 0; i < Hd.size() && seen.any(); ++i) Hd[i] = seen.fraction[i] > 0 ? Hd[i] / seen.fraction[i] : glm::vec3(0.f);
+    for (size_t i = 0; i < Hd.size() && seen.any(); ++i)
+      Hd[i] = seen.fraction[i] > 0 ? Hd[i] / seen.fraction[i] : glm::vec3(0.f);
     res.Bdirect = patchAverageDirect(s, u.E, u.rho, Hd);
   }
   direct.report(opt, res.stats);
