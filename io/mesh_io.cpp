@@ -358,10 +358,7 @@ void checkHead(std::string_view head, const std::string& ext, uintmax_t size, co
     const bool undecided = head.size() < size && (start == std::string_view::npos || start + 5 > head.size());
     const bool ascii = undecided || (start != std::string_view::npos && head.substr(start, 5) == "solid");
     if (!ascii && !(size >= 84 && size == 84 + 50 * uintmax_t(n)))
-      failRead(name, size < 84 ? "not an STL file (too short for a binary STL, and no 'solid' line)"
-                               : "a binary STL whose triangle count (" + std::to_string(n) + ", so " +
-                                     std::to_string(84 + 50 * uint64_t(n)) + " bytes) does not match its " +
-                                     std::to_string(size) + " bytes, and not an ASCII STL ('solid')");
+      failRead(name, detail::notAnStl(n, size));
   } else if (const size_t nul = head.find('\0'); nul != std::string_view::npos) {  // OBJ, OFF: text
     failRead(name, "not a text file (a zero byte at offset " + std::to_string(nul) + ")");
   }

@@ -87,6 +87,19 @@ std::string shortNumber(double v) {
   return b;
 }
 
+bool colourChannel(double scaled, uint8_t& byte) {
+  if (!(scaled >= -0.5 && scaled < 255.5)) return false;
+  byte = uint8_t(std::clamp(std::lround(scaled), 0L, 255L));
+  return true;
+}
+
+std::string notAnStl(uint32_t n, uint64_t size) {
+  return size < 84 ? "not an STL file (too short for a binary STL, and no 'solid' line)"
+                   : "a binary STL whose triangle count (" + std::to_string(n) + ", so " +
+                         std::to_string(84 + 50 * uint64_t(n)) + " bytes) does not match its " +
+                         std::to_string(size) + " bytes, and not an ASCII STL ('solid')";
+}
+
 std::string quoted(std::string_view text) {
   std::string s = "'";
   for (size_t i = 0; i < text.size() && i < 60; ++i) {

@@ -65,6 +65,13 @@ void checkPolygons(const Polygons& p, const std::string& name);
 std::string quoted(std::string_view text);
 // A number for a message, as %g writes it (300, 0.5, 1e+30).
 std::string shortNumber(double v);
+// A colour channel already on the 0..255 scale as a byte; false where it
+// lies outside by more than rounding (the readers refuse it, not clamp it).
+bool colourChannel(double scaled, uint8_t& byte);
+// Why a file of `size` bytes is neither a binary STL (its count says n
+// triangles) nor an ASCII one: the same sentence from the first bytes and
+// from the whole file.
+std::string notAnStl(uint32_t n, uint64_t size);
 
 // The readers (each in its own file). Every one throws std::runtime_error
 // with one sentence naming `name` on any defect.

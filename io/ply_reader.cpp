@@ -300,10 +300,11 @@ uint8_t colourByte(Type t, double v, const std::string& name, const std::string&
   // 16-bit colours (ushort, as some scanners write them) are 0..65535.
   const bool wide = t == Type::U16;
   const double c = wide ? v / 257.0 : isInteger(t) ? v : v * 255.0;
-  if (!(c >= -0.5 && c < 255.5))
+  uint8_t byte = 0;
+  if (!colourChannel(c, byte))
     failRead(name, where + ": colour '" + channel + "' is " + shortNumber(v) + ", outside " +
                        (isInteger(t) ? "0..255 (an integer colour)" : "0..1 (a floating-point colour)"));
-  return uint8_t(std::clamp(std::lround(c), 0L, 255L));
+  return byte;
 }
 
 // The least number of body bytes one element of e takes.

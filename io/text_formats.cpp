@@ -77,13 +77,11 @@ bool offColour(const std::vector<std::string_view>& w, size_t first, glm::u8vec3
   for (int k = 0; k < 3; ++k) {
     double v = 0;
     if (!parseDouble(w[first + size_t(k)], v)) return false;
-    const double b = isFloat ? v * 255.0 : v;
-    if (!(b >= -0.5 && b < 255.5)) {
+    if (!colourChannel(isFloat ? v * 255.0 : v, c[k])) {
       outside = "a colour channel of " + shortNumber(v) + ", outside " +
                 (isFloat ? "0..1 (a colour written with a point)" : "0..255 (an integer colour)");
       return false;
     }
-    c[k] = uint8_t(std::clamp(std::lround(b), 0L, 255L));
   }
   return true;
 }
@@ -303,10 +301,7 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
       if (bytes.size() >= 84) std::memcpy(&v, bytes.data() + 80, 4);
       return v;
     }();
-    failRead(name, bytes.size() < 84 ? "not an STL file (too short for a binary STL, and no 'solid' line)"
-                                     : "a binary STL whose triangle count (" + std::to_string(n) + ", so " +
-                                           std::to_string(84 + 50 * uint64_t(n)) + " bytes) does not match its " +
-                                           std::to_string(bytes.size()) + " bytes, and not an ASCII STL ('solid')");
+    failRead(name, notAnStl(n, bytes.size()));
   }
   Lines in{bytes, name, Comments::None};
   in.next();  // solid NAME
