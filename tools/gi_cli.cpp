@@ -200,6 +200,11 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   std::unique_ptr<tbb::global_control> threads;
   if (a.threads > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(a.threads));
   Timer timer;
+  // The output is PLY whatever its name says: a name promising another
+  // format (x.obj, or none) is refused before any work.
+  if (!a.output.empty() && lowerExtension(a.output) != ".ply")
+    throw std::invalid_argument("--output '" + a.output + "': gi writes PLY (vertex colour, quality and the layers' names, "
+                                "which OBJ, OFF and STL cannot hold); give a name ending in .ply");
   std::optional<RunFiles> early;  // every file, before the mesh is loaded
   try {
     early = runFiles(kind, a, valuesBeforeLoading(specs, a));

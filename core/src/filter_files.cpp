@@ -17,6 +17,12 @@ std::string imageStem(const std::string& path) {
   return dot != std::string::npos && (slash == std::string::npos || dot > slash) ? path.substr(0, dot) : path;
 }
 
+std::string lowerExtension(const std::string& path) {
+  std::string ext = path.substr(imageStem(path).size());
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
 std::string stdErrorImagePath(const std::string& imagePath) { return imageStem(imagePath) + "_stderr.png"; }
 
 namespace {
@@ -25,9 +31,7 @@ namespace {
 // the name says: a name that promises another format (x.jpg, or none) is
 // refused before any work rather than holding PNG data under it.
 void image(FilterFiles& f, const std::string& png, const std::string& parameter) {
-  std::string ext = png.substr(imageStem(png).size());
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext != ".png")
+  if (lowerExtension(png) != ".png")
     throw std::invalid_argument(parameter + " '" + png + "': the pictures are written as PNG; give a name ending in .png");
   f.writes.push_back({png, parameter});
   f.writes.push_back({pfmPath(png), parameter});

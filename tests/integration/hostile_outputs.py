@@ -99,7 +99,7 @@ OVERWRITE = [
     ("hard_link", ["ao", "in.ply", "-o", "hard.ply"]),
     ("save_result", ["ao", "in.ply", "-o", "o.ply", "--save-result", "in.ply"]),
     ("residual_csv", ["radiosity", "in.ply", "-o", "o.ply", "--residual_csv", "in.ply"]),
-    ("export_system", ["radiosity", "in.ply", "-o", "p_B.mtx", "--export_system", "p"]),  # p_F.mtx, ..., p_B.mtx
+    ("export_system", ["radiosity", "in.ply", "-o", "o.ply", "--save-result", "p_B.mtx", "--export_system", "p"]),  # p_F.mtx, ..., p_B.mtx
     ("image_path", ["render", "in.ply", "--image_path", "in.ply"], "written as PNG"),  # the name alone refuses it
     ("image_and_result", ["render", "in.ply", "--image_path", "x.png", "--save-result", "x.png"]),
     ("image_pfm", ["render", "in.ply", "--image_path", "in.png", "--layer", "in.pfm"]),
@@ -260,6 +260,8 @@ def check_numbers_and_batches(gi, tmp):
          "single-precision", 1, "s.mlx"),
         ("script of a mesh of +-3e38 (render)", ["script", "render", "--mesh", "huge.ply", "-o", "s.mlx"],
          "single-precision", 1, "s.mlx"),
+        ("an output named .obj (gi writes PLY)", ["ao", "in.ply", "-o", "o.obj", "-q"], "ending in .ply", 1, "o.obj"),
+        ("an output with no extension", ["ao", "in.ply", "-o", "o", "-q"], "ending in .ply", 1, "o"),
         ("--max_distance 1e-50", ["ao", "in.ply", "-o", "o.ply", "--max_distance", "1e-50", "-q"], "max_distance", 1, "o.ply"),
         ("--max_distance 1e-49%", ["ao", "in.ply", "-o", "o.ply", "--max_distance", "1e-49%", "-q"], "max_distance", 1, "o.ply"),
         ("--max_radius 1e-300", ["photonmap", "in.ply", "-o", "o.ply", "--max_radius", "1e-300", "-q"], "max_radius", 1, "o.ply"),

@@ -37,6 +37,10 @@ std::string pfmPath(const std::string& imagePath);
 // "dir/name.png" -> "dir/name" (a name without an extension stays whole):
 // the stem the pictures beside an image are named from.
 std::string imageStem(const std::string& imagePath);
+
+// A file name's extension in lower case with its dot ("x.PLY" -> ".ply"),
+// or "" where the name has none.
+std::string lowerExtension(const std::string& path);
 // A path-traced view's standard error per pixel goes beside its image.
 std::string stdErrorImagePath(const std::string& imagePath);
 
