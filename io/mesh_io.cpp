@@ -16,6 +16,8 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include <glm/gtc/constants.hpp>
+
 #include "atomic_file.h"
 #include "gi/color.h"
 #include "mesh_parts.h"
@@ -224,6 +226,37 @@ namespace {
 // of area 192 came out of area 4288, a quarter of its triangles reversed,
 // with no word; an outside audit).
 constexpr size_t kMaxEarClipped = 256;
+
+// The total turning of a closed polygon in the plane: the sum of the angles
+// between consecutive edges (2 pi for a simple polygon, 4 pi for a
+// pentagram, 0 for a figure eight).
+double turning(const std::vector<glm::dvec2>& q) {
+  const size_t n = q.size();
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec2 e = q[(i + 1) % n] - q[i], f = q[(i + 2) % n] - q[(i + 1) % n];
+    sum += std::atan2(e.x * f.y - e.y * f.x, glm::dot(e, f));
+  }
+  return sum;
+}
+
+// Whether two edges that share no corner cross properly (each edge's ends
+// strictly on either side of the other's line): O(n^2), for polygons of at
+// most kMaxEarClipped corners.
+bool crossesItself(const std::vector<glm::dvec2>& q) {
+  const size_t n = q.size();
+  auto side = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+    const double t = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    return (t > 0.0) - (t < 0.0);
+  };
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the last corner
+      const glm::dvec2 &a = q[i], &b = q[i + 1], &c = q[j], &d = q[(j + 1) % n];
+      if (side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0) return true;
+    }
+  return false;
+}
 bool triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, std::vector<glm::uvec3>& out) {
   out.clear();
   if (n == 3) {  // most faces: nothing to decide, nothing to allocate
@@ -241,7 +274,14 @@ bool triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n
     const glm::dvec3 &a = pts[v[i]], &b = pts[v[(i + 1) % n]];
     normal += glm::dvec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
   }
-  if (!(glm::length(normal) > 0.0)) return fan(left), true;  // no area whatever the split
+  if (!(glm::length(normal) > 0.0)) {
+    // No net area: either no area whatever the split (every corner on one
+    // line), or lobes of opposite turn that cancel (a symmetric bow tie),
+    // which crosses itself.
+    for (size_t i = 1; i + 1 < n; ++i)
+      if (glm::length(glm::cross(pts[v[i]] - pts[v[0]], pts[v[i + 1]] - pts[v[0]])) > 0.0) return fan(left), false;
+    return fan(left), true;
+  }
   // The plane's two axes, from the polygon's own first corner (2-D coordinates
   // of the same scale as the polygon).
   const glm::dvec3 nz = glm::normalize(normal);
@@ -257,8 +297,12 @@ bool triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n
   };
   bool convex = true;
   for (size_t i = 0; i < n && convex; ++i) convex = turn(uint32_t(i), uint32_t((i + 1) % n), uint32_t((i + 2) % n)) >= 0.0;
-  if (convex) return fan(left), true;
+  // Turning one way at every corner, a polygon is convex when it turns once
+  // round; a pentagram turns the same way at every corner and goes round
+  // twice.
+  if (convex) return fan(left), std::fabs(turning(q)) < 3.0 * glm::pi<double>();
   if (n > kMaxEarClipped) return fan(left), false;
+  if (crossesItself(q)) return fan(left), false;  // a bow tie: ear clipping would cut it as if it did not
   auto inside = [&](uint32_t p, uint32_t a, uint32_t b, uint32_t c) {
     return turn(a, b, p) >= 0.0 && turn(b, c, p) >= 0.0 && turn(c, a, p) >= 0.0;
   };

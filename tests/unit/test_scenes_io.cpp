@@ -333,6 +333,40 @@ TEST(ScenesIo, ConcavePolygonsAreCutInsideThem) {
   }
 }
 
+// A polygon that crosses itself has no inside to cut: a bow tie (the
+// symmetric one's lobes cancel, so it has no net normal; a lopsided one's
+// do not), a pentagram (turning the same way at every corner, twice round)
+// and a bow tie among concave corners are each split and warned about, once
+// per file; the simple polygons beside them are not (an outside audit: a
+// bow-tie quad was cut without a word).
+TEST(ScenesIo, SelfCrossingPolygonsAreWarned) {
+  std::vector<glm::dvec2> pentagram;
+  for (int k = 0; k < 5; ++k) pentagram.push_back({std::cos(4 * kPi * k / 5), std::sin(4 * kPi * k / 5)});
+  const std::vector<std::pair<std::vector<glm::dvec2>, bool>> polys = {
+      {{{0, 0}, {1, 1}, {1, 0}, {0, 1}}, true},                    // symmetric bow tie
+      {{{0, 0}, {2, 2}, {2, 0}, {0, 1}}, true},                    // lopsided bow tie
+      {pentagram, true},                                           // every corner turns left
+      {{{0, 0}, {3, 0}, {3, 3}, {2, 1}, {1, 3}, {1, -1}}, true},   // concave, one pair of edges crossing
+      {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, false},                   // square
+      {{{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}}, false},   // L
+      {{{0, 0}, {1, 0}, {2, 0}, {2, 1}, {0, 1}}, false},           // a flat corner
+  };
+  for (const auto& [p, crossing] : polys) {
+    const size_t n = p.size();
+    std::string off = "OFF\n" + std::to_string(n) + " 1 0\n", face = std::to_string(n);
+    for (size_t k = 0; k < n; ++k) {
+      char line[96];
+      std::snprintf(line, sizeof line, "%.17g %.17g 0\n", p[k].x, p[k].y);
+      off += line;
+      face += " " + std::to_string(k);
+    }
+    const auto m = gi::io::parseMesh(off + face + "\n", "off", "p.off");
+    EXPECT_EQ(m.scene.faceCount(), n - 2) << face;
+    ASSERT_EQ(m.warnings.size(), crossing ? 1u : 0u) << face;
+    if (crossing) EXPECT_NE(m.warnings[0].find("cross"), std::string::npos) << m.warnings[0];
+  }
+}
+
 // Ear clipping stops at 256 corners (its rounds are O(n^2)): a concave
 // star of 254 corners is cut inside itself, one of 258 is split as a fan
 // and the loader says so (an outside audit found a 258-corner comb's area
