@@ -404,6 +404,10 @@ void checkHead(std::string_view head, const std::string& ext, uintmax_t size, co
     if (!ascii && !(size >= 84 && size == 84 + 50 * uintmax_t(n)))
       failRead(name, detail::notAnStl(n, size));
   } else if (const size_t nul = head.find('\0'); nul != std::string_view::npos) {  // OBJ, OFF: text
+    // Binary OFF says so on its first line ("OFF BINARY"): name it rather
+    // than the zero bytes that follow.
+    if (ext == "off" && head.substr(0, std::min(head.find('\n'), nul)).find("BINARY") != std::string_view::npos)
+      failRead(name, "binary OFF is not supported (only ASCII [C][N]OFF); convert it to ASCII OFF or PLY");
     failRead(name, "not a text file (a zero byte at offset " + std::to_string(nul) + ")");
   }
 }

@@ -322,9 +322,18 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
     std::ofstream(z).close();
     fs::resize_file(z, size_t(1) << 30);
   }
+  // Binary OFF names itself on its first line: said so, not its zero bytes.
+  const std::string binaryOff = tempPath("binary.off");
+  {
+    std::ofstream f(binaryOff, std::ios::binary);
+    f << "OFF BINARY\n";
+    const int32_t counts[3] = {3, 1, 0};
+    f.write(reinterpret_cast<const char*>(counts), sizeof counts);
+  }
   for (const auto& [path, fragment] : {std::pair<std::string, std::string>{dir, "is a directory"},
                                        {zerosPly, "not a PLY file"},
                                        {zerosObj, "not a text file"},
+                                       {binaryOff, "binary OFF is not supported"},
                                        {zerosStl, "does not match its 1073741824 bytes"},
                                        {empty, "empty (0 bytes)"},
                                        {tempPath("none.ply"), "no such file"},
@@ -338,7 +347,7 @@ TEST(MeshReaders, PathsThatAreNoMeshFile) {
   }
   fs::remove_all(dir);
   fs::remove(empty);
-  for (const std::string& z : {zerosPly, zerosObj, zerosStl}) fs::remove(z);
+  for (const std::string& z : {zerosPly, zerosObj, zerosStl, binaryOff}) fs::remove(z);
   // An ASCII STL whose 'solid' lies past the first 4 KiB is the reader's to
   // judge (5,000 blank lines first were refused; an outside review).
   const std::string late = tempPath("late.stl");
