@@ -108,11 +108,13 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
       std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
       median = edges[edges.size() / 2];
     }
+    // Said in the mesh's own units (the options here are local: Scene::unit).
+    const double u = scene.unit;
     if (o.maxDistance <= 10.0 * eps)
-      st.warn("max_distance " + num(o.maxDistance) + " is within 10 ray offsets (rays start " + num(eps) +
+      st.warn("max_distance " + num(o.maxDistance * u) + " is within 10 ray offsets (rays start " + num(eps * u) +
               " off the surface): what it sees is where the rays start, not the shape");
     else if (o.maxDistance < 0.1 * median)
-      st.warn("max_distance " + num(o.maxDistance) + " is below a tenth of the median edge length " + num(median) +
+      st.warn("max_distance " + num(o.maxDistance * u) + " is below a tenth of the median edge length " + num(median * u) +
               ": within it a vertex sees only its own faces, so the result shows the angles between neighbouring faces, "
               "not the rest of the mesh");
   }

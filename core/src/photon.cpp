@@ -331,7 +331,7 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
   for (int c = 0; c < 3; ++c)
     if (ts.emittedRGB[c] > 0 && ts.lostRGB[c] / ts.emittedRGB[c] > e.check.lostChannelShare)
       e.check.lostChannelShare = ts.lostRGB[c] / ts.emittedRGB[c], e.check.lostChannel = c;
-  warnMeaninglessPhotonParameters(r.opt, e.check, st);
+  warnMeaninglessPhotonParameters(r.opt, e.check, r.s.unit, st);
   if (e.verticesWithoutPhotons)
     st.note(std::to_string(e.verticesWithoutPhotons) +
             " vertices reached by no photon within the gather radius: direct light only");

@@ -18,7 +18,7 @@ std::string num(double v) {
 
 }  // namespace
 
-void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st) {
+void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, double unit, RunStats& st) {
   // The mean distance between photons, sqrt(area / photons): a radius below
   // it holds about pi (r / spacing)^2 < pi photons, mostly 0 or 1.
   bool capTooSmall = false;
@@ -26,10 +26,11 @@ void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGathe
     const double spacing = std::sqrt(c.surfaceArea / double(c.mapPhotons));
     if (opt.maxRadius < spacing) {
       capTooSmall = true;
-      st.warn("max_radius " + num(opt.maxRadius) + " is below the mean photon spacing " + num(spacing) + " (sqrt of " +
-              num(c.surfaceArea) + " diffuse area / " + std::to_string(c.mapPhotons) +
+      // Lengths and areas in the mesh's own units (the options here are local: Scene::unit).
+      st.warn("max_radius " + num(opt.maxRadius * unit) + " is below the mean photon spacing " + num(spacing * unit) +
+              " (sqrt of " + num(c.surfaceArea * unit * unit) + " diffuse area / " + std::to_string(c.mapPhotons) +
               " photons): a gather holds 0 or 1 photon, read as the density of its whole disk, so vertex values are 0 or "
-              "many times too bright; use max_radius >= " + num(spacing * std::sqrt(opt.kNearest / M_PI)) + " (room for " +
+              "many times too bright; use max_radius >= " + num(spacing * std::sqrt(opt.kNearest / M_PI) * unit) + " (room for " +
               std::to_string(opt.kNearest) + " photons) or more photons");
     }
   }

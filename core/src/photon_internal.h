@@ -58,7 +58,8 @@ constexpr int kFewPhotons = 4;
 // a gather radius cap below the photon spacing, estimates of a handful of
 // photons, k below 3 (no finite mean or variance), k above the map's
 // photons, and paths cut at max_depth carrying much of the power.
-void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, RunStats& st);
+// unit: Scene::unit, for lengths said in the mesh's own units.
+void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, double unit, RunStats& st);
 
 // A final-gather ray's diffuse hit: the face, the point, its unit normal,
 // the length of the ray's last leg and a key of its own (vertex, ray).

@@ -45,6 +45,23 @@ Scene litBox(int n = 8, float rho = 0.5f) {
   return sf.scene;
 }
 
+// The same scene k times larger (its per-face properties kept): past 2^20
+// of diagonal the engine works in a local unit other than 1 (Scene::unit).
+Scene scaled(const Scene& s, double k) {
+  std::vector<glm::dvec3> pts;
+  for (const glm::vec3& p : s.positions) pts.push_back(s.toWorld(p) * k);
+  Scene t = Scene::fromAbsolute(pts, s.triangles);
+  t.rho = s.rho, t.emission = s.emission, t.material = s.material;
+  return t;
+}
+
+// The first number after `after` in a warning that contains it.
+double numberAfter(const RunStats& st, const std::string& after) {
+  for (const auto& w : st.warnings)
+    if (const size_t at = w.find(after); at != std::string::npos) return std::stod(w.substr(at + after.size()));
+  return std::nan("");
+}
+
 }  // namespace
 
 // A gather radius cap below the mean photon spacing sqrt(area / photons):
@@ -75,6 +92,31 @@ TEST(PhotonWarnings, GatherRadiusBelowThePhotonSpacing) {
   o.passes = 2;
   o.maxRadius = 0.1 * spacing;  // the two passes' photons together: spacing / sqrt(2)
   EXPECT_TRUE(warned(computePhotonMap(s, *caster, o).stats, "below the mean photon spacing"));
+}
+
+// The warning speaks the mesh's units at every scale: the box 2^24 times
+// larger (local unit 2^24) at a fifth of its spacing quotes the radius given
+// and the spacing and the radius to use 2^24 times the unit box's (an
+// outside audit: at a diagonal of 8.7e6 it quoted local units, and following
+// its advice made the radius 7e6 times too small).
+TEST(PhotonWarnings, SaidInTheMeshUnits) {
+  const double k = 16777216.0;
+  const Scene unitBox = litBox(), big = scaled(unitBox, k);
+  ASSERT_GT(big.unit, 1e6);  // a local unit other than 1
+  PhotonOptions o;
+  o.photons = 20000;
+  o.directLight = false;
+  auto c1 = makeEmbreeCaster(unitBox), c2 = makeEmbreeCaster(big);
+  const double spacing = std::sqrt(6.0 / computePhotonMap(unitBox, *c1, o).stats.get("photons_global_map"));
+  o.maxRadius = 0.2 * spacing;
+  const RunStats small = computePhotonMap(unitBox, *c1, o).stats;
+  o.maxRadius = 0.2 * spacing * k;
+  const RunStats large = computePhotonMap(big, *c2, o).stats;
+  for (const char* what : {"max_radius ", "mean photon spacing ", "use max_radius >= "}) {
+    const double a = numberAfter(small, what), b = numberAfter(large, what);
+    ASSERT_TRUE(a > 0 && b > 0) << what << all(large);
+    EXPECT_NEAR(b / (a * k), 1.0, 0.01) << what << all(large);  // three digits printed
+  }
 }
 
 // A cap just above the spacing (1.1 x: 3.8 photons per gather on average)
@@ -190,6 +232,28 @@ TEST(AmbientWarnings, MaxDistanceAgainstTheOffsetAndTheMesh) {
     o.maxDistance = 0.1 * scale.diagonal;
     const RunStats st = computeAmbient(s, *caster, o).stats;
     EXPECT_TRUE(st.warnings.empty()) << all(st);
+  }
+}
+
+// The same warnings in the mesh's units: the scene 2^24 times larger quotes
+// max_distance, the ray offset and the median edge 2^24 times larger.
+TEST(AmbientWarnings, SaidInTheMeshUnits) {
+  const double k = 16777216.0;
+  const Scene unitScene = scenes::floorWithWall(4.0, 1.0, 20).scene, big = scaled(unitScene, k);
+  ASSERT_GT(big.unit, 1e6);  // a local unit other than 1
+  auto c1 = makeEmbreeCaster(unitScene), c2 = makeEmbreeCaster(big);
+  AmbientOptions o;
+  o.raysPerVertex = 16;
+  for (double d : {5.0 * sceneScale(unitScene).rayEpsilon, 0.01}) {
+    o.maxDistance = d;
+    const RunStats small = computeAmbient(unitScene, *c1, o).stats;
+    o.maxDistance = d * k;
+    const RunStats large = computeAmbient(big, *c2, o).stats;
+    for (const char* what : {"max_distance ", "rays start ", "median edge length "}) {
+      const double a = numberAfter(small, what), b = numberAfter(large, what);
+      if (std::isnan(a)) continue;  // each warning names two of the three
+      EXPECT_NEAR(b / (a * k), 1.0, 0.01) << what << all(large);
+    }
   }
 }
 
