@@ -119,7 +119,7 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
         case ParamType::Color: {
           glm::vec3 c = v.getVec(s.name);
           for (int k = 0; k < 3; ++k)
-            if (!(c[k] >= 0.f && c[k] <= 1.f)) return "parameter '" + s.name + "' has a channel outside [0, 1]";
+            if (!(c[k] >= 0.f && c[k] <= 1.f)) return "parameter '" + s.name + "' has a channel outside 0-255";
           break;
         }
         case ParamType::Direction: {
@@ -241,6 +241,8 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         }
         auto n = splitNumbers(text);
         if (n.size() != 3) throw bad("expected r,g,b (0-255) or #rrggbb");
+        for (double c : n)
+          if (!(c >= 0.0 && c <= 255.0)) throw bad("each channel of r,g,b lies in 0-255");
         return glm::vec3(float(n[0] / 255.0), float(n[1] / 255.0), float(n[2] / 255.0));
       }
       case ParamType::Direction:

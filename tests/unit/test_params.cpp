@@ -258,6 +258,17 @@ TEST(Params, ParseValueEveryType) {
   EXPECT_EQ(std::get<glm::vec3>(parse("tint", "255, 128, 0")), orange);
   for (const char* t : {"#ff80", "#ff80zz", "#gg8000", "255,128", "255,128,0,1", "a,b,c", "", "orange", "#12345g"})
     expectParseError("tint", t);
+  // Channels outside 0-255 are said in the units the text uses (they were
+  // refused later as "outside [0, 1]"; an outside audit).
+  for (const char* t : {"300,255,255", "-1,0,0", "0,0,255.5"}) {
+    expectParseError("tint", t);
+    try {
+      (void)parse("tint", t);
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("0-255"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(std::get<glm::vec3>(parse("tint", "0,0,255")), glm::vec3(0.f, 0.f, 1.f));
 
   EXPECT_EQ(std::get<glm::vec3>(parse("dir", "0,-1,0.5")), glm::vec3(0.f, -1.f, 0.5f));
   for (const char* t : {"0,1", "0,1,x", "", "1,2,3,4"}) expectParseError("dir", t);
