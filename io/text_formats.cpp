@@ -193,6 +193,11 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
   };
   while (in.next()) {
     const std::string_view key = in.words[0];
+    const bool numeric = key == "v" || key == "vt" || key == "vn" || key == "f";  // names may hold '#'
+    for (size_t k = 1; numeric && k < in.words.size(); ++k)
+      if (in.words[k].find('#') != std::string_view::npos)
+        failRead(name, in.at() + ": a comment after the data (" + quoted(in.words[k]) +
+                           "); the OBJ reader takes '#' only at the start of a line: move the comment to a line of its own");
     if (key == "v") {
       numbers(3, 6, "3 coordinates (and an optional w or r g b)");
       if (in.words.size() == 6) failRead(name, in.at() + ": 'v' with 5 numbers");

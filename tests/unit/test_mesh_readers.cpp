@@ -123,7 +123,8 @@ TEST(MeshReaders, DamagedFilesAreOneSentenceNamingThePlace) {
       // vertex 3 did not exist there and the face wrote vertex 3's normal past the array.
       {"OBJ vertex line starting with a form feed", "obj",
        "v 0 0 0\nv 1 0 0\n\fv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n", "line 3 holds a control character"},
-      {"OBJ comment inside a face", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3#4 5\n", "line 4: vertex index '3#4'"},
+      {"OBJ comment inside a face", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3#4 5\n", "line 4: a comment after the data ('3#4')"},
+      {"OBJ comment after a face", "obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 # a face\n", "line 4: a comment after the data ('#')"},
       {"OFF counts that lie high", "off", "OFF\n9 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "a count that lies"},
       {"OFF extra faces", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", "line 7: data after the last face"},
       {"OFF index beyond", "off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "line 6: face 0 uses vertex '3'"},
