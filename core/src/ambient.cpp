@@ -400,7 +400,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   size_t twoSided = 0;
   for (uint32_t v : sides.vertex) twoSided += part.contains(v, nv);
   if (twoSided)
-    st.note(std::to_string(twoSided) + " vertices on a two-sided surface (each face with a reversed copy: no normal) "
+    st.note(std::to_string(twoSided) + " vertices on a two-sided surface or where faces turned opposite ways meet (their normals cancel) "
             "took the mean of their two sides" + std::string(opt.bentNormals ? " (their bent normals stay 0)" : ""));
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a side to "
                           "cast from (a fold whose faces' normals cancel) got 0");

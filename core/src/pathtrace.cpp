@@ -490,7 +490,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   size_t twoSidedTraced = 0;
   for (uint32_t v : sides.vertex) twoSidedTraced += part.contains(v, nv) && acc[v].n > 0;
   if (twoSidedTraced)
-    st.note(std::to_string(twoSidedTraced) + " vertices on a two-sided surface (its faces' normals cancel) took the "
+    st.note(std::to_string(twoSidedTraced) + " vertices on a two-sided surface or where faces turned opposite ways meet (their faces' normals cancel) took the "
             "mean of their two sides (each sample a path from either side)");
   if (valid < part.count(nv))
     st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "

@@ -501,7 +501,7 @@ VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const
   const Totals totals = totalsOver(out.B, out.stdError, counted);
   out.stats.set("mean_luminance_B", totals.meanLuminance);
   out.stats.set("photon_noise_estimate", totals.rmsNoise);
-  out.stats.note(std::to_string(sides.vertex.size()) + " vertices on a two-sided surface (its faces' normals cancel) "
+  out.stats.note(std::to_string(sides.vertex.size()) + " vertices on a two-sided surface or where faces turned opposite ways meet (their faces' normals cancel) "
                  "took the mean of their two sides (the counts of estimates above count each side)");
   return out;
 }

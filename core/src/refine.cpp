@@ -211,6 +211,8 @@ struct MeshRefiner::Impl {
     inherit(m.scene.emission, base.emission);
     inherit(m.scene.material, base.material);
     inherit(m.scene.ior, base.ior);
+    inherit(m.scene.roughness, base.roughness);
+    inherit(m.scene.leftOut, base.leftOut);
     m.vertexParents = parents;
     m.inputVertices = base.positions.size();
   }
@@ -228,6 +230,8 @@ MeshRefiner::MeshRefiner(const Scene& input) : impl_(std::make_unique<Impl>()) {
   check(input.emission.size(), "emission");
   check(input.material.size(), "material");
   check(input.ior.size(), "index of refraction");
+  check(input.roughness.size(), "roughness");
+  check(input.leftOut.size(), "faces left out");
   Impl& d = *impl_;
   d.base = input;
   d.positions = input.positions;

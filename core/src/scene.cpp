@@ -97,12 +97,14 @@ size_t Scene::append(const Scene& o) {
   const bool anyRho = !rho.empty() || !o.rho.empty(), anyE = !emission.empty() || !o.emission.empty();
   const bool anyMat = !material.empty() || !o.material.empty(), anyIor = !ior.empty() || !o.ior.empty();
   const bool anyRough = !roughness.empty() || !o.roughness.empty();
+  const bool anyLeftOut = !leftOut.empty() || !o.leftOut.empty();
   const bool anyN = !vertexNormals.empty() || !o.vertexNormals.empty();
   if (anyRho) fillTo(rho, fOff, glm::vec3(0.5f));
   if (anyE) fillTo(emission, fOff, glm::vec3(0.f));
   if (anyMat) fillTo(material, fOff, Material::Diffuse);
   if (anyIor) fillTo(ior, fOff, 1.5f);
   if (anyRough) fillTo(roughness, fOff, 0.2f);
+  if (anyLeftOut) fillTo(leftOut, fOff, uint8_t(0));
   if (anyN) fillTo(vertexNormals, vOff, glm::vec3(0.f));
   // The union's unit: rescale what is here (by a power of two: exact) if it changes.
   std::vector<glm::dvec3> world;
@@ -129,6 +131,7 @@ size_t Scene::append(const Scene& o) {
     if (anyMat) material.push_back(o.faceMaterial(f));
     if (anyIor) ior.push_back(o.ior.empty() ? 1.5f : o.ior[f]);
     if (anyRough) roughness.push_back(o.faceRoughness(f));
+    if (anyLeftOut) leftOut.push_back(o.leftOut.empty() ? 0 : o.leftOut[f]);
   }
   if (anyN) {
     if (o.vertexNormals.empty()) vertexNormals.resize(positions.size(), glm::vec3(0.f));
@@ -185,6 +188,7 @@ std::vector<uint8_t> usableFaceMask(const Scene& s) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.faceCount(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t f = r.begin(); f < r.end(); ++f) {
       const auto& t = s.triangles[f];
+      if (!s.leftOut.empty() && s.leftOut[f]) continue;
       if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) continue;
       if (!finite3(s.positions[t.x]) || !finite3(s.positions[t.y]) || !finite3(s.positions[t.z])) continue;
       glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), c(s.positions[t.z]);
@@ -287,6 +291,95 @@ std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<ui
   return n;
 }
 
+namespace {
+
+// What the faces' corner positions say: the faces that repeat another's
+// corners in its turn, the two-sided pairs, and the edges along which two
+// faces run the same way.
+struct CornerGroups {
+  std::vector<std::pair<uint32_t, uint32_t>> duplicates;  // (copy, original)
+  size_t twoSidedPairs = 0, misorientedEdges = 0;
+};
+
+// ok: usable faces; used: the vertices they use.
+CornerGroups cornerGroups(const Scene& s, const std::vector<uint8_t>& ok, const std::vector<uint8_t>& used) {
+  const size_t nv = s.vertexCount(), nf = s.faceCount();
+  CornerGroups g;
+  // Corners with equal positions get one id (the vertices in position
+  // order), then faces are compared as sorted id triples: integers, where
+  // sorting the faces by their nine coordinates cost 0.2 s a call at a
+  // million triangles.
+  std::vector<uint32_t> order;
+  order.reserve(nv);
+  for (size_t i = 0; i < nv; ++i)
+    if (used[i]) order.push_back(uint32_t(i));
+  auto less = [&](uint32_t a, uint32_t b) {
+    const glm::vec3 &p = s.positions[a], &q = s.positions[b];
+    return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<uint32_t> id(nv, 0);
+  for (size_t k = 0; k < order.size(); ++k)
+    id[order[k]] = k > 0 && !less(order[k - 1], order[k]) ? id[order[k - 1]] : uint32_t(k);
+  // The sorted ids, the turn (0 where the sorted order is a rotation of the
+  // face's own, 1 where it is reversed) and the face.
+  std::vector<std::array<uint32_t, 5>> keys;
+  keys.reserve(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    if (!ok[f]) continue;
+    const std::array<uint32_t, 3> turn = {id[s.triangles[f].x], id[s.triangles[f].y], id[s.triangles[f].z]};
+    std::array<uint32_t, 3> c = turn;
+    std::sort(c.begin(), c.end());
+    const int first = int(std::find(turn.begin(), turn.end(), c[0]) - turn.begin());
+    keys.push_back({c[0], c[1], c[2], turn[size_t((first + 1) % 3)] == c[1] ? 0u : 1u, uint32_t(f)});
+  }
+  std::sort(keys.begin(), keys.end());
+  // A face turned as an earlier one on the same corners is a duplicate (of
+  // the group's first face); a group on the same corners with both turns is
+  // a two-sided pair.
+  for (size_t k = 1, first = 0; k < keys.size(); ++k) {
+    const bool sameCorners = std::equal(keys[k].begin(), keys[k].begin() + 3, keys[k - 1].begin());
+    if (!sameCorners || keys[k][3] != keys[k - 1][3]) first = k;
+    if (sameCorners && keys[k][3] == keys[k - 1][3]) g.duplicates.push_back({keys[k][4], keys[first][4]});
+    else if (sameCorners) ++g.twoSidedPairs;
+  }
+  // Edges met by exactly two faces that run along them the same way: one of
+  // the two is turned over (its front is the other's back). Grouped by the
+  // edge's lower id (a count, then the slots: linear, no sort of all edges).
+  std::vector<uint32_t> start(order.size() + 2, 0), slot;
+  auto each = [&](auto&& visit) {
+    for (const auto& key : keys) {
+      const glm::uvec3& t = s.triangles[key[4]];
+      for (int e = 0; e < 3; ++e) visit(id[t[e]], id[t[(e + 1) % 3]]);
+    }
+  };
+  each([&](uint32_t a, uint32_t b) { ++start[std::min(a, b) + 2]; });
+  for (size_t k = 2; k < start.size(); ++k) start[k] += start[k - 1];
+  slot.resize(3 * keys.size());
+  each([&](uint32_t a, uint32_t b) { slot[start[std::min(a, b) + 1]++] = (std::max(a, b) << 1) | (a < b ? 0u : 1u); });
+  for (size_t lo = 0; lo + 1 < start.size(); ++lo) {
+    const auto first = slot.begin() + start[lo], last = slot.begin() + start[lo + 1];
+    std::sort(first, last);
+    for (auto it = first; it != last;) {
+      auto end = it;
+      while (end != last && (*end >> 1) == (*it >> 1)) ++end;
+      if (end - it == 2 && *it == *(it + 1)) ++g.misorientedEdges;
+      it = end;
+    }
+  }
+  return g;
+}
+
+}  // namespace
+
+std::vector<std::pair<uint32_t, uint32_t>> duplicatedFaces(const Scene& s) {
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  std::vector<uint8_t> used(s.vertexCount(), 0);
+  for (size_t f = 0; f < ok.size(); ++f)
+    if (ok[f]) used[s.triangles[f].x] = used[s.triangles[f].y] = used[s.triangles[f].z] = 1;
+  return cornerGroups(s, ok, used).duplicates;
+}
+
 SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<uint8_t>* usable) {
   SceneReport r;
   r.vertices = s.vertexCount();
@@ -306,6 +399,7 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
     const auto& t = s.triangles[f];
     if (t.x >= nv || t.y >= nv || t.z >= nv || t.x == t.y || t.y == t.z || t.x == t.z) { ++r.invalidFaces; continue; }
     if (!finite[t.x] || !finite[t.y] || !finite[t.z]) { ++r.facesOnNonFinite; continue; }
+    if (!s.leftOut.empty() && s.leftOut[f]) { ++r.leftOutFaces; continue; }
     if (!ok[f]) { ++r.degenerateFaces; continue; }
     used[t.x] = used[t.y] = used[t.z] = 1;
     glm::vec3 E = s.faceEmission(f);
@@ -319,42 +413,10 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
   // earlier usable face. Coplanar copies hide each other at random in ray
   // casting, so exact energy accounting does not hold for them.
   if (duplicateFaces) {
-    // Corners with equal positions get one id (the vertices in position
-    // order), then faces are compared as sorted id triples: integers, where
-    // sorting the faces by their nine coordinates cost 0.2 s a call at a
-    // million triangles.
-    std::vector<uint32_t> order;
-    order.reserve(nv);
-    for (size_t i = 0; i < nv; ++i)
-      if (used[i]) order.push_back(uint32_t(i));
-    auto less = [&](uint32_t a, uint32_t b) {
-      const glm::vec3 &p = s.positions[a], &q = s.positions[b];
-      return p.x != q.x ? p.x < q.x : p.y != q.y ? p.y < q.y : p.z < q.z;
-    };
-    std::sort(order.begin(), order.end(), less);
-    std::vector<uint32_t> id(nv, 0);
-    for (size_t k = 0; k < order.size(); ++k)
-      id[order[k]] = k > 0 && !less(order[k - 1], order[k]) ? id[order[k - 1]] : uint32_t(k);
-    // The sorted ids and the turn: 0 where the sorted order is a rotation
-    // of the face's own, 1 where it is reversed.
-    std::vector<std::array<uint32_t, 4>> keys;
-    keys.reserve(r.faces);
-    for (size_t f = 0; f < r.faces; ++f) {
-      if (!ok[f]) continue;
-      const std::array<uint32_t, 3> turn = {id[s.triangles[f].x], id[s.triangles[f].y], id[s.triangles[f].z]};
-      std::array<uint32_t, 3> c = turn;
-      std::sort(c.begin(), c.end());
-      const int first = int(std::find(turn.begin(), turn.end(), c[0]) - turn.begin());
-      keys.push_back({c[0], c[1], c[2], turn[size_t((first + 1) % 3)] == c[1] ? 0u : 1u});
-    }
-    std::sort(keys.begin(), keys.end());
-    // A face turned as an earlier one on the same corners is a duplicate; a
-    // group on the same corners with both turns is a two-sided pair.
-    for (size_t k = 1; k < keys.size(); ++k) {
-      const bool sameCorners = std::equal(keys[k].begin(), keys[k].begin() + 3, keys[k - 1].begin());
-      if (sameCorners && keys[k][3] == keys[k - 1][3]) ++r.duplicateFaces;
-      else if (sameCorners) ++r.twoSidedPairs;
-    }
+    const CornerGroups g = cornerGroups(s, ok, used);
+    r.duplicateFaces = g.duplicates.size();
+    r.twoSidedPairs = g.twoSidedPairs;
+    r.misorientedEdges = g.misorientedEdges;
   }
   if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; }
   const SceneScale sc = sceneScale(s);
@@ -396,6 +458,10 @@ std::string SceneReport::summary() const {
   if (duplicateFaces)
     line += "; " + std::to_string(duplicateFaces) +
             " duplicated faces (coplanar copies shadow each other at random: remove them for exact results)";
+  if (leftOutFaces)
+    line += "; " + std::to_string(leftOutFaces) + " duplicated faces left out";
+  if (misorientedEdges)
+    line += "; " + std::to_string(misorientedEdges) + " edges between faces turned opposite ways";
   if (twoSidedPairs)
     line += "; " + std::to_string(twoSidedPairs) +
             " two-sided pairs (faces with a reversed copy on the same corners: lit on both sides)";

@@ -222,6 +222,44 @@ TEST(Scene, DuplicateFacesByPositionNotIndex) {
   EXPECT_NEAR(gi::sceneDiagonal(s), r.diagonal, 1e-12);
 }
 
+// Edges along which two faces run the same way: one of them is turned over.
+// A closed cube of 12 triangles has none; one triangle turned over gives its
+// three edges; the cube as a soup (every face its own vertices) is judged
+// by positions, the same; the duplicates found are listed as (copy,
+// original) pairs, the original the first face of its corners.
+TEST(Scene, MisorientedEdgesAndDuplicatePairs) {
+  gi::Scene s = gi::Scene::fromAbsolute(cubePoints(2, glm::dvec3(0.0)), cubeFaces());
+  EXPECT_EQ(gi::analyzeScene(s).misorientedEdges, 0u);
+  std::swap(s.triangles[5].y, s.triangles[5].z);
+  EXPECT_EQ(gi::analyzeScene(s).misorientedEdges, 3u);
+  EXPECT_NE(gi::analyzeScene(s).summary().find("3 edges between faces turned opposite ways"), std::string::npos);
+  std::vector<glm::dvec3> soup;
+  std::vector<glm::uvec3> tris;
+  for (const glm::uvec3& t : s.triangles) {
+    for (int k = 0; k < 3; ++k) soup.push_back(s.toWorld(s.positions[t[k]]));
+    tris.push_back({uint32_t(soup.size() - 3), uint32_t(soup.size() - 2), uint32_t(soup.size() - 1)});
+  }
+  gi::Scene loose = gi::Scene::fromAbsolute(soup, tris);
+  EXPECT_EQ(gi::analyzeScene(loose).misorientedEdges, 3u);
+  loose.triangles.push_back(loose.triangles[7]);
+  loose.triangles.push_back(loose.triangles[2]);
+  loose.triangles.push_back(loose.triangles[7]);
+  auto pairs = gi::duplicatedFaces(loose);
+  std::sort(pairs.begin(), pairs.end());
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(pairs[0], (std::pair<uint32_t, uint32_t>{12, 7}));
+  EXPECT_EQ(pairs[1], (std::pair<uint32_t, uint32_t>{13, 2}));
+  EXPECT_EQ(pairs[2], (std::pair<uint32_t, uint32_t>{14, 7}));
+  loose.leftOut.assign(loose.faceCount(), 0);
+  for (const auto& [copy, original] : pairs) loose.leftOut[copy] = 1;
+  const gi::SceneReport r = gi::analyzeScene(loose);
+  EXPECT_EQ(r.leftOutFaces, 3u);
+  EXPECT_EQ(r.duplicateFaces, 0u);
+  EXPECT_EQ(r.degenerateFaces, 0u);
+  EXPECT_EQ(r.usableFaces(), 12u);
+  EXPECT_EQ(gi::usableFaceMask(loose)[13], 0);
+}
+
 TEST(Scene, VertexNormalsOfClosedCubePointOutwards) {
   // Near and far (1e6 offset) cubes; one extra isolated vertex gets zero.
   for (double off : {0.0, 1e6}) {

@@ -125,6 +125,11 @@ struct FilterResult {
   // to map to faceQuality and faceColor (radiosity's face output).
   std::vector<glm::vec3> faceRadiometry;
 
+  // Duplicated faces left out of the computation (Scene::leftOut), as
+  // (copy, original) pairs of faces, and of vertices where a copy's corner
+  // is a vertex of its own: the output gives each its original's values.
+  std::vector<std::pair<uint32_t, uint32_t>> sameFaces, sameVertices;
+
   SceneReport report;    // the scene the algorithm saw (after the conventions)
   std::string setupLog;  // reflectance, emitters, materials: what the conventions chose
   std::vector<std::string> setupWarnings;  // what of it the log warns of (added to stats by the estimate)

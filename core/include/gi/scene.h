@@ -35,6 +35,9 @@ struct Scene {
   std::vector<Material> material;         // per face (empty: all diffuse)
   std::vector<float> ior;                 // per face index of refraction for Glass (empty: 1.5)
   std::vector<float> roughness;           // per face GGX alpha for Glossy (empty: 0.2)
+  // Per face (empty: none): faces every computation leaves out, as it does a
+  // degenerate one (the filters' set-up marks a duplicated face's copies).
+  std::vector<uint8_t> leftOut;
 
   size_t vertexCount() const { return positions.size(); }
   size_t faceCount() const { return triangles.size(); }
@@ -89,13 +92,15 @@ struct SceneReport {
   size_t facesOnNonFinite = 0;     // faces touching a non-finite vertex
   size_t isolatedVertices = 0;     // referenced by no usable face
   size_t emitterFaces = 0;
+  size_t leftOutFaces = 0;         // Scene::leftOut (not counted as degenerate)
   size_t duplicateFaces = 0;       // usable faces repeating an earlier face's corners, in its turn
+  size_t misorientedEdges = 0;     // edges of two faces that run along them the same way (one face turned over)
   size_t twoSidedPairs = 0;        // corners with faces of both turns (a two-sided surface's faces)
   double emittedPower = 0.0;       // luminance-weighted, W
   glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
   double diagonal = 0.0;           // bbox diagonal of the vertices some face uses (world units)
   double rayEpsilon = 0.0;         // offset for ray origins (local units)
-  size_t usableFaces() const { return faces - invalidFaces - degenerateFaces - facesOnNonFinite; }
+  size_t usableFaces() const { return faces - invalidFaces - degenerateFaces - facesOnNonFinite - leftOutFaces; }
   std::string summary() const;     // one line for logs
 };
 
@@ -103,6 +108,10 @@ struct SceneReport {
 // duplicateFaces (left 0) it skips the one part that sorts every face
 // (0.1 s at a million faces): for algorithms that do not depend on it.
 SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::vector<uint8_t>* usable = nullptr);
+// The usable faces that repeat an earlier usable face's three corner
+// positions in the same turn, each with that face: (copy, original) pairs,
+// the original the first face of its group.
+std::vector<std::pair<uint32_t, uint32_t>> duplicatedFaces(const Scene& s);
 // Only the scale (one pass over the vertices): what the algorithms need for
 // their ray offsets, without the defect counts of a full report.
 struct SceneScale {
