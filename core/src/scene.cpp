@@ -477,7 +477,8 @@ std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::v
   std::vector<glm::dvec3> pull(nv, glm::dvec3(0.0));
   std::vector<int> count(nv, 0);
   std::vector<uint8_t> own;
-  addCornerTerms(s, usableFaces(s, usable, own), pull, &count, [&s](size_t f, CornerTerm* out) {
+  const std::vector<uint8_t>& ok = usableFaces(s, usable, own);
+  addCornerTerms(s, ok, pull, &count, [&s](size_t f, CornerTerm* out) {
     const auto& t = s.triangles[f];
     const glm::dvec3 c = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
     for (int k = 0; k < 3; ++k) {
@@ -486,16 +487,40 @@ std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::v
       out[k] = l > 0 ? CornerTerm{d / l, true} : CornerTerm{};
     }
   });
-  std::vector<glm::vec3> o(nv);
+  std::vector<glm::dvec3> shift(nv, glm::dvec3(0.0));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const glm::dvec3 n(normals[i]);
       glm::dvec3 p = count[i] ? pull[i] / double(count[i]) : glm::dvec3(0.0);
       p -= n * glm::dot(p, n);  // tangential part only
       const double l = glm::length(p);
-      const glm::dvec3 shift = l > 0.2 ? p / l : glm::dvec3(0.0);  // symmetric one-rings need no pull
-      o[i] = glm::vec3(glm::dvec3(s.positions[i]) + double(eps) * (n + shift));
+      if (l > 0.2) shift[i] = p / l;  // symmetric one-rings need no pull
     }
+  });
+  // The pull must not take the origin behind one of the vertex's own faces:
+  // at a box's inner corner whose floor is a fan of six triangles, the floor
+  // faces outnumber the walls' in the pull, which tipped it down through the
+  // floor, and every path from the corner started outside the box (an
+  // outside audit: the reference read 0 there, radiosity and photon mapping
+  // the direct light alone). Along each face's normal m the offset keeps at
+  // least half the clearance the normal alone gives: n.m + a (shift.m) >=
+  // n.m / 2, the largest such a in [0, 1].
+  std::vector<double> keep(nv, 1.0);
+  for (size_t f = 0; f < ok.size(); ++f) {
+    if (!ok[f]) continue;
+    const glm::dvec3 m = glm::normalize(glm::dvec3(faceNormalUnnormalized(s, f)));
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t i = s.triangles[f][k];
+      const double along = glm::dot(shift[i], m);
+      if (!(along < 0.0)) continue;
+      const double clearance = glm::dot(glm::dvec3(normals[i]), m);
+      keep[i] = std::min(keep[i], std::max(0.0, 0.5 * clearance / -along));
+    }
+  }
+  std::vector<glm::vec3> o(nv);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv, 1 << 14), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i)
+      o[i] = glm::vec3(glm::dvec3(s.positions[i]) + double(eps) * (glm::dvec3(normals[i]) + keep[i] * shift[i]));
   });
   return o;
 }
