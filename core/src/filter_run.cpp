@@ -24,6 +24,7 @@
 #include "gi/thickness.h"
 #include "gi/vertex_order.h"
 #include "filter_views.h"
+#include "scene_defects.h"
 
 namespace gi {
 
@@ -32,55 +33,11 @@ namespace {
 using detail::scalarAttribute;
 using detail::vectorAttribute;
 using detail::firstPassCausticsAttribute;
+using detail::copyDuplicates;
+using detail::leaveOutDuplicates;
+using detail::strayExtentWarning;
 
 // Validation, the scene conventions and the scene report: steps 1 and 2.
-// Rays met a face and its copy at random, and both emitted: a Cornell box
-// whose light faces were listed twice came out twice as bright in every
-// solver, its walls listed twice 27% dark in photon mapping (an outside
-// audit). Each copy is left out of the computation (Scene::leftOut) and
-// takes its original's values in the output; a copy's corner that is a
-// vertex of its own (an unwelded copy) takes the original's corner's.
-void leaveOutDuplicates(FilterInput& in, FilterResult& res) {
-  Scene& s = in.scene;
-  res.sameFaces = duplicatedFaces(s);
-  s.leftOut.assign(s.faceCount(), 0);
-  for (const auto& [copy, original] : res.sameFaces) s.leftOut[copy] = 1;
-  std::vector<uint8_t> kept(s.vertexCount(), 0);  // on a face the computation keeps
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (!s.leftOut[f]) kept[s.triangles[f].x] = kept[s.triangles[f].y] = kept[s.triangles[f].z] = 1;
-  for (const auto& [copy, original] : res.sameFaces)
-    for (int k = 0; k < 3; ++k) {
-      const uint32_t v = s.triangles[copy][k];
-      if (kept[v]) continue;
-      for (int j = 0; j < 3; ++j)
-        if (s.positions[s.triangles[original][j]] == s.positions[v]) res.sameVertices.push_back({v, s.triangles[original][j]});
-      kept[v] = 1;  // once
-    }
-  res.report = analyzeScene(s);  // the copies counted as left out
-  res.setupLog += std::string(res.setupLog.empty() ? "" : "; ") + std::to_string(res.sameFaces.size()) +
-                  " faces repeat another face's corners in the same turn: each is computed once, its copies "
-                  "neither emitting nor blocking light, and shown with its values (MeshLab: Cleaning and "
-                  "Repairing > Remove Duplicate Faces removes them)";
-}
-
-// The output's copies of duplicated faces (and their own vertices) take
-// their originals' values; nothing to do for a refined mesh (other faces).
-void copyDuplicates(FilterResult& res) {
-  if (res.refined) return;
-  auto copy = [](auto& values, const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t width = 1) {
-    if (values.empty()) return;
-    for (const auto& [to, from] : pairs)
-      for (size_t c = 0; c < width; ++c) values[width * to + c] = values[width * from + c];
-  };
-  copy(res.vertexQuality, res.sameVertices);
-  copy(res.vertexColor, res.sameVertices);
-  copy(res.vertexNormal, res.sameVertices);
-  for (VertexAttribute& a : res.attributes) copy(a.values, res.sameVertices, size_t(a.components));
-  copy(res.faceQuality, res.sameFaces);
-  copy(res.faceColor, res.sameFaces);
-  copy(res.faceRadiometry, res.sameFaces);
-}
-
 void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   if (in.scene.faceCount() == 0)
     throw std::invalid_argument(in.scene.vertexCount() == 0
@@ -118,6 +75,8 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   if (res.report.usableFaces() == 0)
     throw std::invalid_argument("the mesh has no usable triangles (" + res.report.summary() + ")");
   if (res.report.duplicateFaces && kind != FilterKind::ErrorMap) leaveOutDuplicates(in, res);
+  if (kind != FilterKind::ErrorMap)
+    if (auto w = strayExtentWarning(in.scene, res.report)) res.setupWarnings.push_back(*w);
   // A face turned over shows its black back to what its neighbours light,
   // and the vertices it shares read dark (an outside audit: half a Cornell
   // box's faces turned over left 477 of 1,010 lit vertices below 0.01, with

@@ -503,18 +503,21 @@ std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::v
   // floor, and every path from the corner started outside the box (an
   // outside audit: the reference read 0 there, radiosity and photon mapping
   // the direct light alone). Along each face's normal m the offset keeps at
-  // least half the clearance the normal alone gives: n.m + a (shift.m) >=
-  // n.m / 2, the largest such a in [0, 1].
+  // least half the clearance the normal alone gives, on the side of the
+  // face the normal leaves on (the front for outward normals, the back for
+  // thickness's inward ones: an unwelded cube's corner was pulled out of
+  // the cube through its own face): |n.m + a (shift.m)| >= |n.m| / 2, the
+  // largest such a in [0, 1].
   std::vector<double> keep(nv, 1.0);
   for (size_t f = 0; f < ok.size(); ++f) {
     if (!ok[f]) continue;
     const glm::dvec3 m = glm::normalize(glm::dvec3(faceNormalUnnormalized(s, f)));
     for (int k = 0; k < 3; ++k) {
       const uint32_t i = s.triangles[f][k];
-      const double along = glm::dot(shift[i], m);
-      if (!(along < 0.0)) continue;
       const double clearance = glm::dot(glm::dvec3(normals[i]), m);
-      keep[i] = std::min(keep[i], std::max(0.0, 0.5 * clearance / -along));
+      const double along = (clearance < 0.0 ? -1.0 : 1.0) * glm::dot(shift[i], m);
+      if (!(along < 0.0)) continue;
+      keep[i] = std::min(keep[i], std::max(0.0, 0.5 * std::fabs(clearance) / -along));
     }
   }
   std::vector<glm::vec3> o(nv);

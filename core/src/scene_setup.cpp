@@ -355,7 +355,7 @@ std::optional<std::string> whiteReflectanceWarning(const Scene& s) {
   }
   if (!clamped) return std::nullopt;
   return std::to_string(clamped) +
-         " reflectance channels of diffuse faces at or above 1 (white colours) limited to 0.999: rho = 1 returns all "
+         " reflectance channels of diffuse faces at or above 0.999 (white or nearly white colours) limited to 0.999: rho = 1 returns all "
          "the light it receives, and a closed room never converges; at 0.999 B there reaches about 1000 times the "
          "emission (choose a reflectance below 1)";
 }

@@ -519,6 +519,37 @@ TEST(SceneWarnings, WhiteColoursOnAMirrorLayerAreNotCounted) {
   }
 }
 
+// A bounding box stretched by a far part (one small triangle, 3 of the
+// vertices) makes the ray offset large against the rest: said when the box
+// is more than 100 times the extent of the bulk of the vertices (the floor
+// with its wall, 20 across, and a triangle 10,000 away: about 850 times),
+// not for the scene as it is, nor with the triangle 20 away (2 times).
+TEST(SceneWarnings, StrayFarPartsAreWarned) {
+  for (double far : {0.0, 20.0, 10000.0}) {
+    scenes::SceneFile sf = scenes::floorWithWall(4.0, 1.0, 10);
+    if (far > 0.0) {
+      std::vector<glm::dvec3> p;
+      for (const glm::vec3& q : sf.scene.positions) p.push_back(sf.scene.toWorld(q));
+      const uint32_t k = uint32_t(p.size());
+      p.push_back({far, far, far}), p.push_back({far + 0.01, far, far}), p.push_back({far, far + 0.01, far});
+      std::vector<glm::uvec3> t = sf.scene.triangles;
+      t.push_back({k, k + 1, k + 2});
+      Scene s = Scene::fromAbsolute(p, t);
+      s.rho = sf.scene.rho, s.emission = sf.scene.emission;
+      if (!s.rho.empty()) s.rho.push_back(s.rho.back());
+      if (!s.emission.empty()) s.emission.push_back(glm::vec3(0.f));
+      sf.scene = s;
+      if (!sf.attrs.faceColor.empty()) sf.attrs.faceColor.push_back(sf.attrs.faceColor.back());
+      if (!sf.attrs.faceQuality.empty()) sf.attrs.faceQuality.push_back(0.f);
+      if (!sf.attrs.vertexColor.empty()) sf.attrs.vertexColor.resize(p.size(), sf.attrs.vertexColor.back());
+    }
+    FilterInput in = test::filterInput(FilterKind::AmbientOcclusion, sf);
+    in.values.set("rays_per_vertex", 16);
+    const FilterResult r = runFilter(FilterKind::AmbientOcclusion, in);
+    EXPECT_EQ(warned(r.stats, "times the extent of the bulk of the vertices"), far > 100.0) << far << ": " << all(r.stats);
+  }
+}
+
 // Faces turned over against their neighbours are warned of (an outside
 // audit: half a Cornell box's faces turned over left most lit vertices
 // black, with no word); the box as it is says nothing.

@@ -1,0 +1,98 @@
+#include "scene_defects.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+namespace gi::detail {
+
+// Rays start 1e-5 of the bounding box's diagonal off the surfaces (and
+// float coordinates centred on the box lose that much precision): a box
+// stretched by a few far vertices makes that offset large against the rest
+// of the mesh (an outside audit: one triangle 100 m away from a 1.4 m scene
+// moved its direct light by 2.4%; one spike vertex 1e6 away turned a floor
+// under a cube from 0 to 1 in ambient occlusion). Said when the box's
+// diagonal exceeds 100 times that of the bulk of the vertices (each axis
+// without its 1% most extreme at either end, at least 8; meshes of 32
+// vertices or more).
+std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport& rep) {
+  std::vector<uint8_t> used(s.vertexCount(), 0);
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  for (size_t f = 0; f < ok.size(); ++f)
+    if (ok[f]) used[s.triangles[f].x] = used[s.triangles[f].y] = used[s.triangles[f].z] = 1;
+  std::vector<float> c;
+  c.reserve(s.vertexCount());
+  glm::dvec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    c.clear();
+    for (size_t i = 0; i < used.size(); ++i)
+      if (used[i]) c.push_back(s.positions[i][a]);
+    // Too few vertices to tell a stray one from the shape; at most 1% of
+    // them, but at least 8, may lie beyond each side of the bulk's box.
+    if (c.size() < 32) return std::nullopt;
+    const size_t out = std::max<size_t>(8, c.size() / 100), k0 = out, k1 = c.size() - 1 - out;
+    std::nth_element(c.begin(), c.begin() + long(k0), c.end());
+    lo[a] = c[k0];
+    std::nth_element(c.begin(), c.begin() + long(k1), c.end());
+    hi[a] = c[k1];
+  }
+  const double bulk = glm::length(hi - lo) * s.unit, diag = rep.diagonal;
+  if (!(diag > 100.0 * bulk)) return std::nullopt;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "the bounding box (diagonal %.3g) is %.0f times the extent of the bulk of the vertices (%.3g): rays start "
+                "%.3g off the surfaces (1e-5 of the box), %.2g%% of that extent, so shadows, gaps and small parts "
+                "read wrong; remove stray far vertices or far parts, or compute them apart",
+                diag, diag / std::max(bulk, 1e-300), bulk, rep.rayEpsilon * s.unit,
+                100.0 * rep.rayEpsilon * s.unit / std::max(bulk, 1e-300));
+  return std::string(buf);
+}
+
+// Rays met a face and its copy at random, and both emitted: a Cornell box
+// whose light faces were listed twice came out twice as bright in every
+// solver, its walls listed twice 27% dark in photon mapping (an outside
+// audit). Each copy is left out of the computation (Scene::leftOut) and
+// takes its original's values in the output; a copy's corner that is a
+// vertex of its own (an unwelded copy) takes the original's corner's.
+void leaveOutDuplicates(FilterInput& in, FilterResult& res) {
+  Scene& s = in.scene;
+  res.sameFaces = duplicatedFaces(s);
+  s.leftOut.assign(s.faceCount(), 0);
+  for (const auto& [copy, original] : res.sameFaces) s.leftOut[copy] = 1;
+  std::vector<uint8_t> kept(s.vertexCount(), 0);  // on a face the computation keeps
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (!s.leftOut[f]) kept[s.triangles[f].x] = kept[s.triangles[f].y] = kept[s.triangles[f].z] = 1;
+  for (const auto& [copy, original] : res.sameFaces)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = s.triangles[copy][k];
+      if (kept[v]) continue;
+      for (int j = 0; j < 3; ++j)
+        if (s.positions[s.triangles[original][j]] == s.positions[v]) res.sameVertices.push_back({v, s.triangles[original][j]});
+      kept[v] = 1;  // once
+    }
+  res.report = analyzeScene(s);  // the copies counted as left out
+  res.setupLog += std::string(res.setupLog.empty() ? "" : "; ") + std::to_string(res.sameFaces.size()) +
+                  " faces repeat another face's corners in the same turn: each is computed once, its copies "
+                  "neither emitting nor blocking light, and shown with its values (MeshLab: Cleaning and "
+                  "Repairing > Remove Duplicate Faces removes them)";
+}
+
+// The output's copies of duplicated faces (and their own vertices) take
+// their originals' values; nothing to do for a refined mesh (other faces).
+void copyDuplicates(FilterResult& res) {
+  if (res.refined) return;
+  auto copy = [](auto& values, const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t width = 1) {
+    if (values.empty()) return;
+    for (const auto& [to, from] : pairs)
+      for (size_t c = 0; c < width; ++c) values[width * to + c] = values[width * from + c];
+  };
+  copy(res.vertexQuality, res.sameVertices);
+  copy(res.vertexColor, res.sameVertices);
+  copy(res.vertexNormal, res.sameVertices);
+  for (VertexAttribute& a : res.attributes) copy(a.values, res.sameVertices, size_t(a.components));
+  copy(res.faceQuality, res.sameFaces);
+  copy(res.faceColor, res.sameFaces);
+  copy(res.faceRadiometry, res.sameFaces);
+}
+
+}  // namespace gi::detail

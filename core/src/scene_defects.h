@@ -1,0 +1,24 @@
+// Defects of a scene that the filters' set-up mends or warns of, before
+// any algorithm runs: faces listed twice (computed once, their copies given
+// their originals' values in the output) and a bounding box stretched by
+// stray far vertices (the ray offset scales with it).
+#pragma once
+#include <optional>
+#include <string>
+
+#include "gi/filter_run.h"
+
+namespace gi::detail {
+
+// Leaves each duplicated face's copies out of the computation
+// (Scene::leftOut) and records them in res.sameFaces and res.sameVertices;
+// res.report is made again, the copies counted as left out.
+void leaveOutDuplicates(FilterInput& in, FilterResult& res);
+// Gives the output's copies their originals' values (per vertex and per
+// face); nothing for a refined mesh.
+void copyDuplicates(FilterResult& res);
+// The warning for a bounding box more than 100 times the extent of the bulk of
+// the vertices, or none.
+std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport& rep);
+
+}  // namespace gi::detail
