@@ -314,6 +314,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     j["scene"] = {{"vertices", rep.vertices}, {"faces", rep.faces}, {"usable_faces", rep.usableFaces()},
                   {"degenerate_faces", rep.degenerateFaces}, {"invalid_faces", rep.invalidFaces},
                   {"nonfinite_vertices", rep.nonFiniteVertices}, {"isolated_vertices", rep.isolatedVertices},
+                  {"duplicated_faces_left_out", rep.leftOutFaces}, {"misoriented_edges", rep.misorientedEdges},
                   {"emitter_faces", rep.emitterFaces}, {"diagonal", rep.diagonal}};
     j["stats"] = statsJson(r.stats);
     j["notes"] = r.stats.notes;

@@ -12,12 +12,15 @@
 #include "gi/hemicube_view.h"
 #include "gi/output.h"
 #include "gi/render.h"
+#include "scene_defects.h"
 
 namespace gi::detail {
 
 void runFormFactors(FilterInput& in, FilterResult& res) {
   const Scene& s = in.scene;
-  const uint32_t face = chosenFace(in.values.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t chosen = chosenFace(in.values.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t face = originalFace(res, chosen);  // a duplicated face's copy stands for its original
+  if (face != chosen) res.stats.note("face " + std::to_string(chosen) + " repeats face " + std::to_string(face) + ": computed for it");
   const auto caster = makeEmbreeCaster(s);
   const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(in.values), face);
   FormFactorOutput out = formFactorOutput(s, rep, face);
@@ -39,7 +42,9 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
 void runHemicube(FilterInput& in, FilterResult& res) {
   const Scene& s = in.scene;
   const ParamValues& v = in.values;
-  const uint32_t face = chosenFace(v.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t chosen = chosenFace(v.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t face = originalFace(res, chosen);  // a duplicated face's copy stands for its original
+  if (face != chosen) res.stats.note("face " + std::to_string(chosen) + " repeats face " + std::to_string(face) + ": computed for it");
   if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(face) + " is degenerate");
   const Timer timer;
   const auto caster = makeEmbreeCaster(s);

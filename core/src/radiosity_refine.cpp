@@ -132,7 +132,10 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
       why = "nothing left above the thresholds";
       break;
     }
-    const size_t take = facesWithinBudget(refiner, marks.faces, budget);
+    // Faces left out of the computation (a duplicated face's copies) are
+    // no patches: never split, and not counted against the budget.
+    const size_t leftOut = size_t(std::count(sc.leftOut.begin(), sc.leftOut.end(), uint8_t(1)));
+    const size_t take = facesWithinBudget(refiner, marks.faces, budget + leftOut);
     if (take == 0) {
       why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(marks.faces.size()) +
             " faces still above the thresholds)";

@@ -118,6 +118,7 @@ struct MeshRefiner::Impl {
     for (size_t f = 0; f < faces.size(); ++f) {
       if (p.removed[f]) continue;
       if (p.red[f]) { n += 4; continue; }
+      if (!srcValid[faces[f].src]) { n += 1; continue; }  // never split (apply keeps it whole)
       int count = 0;
       for (int k = 0; k < 3; ++k) count += p.split.count(edgeKey(faces[f].v[k], faces[f].v[(k + 1) % 3])) ? 1 : 0;
       n += count == 1 ? 2 : 1;
@@ -239,7 +240,13 @@ MeshRefiner::MeshRefiner(const Scene& input) : impl_(std::make_unique<Impl>()) {
   d.parents.resize(input.positions.size());
   for (uint32_t v = 0; v < input.positions.size(); ++v) d.parents[v] = glm::uvec2(v, v);
   const size_t nv = input.positions.size();
-  for (const auto& t : input.triangles) d.srcValid.push_back(t.x < nv && t.y < nv && t.z < nv ? 1 : 0);
+  // A face the computation leaves out (a duplicated face's copy) is never
+  // split either: it would only add patches that take no part.
+  for (size_t f = 0; f < input.faceCount(); ++f) {
+    const glm::uvec3& t = input.triangles[f];
+    const bool leftOut = !input.leftOut.empty() && input.leftOut[f];
+    d.srcValid.push_back(t.x < nv && t.y < nv && t.z < nv && !leftOut ? 1 : 0);
+  }
   d.faces.resize(input.triangles.size());
   for (uint32_t f = 0; f < input.triangles.size(); ++f) d.faces[f] = {input.triangles[f], f, 0, kNotGreen};
   d.publish();

@@ -334,14 +334,26 @@ CornerGroups cornerGroups(const Scene& s, const std::vector<uint8_t>& ok, const 
     keys.push_back({c[0], c[1], c[2], turn[size_t((first + 1) % 3)] == c[1] ? 0u : 1u, uint32_t(f)});
   }
   std::sort(keys.begin(), keys.end());
-  // A face turned as an earlier one on the same corners is a duplicate (of
-  // the group's first face); a group on the same corners with both turns is
-  // a two-sided pair.
-  for (size_t k = 1, first = 0; k < keys.size(); ++k) {
-    const bool sameCorners = std::equal(keys[k].begin(), keys[k].begin() + 3, keys[k - 1].begin());
-    if (!sameCorners || keys[k][3] != keys[k - 1][3]) first = k;
-    if (sameCorners && keys[k][3] == keys[k - 1][3]) g.duplicates.push_back({keys[k][4], keys[first][4]});
-    else if (sameCorners) ++g.twoSidedPairs;
+  // Faces on the same corners in the same turn are one face listed again: a
+  // group's original is the face that emits, else one that is not diffuse
+  // (a mirror or glass layer lying on a wall), else the first; the others
+  // are its duplicates (a light panel given as a layer over the ceiling's
+  // own faces is the light, not a copy of the ceiling: an outside review).
+  // A group on the same corners with both turns is a two-sided pair.
+  auto rank = [&](uint32_t f) {
+    const glm::vec3 E = s.faceEmission(f);
+    return (E.r > 0.f || E.g > 0.f || E.b > 0.f) ? 0 : s.faceMaterial(f) != Material::Diffuse ? 1 : 2;
+  };
+  for (size_t first = 0; first < keys.size();) {
+    size_t end = first + 1;
+    while (end < keys.size() && std::equal(keys[end].begin(), keys[end].begin() + 4, keys[first].begin())) ++end;
+    if (first > 0 && std::equal(keys[first].begin(), keys[first].begin() + 3, keys[first - 1].begin())) ++g.twoSidedPairs;
+    size_t best = first;
+    for (size_t k = first + 1; k < end; ++k)
+      if (rank(keys[k][4]) < rank(keys[best][4])) best = k;
+    for (size_t k = first; k < end; ++k)
+      if (k != best) g.duplicates.push_back({keys[k][4], keys[best][4]});
+    first = end;
   }
   // Edges met by exactly two faces that run along them the same way: one of
   // the two is turned over (its front is the other's back). Grouped by the

@@ -6,6 +6,10 @@
 
 namespace gi::detail {
 
+namespace {
+constexpr uint32_t kNoFace = 0xffffffffu;
+}  // namespace
+
 // Rays start 1e-5 of the bounding box's diagonal off the surfaces (and
 // float coordinates centred on the box lose that much precision): a box
 // stretched by a few far vertices makes that offset large against the rest
@@ -60,8 +64,9 @@ void leaveOutDuplicates(FilterInput& in, FilterResult& res) {
   s.leftOut.assign(s.faceCount(), 0);
   for (const auto& [copy, original] : res.sameFaces) s.leftOut[copy] = 1;
   std::vector<uint8_t> kept(s.vertexCount(), 0);  // on a face the computation keeps
+  const std::vector<uint8_t> ok = usableFaceMask(s);  // the copies left out
   for (size_t f = 0; f < s.faceCount(); ++f)
-    if (!s.leftOut[f]) kept[s.triangles[f].x] = kept[s.triangles[f].y] = kept[s.triangles[f].z] = 1;
+    if (ok[f]) kept[s.triangles[f].x] = kept[s.triangles[f].y] = kept[s.triangles[f].z] = 1;
   for (const auto& [copy, original] : res.sameFaces)
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = s.triangles[copy][k];
@@ -77,10 +82,18 @@ void leaveOutDuplicates(FilterInput& in, FilterResult& res) {
                   "Repairing > Remove Duplicate Faces removes them)";
 }
 
+uint32_t originalFace(const FilterResult& res, uint32_t face) {
+  for (const auto& [copyFace, original] : res.sameFaces)
+    if (copyFace == face) return original;
+  return face;
+}
+
 // The output's copies of duplicated faces (and their own vertices) take
-// their originals' values; nothing to do for a refined mesh (other faces).
+// their originals' values. A refined mesh keeps the input's vertices first,
+// in order, and never splits a copy: its face takes the area-weighted mean
+// of the faces its original became (the linear values: the colours follow
+// from them, or keep the first face's).
 void copyDuplicates(FilterResult& res) {
-  if (res.refined) return;
   auto copy = [](auto& values, const std::vector<std::pair<uint32_t, uint32_t>>& pairs, size_t width = 1) {
     if (values.empty()) return;
     for (const auto& [to, from] : pairs)
@@ -90,9 +103,34 @@ void copyDuplicates(FilterResult& res) {
   copy(res.vertexColor, res.sameVertices);
   copy(res.vertexNormal, res.sameVertices);
   for (VertexAttribute& a : res.attributes) copy(a.values, res.sameVertices, size_t(a.components));
-  copy(res.faceQuality, res.sameFaces);
-  copy(res.faceColor, res.sameFaces);
-  copy(res.faceRadiometry, res.sameFaces);
+  if (!res.refined) {
+    copy(res.faceQuality, res.sameFaces);
+    copy(res.faceColor, res.sameFaces);
+    copy(res.faceRadiometry, res.sameFaces);
+    return;
+  }
+  if (res.sameFaces.empty() || (res.faceQuality.empty() && res.faceRadiometry.empty())) return;
+  const RefinedMesh& m = *res.refined;
+  std::vector<uint32_t> originalOf(m.sourceFace.empty() ? 0 : *std::max_element(m.sourceFace.begin(), m.sourceFace.end()) + 1,
+                                   kNoFace);
+  for (const auto& [copyFace, original] : res.sameFaces)
+    if (copyFace < originalOf.size()) originalOf[copyFace] = original;
+  // The mean over each original's refined faces.
+  std::vector<double> area(originalOf.size(), 0.0), quality(originalOf.size(), 0.0);
+  std::vector<glm::dvec3> radiometry(originalOf.size(), glm::dvec3(0.0));
+  for (size_t f = 0; f < m.sourceFace.size(); ++f) {
+    const uint32_t src = m.sourceFace[f];
+    const double a = faceArea(m.scene, f);
+    area[src] += a;
+    if (!res.faceQuality.empty()) quality[src] += a * res.faceQuality[f];
+    if (!res.faceRadiometry.empty()) radiometry[src] += a * glm::dvec3(res.faceRadiometry[f]);
+  }
+  for (size_t f = 0; f < m.sourceFace.size(); ++f) {
+    const uint32_t o = originalOf[m.sourceFace[f]];
+    if (o == kNoFace || !(area[o] > 0.0)) continue;
+    if (!res.faceQuality.empty()) res.faceQuality[f] = float(quality[o] / area[o]);
+    if (!res.faceRadiometry.empty()) res.faceRadiometry[f] = glm::vec3(radiometry[o] / area[o]);
+  }
 }
 
 }  // namespace gi::detail

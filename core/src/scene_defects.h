@@ -17,6 +17,9 @@ void leaveOutDuplicates(FilterInput& in, FilterResult& res);
 // Gives the output's copies their originals' values (per vertex and per
 // face); nothing for a refined mesh.
 void copyDuplicates(FilterResult& res);
+// The face a chosen face stands for: its original where it is a duplicated
+// face's copy (left out of the computation), else itself.
+uint32_t originalFace(const FilterResult& res, uint32_t face);
 // The warning for a bounding box more than 100 times the extent of the bulk of
 // the vertices, or none.
 std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport& rep);

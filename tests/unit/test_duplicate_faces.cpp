@@ -106,3 +106,91 @@ TEST(DuplicateFaces, ComputedOnceInEveryFilter) {
     }
   }
 }
+
+// The face kept of a group is the one that emits (or is not diffuse), not
+// the first: a light given as faces of its own over the ceiling's (a layer
+// after the room's) is the light (an outside review: the room's faces came
+// first, the light's were left out, and the scene had no emitter).
+TEST(DuplicateFaces, TheLightIsKeptOverTheSurfaceItCovers) {
+  const scenes::SceneFile clean = scenes::cornellBox(100.0);
+  const size_t nv = clean.scene.vertexCount();
+  std::vector<size_t> lights;
+  for (size_t f = 0; f < clean.scene.faceCount(); ++f)
+    if (luminance(clean.scene.faceEmission(f)) > 0.f) lights.push_back(f);
+  ASSERT_FALSE(clean.attrs.faceQuality.empty());
+  // The copies (own vertices) emit; the faces they cover do not.
+  scenes::SceneFile panel = withCopies(clean, lights, true);
+  for (size_t f : lights) panel.attrs.faceQuality[f] = 0.f;
+  const std::vector<std::pair<const char*, const char*>> values = {{"rays_per_patch", "256"}, {"gather_rays", "16"}};
+  const FilterResult base = run(FilterKind::Radiosity, clean, values), r = run(FilterKind::Radiosity, panel, values);
+  // Away from the light's own corners (a separate sheet now: its border
+  // vertices belong to the ceiling alone) the same values; the light's
+  // samples are drawn on other faces (other seeds), the mean must agree to
+  // the sampling noise.
+  std::vector<uint8_t> onLight(nv, 0);
+  for (size_t f : lights)
+    for (int k = 0; k < 3; ++k) onLight[clean.scene.triangles[f][k]] = 1;
+  double sumA = 0, sumB = 0, worst = 0;
+  for (size_t v = 0; v < nv; ++v) {
+    if (onLight[v]) continue;
+    sumA += base.vertexQuality[v], sumB += r.vertexQuality[v];
+    worst = std::max(worst, std::fabs(double(r.vertexQuality[v]) - base.vertexQuality[v]) /
+                                std::max(1e-3, double(base.vertexQuality[v])));
+  }
+  EXPECT_NEAR(sumB / sumA, 1.0, 0.002);
+  EXPECT_LT(worst, 0.02);  // before: no emitter at all
+  EXPECT_NEAR(r.stats.get("emitted_power_W"), base.stats.get("emitted_power_W"), 1e-6 * base.stats.get("emitted_power_W"));
+}
+
+// With refinement the copies are never split nor counted against the
+// patch budget; their own vertices show their originals' values, and each
+// copy's face the area-weighted mean of the faces its original became.
+TEST(DuplicateFaces, RefinementLeavesTheCopiesWhole) {
+  const scenes::SceneFile clean = scenes::cornellBox(100.0);
+  const size_t nv = clean.scene.vertexCount(), nf = clean.scene.faceCount();
+  std::vector<size_t> lights;
+  for (size_t f = 0; f < nf; ++f)
+    if (luminance(clean.scene.faceEmission(f)) > 0.f) lights.push_back(f);
+  const std::vector<std::pair<const char*, const char*>> values = {
+      {"rays_per_patch", "256"}, {"gather_rays", "16"}, {"refine", "true"}, {"refine_max_depth", "1"},
+      {"refine_max_patches", "2000"}, {"face_output", "true"}};
+  const FilterResult base = run(FilterKind::Radiosity, clean, values);
+  for (bool own : {false, true}) {
+    const scenes::SceneFile doubled = withCopies(clean, lights, own);
+    const FilterResult r = run(FilterKind::Radiosity, doubled, values);
+    ASSERT_TRUE(base.refined && r.refined);
+    // The same patches: the copies add none and none of theirs is split.
+    EXPECT_EQ(r.refined->scene.faceCount(), base.refined->scene.faceCount() + lights.size()) << own;
+    for (size_t v = 0; v < nv; ++v) ASSERT_EQ(r.vertexQuality[v], base.vertexQuality[v]) << own << ", vertex " << v;
+    size_t copy = nv;
+    for (size_t f : lights)
+      for (int k = 0; own && k < 3; ++k, ++copy)
+        ASSERT_EQ(r.vertexQuality[copy], r.vertexQuality[clean.scene.triangles[f][k]]) << "face " << f;
+    // Each copy's face: the mean of its original's refined faces.
+    const RefinedMesh& m = *r.refined;
+    for (size_t k = 0; k < lights.size(); ++k) {
+      double a = 0, q = 0;
+      size_t at = m.sourceFace.size();
+      for (size_t f = 0; f < m.sourceFace.size(); ++f) {
+        if (m.sourceFace[f] == lights[k]) a += faceArea(m.scene, f), q += faceArea(m.scene, f) * r.faceQuality[f];
+        if (m.sourceFace[f] == nf + k) at = f;
+      }
+      ASSERT_LT(at, m.sourceFace.size());
+      EXPECT_NEAR(r.faceQuality[at], q / a, 1e-4 * q / a) << own << ", light face " << lights[k];
+    }
+  }
+}
+
+// A copy chosen for the form factors or the hemicube stands for its
+// original (it was refused as degenerate).
+TEST(DuplicateFaces, AChosenCopyStandsForItsOriginal) {
+  const scenes::SceneFile clean = scenes::cornellBox(100.0);
+  const size_t nf = clean.scene.faceCount();
+  const scenes::SceneFile doubled = withCopies(clean, {7}, true);
+  for (FilterKind kind : {FilterKind::FormFactorsOfFace, FilterKind::HemicubeOfFace}) {
+    const FilterResult a = run(kind, doubled, {{"face_index", "7"}});
+    const FilterResult b = run(kind, doubled, {{"face_index", std::to_string(nf).c_str()}});
+    ASSERT_EQ(a.faceQuality.size(), b.faceQuality.size());
+    for (size_t f = 0; f < a.faceQuality.size(); ++f) ASSERT_EQ(a.faceQuality[f], b.faceQuality[f]) << f;
+  }
+}
