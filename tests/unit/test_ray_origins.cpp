@@ -13,6 +13,7 @@
 #include <cmath>
 #include <vector>
 
+#include "gi/ambient.h"
 #include "gi/color.h"
 #include "gi/pathtrace.h"
 #include "gi/raycaster.h"
@@ -21,6 +22,8 @@
 using namespace gi;
 
 namespace {
+
+constexpr double kPi = 3.14159265358979323846;
 
 // The unit box seen from inside: walls of two triangles, the ceiling (z = 1)
 // emitting E = 1, the floor a fan of `fan` triangles from its corner at the
@@ -106,4 +109,78 @@ TEST(RayOrigins, BoxCornerOverAFanFloor) {
     const float b = corner(fan, se);
     EXPECT_NEAR(b, b2, 4.f * std::sqrt(se * se + se2 * se2)) << "fan " << fan;
   }
+}
+
+namespace {
+
+// A flat sheet (z = 0, facing up) around a vertex at the origin: the wedge
+// from angle 0 to `span` cut into triangles at the given angles, out to
+// radius 1; the vertex is index 0.
+Scene wedge(const std::vector<double>& cuts) {
+  std::vector<glm::dvec3> p = {{0, 0, 0}};
+  for (double a : cuts) p.push_back({std::cos(a), std::sin(a), 0.0});
+  std::vector<glm::uvec3> t;
+  for (uint32_t k = 1; k + 1 < p.size(); ++k) t.push_back({0, k, k + 1});
+  return Scene::fromAbsolute(p, t);
+}
+
+// Vertex 0's ray origin less its position (local units: the scenes here are of unit size).
+glm::vec3 originOfVertex0(const Scene& s, float eps) {
+  return vertexRayOrigins(s, vertexNormalsForRays(s), eps)[0] - s.positions[0];
+}
+
+}  // namespace
+
+// The pull follows the wedge the faces span, not its triangles: a straight
+// border (180 degrees) cut into 2 triangles or into 12 with slivers of 0.01
+// degree along the border, and an L-shaped room's inner corner (270
+// degrees) cut into 6 triangles two ways, give the same origin. The mean
+// of the directions to the faces' centroids did not: thin triangles along
+// a border cancelled each other (the origin sat on a wall standing there:
+// a crease vertex read 0.09 for 0.33), and one fan of the L's corner
+// pointed into the block (0.0035 for 0.020; an outside audit).
+TEST(RayOrigins, TheWedgeNotItsTrianglesSetsThePull) {
+  const double d = kPi / 180;
+  const float eps = 1e-3f;
+  const glm::vec3 border2 = originOfVertex0(wedge({0, 90 * d, 180 * d}), eps);
+  const glm::vec3 border12 = originOfVertex0(
+      wedge({0, 0.01 * d, 0.02 * d, 30 * d, 60 * d, 90 * d, 100 * d, 150 * d, 179.97 * d, 179.98 * d, 179.99 * d, 180 * d}), eps);
+  EXPECT_NEAR(glm::length(border2 - border12), 0.f, 1e-4f * eps);
+  EXPECT_NEAR(border2.y, 2 * eps, 1e-4f * eps);  // 2 eps into the sheet, eps up
+  EXPECT_NEAR(border2.z, eps, 1e-4f * eps);
+  const glm::vec3 lA = originOfVertex0(wedge({0, 45 * d, 90 * d, 135 * d, 180 * d, 225 * d, 270 * d}), eps);
+  const glm::vec3 lB = originOfVertex0(wedge({0, 26.6 * d, 90 * d, 153.4 * d, 180 * d, 243.4 * d, 270 * d}), eps);
+  EXPECT_NEAR(glm::length(lA - lB), 0.f, 1e-4f * eps);
+  // Towards the wedge's middle (135 degrees), away from the block (315 degrees): 2 eps.
+  EXPECT_NEAR(lA.x, -std::sqrt(2.f) * eps, 1e-4f * eps);
+  EXPECT_NEAR(lA.y, std::sqrt(2.f) * eps, 1e-4f * eps);
+}
+
+// A floor vertex where a separate sheet meets the floor at 30 degrees: the
+// cosine-weighted directions between the two, (1 - cos 30) / 2 = 0.0670,
+// with the floor cut into slivers along the crease (4,096 rays, 4 standard
+// errors). With the pull at 45 degrees above the floor the origin lay
+// behind the other sheet and read 0.93 (an outside audit).
+TEST(RayOrigins, SeparateSheetsMeetingAtANarrowCrease) {
+  const double d = kPi / 180;
+  // Floor: the wedge around the vertex from 0 to 180 degrees (x > 0 side
+  // is y > 0 here), slivers by the crease line (the x axis).
+  Scene s = wedge({0, 0.02 * d, 0.05 * d, 45 * d, 90 * d, 135 * d, 179.95 * d, 179.98 * d, 180 * d});
+  // The other sheet: through the x axis, rising at 30 degrees over y > 0,
+  // facing down towards the floor, from x = -1 to 1 and out to 1.
+  std::vector<glm::dvec3> p;
+  for (const glm::vec3& q : s.positions) p.push_back(s.toWorld(q));
+  const uint32_t k = uint32_t(p.size());
+  const double c = std::cos(30 * d), sn = std::sin(30 * d);
+  p.push_back({-1, 0, 0}), p.push_back({1, 0, 0}), p.push_back({1, c, sn}), p.push_back({-1, c, sn});
+  std::vector<glm::uvec3> t = s.triangles;
+  t.push_back({k, k + 2, k + 1}), t.push_back({k, k + 3, k + 2});  // facing down (towards the floor)
+  const Scene both = Scene::fromAbsolute(p, t);
+  ASSERT_LT(glm::dot(faceNormalUnnormalized(both, both.faceCount() - 1), glm::vec3(0, 0, 1)), 0.f);
+  auto caster = makeEmbreeCaster(both);
+  AmbientOptions o;
+  o.raysPerVertex = 4096;
+  const AmbientResult r = computeAmbient(both, *caster, o);
+  const double exact = (1 - c) / 2;
+  EXPECT_NEAR(r.value[0], exact, 4 * r.stdError[0]);
 }

@@ -137,8 +137,10 @@ const std::vector<uint8_t>& usableFaces(const Scene& s, const std::vector<uint8_
 namespace gi {
 // Ray origins for per-vertex estimators: lifted by eps along the normal and,
 // where the one-ring is lopsided (mesh borders, the edge where a floor meets a
-// separate wall sheet), pulled by eps into the incident faces, so that rays
-// cannot slip under an adjacent wall at t = 0 and leak.
+// separate wall sheet), pulled by 2 eps into the wedge its faces span (along
+// the mean direction over the wedge, whatever its triangles), so that rays
+// cannot slip under an adjacent wall at t = 0 and leak; never so far that
+// the origin leaves the normal's side of one of its own faces.
 std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps,
                                         const std::vector<uint8_t>* usable = nullptr);
 }  // namespace gi
