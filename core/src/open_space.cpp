@@ -215,10 +215,11 @@ bool OpenSpaceTest::openWithin(uint32_t vertex, float maxDistance) const {
   if (m.faces.empty()) return true;
   if (m.nodes.empty()) throw std::logic_error("OpenSpaceTest::openWithin before build()");
   const glm::vec3 p = m.s.positions[vertex], n = m.normals[vertex];
-  // Ray origins lie within sqrt(2) eps of p (lifted by eps, and pulled by
-  // eps into the faces at lopsided one-rings): reach 2 eps beyond maxDistance.
-  const float reach = maxDistance + 2.f * m.eps;
-  const float R = maxDistance + m.maxRadius + 2.f * m.eps;
+  // Ray origins lie within sqrt(5) eps of p (lifted by eps, and pulled by
+  // 2 eps into the faces at lopsided one-rings: vertexRayOrigins): reach
+  // 3 eps beyond maxDistance.
+  const float reach = maxDistance + 3.f * m.eps;
+  const float R = maxDistance + m.maxRadius + 3.f * m.eps;
   const float limit = 0.5f * m.eps;
   // A face blocks when it is within the reach of some ray (its bounding
   // sphere) and a corner lies at or above the plane eps/2 over the tangent

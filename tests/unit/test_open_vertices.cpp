@@ -108,8 +108,8 @@ TEST(AmbientOcclusionStress, NonFiniteUserNormalIsInvalid) {
 }
 
 // The proof for rays limited to max_distance searches far enough for ray
-// origins pulled into the faces at a lopsided one-ring (sqrt(2) eps from the
-// vertex): a single floor triangle's corner under a fin whose tip passes its
+// origins pulled into the faces at a lopsided one-ring (sqrt(5) eps from the
+// vertex: eps up, 2 eps along the corner's bisector): a single floor triangle's corner under a fin whose tip passes its
 // ray origin, with the fin's centre just beyond the reach of a search for
 // origins at eps. It got 1 with the proof and 0.2 with rays.
 TEST(AmbientOcclusion, OpenWithinReachCoversPulledOrigins) {
@@ -127,7 +127,7 @@ TEST(AmbientOcclusion, OpenWithinReachCoversPulledOrigins) {
   const uint32_t p = add({0, 0, 0});
   const uint32_t f1 = add({3 * eps, 0, 0}), f2 = add({0, 3 * eps, 0});
   s.triangles.push_back({p, f1, f2});
-  const glm::dvec3 o = eps * glm::dvec3(std::sqrt(0.5), std::sqrt(0.5), 1.0);  // p's ray origin
+  const glm::dvec3 o = eps * glm::dvec3(std::sqrt(2.0), std::sqrt(2.0), 1.0);  // p's ray origin
   // The fin: a long thin triangle in a plane just above o, its axis 20 degrees
   // below the direction of the pull, its tip 0.1 eps behind o.
   const double th = 0.25 * M_PI + 20.0 * M_PI / 180.0;
