@@ -71,10 +71,11 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   // After the materials: a mirror's or glass layer's faces take the specular colour.
   if (v.has("reflectance_source"))
     if (auto w = whiteReflectanceWarning(in.scene)) res.setupWarnings.push_back(*w);
-  res.report = analyzeScene(in.scene);
+  res.report = analyzeScene(in.scene, true, nullptr, &res.sameFaces);  // the pairs for leaveOutDuplicates
   if (res.report.usableFaces() == 0)
     throw std::invalid_argument("the mesh has no usable triangles (" + res.report.summary() + ")");
-  if (res.report.duplicateFaces && kind != FilterKind::ErrorMap) leaveOutDuplicates(in, res);
+  if (kind == FilterKind::ErrorMap) res.sameFaces.clear();  // compares values as they are, copies included
+  else if (res.report.duplicateFaces) leaveOutDuplicates(in, res);
   if (kind != FilterKind::ErrorMap)
     if (auto w = strayExtentWarning(in.scene, res.report)) res.setupWarnings.push_back(*w);
   // A face turned over shows its black back to what its neighbours light,

@@ -392,7 +392,8 @@ std::vector<std::pair<uint32_t, uint32_t>> duplicatedFaces(const Scene& s) {
   return cornerGroups(s, ok, used).duplicates;
 }
 
-SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<uint8_t>* usable) {
+SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<uint8_t>* usable,
+                         std::vector<std::pair<uint32_t, uint32_t>>* duplicates) {
   SceneReport r;
   r.vertices = s.vertexCount();
   r.faces = s.faceCount();
@@ -425,8 +426,9 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
   // earlier usable face. Coplanar copies hide each other at random in ray
   // casting, so exact energy accounting does not hold for them.
   if (duplicateFaces) {
-    const CornerGroups g = cornerGroups(s, ok, used);
+    CornerGroups g = cornerGroups(s, ok, used);
     r.duplicateFaces = g.duplicates.size();
+    if (duplicates) *duplicates = std::move(g.duplicates);
     r.twoSidedPairs = g.twoSidedPairs;
     r.misorientedEdges = g.misorientedEdges;
   }

@@ -59,8 +59,7 @@ std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport&
 // takes its original's values in the output; a copy's corner that is a
 // vertex of its own (an unwelded copy) takes the original's corner's.
 void leaveOutDuplicates(FilterInput& in, FilterResult& res) {
-  Scene& s = in.scene;
-  res.sameFaces = duplicatedFaces(s);
+  Scene& s = in.scene;  // res.sameFaces: the pairs the set-up's scene report found
   s.leftOut.assign(s.faceCount(), 0);
   for (const auto& [copy, original] : res.sameFaces) s.leftOut[copy] = 1;
   std::vector<uint8_t> kept(s.vertexCount(), 0);  // on a face the computation keeps

@@ -10,8 +10,9 @@
 
 namespace gi::detail {
 
-// Leaves each duplicated face's copies out of the computation
-// (Scene::leftOut) and records them in res.sameFaces and res.sameVertices;
+// Leaves each duplicated face's copies, res.sameFaces (as analyzeScene
+// found them), out of the computation (Scene::leftOut), records their own
+// vertices in res.sameVertices;
 // res.report is made again, the copies counted as left out.
 void leaveOutDuplicates(FilterInput& in, FilterResult& res);
 // Gives the output's copies their originals' values (per vertex and per

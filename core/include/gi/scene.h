@@ -107,7 +107,9 @@ struct SceneReport {
 // Counts every defect and computes the scale used for ray offsets. Without
 // duplicateFaces (left 0) it skips the one part that sorts every face
 // (0.1 s at a million faces): for algorithms that do not depend on it.
-SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::vector<uint8_t>* usable = nullptr);
+// *duplicates (if given, with duplicateFaces): the pairs duplicatedFaces returns.
+SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::vector<uint8_t>* usable = nullptr,
+                         std::vector<std::pair<uint32_t, uint32_t>>* duplicates = nullptr);
 // The usable faces that repeat an earlier usable face's three corner
 // positions in the same turn, each with that face: (copy, original) pairs,
 // the original the first face of its group.
