@@ -158,10 +158,16 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   } else {
     for (size_t at : declared.materialLines) text[at] = '#';  // from memory: no library is opened
   }
+  // Faces listing a vertex twice are hidden from OpenMesh (it drops or
+  // rewrites them) and put back in their places below; the text is then read
+  // from memory, the material libraries' Kd being ours anyway.
+  for (size_t at : declared.repeatLines) text[at] = '#';
+  if (!declared.repeatLines.empty())
+    for (size_t at : declared.materialLines) text[at] = '#';
   bool ok = false;
   try {
     const QuietOpenMesh quiet;
-    if (!path.empty() && ext == "obj") {
+    if (!path.empty() && ext == "obj" && declared.repeatLines.empty()) {
       ok = OpenMesh::IO::read_mesh(m, path, opt);
     } else {
       std::istringstream in{text};
@@ -172,10 +178,11 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   }
   if (!ok) failRead(name, "OpenMesh could not parse it as a ." + ext + " mesh");
   // STL: OpenMesh merges equal corners and drops triangles left with a repeated corner (no area).
-  if (ext == "obj" && (m.n_faces() != declared.faces || m.n_vertices() < declared.vertices))
+  const size_t hidden = declared.repeatLines.size();
+  if (ext == "obj" && (m.n_faces() + hidden != declared.faces || m.n_vertices() < declared.vertices))
     failRead(name, "OpenMesh read " + std::to_string(m.n_faces()) + " faces and " + std::to_string(m.n_vertices()) +
-                       " vertices of the " + std::to_string(declared.faces) + " and " + std::to_string(declared.vertices) +
-                       " in the file");
+                       " vertices of the " + std::to_string(declared.faces - hidden) + " and " +
+                       std::to_string(declared.vertices) + " in the file");
   const bool hasVC = objColors && opt.vertex_has_color(), hasVN = ext == "obj" && opt.vertex_has_normal();
 
   Polygons p;
@@ -187,10 +194,22 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
     if (hasVN) p.normals.push_back({m.normal(v)[0], m.normal(v)[1], m.normal(v)[2]});
   }
   p.index.reserve(m.n_faces() * 3);
+  size_t fileFace = 0, fileCorner = 0;
+  auto hiddenFaces = [&] {  // the file's faces OpenMesh did not see, up to its next one
+    for (; fileFace < declared.faceRepeats.size() && declared.faceRepeats[fileFace]; ++fileFace) {
+      const uint32_t n = declared.faceSize[fileFace];
+      p.index.insert(p.index.end(), declared.corners.begin() + long(fileCorner), declared.corners.begin() + long(fileCorner + n));
+      p.faceStart.push_back(uint32_t(p.index.size()));
+      fileCorner += n;
+    }
+  };
   for (auto f : m.faces()) {
+    if (hidden) hiddenFaces();
     for (auto v : m.fv_range(f)) p.index.push_back(uint32_t(v.idx()));
     p.faceStart.push_back(uint32_t(p.index.size()));
+    if (hidden && fileFace < declared.faceSize.size()) fileCorner += declared.faceSize[fileFace++];
   }
+  if (hidden) hiddenFaces();
   if (ext == "obj") objAsTheFileSays(declared, kd, p);
   return p;
 }
@@ -214,122 +233,6 @@ struct ByteWriter {
 
 namespace {
 
-// A polygon's triangles as corner positions k (0..n-1) of its vertex list v:
-// a fan from the first corner where the polygon is convex (the same
-// triangles as before for every convex face), else ear clipping in the
-// plane of its Newell normal, so that a concave polygon's triangles stay
-// inside it (a fan from a reflex corner covered the notch outside: a quad
-// of area 1 came out 3; an outside audit). Ears are clipped in O(n^2) a
-// round; a concave polygon of more than kMaxEarClipped corners, or one
-// where no ear is found (self-intersecting), keeps the fan for what is
-// left, and the function returns false: the loader warns (a 258-corner comb
-// of area 192 came out of area 4288, a quarter of its triangles reversed,
-// with no word; an outside audit).
-constexpr size_t kMaxEarClipped = 256;
-
-// The total turning of a closed polygon in the plane: the sum of the angles
-// between consecutive edges (2 pi for a simple polygon, 4 pi for a
-// pentagram, 0 for a figure eight).
-double turning(const std::vector<glm::dvec2>& q) {
-  const size_t n = q.size();
-  double sum = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    const glm::dvec2 e = q[(i + 1) % n] - q[i], f = q[(i + 2) % n] - q[(i + 1) % n];
-    sum += std::atan2(e.x * f.y - e.y * f.x, glm::dot(e, f));
-  }
-  return sum;
-}
-
-// Whether two edges that share no corner cross properly (each edge's ends
-// strictly on either side of the other's line): O(n^2), for polygons of at
-// most kMaxEarClipped corners.
-bool crossesItself(const std::vector<glm::dvec2>& q) {
-  const size_t n = q.size();
-  auto side = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
-    const double t = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    return (t > 0.0) - (t < 0.0);
-  };
-  for (size_t i = 0; i < n; ++i)
-    for (size_t j = i + 2; j < n; ++j) {
-      if (i == 0 && j == n - 1) continue;  // neighbours through the last corner
-      const glm::dvec2 &a = q[i], &b = q[i + 1], &c = q[j], &d = q[(j + 1) % n];
-      if (side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0) return true;
-    }
-  return false;
-}
-bool triangulate(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, std::vector<glm::uvec3>& out) {
-  out.clear();
-  if (n == 3) {  // most faces: nothing to decide, nothing to allocate
-    out.push_back({0, 1, 2});
-    return true;
-  }
-  auto fan = [&](const std::vector<uint32_t>& k) {
-    for (size_t i = 1; i + 1 < k.size(); ++i) out.push_back({k[0], k[i], k[i + 1]});
-  };
-  std::vector<uint32_t> left(n);
-  for (size_t i = 0; i < n; ++i) left[i] = uint32_t(i);
-  if (n <= 3) return fan(left), true;
-  glm::dvec3 normal(0.0);  // Newell's normal
-  for (size_t i = 0; i < n; ++i) {
-    const glm::dvec3 &a = pts[v[i]], &b = pts[v[(i + 1) % n]];
-    normal += glm::dvec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
-  }
-  if (!(glm::length(normal) > 0.0)) {
-    // No net area: either no area whatever the split (every corner on one
-    // line), or lobes of opposite turn that cancel (a symmetric bow tie),
-    // which crosses itself.
-    for (size_t i = 1; i + 1 < n; ++i)
-      if (glm::length(glm::cross(pts[v[i]] - pts[v[0]], pts[v[i + 1]] - pts[v[0]])) > 0.0) return fan(left), false;
-    return fan(left), true;
-  }
-  // The plane's two axes, from the polygon's own first corner (2-D coordinates
-  // of the same scale as the polygon).
-  const glm::dvec3 nz = glm::normalize(normal);
-  const glm::dvec3 ax = glm::normalize(std::fabs(nz.x) < 0.9 ? glm::cross(nz, glm::dvec3(1, 0, 0)) : glm::cross(nz, glm::dvec3(0, 1, 0)));
-  const glm::dvec3 ay = glm::cross(nz, ax);
-  std::vector<glm::dvec2> q(n);
-  for (size_t i = 0; i < n; ++i) {
-    const glm::dvec3 d = pts[v[i]] - pts[v[0]];
-    q[i] = {glm::dot(d, ax), glm::dot(d, ay)};
-  }
-  auto turn = [&](uint32_t a, uint32_t b, uint32_t c) {  // > 0: counter-clockwise about the normal
-    return (q[b].x - q[a].x) * (q[c].y - q[a].y) - (q[b].y - q[a].y) * (q[c].x - q[a].x);
-  };
-  bool convex = true;
-  for (size_t i = 0; i < n && convex; ++i) convex = turn(uint32_t(i), uint32_t((i + 1) % n), uint32_t((i + 2) % n)) >= 0.0;
-  // Turning one way at every corner, a polygon is convex when it turns once
-  // round; a pentagram turns the same way at every corner and goes round
-  // twice.
-  if (convex) return fan(left), std::fabs(turning(q)) < 3.0 * glm::pi<double>();
-  if (n > kMaxEarClipped) return fan(left), false;
-  if (crossesItself(q)) return fan(left), false;  // a bow tie: ear clipping would cut it as if it did not
-  auto inside = [&](uint32_t p, uint32_t a, uint32_t b, uint32_t c) {
-    return turn(a, b, p) >= 0.0 && turn(b, c, p) >= 0.0 && turn(c, a, p) >= 0.0;
-  };
-  // Walking round the corners, clipping each ear met: a whole round without
-  // one means a self-intersecting polygon.
-  size_t i = 0, misses = 0;
-  while (left.size() > 3 && misses < left.size()) {
-    const size_t m = left.size();
-    i %= m;
-    const uint32_t a = left[(i + m - 1) % m], b = left[i], c = left[(i + 1) % m];
-    bool ear = turn(a, b, c) > 0.0;  // reflex or flat: no ear
-    for (size_t j = 0; j < m && ear; ++j) {
-      const uint32_t p = left[j];
-      if (p != a && p != b && p != c && q[p] != q[a] && q[p] != q[b] && q[p] != q[c]) ear = !inside(p, a, b, c);
-    }
-    if (!ear) {
-      ++i, ++misses;
-      continue;
-    }
-    out.push_back({a, b, c});
-    left.erase(left.begin() + long(i));
-    misses = 0;
-  }
-  fan(left);
-  return left.size() <= 3;
-}
-
 LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::string& name, const std::string& path) {
   if (ext != "ply" && ext != "obj" && ext != "off" && ext != "stl")
     failRead(name, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
@@ -346,12 +249,13 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   tris.reserve(p.index.size());
   std::vector<glm::uvec3> corners;
   size_t fanned = 0, largest = 0;
+  std::vector<uint32_t> once;
   for (size_t f = 0; f < nf; ++f) {
     const uint32_t* v = p.index.data() + p.faceStart[f];
     const size_t n = p.faceStart[f + 1] - p.faceStart[f];
-    if (!triangulate(p.points, v, n, corners)) ++fanned, largest = std::max(largest, n);
-    for (const glm::uvec3& k : corners) {
-      tris.push_back({v[k.x], v[k.y], v[k.z]});
+    const size_t before = tris.size();
+    if (!detail::cutFace(p.points, v, n, once, corners, tris)) ++fanned, largest = std::max(largest, n);
+    for (size_t t = before; t < tris.size(); ++t) {
       out.triangleToFace.push_back(uint32_t(f));
       if (!p.faceColor.empty()) out.attrs.faceColor.push_back(p.faceColor[f]);
       if (!p.faceQuality.empty()) out.attrs.faceQuality.push_back(p.faceQuality[f]);
@@ -360,8 +264,9 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   }
   if (fanned)
     out.warnings.push_back(name + ": " + std::to_string(fanned) + " polygon" + (fanned == 1 ? " is" : "s are") +
-                           " concave with more than " + std::to_string(kMaxEarClipped) +
-                           " corners or cross" + (fanned == 1 ? "es itself" : " themselves") + " (the largest has " +
+                           " concave with more than " + std::to_string(detail::kMaxEarClipped) +
+                           " corners, cross" + (fanned == 1 ? "es itself" : " themselves") +
+                           " or pass a corner twice (the largest has " +
                            std::to_string(largest) + "): split as a fan from the first corner, whose triangles "
                            "cover area outside the polygon and may face the other way; triangulate it before "
                            "loading");

@@ -76,8 +76,6 @@ void checkPolygons(const Polygons& p, const std::string& name) {
       if (v >= p.points.size())
         failRead(name, "face " + std::to_string(f) + " uses vertex " + std::to_string(v) + ", outside the " +
                            std::to_string(p.points.size()) + " vertices");
-    if (const uint32_t twice = repeatedIndex(face); twice != kNone)
-      failRead(name, "face " + std::to_string(f) + " lists vertex " + std::to_string(twice) + " twice");
   }
 }
 

@@ -55,7 +55,8 @@ uint32_t repeatedIndex(const std::vector<uint32_t>& face);
 // a coordinate beyond float's range would become infinite there.
 bool fitsFloat(double v);
 
-// Throws unless every face has >= 3 distinct indices below the vertex count
+// Throws unless every face has >= 3 indices below the vertex count (a face
+// may list a vertex twice: parse() collapses or keeps it, see there)
 // and every point and normal is finite and within float range. Messages say
 // "FACE_WORD f" / "vertex v" (face numbers as the reader counts them).
 void checkPolygons(const Polygons& p, const std::string& name);
@@ -73,6 +74,15 @@ bool colourChannel(double scaled, uint8_t& byte);
 // from the whole file.
 std::string notAnStl(uint32_t n, uint64_t size);
 
+// A face of n vertex ids v as triangles appended to `tris` (polygon_cut.cpp:
+// a fan where convex, ear clipping where concave, a face listing a vertex
+// twice in its place; `once` and `corners` are scratch space). False where
+// it was cut as a fan that may cover area outside it: concave with more than
+// kMaxEarClipped corners, crossing itself, or through one vertex twice.
+constexpr size_t kMaxEarClipped = 256;
+bool cutFace(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, std::vector<uint32_t>& once,
+             std::vector<glm::uvec3>& corners, std::vector<glm::uvec3>& tris);
+
 // The readers (each in its own file). Every one throws std::runtime_error
 // with one sentence naming `name` on any defect.
 Polygons readPly(std::string_view bytes, const std::string& name);  // ply_reader.cpp
@@ -89,6 +99,9 @@ struct Counts {
   // leaves the colour of a face without a material's Kd undefined):
   std::vector<glm::dvec3> points;          // every 'v', in double
   std::vector<uint32_t> corners;           // every face's vertices (0-based), face after face
+  std::vector<uint32_t> faceSize;          // OBJ: each face's corner count
+  std::vector<size_t> repeatLines;         // OBJ: byte offsets of faces listing a vertex twice
+  std::vector<uint8_t> faceRepeats;        // OBJ: per face, 1 where it lists a vertex twice
   std::vector<int> faceMaterial;           // per face: index into materialNames, -1 before any usemtl
   std::vector<std::string> materialNames;  // the usemtl names, in order of first use
   size_t coloredVertices = 0;              // 'v' lines with r g b

@@ -380,8 +380,6 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
                                  std::to_string(nv) + " vertices");
             face.push_back(uint32_t(v));
           }
-          if (const uint32_t twice = repeatedIndex(face); twice != kNone)
-            failRead(name, what() + " lists vertex " + std::to_string(twice) + " twice");
           out.index.insert(out.index.end(), face.begin(), face.end());
           out.faceStart.push_back(uint32_t(out.index.size()));
           continue;

@@ -146,8 +146,6 @@ Polygons readOff(std::string_view bytes, const std::string& name) {
                            std::to_string(nv));
       face.push_back(uint32_t(v));
     }
-    if (const uint32_t twice = repeatedIndex(face); twice != kNone)
-      failRead(name, in.at() + ": face " + std::to_string(f) + " lists vertex " + std::to_string(twice) + " twice");
     p.index.insert(p.index.end(), face.begin(), face.end());
     p.faceStart.push_back(uint32_t(p.index.size()));
     glm::u8vec3 c(255);
@@ -236,8 +234,12 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
         if (k == 1) shape = myShape;
         else if (myShape != shape) failRead(name, in.at() + ": the face mixes vertex reference forms (v, v/t, v//n, v/t/n)");
       }
-      if (const uint32_t twice = repeatedIndex(face); twice != kNone)
-        failRead(name, in.at() + ": the face lists vertex " + std::to_string(twice + 1) + " twice");
+      // OpenMesh drops or rewrites a face listing a vertex twice: such a face
+      // is hidden from it and taken as the file gives it (see mesh_io.cpp).
+      const bool repeats = repeatedIndex(face) != kNone;
+      if (repeats) c.repeatLines.push_back(size_t(in.line.data() - bytes.data()));
+      c.faceRepeats.push_back(uint8_t(repeats));
+      c.faceSize.push_back(uint32_t(face.size()));
       c.corners.insert(c.corners.end(), face.begin(), face.end());
       c.faceMaterial.push_back(material);
       ++c.faces;

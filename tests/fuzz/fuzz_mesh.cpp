@@ -19,15 +19,15 @@ namespace {
   std::abort();
 }
 
-// What the engine relies on after loading: indices in range, finite positions,
+// What the engine relies on after loading: indices in range (a triangle
+// listing a vertex twice is an invalid face every filter leaves out), finite positions,
 // attribute arrays of the right lengths.
 void checkMesh(const gi::io::LoadedMesh& m, const char* format) {
   const gi::Scene& s = m.scene;
   if (s.faceCount() == 0) broken("no faces", format);
   for (const auto& t : s.triangles)
-    if (t.x >= s.vertexCount() || t.y >= s.vertexCount() || t.z >= s.vertexCount() || t.x == t.y || t.y == t.z ||
-        t.x == t.z)
-      broken("a triangle index out of range or repeated", format);
+    if (t.x >= s.vertexCount() || t.y >= s.vertexCount() || t.z >= s.vertexCount())
+      broken("a triangle index out of range", format);  // a repeated one is read in its place: filters leave it out
   for (const auto& p : s.positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) broken("a non-finite position", format);
   if (m.triangleToFace.size() != s.faceCount()) broken("triangleToFace of the wrong length", format);

@@ -15,9 +15,12 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
+#include "gi/scene.h"
 #include "mesh_io.h"
 
 namespace fs = std::filesystem;
@@ -81,7 +84,6 @@ TEST(MeshReaders, DamagedFilesAreOneSentenceNamingThePlace) {
   const Case cases[] = {
       {"face index beyond the vertices", "ply", asciiTri("0 0 0", "3 0 1 7 1 2 3"), "face 0 uses vertex index 7"},
       {"negative face index", "ply", asciiTri("0 0 0", "3 0 -1 2 1 2 3"), "face 0 uses vertex index -1"},
-      {"repeated face index", "ply", asciiTri("0 0 0", "3 0 2 2 1 2 3"), "face 0 lists vertex 2 twice"},
       {"face of two indices", "ply", asciiTri("0 0 0", "2 0 1 1 2 3"), "face 0 has 2 vertex indices"},
       {"ASCII nan", "ply", asciiTri("nan 0 0", "3 0 1 2 1 2 3"), "vertex 0: property 'x'"},
       {"ASCII 1e39 in a float", "ply", asciiTri("1e39 0 0", "3 0 1 2 1 2 3"), "vertex 0: property 'x'"},
@@ -397,4 +399,50 @@ TEST(MeshReaders, ColoursOutsideTheirRangeAreRefused) {
     EXPECT_NE(std::string(e.what()).find("vertex 1 has a colour channel of 2, outside 0..1"), std::string::npos)
         << e.what();
   }
+}
+
+// A face that lists a vertex twice (a collapsed edge's "a b b", a quad
+// "a b b c": exporters and decimators leave them) refused the whole file; now
+// it is read in its place: runs of one vertex are one corner, and a polygon of
+// n corners stays n - 2 triangles (so that later faces keep their numbers, as
+// MeshLab counts them), those without area being left out by every filter as
+// invalid faces. Its colour and quality stay with it. PLY, OFF and OBJ alike
+// (OBJ with a material library: OpenMesh would drop such a face).
+TEST(MeshReaders, FacesListingAVertexTwiceAreReadInTheirPlaces) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 4\nproperty list uchar int vertex_indices\nproperty float quality\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n3 0 1 1 1\n4 0 1 1 2 2\n5 0 2 2 3 3 3\n3 0 1 4 4\n";
+  const std::string off = "OFF\n5 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n3 0 1 1\n4 0 1 1 2\n5 0 2 2 3 3\n3 0 1 4\n";
+  const std::string dir = tempPath("repeat");
+  fs::create_directories(dir);
+  std::ofstream(dir + "/m.mtl") << "newmtl red\nKd 1 0 0\nnewmtl grey\nKd 0.5 0.5 0.5\n";
+  std::ofstream(dir + "/m.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nusemtl red\n"
+                                   "f 1 2 2\nf 1 2 2 3\nusemtl grey\nf 1 3 3 4 4\nf 1 2 5\n";
+  const auto fromObj = gi::io::loadMesh(dir + "/m.obj");
+  fs::remove_all(dir);
+  const std::vector<glm::uvec3> expected{{0, 1, 1}, {0, 1, 2}, {1, 1, 1}, {0, 2, 3}, {2, 2, 2}, {2, 2, 2}, {0, 1, 4}};
+  for (const auto& [what, m] : {std::pair<const char*, gi::io::LoadedMesh>{"ply", gi::io::parseMesh(ply, "ply", "a.ply")},
+                                {"off", gi::io::parseMesh(off, "off", "a.off")},
+                                {"obj", fromObj}}) {
+    SCOPED_TRACE(what);
+    EXPECT_EQ(m.scene.triangles, expected);
+    EXPECT_EQ(m.triangleToFace, (std::vector<uint32_t>{0, 1, 1, 2, 2, 2, 3}));
+    EXPECT_TRUE(m.warnings.empty());
+    const gi::SceneReport r = gi::analyzeScene(m.scene);
+    EXPECT_EQ(r.invalidFaces, 4u);
+    EXPECT_EQ(r.usableFaces(), 3u);
+  }
+  const auto q = gi::io::parseMesh(ply, "ply", "a.ply").attrs.faceQuality;
+  EXPECT_EQ(q, (std::vector<float>{1, 2, 2, 3, 3, 3, 4}));
+  ASSERT_EQ(fromObj.attrs.faceColor.size(), 7u);
+  EXPECT_EQ(fromObj.attrs.faceColor[2], glm::u8vec3(255, 0, 0));
+  EXPECT_EQ(fromObj.attrs.faceColor[3], glm::u8vec3(188, 188, 188));
+  // A polygon through one vertex twice, not in a run (two triangles touching
+  // at a corner): a fan of its corners as listed, with the fan's warning.
+  const auto eight = gi::io::parseMesh("OFF\n5 1 0\n0 0 0\n1 0 0\n1 1 0\n-1 0 0\n-1 -1 0\n6 0 1 2 0 3 4\n", "off", "b.off");
+  EXPECT_EQ(eight.scene.triangles,
+            (std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 0}, {0, 0, 3}, {0, 3, 4}}));
+  ASSERT_EQ(eight.warnings.size(), 1u);
+  EXPECT_NE(eight.warnings[0].find("pass a corner twice"), std::string::npos) << eight.warnings[0];
 }
