@@ -66,15 +66,14 @@ ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) 
   return v;
 }
 
-static std::string num(double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%g", x);
-  return b;
-}
-
 // The shortest text that reads back as x (a range message rounded to six
 // digits said "0.5 is outside [0, 0.5]" of 0.5000001, an outside audit).
 static std::string exact(double x) {
+  char b[64];
+  const auto r = std::to_chars(b, b + sizeof b, x);
+  return std::string(b, r.ptr);
+}
+static std::string exact(float x) {  // a vector's component: the shortest text of the float itself
   char b[64];
   const auto r = std::to_chars(b, b + sizeof b, x);
   return std::string(b, r.ptr);
@@ -157,12 +156,12 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
       case ParamType::Int: o << v.getInt(s.name); break;
       case ParamType::Enum: o << s.choices.at(size_t(v.getInt(s.name))); break;
       case ParamType::Float:
-      case ParamType::Distance: o << num(v.getFloat(s.name)); break;
+      case ParamType::Distance: o << exact(v.getFloat(s.name)); break;
       case ParamType::Color:
       case ParamType::Direction:
       case ParamType::Point: {
         glm::vec3 c = v.getVec(s.name);
-        o << num(c.x) << ',' << num(c.y) << ',' << num(c.z);
+        o << exact(c.x) << ',' << exact(c.y) << ',' << exact(c.z);
         break;
       }
       case ParamType::String: o << '"' << v.getString(s.name) << '"'; break;

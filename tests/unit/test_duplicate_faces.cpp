@@ -101,8 +101,9 @@ TEST(DuplicateFaces, ComputedOnceInEveryFilter) {
         for (int k = 0; own && k < 3; ++k, ++copy)
           ASSERT_EQ(r.vertexQuality[copy], r.vertexQuality[clean.scene.triangles[f][k]]) << name << ", face " << f;
       // Per-face output: each copy shows its original's value.
-      if (!r.faceQuality.empty())
+      if (!r.faceQuality.empty()) {
         for (size_t k = 0; k < faces.size(); ++k) ASSERT_EQ(r.faceQuality[nf + k], r.faceQuality[faces[k]]) << name;
+      }
     }
   }
 }

@@ -61,6 +61,24 @@ TEST(Params, DefaultValues) {
   EXPECT_EQ(gi::findSpec(specs, "nope"), nullptr);
 }
 
+// describe() keys a cached result: every number as the shortest text that
+// reads back as itself. With six digits two point lights 278 apart at 5.56e8
+// (and distances 1e-6 apart) shared one cache entry, and the second run
+// reused the first's values (an outside audit).
+TEST(Params, DescribeKeepsEveryDigit) {
+  const auto specs = testSpecs();
+  gi::ParamValues a = gi::defaultValues(specs, kDiag), b = a;
+  a.set("radius", 1.000001), b.set("radius", 1.000002);
+  EXPECT_NE(gi::describe(specs, a), gi::describe(specs, b));
+  a = b;
+  a.set("dir", glm::vec3(5.56000278e8f, 1.f, 0.f)), b.set("dir", glm::vec3(5.56e8f, 1.f, 0.f));
+  EXPECT_NE(gi::describe(specs, a), gi::describe(specs, b));
+  b.set("radius", 0.1), b.set("tint", glm::vec3(0.1f, 0.5f, 0.f));
+  const std::string d = gi::describe(specs, b);
+  EXPECT_NE(d.find("radius=0.1,"), std::string::npos) << d;  // short where the value is
+  EXPECT_NE(d.find("tint=0.1,0.5,0"), std::string::npos) << d;
+}
+
 // validate() with one parameter changed: an error naming it, or none.
 std::optional<std::string> validateWith(const std::string& name, gi::ParamValue x) {
   const auto specs = testSpecs();

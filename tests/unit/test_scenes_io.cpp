@@ -363,7 +363,9 @@ TEST(ScenesIo, SelfCrossingPolygonsAreWarned) {
     const auto m = gi::io::parseMesh(off + face + "\n", "off", "p.off");
     EXPECT_EQ(m.scene.faceCount(), n - 2) << face;
     ASSERT_EQ(m.warnings.size(), crossing ? 1u : 0u) << face;
-    if (crossing) EXPECT_NE(m.warnings[0].find("cross"), std::string::npos) << m.warnings[0];
+    if (crossing) {
+      EXPECT_NE(m.warnings[0].find("cross"), std::string::npos) << m.warnings[0];
+    }
   }
 }
 
