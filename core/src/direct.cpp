@@ -432,6 +432,30 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
   return H;
 }
 
+std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                                const std::vector<std::vector<glm::vec3>>& points) {
+  if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
+  if (points.size() != s.faceCount()) throw std::logic_error("seen points: one list per face");
+  std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
+  const DirectLight direct(s, caster, false);
+  if (direct.empty()) return H;
+  const int budget = lightSamples / direct.maxPoints(lightSamples);
+  parallelBlocks(s.faceCount(), Progress(nullptr), "direct light of seen parts", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const size_t m = std::min(points[i].size(), kSeenPartLightPoints);
+      if (m == 0) continue;
+      const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
+      const PaddedSobol smp(hash3(uint32_t(i), seed, 0xdau));
+      glm::dvec3 sum(0.0);
+      for (size_t k = 0; k < m; ++k)
+        sum += glm::dvec3(direct.estimate(points[i][k] + n * direct.eps(), n, smp, uint32_t(k), budget,
+                                          hash3(uint32_t(i), seed ^ uint32_t(k), 0xdbu), uint32_t(i)).H);
+      H[i] = glm::vec3(sum / double(m));
+    }
+  });
+  return H;
+}
+
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                               const Progress& progress, const VertexPart& part,
                                               const SkyOpenings* portals) {

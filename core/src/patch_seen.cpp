@@ -11,13 +11,16 @@ namespace {
 
 // Whether point k of patch i is buried: none of up to kRaysPerPoint
 // cosine-weighted rays meets the front of another face or leaves the scene
-// (the first that does proves it open). `rays` counts those cast.
+// (the first that does proves it open). `rays` counts those cast; an open
+// point is added to `open` (on the face) when given.
 bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::vec3& n, const Frame& frame, float eps,
-                 const PaddedSobol& points, uint32_t k, uint32_t seed, uint64_t& rays) {
+                 const PaddedSobol& points, uint32_t k, uint32_t seed, uint64_t& rays,
+                 std::vector<glm::vec3>* open = nullptr) {
   const auto& t = s.triangles[i];
   const glm::vec2 w = strictlyInside(uniformTriangle(points(k, 0)));
+  const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z];
   Ray ray;
-  ray.o = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
+  ray.o = x + n * eps;
   // Directions of their own per point: the point's rays stratify its hemisphere.
   const PaddedSobol dirs(hash3(uint32_t(i), seed ^ k, 0x5e3du));
   for (uint32_t r = 0; r < uint32_t(PatchSeen::kRaysPerPoint); ++r) {
@@ -26,7 +29,10 @@ bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::v
     ray.tfar = std::numeric_limits<float>::infinity();
     const Hit h = caster.intersect(ray);
     ++rays;
-    if (!h.valid() || (h.face != i && glm::dot(ray.d, h.ng) < 0.f)) return false;
+    if (!h.valid() || (h.face != i && glm::dot(ray.d, h.ng) < 0.f)) {
+      if (open) open->push_back(x);
+      return false;
+    }
   }
   return true;
 }
@@ -40,6 +46,7 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
   const float eps = float(sceneScale(s).rayEpsilon);
   PatchSeen out;
   out.fraction.assign(n, 1.f);
+  out.seenPoints.assign(n, {});
   std::atomic<uint64_t> rays{0};
   parallelBlocks(n, progress, "seen parts of patches", [&](size_t b, size_t e) {
     uint64_t r = 0;
@@ -51,8 +58,9 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
       // The first points of the sequence screen the patch; where one is
       // buried the estimate takes kPoints (the screen's among them).
       int buried = 0;
+      std::vector<glm::vec3> open;
       for (uint32_t k = 0; k < uint32_t(PatchSeen::kScreenPoints); ++k)
-        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r);
+        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r, &open);
       if (buried == 0) continue;
       // Every screening point buried: the patch is taken as wholly buried
       // (a seen part under 1/16 of it goes with it), which spares a large
@@ -63,8 +71,9 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
         continue;
       }
       for (uint32_t k = PatchSeen::kScreenPoints; k < uint32_t(PatchSeen::kPoints); ++k)
-        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r);
+        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r, &open);
       out.fraction[i] = float(1.0 - double(buried) / PatchSeen::kPoints);
+      if (out.fraction[i] > 0.f) out.seenPoints[i] = std::move(open);
     }
     rays += r;
   });

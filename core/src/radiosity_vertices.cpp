@@ -182,7 +182,7 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   for (size_t v = 0; v < Hd.size(); ++v) Hd[v] += Hout[v];
   Timer gt;
   const std::vector<glm::vec3> Hi =
-      gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect);
+      gather ? gatherIndirect(s, caster, mat, opt, res, progress.sub(o, 1.0)) : faceToVertex(s, res.Hindirect, res.seenShare);
   if (gather) res.stats.add("final_gather_seconds", gt.seconds());
   res.Bdirect.assign(s.vertexCount(), glm::vec3(0.f));
   for (size_t v = 0; v < s.vertexCount(); ++v) {
@@ -208,7 +208,7 @@ void radiosityVertexValues(const Scene& s, const RayCaster& caster, const Radios
   size_t nTwoSided = 0;
   for (size_t v = 0; v < s.vertexCount(); ++v) {
     if (mat.valid[v] || !mat.diffuse[v] || !opt.vertices.contains(v, s.vertexCount())) continue;
-    if (average.empty()) average = faceToVertex(s, res.B);
+    if (average.empty()) average = faceToVertex(s, res.B, res.seenShare);
     res.Bvertex[v] = average[v];
     ++nTwoSided;
   }

@@ -332,7 +332,8 @@ std::string setEmission(Scene& s, const MeshAttributes& a, const ParamValues& v)
     for (size_t f = 0; f < nf; ++f)
       if (a.faceQuality[f] > th) { s.emission[f] = E; ++count; }
   }
-  return msg + "; " + std::to_string(count) + " emitter faces";
+  return msg + "; " + std::to_string(count) + " emitter faces" +
+         (count && E == glm::vec3(0.f) ? " emitting nothing (emitter_intensity 0 or emitter_color black)" : "");
 }
 
 }  // namespace
@@ -370,12 +371,18 @@ std::vector<Rgb8> VertexOutput::displayColors() const {
 }
 
 std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace) {
+  return faceToVertex(s, perFace, {});
+}
+
+std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace,
+                                    const std::vector<float>& seenShare) {
   std::vector<glm::dvec3> acc(s.vertexCount(), glm::dvec3(0.0));
   std::vector<double> w(s.vertexCount(), 0.0);
   const auto ok = usableFaceMask(s);
   for (size_t f = 0; f < s.faceCount(); ++f) {
     if (!ok[f]) continue;
-    const double a = faceArea(s, f);
+    const double a = faceArea(s, f) * (seenShare.empty() ? 1.0 : double(seenShare[f]));
+    if (!(a > 0.0)) continue;
     for (int k = 0; k < 3; ++k) { acc[s.triangles[f][k]] += a * glm::dvec3(perFace[f]); w[s.triangles[f][k]] += a; }
   }
   std::vector<glm::vec3> out(s.vertexCount(), glm::vec3(0.f));

@@ -95,6 +95,16 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
                                              const Progress& progress = Progress(nullptr), RunStats* stats = nullptr,
                                              const SkyOpenings* portals = nullptr);
 
+// The mean direct irradiance from the emitters over given points of each face
+// (points[f] on face f, not lifted; faces without points get 0): the seen
+// part of a partly buried patch (PatchSeen::seenPoints), whose light is the
+// mean over its own points, so no larger than at its brightest point. Up to
+// kSeenPartLightPoints points a face, each with the shadow rays a point of
+// patchDirectIrradiance gets.
+inline constexpr size_t kSeenPartLightPoints = 16;
+std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
+                                                const std::vector<std::vector<glm::vec3>>& points);
+
 // The same at every vertex (used for the per-vertex output), or at the
 // vertices of one part (the others 0); with luminaires, one point with up
 // to lightSamples shadow rays per luminaire in penumbra.

@@ -39,6 +39,12 @@ struct PatchSeen {
   static constexpr int kPoints = 64;         // on a patch where some of them were buried
   static constexpr int kRaysPerPoint = 32;   // at most, per point
   std::vector<float> fraction;  // per face: the share of its area seen (1 for emitters and unusable faces)
+  // Per face with 0 < share < 1: its points found open (on the face, not
+  // lifted), uniform over the seen part; empty for every other face. The
+  // seen part's own light is estimated there (seenPartDirectIrradiance):
+  // the patch mean over the share is a ratio of two estimates from different
+  // points, unbounded where the share is small.
+  std::vector<std::vector<glm::vec3>> seenPoints;
   size_t partial = 0;           // patches with 0 < share < 1
   size_t buried = 0;            // patches with share 0
   double buriedArea = 0;        // sum of (1 - share) A over the patches (local units)

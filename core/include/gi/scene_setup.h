@@ -131,5 +131,11 @@ struct VertexOutput {
 
 // Vertex values from per-face values: area-weighted mean of incident usable faces.
 std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace);
+// The same weighted by each face's seen share (gi/patch_seen.h; empty: all
+// seen): the mean over the surface the scene sees around the vertex, so a
+// patch buried under a block neither darkens the vertices it shares with
+// the floor beside it nor, seen in a sliver, lends its noisy value whole.
+std::vector<glm::vec3> faceToVertex(const Scene& s, const std::vector<glm::vec3>& perFace,
+                                    const std::vector<float>& seenShare);
 
 }  // namespace gi
