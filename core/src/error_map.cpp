@@ -41,9 +41,11 @@ std::vector<ParamSpec> ErrorMapOptions::specs() {
        .type = ParamType::String, .defText = ""},
       {.name = "error_measure", .label = "Error written",
        .help = "What goes to vertex quality: the difference value - reference (units of the value), the relative "
-               "difference (value - reference) / |reference| (undefined, 0, where the reference is 0), or the "
+               "difference (value - reference) / |reference|, or the "
                "z-score (value - reference) / sqrt(s_ref^2 + s_value^2): about N(0,1) where the value is right, "
-               "so |z| > 3 (0.27% of vertices by chance) marks a real error.",
+               "so |z| > 3 (0.27% of vertices by chance) marks a real error. A difference where the reference is 0 "
+               "(relative) or has an error bar of 0 (z-score) is unbounded: written as +-3.4e38, the ramp's ends, "
+               "with a warning; where the two agree, 0.",
        .type = ParamType::Enum, .def = kErrorMeasures.index(ErrorMeasure::Difference),
        .choices = kErrorMeasures.choices()},
       {.name = "color_range", .label = "Colour range",
@@ -99,25 +101,35 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   ErrorMapResult out;
   out.error.assign(n, 0.f);
   double sumD2 = 0, sumR2 = 0, sumD = 0, maxAbs = 0, sumZ2 = 0;
-  size_t used = 0, undefined = 0, beyond3 = 0, zCount = 0, saturated = 0;
+  size_t used = 0, notFinite = 0, noBar = 0, beyond3 = 0, zCount = 0, saturated = 0;
+  // A difference where the reference is 0 (relative) or both error bars are
+  // 0 (z-score): the error is unbounded. It was written as 0, white, "no
+  // error", which hid a radiosity light leak into a half the reference sees
+  // wholly dark, 0 +- 0 (an outside audit); now the ramp's end, as an error
+  // beyond single precision is.
+  std::vector<size_t> unbounded;
   for (size_t i = 0; i < n; ++i) {
     const double v = value[i], r = reference[i];
-    if (!std::isfinite(v) || !std::isfinite(r)) { ++undefined; continue; }
+    if (!std::isfinite(v) || !std::isfinite(r)) { ++notFinite; continue; }
     const double d = v - r;
     sumD2 += d * d, sumR2 += r * r, sumD += d, maxAbs = std::max(maxAbs, std::abs(d));
     ++used;
     double e = d;
     if (measure == ErrorMeasure::Relative) {
       if (r == 0.0) {
-        if (d != 0.0) ++undefined;
-        continue;  // 0 written: no relative error where the reference is 0
+        if (d != 0.0) unbounded.push_back(i);
+        continue;
       }
       e = d / std::abs(r);
     } else if (measure == ErrorMeasure::ZScore) {
       const double sr = sigmaRef.empty() ? 0.0 : sigmaRef[i], sv = sigmaValue.empty() ? 0.0 : sigmaValue[i];
       const double s = std::sqrt(sr * sr + sv * sv);
-      if (!(s > 0.0) || !std::isfinite(s) || sr < 0.0 || sv < 0.0) {  // a negative error bar is no error bar
-        if (d != 0.0) ++undefined;  // a difference with no error bar: no z
+      if (!std::isfinite(s) || sr < 0.0 || sv < 0.0) {  // a negative error bar is no error bar: no z, 0 written
+        ++noBar;
+        continue;
+      }
+      if (!(s > 0.0)) {
+        if (d != 0.0) unbounded.push_back(i);
         continue;
       }
       e = d / s;
@@ -133,7 +145,14 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     }
     out.error[i] = float(e);
   }
-  // The colour range: given, or the 99th percentile of |error| (z: 3).
+  // With no error bar anywhere (a reference of one path a vertex) the bars
+  // are unknown, not 0: no z is written at all (said below).
+  const bool noZ = measure == ErrorMeasure::ZScore && zCount == 0;
+  const float top = std::numeric_limits<float>::max();
+  if (!noZ)
+    for (size_t i : unbounded) out.error[i] = value[i] > reference[i] ? top : -top;
+  // The colour range: given, or the 99th percentile of |error| (z: 3),
+  // without the errors at the float's ends.
   double R = colorRange;
   if (!(R > 0.0)) {
     if (measure == ErrorMeasure::ZScore) {
@@ -141,7 +160,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     } else {
       std::vector<float> a;
       for (float e : out.error)
-        if (e != 0.f) a.push_back(std::abs(e));
+        if (e != 0.f && std::abs(e) < top) a.push_back(std::abs(e));
       if (!a.empty()) {
         const size_t k = std::min(a.size() - 1, size_t(0.99 * double(a.size())));
         std::nth_element(a.begin(), a.begin() + long(k), a.end());
@@ -164,7 +183,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     st.note("no relative RMS error: the reference is 0 at every vertex and the value is not");
   st.add("max_abs_error", maxAbs);
   st.add("mean_error", used ? sumD / double(used) : 0.0);
-  if (measure == ErrorMeasure::ZScore && zCount == 0 && undefined > 0) {
+  if (noZ && (unbounded.size() + noBar) > 0) {
     // rms_z 0 would read as a perfect agreement (a reference of one path a
     // vertex writes error bars of 0: an outside sweep, 5 December 2026).
     st.warn("no vertex has an error bar (all are 0 or missing): no z-score is defined and none is reported; "
@@ -182,9 +201,16 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   if (saturated)
     st.warn(std::to_string(saturated) + " errors beyond single precision were written as +-" +
             fmt(double(std::numeric_limits<float>::max())));
-  if (undefined)
-    st.note(std::to_string(undefined) + " vertices with no defined " + kErrorMeasures.logName(measure) +
-            " (reference 0, no error bar or a negative one, or not finite): 0 written");
+  if (!noZ && !unbounded.empty())
+    st.warn(std::to_string(unbounded.size()) + " vertices differ from a reference " +
+            (measure == ErrorMeasure::Relative ? "of 0" : "whose error bars are 0 (and the value's too)") +
+            ": their " + kErrorMeasures.logName(measure) + " is unbounded, written as +-" + fmt(double(top)) +
+            " (the colour ramp's ends; left out of the statistics but rms_error and max_abs_error)");
+  if (notFinite)
+    st.warn(std::to_string(notFinite) + " vertices where the value or the reference is not a finite number: 0 "
+            "written, left out of every statistic");
+  if (noBar && !noZ)
+    st.warn(std::to_string(noBar) + " vertices with a negative or non-finite error bar: no z-score, 0 written");
   return out;
 }
 

@@ -235,9 +235,9 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   const FilterResult negative = errorMapOf(sf, attrs, {{"reference_error", "Bad"}, {"error_measure", "2"}});
   EXPECT_EQ(negative.vertexQuality[0], 0.f);
   EXPECT_FLOAT_EQ(negative.vertexQuality[1], 2.f);
-  bool said = false;
-  for (const auto& n : negative.stats.notes) said |= n.find("1 vertices with no defined") != std::string::npos;
-  EXPECT_TRUE(said);
+  ASSERT_EQ(negative.stats.warnings.size(), 1u);
+  EXPECT_NE(negative.stats.warnings[0].find("1 vertices with a negative or non-finite error bar"), std::string::npos)
+      << negative.stats.warnings[0];
   // Error bars of 0 everywhere (a reference of one path a vertex): no
   // z-score anywhere, said by a warning of the filter (its estimate's
   // warnings never reached the filter's log until 5 December 2026), and no
@@ -278,4 +278,36 @@ TEST(ErrorMap, ErrorsBeyondSinglePrecisionStayHuge) {
   }
   const ErrorMapResult fine = errorMap({1.f, 2.f}, {1.5f, 1.f}, {}, {}, ErrorMeasure::Relative, 0.0);
   EXPECT_TRUE(fine.stats.warnings.empty());
+}
+
+// A difference where the reference is 0 (relative error) or where both
+// error bars are 0 (z-score) is an unbounded error: written at the ramp's
+// end with a warning. It was written as 0, white, which hid radiosity's
+// leak into the shadow_leak scene's dark half (the reference 0 +- 0 there,
+// radiosity 0.0069 to 0.0207 at 24 vertices; an outside audit). Where the
+// two agree it stays 0; a value or reference that is not finite is 0 and
+// said too (it was a note).
+TEST(ErrorMap, UnboundedErrorsAreShownNotHidden) {
+  const float top = std::numeric_limits<float>::max(), nan = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<float> value = {0.02f, 0.f, 1.5f, 0.5f, nan}, ref = {0.f, 0.f, 1.f, 1.f, 1.f};
+  const std::vector<float> bars = {0.f, 0.f, 0.25f, 0.25f, 0.25f};
+  const ErrorMapResult z = errorMap(value, ref, bars, {}, ErrorMeasure::ZScore, 0.0);
+  EXPECT_EQ(z.error, (std::vector<float>{top, 0.f, 2.f, -2.f, 0.f}));
+  EXPECT_DOUBLE_EQ(z.stats.get("rms_z"), 2.0);  // the bounded ones
+  const ErrorMapResult r = errorMap(value, ref, {}, {}, ErrorMeasure::Relative, 0.0);
+  EXPECT_EQ(r.error, (std::vector<float>{top, 0.f, 0.5f, -0.5f, 0.f}));
+  EXPECT_FLOAT_EQ(float(r.range), 0.5f);  // the automatic range leaves the unbounded out
+  for (const ErrorMapResult* m : {&z, &r}) {
+    ASSERT_EQ(m->stats.warnings.size(), 2u);
+    EXPECT_EQ(m->stats.warnings[0].rfind("1 vertices differ from a reference", 0), 0u) << m->stats.warnings[0];
+    EXPECT_EQ(m->stats.warnings[1].rfind("1 vertices where the value or the reference is not a finite", 0), 0u)
+        << m->stats.warnings[1];
+  }
+  const Rgb8 red = divergingColor(1.0);  // the ramp's end
+  EXPECT_EQ(z.color[0].r, red.r);
+  EXPECT_EQ(z.color[0].g, red.g);
+  EXPECT_EQ(z.color[0].b, red.b);
+  const ErrorMapResult d = errorMap(value, ref, {}, {}, ErrorMeasure::Difference, 0.0);
+  EXPECT_FLOAT_EQ(d.error[0], 0.02f);
+  ASSERT_EQ(d.stats.warnings.size(), 1u);  // only the NaN
 }
