@@ -211,12 +211,33 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
 }
 
 // FNV-1a, 64 bits, as 16 hex digits.
-std::string hashText(const std::string& s) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+uint64_t fnv(uint64_t h, const char* p, size_t n) {
+  for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(p[i])) * 1099511628211ull;
+  return h;
+}
+std::string hex64(uint64_t h) {
   char b[17];
   std::snprintf(b, sizeof b, "%016llx", (unsigned long long)h);
   return b;
+}
+std::string hashText(const std::string& s) { return hex64(fnv(1469598103934665603ull, s.data(), s.size())); }
+
+// A result file as it was written: its size and the hash of its bytes ("" if
+// it cannot be read). A resumed batch takes a result as done only where its
+// summary records the same: one truncated or edited by hand since was
+// counted as done (an outside audit).
+std::string fileDigest(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return "";
+  uint64_t h = 1469598103934665603ull, size = 0;
+  std::vector<char> buf(1 << 16);
+  while (in) {
+    in.read(buf.data(), std::streamsize(buf.size()));
+    const size_t got = size_t(in.gcount());
+    h = fnv(h, buf.data(), got), size += got;
+  }
+  if (in.bad()) return "";
+  return std::to_string(size) + ":" + hex64(h);
 }
 
 // What decides a mesh's result: the program's version, the filter, every
@@ -275,7 +296,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   for (const std::string& w : mesh.warnings) r.stats.warn(w);
   // The layers first: a result PLY that exists has its layers beside it. Each file is written whole or not at all.
   const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
-  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers);
+  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes);
   json s;
   s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
   s["resolved"] = describe(specs, in.values);
@@ -436,7 +457,8 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     };
     const bool same = text("params_hash") == hash;
     const std::string tag = "[" + std::to_string(k + 1) + "/" + std::to_string(jobs.size()) + "] " + job.input + ": ";
-    if (same && text("status") == "ok" && fs::exists(ply)) {
+    if (same && text("status") == "ok" && fs::exists(ply) && !text("output_digest").empty() &&
+        text("output_digest") == fileDigest(ply)) {
       ++before;
       raysAll += number("rays");
       computeAll += number("seconds");
@@ -464,6 +486,7 @@ int run(const Args& a, const std::vector<std::string>& extras) {
       s.update(r);
       s["status"] = "ok";
       s["output"] = ply.string();
+      s["output_digest"] = fileDigest(ply);
       ++baked;
       rays += r.value("rays", 0.0);
       raysAll += r.value("rays", 0.0);

@@ -282,7 +282,13 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     if (!damaged.empty()) r.stats.warn("the cached result could not be used, so it was computed again: " + damaged);
   }
   for (const std::string& w : mesh.warnings) r.stats.warn(w);
-  const bool caching = !reused && !cached.empty() && !r.refined && r.layers.empty();  // a cached result holds no geometry
+  // A cached result holds no geometry and no image (a view written as an
+  // image would be computed again every time, each run saying "cached as":
+  // an outside audit); such a run says so instead.
+  const bool caching = !reused && !cached.empty() && !r.refined && r.layers.empty() && r.images.empty();
+  if (!reused && !cached.empty() && !caching)
+    r.stats.note(std::string("not cached: the cache keeps per-vertex and per-face results, not ") +
+                 (!r.images.empty() ? "images" : r.refined ? "refined meshes" : "new layers"));
   // The files the result names, checked as the plan was before anything is written.
   std::vector<files::Named> outputs = resultOutputs(a, r);
   if (caching) outputs.push_back({cached, "--cache"});
@@ -295,7 +301,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
 
   std::vector<std::string> layerFiles;
   if (!a.output.empty()) {
-    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r, in.layers);
+    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes);
     layerFiles = writeLayerPlys(a.output, r);
   } else if (!r.layers.empty()) {
     r.stats.note("the new layers are written only beside an output (-o)");

@@ -113,6 +113,17 @@ def case_basic(a, tmp):
     check(all(stamp(os.path.join(out, n + ".ply")) == stamps[n] for n in names), "rerun: no PLY rewritten")
     check(abs(rep["rays_all"] - rays) <= 1e-6 * rays, "rerun: rays of the results done before still counted")
 
+    # A result cut short (or edited) since its summary was written is not
+    # done: its size and hash differ from the summary's (it was counted as
+    # done before; an outside audit).
+    victim = os.path.join(out, names[0] + ".ply")
+    with open(victim, "r+b") as f:
+        f.truncate(1000)
+    rep = json.loads(run(cmd).stdout)
+    check(rep["baked"] == 1 and rep["done_before"] == len(names) - 1,
+          "a truncated result is baked again, the others not (%s)" % {k: rep[k] for k in ("baked", "done_before")})
+    check(os.path.getsize(victim) > 1000, "the truncated result was rewritten whole")
+
     cmd[cmd.index("16")] = "12"
     rep = json.loads(run(cmd).stdout)
     check(rep["baked"] == len(names) - 1 and rep["done_before"] == 1,

@@ -384,6 +384,16 @@ def check_side_files(gi, tmp):
     os.mkfifo(stored[0])
     rc, _, lines = run([gi] + args, cwd=d, timeout=60)
     report(failures, "a pipe as the cache file", one_error(rc, lines, "not a regular file"), rc, lines)
+    # A view written as an image is not cached (the cache holds no images):
+    # said, and no cache file claimed (it said "cached as" every run).
+    views = os.path.join(d, "views")
+    os.makedirs(views)
+    rc, out, lines = run([gi] + fast(["render", "in.ply", "--image_path", "v.png", "--json", "--cache", views]), cwd=d)
+    notes = json.loads(out).get("notes", []) if rc == 0 else []
+    said = any(n.startswith("not cached: the cache keeps") for n in notes) and \
+        not any(n.startswith("cached as") for n in notes) and not os.listdir(views)
+    report(failures, "a view as an image with --cache", None if said else
+           "expected exit 0, a note 'not cached' and no cache file", rc, lines)
     return failures
 
 
