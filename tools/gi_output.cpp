@@ -1,6 +1,7 @@
 #include "gi_output.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "gi/refine.h"
 #include "mesh_io.h"
@@ -9,7 +10,7 @@ namespace gi {
 
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
                     const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
-                    const std::vector<LayerRange>& layers) {
+                    const std::vector<LayerRange>& layers, const std::vector<VertexAttribute>& earlier) {
   const Scene& out = r.refined ? r.refined->scene : input;
   MeshAttributes attrs = r.refined ? refineAttributes(inputAttrs, *r.refined) : inputAttrs;
   if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
@@ -22,6 +23,16 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
                    : r.refined             ? refineVertexNormals(fileNormals, *r.refined)
                                            : fileNormals;
   extras.attributes = r.attributes;
+  if (!r.refined)
+    for (const VertexAttribute& a : earlier) {
+      const bool replaced = std::any_of(r.attributes.begin(), r.attributes.end(),
+                                        [&](const VertexAttribute& b) { return b.name == a.name; });
+      const bool finite = std::all_of(a.values.begin(), a.values.end(), [](float x) { return std::isfinite(x); });
+      // The writer's own properties (quality, alpha, ...) are the result's to write.
+      const bool own = io::plyVertexPropertyOfItsOwn(a.components == 1 ? a.name : a.name + "_x");
+      if (!replaced && finite && !own && a.values.size() == size_t(a.components) * input.vertexCount())
+        extras.attributes.push_back(a);  // (one holding NaN, as a hostile file may, is not written on)
+    }
   if (!r.refined || layers.size() < 2) {
     for (const LayerRange& l : layers) extras.layers.push_back({l.name, l.faceCount});
     io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);

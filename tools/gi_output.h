@@ -12,10 +12,14 @@ namespace gi {
 // result leaves alone keeps the input's values (colours, face quality and
 // the file's own normals, which the engine does not use); a scene of two or
 // more layers records them in the file (io::PlyExtras::layers), unless the
-// result refined the mesh.
+// result refined the mesh. The input's per-vertex attributes (what an
+// earlier filter left: Reference, Radiosity, ...) stay beside the result's
+// where it writes none of that name, as they stay on a MeshLab layer (a
+// chain reference -> radiosity -> error map lost the reference on the way;
+// an outside audit); a refined mesh has other vertices and keeps none.
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
                     const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
-                    const std::vector<LayerRange>& layers = {});
+                    const std::vector<LayerRange>& layers = {}, const std::vector<VertexAttribute>& earlier = {});
 
 // Each new layer of the result (photon mapping's photons) as a PLY beside the
 // output, at gi::layerPath (out.ply -> out.Photons.ply): points, colour,

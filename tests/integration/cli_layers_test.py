@@ -82,6 +82,23 @@ def check_refined(a, tmp, files):
                      % (v["nx"], v["ny"], v["nz"]))
 
 
+def check_chain(a, tmp):
+    """A chain of runs keeps what each earlier one left (as a MeshLab layer does): reference, then radiosity,
+    then the error map of radiosity against the reference (the reference was lost on the way; an outside audit)."""
+    box = os.path.join(a.meshes, "cornell_box.ply")
+    ref, rad = os.path.join(tmp, "ref.ply"), os.path.join(tmp, "rad.ply")
+    run([a.gi, "reference", box, "--samples_per_vertex", "16", "-q", "-o", ref])
+    run([a.gi, "radiosity", ref, "--light_samples", "16", "--gather_rays", "16", "-q", "-o", rad])
+    props = [l.split()[-1] for l in header(rad).splitlines() if l.startswith("property")]
+    for want in ("Reference", "ReferenceStdError"):
+        if want not in props:
+            sys.exit("FAILED: radiosity over a reference's PLY dropped %s (%s)" % (want, props))
+    out = json.loads(run([a.gi, "errormap", rad, "--error_measure", "2", "--json", "-q",
+                          "-o", os.path.join(tmp, "err.ply")]))
+    if not 0.0 < out["stats"]["rms_z"] < 50.0:
+        sys.exit("FAILED: the error map of the chain: rms_z %r" % out["stats"].get("rms_z"))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gi", required=True)
@@ -108,6 +125,7 @@ def main():
         if "gi_layer" in header(single):
             sys.exit("FAILED: a one-file scene recorded layers")
         check_refined(a, tmp, files)
+        check_chain(a, tmp)
     print("cli layers: ok")
 
 
