@@ -6,6 +6,16 @@
 
 namespace gi {
 
+namespace {
+// Obscurance needs hit distances: the strata estimator (visibility only) is
+// not among its choices (a script could choose it, and the run refused it).
+std::vector<std::string> estimatorChoices(AmbientMode mode) {
+  std::vector<std::string> c = kAOEstimators.choices();
+  if (mode == AmbientMode::Obscurance) c.resize(size_t(kAOEstimators.index(AOEstimator::Strata)));
+  return c;
+}
+}  // namespace
+
 std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
   std::vector<ParamSpec> s;
   s.push_back({.name = "rays_per_vertex", .label = "Rays per vertex",
@@ -120,8 +130,11 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                          "Which to choose (measured, README): from about 100k vertices, shared with a target error "
                          "(e.g. 0.02, minimum rays 8) reaches a given error with 6 to 8 times fewer rays and about "
                          "a third of the time; on meshes of a few thousand to 30k vertices, or where the occlusion "
-                         "changes from vertex to vertex, per vertex is as fast or faster, and adaptive strata "
-                         "faster still. "
+                         "changes from vertex to vertex, per vertex is as fast or faster" +
+                         std::string(mode == AmbientMode::Obscurance
+                                         ? ". (Occlusion also has 'Adaptive strata', which tests visibility only: "
+                                           "obscurance needs the hit distances.)"
+                                         : ", and adaptive strata faster still. "
                          "'Adaptive strata' (occlusion): each vertex's hemisphere is cut into about "
                          "rays_per_vertex strata (R rows of elevation by 2R of azimuth), one jittered ray each, "
                          "and a stratum is split into four where its neighbours disagree (an occlusion edge "
@@ -130,9 +143,9 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                          "ever finer grids until it is met. It casts about 1.6 times "
                          "rays_per_vertex on occluded vertices and reached MeshLab's errors 1.4 to 1.6 times "
                          "sooner than the per-vertex estimator on the two bunnies (README). "
-                         "The cone option is always per vertex.",
+                         "The cone option is always per vertex."),
                  .type = ParamType::Enum, .def = kAOEstimators.index(AOEstimator::PerVertex),
-                 .choices = kAOEstimators.choices()});
+                 .choices = estimatorChoices(mode)});
     s.push_back({.name = "share_rings", .label = "Sharing: largest neighbourhood (rings)",
                  .help = "Shared estimator: how far a vertex may pool, in mesh rings (1 = its direct neighbours, "
                          "about 7 vertices; 3 = about 37; 5 = about 91). Larger pools more rays where the occlusion "

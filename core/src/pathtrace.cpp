@@ -169,8 +169,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   rules.maxDepth = opt.maxDepth < 0 ? kDepthCap : opt.maxDepth;
   const paths::Integrator tracer(s, caster, lights, rules);
   if (!tracer.anyLight())
-    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face "
-                                "quality), no sky, no sun and no point light");
+    throw std::invalid_argument("the scene has no light: no emitter faces that emit (select them or mark them by "
+                                "face quality, with emitter_intensity above 0 and an emitter_color that is not black), "
+                                "no sky, no sun and no point light");
   const SceneReport rep = analyzeScene(s);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const VertexMaterial mat = vertexMaterial(s);

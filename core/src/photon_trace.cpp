@@ -283,8 +283,9 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
                                  std::vector<uint8_t>* lastHit) {
   const PhotonLights lights(s, opt);
   if (lights.empty())
-    throw std::invalid_argument("the scene has no light: no emitter faces (select them or mark them by face quality), "
-                                "no point or spot light, no sky and no sun");
+    throw std::invalid_argument("the scene has no light: no emitter faces that emit (select them or mark them by face "
+                                "quality, with emitter_intensity above 0 and an emitter_color that is not black), no "
+                                "point or spot light, no sky and no sun");
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   // Fixed-size blocks, concatenated in order: the result is independent of threads.

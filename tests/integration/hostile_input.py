@@ -216,7 +216,7 @@ CASES = [
     ("cli_strata_max_rays", "adaptive strata to a target with max_rays below its first round", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
      ["ao", "FILE", "--estimator", "Adaptive strata", "--target_error", "0.01", "--max_rays", "100"], "above max_rays 100"),
     ("cli_strata_obscurance", "obscurance by adaptive strata", {"a.ply": ascii_ply(TRI, [(0, 1, 2)])},
-     ["obscurance", "FILE", "--estimator", "Adaptive strata"], "tests visibility only"),
+     ["obscurance", "FILE", "--estimator", "Adaptive strata"], "expected one of: Per vertex, Shared with neighbours"),
     ("cli_no_input", "no input file", None, ["ao"], "input"),
     ("cli_no_subcommand", "no subcommand", None, [], "subcommand"),
     ("cli_bad_layer", "a damaged --layer file", {"a.ply": ascii_ply(TRI, [(0, 1, 2)]), "b.ply": ascii_ply(TRI, [(0, 1, 7)])},

@@ -545,3 +545,20 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
     }
   EXPECT_EQ(seen.size(), expected.size());
 }
+
+// Obscurance offers only the estimators it can run: 'Adaptive strata' tests
+// visibility only, and a script that chose it for obscurance (written by
+// `gi script` without a word) failed when run (an outside audit).
+TEST(Params, ObscuranceOffersOnlyItsEstimators) {
+  const auto choices = [](gi::AmbientMode mode) {
+    const auto specs = gi::AmbientOptions::specs(mode);
+    const gi::ParamSpec* e = gi::findSpec(specs, "estimator");
+    return e ? e->choices : std::vector<std::string>{};
+  };
+  EXPECT_EQ(choices(gi::AmbientMode::Occlusion).size(), 3u);
+  EXPECT_EQ(choices(gi::AmbientMode::Obscurance),
+            (std::vector<std::string>{"Per vertex", "Shared with neighbours"}));
+  const auto specs = gi::AmbientOptions::specs(gi::AmbientMode::Obscurance);
+  EXPECT_THROW(gi::parseValue(*gi::findSpec(specs, "estimator"), "Adaptive strata", 1.0), std::invalid_argument);
+  EXPECT_EQ(gi::findSpec(specs, "estimator")->help.find("cone"), std::string::npos);
+}

@@ -677,3 +677,25 @@ TEST(LightWarnings, OpenSkyAndGlassAreNotMistakenForInvertedFaces) {
   auto opaque = makeEmbreeCaster(room);
   EXPECT_TRUE(emitterOrientationWarning(room, *opaque, false).has_value());
 }
+
+// Emitter faces marked but emitting nothing (emitter_intensity 0 or a black
+// emitter_color) are said as such: the refusal read "no emitter faces
+// (select them or mark them by face quality)" on the Cornell box's 40
+// marked faces (an outside audit), and the log now says they emit nothing.
+TEST(SceneWarnings, EmittersThatEmitNothingAreSaidSo) {
+  for (const char* param : {"emitter_intensity", "emitter_color"}) {
+    FilterInput in = test::filterInput(FilterKind::PathTracedReference, scenes::cornellBox(50.0));
+    if (std::string(param) == "emitter_intensity") in.values.set(param, 0.0);
+    else in.values.set(param, glm::vec3(0.f));
+    try {
+      runFilter(FilterKind::PathTracedReference, in);
+      ADD_FAILURE() << param << ": no light must refuse";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("emitter_intensity above 0"), std::string::npos) << e.what();
+    }
+    FilterInput again = test::filterInput(FilterKind::PathTracedReference, scenes::cornellBox(50.0));
+    again.values = in.values;
+    const FilterResult r = prepareFilter(FilterKind::PathTracedReference, again);
+    EXPECT_NE(r.setupLog.find("emitter faces emitting nothing"), std::string::npos) << param << ": " << r.setupLog;
+  }
+}
