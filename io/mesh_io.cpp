@@ -227,6 +227,11 @@ struct ByteWriter {
     std::memcpy(&u, &v, 4);
     u32(u);
   }
+  void f64(double v) {
+    uint64_t u;
+    std::memcpy(&u, &v, 8);
+    u32(uint32_t(u & 0xffffffffu)), u32(uint32_t(u >> 32));
+  }
 };
 
 }  // namespace
@@ -271,6 +276,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
                            "cover area outside the polygon and may face the other way; triangulate it before "
                            "loading");
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
+  out.points = p.points;
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
   out.attrs.vertexSelected = p.vertexSelected;
@@ -401,7 +407,12 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
       if (clean[0] == ' ' || clean[0] == '\t') clean[0] = '_';
       h << "comment gi_layer " << faces << " " << clean << "\n";
     }
-  h << "element vertex " << nv << "\nproperty float x\nproperty float y\nproperty float z\n";
+  const bool exact = extras.positions.size() == nv;
+  const bool asDouble = exact && std::any_of(extras.positions.begin(), extras.positions.end(), [](const glm::dvec3& q) {
+    return double(float(q.x)) != q.x || double(float(q.y)) != q.y || double(float(q.z)) != q.z;
+  });
+  const char* coord = asDouble ? "double" : "float";
+  h << "element vertex " << nv << "\nproperty " << coord << " x\nproperty " << coord << " y\nproperty " << coord << " z\n";
   if (hasN) h << "property float nx\nproperty float ny\nproperty float nz\n";
   if (hasC) h << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   if (hasQ) h << "property float quality\n";
@@ -420,8 +431,12 @@ void writePly(const std::string& path, const Scene& s, const MeshAttributes& att
   w.buf.assign(header.begin(), header.end());
   w.buf.reserve(header.size() + nv * 28 + nf * 20);
   for (size_t i = 0; i < nv; ++i) {
-    const glm::vec3 p(s.toWorld(s.positions[i]));  // absolute coordinates
-    w.f32(p.x), w.f32(p.y), w.f32(p.z);
+    if (asDouble) {
+      w.f64(extras.positions[i].x), w.f64(extras.positions[i].y), w.f64(extras.positions[i].z);
+    } else {
+      const glm::vec3 p = exact ? glm::vec3(extras.positions[i]) : glm::vec3(s.toWorld(s.positions[i]));  // absolute
+      w.f32(p.x), w.f32(p.y), w.f32(p.z);
+    }
     if (hasN) w.f32(extras.normals[i].x), w.f32(extras.normals[i].y), w.f32(extras.normals[i].z);
     if (hasC) {
       if (!vertexColor.empty()) w.u8(vertexColor[i].r), w.u8(vertexColor[i].g), w.u8(vertexColor[i].b);
@@ -491,6 +506,10 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
   if (normals && otherNormals.empty()) otherNormals = computeVertexNormals(other.scene);
   const size_t tri0 = into.triangleToFace.empty() ? 0 : into.triangleToFace.back() + 1;
   into.scene.append(other.scene);
+  if (into.points.size() == nv0 && other.points.size() == nv1)
+    into.points.insert(into.points.end(), other.points.begin(), other.points.end());
+  else
+    into.points.clear();
   if (normals) {
     into.scene.vertexNormals.resize(nv0);
     into.scene.vertexNormals.insert(into.scene.vertexNormals.end(), otherNormals.begin(), otherNormals.end());

@@ -28,6 +28,12 @@ struct LoadedMesh {
   // What the run's log should warn of: polygons no triangulation of ours
   // could keep inside themselves.
   std::vector<std::string> warnings;
+  // The vertices' positions as the file gives them (double): the scene keeps
+  // them as floats about its centre, whose sum with the centre moved
+  // coordinates by a float step in every file written back (a radiosity run
+  // on such a file then differed by up to 0.018 from one on the original;
+  // an outside audit). writePly writes these (PlyExtras::positions).
+  std::vector<glm::dvec3> points;
 };
 
 // Throws std::runtime_error with one sentence ("cannot read X: ...") on failure:
@@ -59,6 +65,9 @@ struct PlyExtras {
   // face order): recorded as "comment gi_layer COUNT NAME" header lines, so
   // that loading the file gives the layers back (MeshLab ignores them).
   std::vector<std::pair<std::string, size_t>> layers;
+  // Absolute positions to write instead of the scene's (the file's, as
+  // read): as float where every coordinate is one, else as double.
+  std::vector<glm::dvec3> positions;
 };
 void writePly(const std::string& path, const Scene& s, const MeshAttributes& attrs,
               const std::vector<float>& vertexQuality, const std::vector<Rgb8>& vertexColor,

@@ -236,7 +236,12 @@ struct AsciiSource {
       v = double(i);
       return Status::Ok;
     }
-    if (parseDouble(t, v)) return type == Type::F32 && !fitsFloat(v) ? Status::Bad : Status::Ok;
+    if (parseDouble(t, v)) {
+      if (type != Type::F32) return Status::Ok;
+      if (!fitsFloat(v)) return Status::Bad;
+      v = double(float(v));  // the value the file declares: "0.1" of a float property is float 0.1, as binary gives it
+      return Status::Ok;
+    }
     if (used || !parseNonFinite(t)) return Status::Bad;
     v = std::numeric_limits<double>::quiet_NaN();  // a kept value says it is not a number
     return Status::Ok;

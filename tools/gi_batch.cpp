@@ -296,7 +296,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
   for (const std::string& w : mesh.warnings) r.stats.warn(w);
   // The layers first: a result PLY that exists has its layers beside it. Each file is written whole or not at all.
   const std::vector<std::string> layers = writeLayerPlys(ply.string(), r);
-  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes);
+  writeResultPly(ply.string(), in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes, mesh.points);
   json s;
   s["scene"] = {{"vertices", r.report.vertices}, {"faces", r.report.faces}, {"usable_faces", r.report.usableFaces()}};
   s["resolved"] = describe(specs, in.values);

@@ -301,7 +301,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
 
   std::vector<std::string> layerFiles;
   if (!a.output.empty()) {
-    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes);
+    writeResultPly(a.output, in.scene, mesh.attrs, fileNormals, r, in.layers, in.attributes, mesh.points);
     layerFiles = writeLayerPlys(a.output, r);
   } else if (!r.layers.empty()) {
     r.stats.note("the new layers are written only beside an output (-o)");

@@ -10,7 +10,8 @@ namespace gi {
 
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
                     const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
-                    const std::vector<LayerRange>& layers, const std::vector<VertexAttribute>& earlier) {
+                    const std::vector<LayerRange>& layers, const std::vector<VertexAttribute>& earlier,
+                    const std::vector<glm::dvec3>& filePoints) {
   const Scene& out = r.refined ? r.refined->scene : input;
   MeshAttributes attrs = r.refined ? refineAttributes(inputAttrs, *r.refined) : inputAttrs;
   if (!r.faceQuality.empty()) attrs.faceQuality = r.faceQuality;
@@ -23,6 +24,7 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
                    : r.refined             ? refineVertexNormals(fileNormals, *r.refined)
                                            : fileNormals;
   extras.attributes = r.attributes;
+  if (!r.refined && filePoints.size() == input.vertexCount()) extras.positions = filePoints;
   if (!r.refined)
     for (const VertexAttribute& a : earlier) {
       const bool replaced = std::any_of(r.attributes.begin(), r.attributes.end(),

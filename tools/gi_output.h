@@ -17,9 +17,12 @@ namespace gi {
 // where it writes none of that name, as they stay on a MeshLab layer (a
 // chain reference -> radiosity -> error map lost the reference on the way;
 // an outside audit); a refined mesh has other vertices and keeps none.
+// `filePoints`: the input's positions as read (io::LoadedMesh::points),
+// written as they are unless the result refined the mesh.
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,
                     const std::vector<glm::vec3>& fileNormals, const FilterResult& r,
-                    const std::vector<LayerRange>& layers = {}, const std::vector<VertexAttribute>& earlier = {});
+                    const std::vector<LayerRange>& layers = {}, const std::vector<VertexAttribute>& earlier = {},
+                    const std::vector<glm::dvec3>& filePoints = {});
 
 // Each new layer of the result (photon mapping's photons) as a PLY beside the
 // output, at gi::layerPath (out.ply -> out.Photons.ply): points, colour,
