@@ -1,9 +1,11 @@
 // Parameter table of the ray-traced view (MeshLab dialog and CLI flags). The
 // filter adds the scene, material, glossy and display tables in front and
 // after it (lightingSceneSpecs, materialSpecs, glossySpecs, displaySpecs).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "gi/color.h"
 #include "gi/pathtrace.h"
@@ -179,6 +181,14 @@ RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene
   const double fov = v.getFloat("fov");
   const CameraChoice camera = kCameraChoices.get(v, "camera");
   if (camera == CameraChoice::LookAt) {
+    // An eye beyond 1e7 scene diagonals sees the scene below a pixel and
+    // starts rays the engine cannot offset (1e30 failed as "an internal
+    // error ... a numerical failure"; an outside audit): refused by name.
+    const double reach = 1e7 * std::max(sceneDiagonal(scene), 1e-30);
+    for (const char* name : {"eye", "target"})
+      if (!(glm::length(glm::dvec3(v.getVec(name)) - scene.origin) <= reach))
+        throw std::invalid_argument(std::string("parameter '") + name + "' lies more than 1e7 scene diagonals (" +
+                                    std::to_string(reach) + ") from the scene");
     o.camera = Camera::lookAt(glm::dvec3(v.getVec("eye")), glm::dvec3(v.getVec("target")), up, fov, w, h);
   } else if (camera == CameraChoice::LayerCamera) {
     if (!layerCamera)

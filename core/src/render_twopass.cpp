@@ -64,7 +64,9 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
   const size_t nv = s.vertexCount();
   if (o.firstPassB.empty())
     throw std::invalid_argument("the two-pass mode needs a first pass on these layers: run 'GI: Radiosity' or "
-                                "'GI: Photon Mapping' (which store the per-vertex radiosity) first");
+                                "'GI: Photon Mapping' (which store the per-vertex radiosity) first, in the same "
+                                "MeshLab session or script (MeshLab 2020.09 does not read per-vertex attributes "
+                                "such as Radiosity from a PLY file; the gi tool does)");
   checkPerVertex(o.firstPassB, nv, "the first pass's radiosity");
   const VertexMaterial mat = vertexMaterial(s);
   tp.R.resize(nv);

@@ -97,6 +97,9 @@ TEST(HemicubeView, ALoneFaceLosesAtMostEverything) {
     const HemicubeView v = hemicubeView(s, *caster, 0, res, 16);
     EXPECT_LE(v.cells.lost, 1.0) << res;
     EXPECT_NEAR(v.cells.lost, 1.0, 1e-12) << res;
+    // Nusselt's disk likewise (its pixels' area summed to 1.0034: an outside audit).
+    EXPECT_LE(v.nusseltLost, 1.0) << res;
+    EXPECT_NEAR(v.nusseltLost, 1.0, 1e-12) << res;
   }
 }
 

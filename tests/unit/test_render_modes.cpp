@@ -490,6 +490,20 @@ TEST(RenderModes, ParameterTable) {
     EXPECT_LE(q->x, 512.0);
   }
   EXPECT_LT(o.camera.eye().z, 0.0);  // in front of the open side
+  // A look-at eye 1e30 away failed as "an internal error ... a numerical
+  // failure" (an outside audit): refused by name beyond 1e7 diagonals.
+  ParamValues far = v;
+  far.set("camera", 1);  // Look at
+  far.set("eye", glm::vec3(1e30f, 0.f, 0.f));
+  try {
+    (void)RenderOptions::fromParams(far, sf.scene);
+    ADD_FAILURE() << "an eye at 1e30 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("parameter 'eye' lies more than 1e7 scene diagonals"), std::string::npos)
+        << e.what();
+  }
+  far.set("eye", glm::vec3(2000.f, 300.f, -3000.f));
+  EXPECT_NO_THROW((void)RenderOptions::fromParams(far, sf.scene));
 
   Scene s = roomA().build();
   std::vector<ParamSpec> mspecs = materialSpecs();
