@@ -207,13 +207,33 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
       fileCorner += n;
     }
   };
+  std::vector<uint8_t> onVisible(p.points.size(), 0);  // a vertex of a face OpenMesh read
   for (auto f : m.faces()) {
     if (hidden) hiddenFaces();
-    for (auto v : m.fv_range(f)) p.index.push_back(uint32_t(v.idx()));
+    for (auto v : m.fv_range(f)) p.index.push_back(uint32_t(v.idx())), onVisible[size_t(v.idx())] = 1;
     p.faceStart.push_back(uint32_t(p.index.size()));
     if (hidden && fileFace < declared.faceSize.size()) fileCorner += declared.faceSize[fileFace++];
   }
   if (hidden) hiddenFaces();
+  // OpenMesh sets a vertex's normal from the faces it reads: one on no such
+  // face (only on a hidden face, or on none) kept uninitialised memory (an
+  // outside review: normals of 3.85e13, different on every run). It takes
+  // the 'vn' of its first corner in a hidden face, else 0 (no normal).
+  if (hasVN && p.normals.size() == p.points.size()) {
+    std::vector<uint8_t> set(onVisible);
+    for (size_t k = 0, f = 0, end = 0; f < declared.faceSize.size(); ++f) {
+      end += declared.faceSize[f];
+      for (; k < end; ++k) {
+        const uint32_t v = declared.corners[k];
+        if (!declared.faceRepeats[f] || v >= set.size() || set[v]) continue;
+        const int vn = k < declared.cornerNormal.size() ? declared.cornerNormal[k] : -1;
+        if (vn < 0 || size_t(vn) >= declared.normals.size()) continue;
+        p.normals[v] = declared.normals[size_t(vn)], set[v] = 1;
+      }
+    }
+    for (size_t v = 0; v < set.size(); ++v)
+      if (!set[v]) p.normals[v] = glm::vec3(0.f);
+  }
   if (ext == "obj") objAsTheFileSays(declared, kd, p);
   return p;
 }

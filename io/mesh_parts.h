@@ -100,6 +100,8 @@ struct Counts {
   std::vector<glm::dvec3> points;          // every 'v', in double
   std::vector<uint32_t> corners;           // every face's vertices (0-based), face after face
   std::vector<uint32_t> faceSize;          // OBJ: each face's corner count
+  std::vector<int> cornerNormal;           // OBJ: each corner's 'vn' index (0-based), -1 where none
+  std::vector<glm::vec3> normals;          // OBJ: every 'vn'
   std::vector<size_t> repeatLines;         // OBJ: byte offsets of faces listing a vertex twice
   std::vector<uint8_t> faceRepeats;        // OBJ: per face, 1 where it lists a vertex twice
   std::vector<int> faceMaterial;           // per face: index into materialNames, -1 before any usemtl

@@ -171,6 +171,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
   size_t nvt = 0, nvn = 0;
   int material = -1;  // the current usemtl
   std::vector<uint32_t> face;
+  std::vector<int> cornerNormal;  // this face's corners' vn, -1 where none
   auto numbers = [&](size_t lo, size_t hi, const char* what) {
     const size_t n = in.words.size() - 1;
     if (n < lo || n > hi)
@@ -213,12 +214,20 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       ++nvt;
     } else if (key == "vn") {
       numbers(3, 3, "3 normal components");
+      glm::vec3 nrm(0.f);
+      for (int k = 0; k < 3; ++k) {
+        double x = 0;
+        parseDouble(in.words[size_t(k) + 1], x);
+        nrm[k] = float(x);
+      }
+      c.normals.push_back(nrm);
       ++nvn;
     } else if (key == "vp") {
       numbers(1, 3, "1 to 3 parameters");
     } else if (key == "f") {
       if (in.words.size() < 4) failRead(name, in.at() + ": a face needs at least 3 vertices, found " + quoted(in.line));
       face.clear();
+      cornerNormal.clear();
       size_t shape = 0;  // slashes and texture index of the first reference: all must match
       for (size_t k = 1; k < in.words.size(); ++k) {
         const std::string_view r = in.words[k];
@@ -229,7 +238,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
         const std::string_view t = s1 == std::string_view::npos ? "" : r.substr(s1 + 1, s2 == std::string_view::npos ? s2 : s2 - s1 - 1);
         const std::string_view n = s2 == std::string_view::npos ? "" : r.substr(s2 + 1);
         if (!t.empty()) resolve(t, nvt, "texture");
-        if (s2 != std::string_view::npos) resolve(n, nvn, "normal");
+        cornerNormal.push_back(s2 != std::string_view::npos ? int(resolve(n, nvn, "normal")) : -1);
         const size_t myShape = (s1 != std::string_view::npos) + (s2 != std::string_view::npos) + 4 * !t.empty();
         if (k == 1) shape = myShape;
         else if (myShape != shape) failRead(name, in.at() + ": the face mixes vertex reference forms (v, v/t, v//n, v/t/n)");
@@ -241,6 +250,7 @@ Counts checkObj(std::string_view bytes, const std::string& name) {
       c.faceRepeats.push_back(uint8_t(repeats));
       c.faceSize.push_back(uint32_t(face.size()));
       c.corners.insert(c.corners.end(), face.begin(), face.end());
+      c.cornerNormal.insert(c.cornerNormal.end(), cornerNormal.begin(), cornerNormal.end());
       c.faceMaterial.push_back(material);
       ++c.faces;
     } else if (key == "usemtl") {

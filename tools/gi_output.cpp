@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <string>
+#include <vector>
 
 #include "gi/refine.h"
 #include "mesh_io.h"
@@ -25,16 +28,34 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
                                            : fileNormals;
   extras.attributes = r.attributes;
   if (!r.refined && filePoints.size() == input.vertexCount()) extras.positions = filePoints;
-  if (!r.refined)
+  if (!r.refined) {
+    // The property names an attribute is written as (NAME, or NAME_x, _y, _z).
+    auto names = [](const VertexAttribute& a) {
+      return a.components == 1 ? std::vector<std::string>{a.name}
+                               : std::vector<std::string>{a.name + "_x", a.name + "_y", a.name + "_z"};
+    };
+    std::set<std::string> taken;
+    for (const VertexAttribute& a : r.attributes)
+      for (const std::string& n : names(a)) taken.insert(n);
     for (const VertexAttribute& a : earlier) {
-      const bool replaced = std::any_of(r.attributes.begin(), r.attributes.end(),
-                                        [&](const VertexAttribute& b) { return b.name == a.name; });
+      // The earlier quality's error bars and path counts describe the
+      // quality this result replaces (a reference's StdError beside
+      // radiosity's quality was read by the error map as radiosity's; an
+      // outside review): not carried.
+      if (a.name == "StdError" || a.name == "StdErrorH" || a.name == "Paths") continue;
       const bool finite = std::all_of(a.values.begin(), a.values.end(), [](float x) { return std::isfinite(x); });
-      // The writer's own properties (quality, alpha, ...) are the result's to write.
-      const bool own = io::plyVertexPropertyOfItsOwn(a.components == 1 ? a.name : a.name + "_x");
-      if (!replaced && finite && !own && a.values.size() == size_t(a.components) * input.vertexCount())
-        extras.attributes.push_back(a);  // (one holding NaN, as a hostile file may, is not written on)
+      const std::vector<std::string> own = names(a);
+      // Not a name the result writes (as NAME or NAME_x...), nor one of the
+      // writer's own properties (quality, alpha, ...); not one holding NaN,
+      // as a hostile file may.
+      const bool free = std::none_of(own.begin(), own.end(), [&](const std::string& n) {
+        return taken.count(n) || io::plyVertexPropertyOfItsOwn(n);
+      });
+      if (!free || !finite || a.values.size() != size_t(a.components) * input.vertexCount()) continue;
+      taken.insert(own.begin(), own.end());
+      extras.attributes.push_back(a);
     }
+  }
   if (!r.refined || layers.size() < 2) {
     for (const LayerRange& l : layers) extras.layers.push_back({l.name, l.faceCount});
     io::writePly(path, out, attrs, r.vertexQuality, r.vertexColor, extras);

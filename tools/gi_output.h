@@ -16,7 +16,8 @@ namespace gi {
 // earlier filter left: Reference, Radiosity, ...) stay beside the result's
 // where it writes none of that name, as they stay on a MeshLab layer (a
 // chain reference -> radiosity -> error map lost the reference on the way;
-// an outside audit); a refined mesh has other vertices and keeps none.
+// an outside audit); a refined mesh has other vertices and keeps none, and
+// the earlier quality's StdError, StdErrorH and Paths are not carried.
 // `filePoints`: the input's positions as read (io::LoadedMesh::points),
 // written as they are unless the result refined the mesh.
 void writeResultPly(const std::string& path, const Scene& input, const MeshAttributes& inputAttrs,

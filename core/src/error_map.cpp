@@ -170,6 +170,10 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
       }
     }
   }
+  // Unbounded errors beside bounded ones that are all 0: any range puts
+  // them at the ramp's end (R = 0 painted them white, "no error": an
+  // outside review).
+  if (!(R > 0.0) && !noZ && !unbounded.empty()) R = 1.0;
   out.range = R;
   out.color.resize(n);
   for (size_t i = 0; i < n; ++i) out.color[i] = divergingColor(R > 0.0 ? out.error[i] / R : 0.0);

@@ -156,7 +156,13 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
       case ParamType::Int: o << v.getInt(s.name); break;
       case ParamType::Enum: o << s.choices.at(size_t(v.getInt(s.name))); break;
       case ParamType::Float:
-      case ParamType::Distance: o << exact(v.getFloat(s.name)); break;
+      case ParamType::Distance: {
+        // A value MeshLab's float dialog gave (53.407f) as its float's
+        // shortest text, not 53.40700149536133; distinct values stay distinct.
+        const double x = v.getFloat(s.name);
+        o << (double(float(x)) == x ? exact(float(x)) : exact(x));
+        break;
+      }
       case ParamType::Color:
       case ParamType::Direction:
       case ParamType::Point: {

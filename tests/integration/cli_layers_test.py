@@ -93,6 +93,10 @@ def check_chain(a, tmp):
     for want in ("Reference", "ReferenceStdError"):
         if want not in props:
             sys.exit("FAILED: radiosity over a reference's PLY dropped %s (%s)" % (want, props))
+    # The reference's own error bars belong to its quality, which radiosity replaced.
+    for stale in ("StdError", "StdErrorH", "Paths"):
+        if stale in props:
+            sys.exit("FAILED: radiosity's PLY carries the reference's %s beside its own quality (%s)" % (stale, props))
     out = json.loads(run([a.gi, "errormap", rad, "--error_measure", "2", "--json", "-q",
                           "-o", os.path.join(tmp, "err.ply")]))
     if not 0.0 < out["stats"]["rms_z"] < 50.0:

@@ -310,4 +310,10 @@ TEST(ErrorMap, UnboundedErrorsAreShownNotHidden) {
   const ErrorMapResult d = errorMap(value, ref, {}, {}, ErrorMeasure::Difference, 0.0);
   EXPECT_FLOAT_EQ(d.error[0], 0.02f);
   ASSERT_EQ(d.stats.warnings.size(), 1u);  // only the NaN
+  // The only error unbounded, every other 0: still at the ramp's end, not
+  // white (the automatic range was 0).
+  const ErrorMapResult lone = errorMap({1.f, 2.f}, {0.f, 2.f}, {}, {}, ErrorMeasure::Relative, 0.0);
+  EXPECT_EQ(lone.error[0], top);
+  EXPECT_EQ(lone.color[0].r, red.r);
+  EXPECT_EQ(lone.color[0].g, red.g);
 }

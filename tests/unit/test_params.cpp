@@ -77,6 +77,8 @@ TEST(Params, DescribeKeepsEveryDigit) {
   const std::string d = gi::describe(specs, b);
   EXPECT_NE(d.find("radius=0.1,"), std::string::npos) << d;  // short where the value is
   EXPECT_NE(d.find("tint=0.1,0.5,0"), std::string::npos) << d;
+  b.set("ratio", double(0.3f));  // a float dialog's value: its float's text
+  EXPECT_NE(gi::describe(specs, b).find("ratio=0.3,"), std::string::npos) << gi::describe(specs, b);
 }
 
 // validate() with one parameter changed: an error naming it, or none.
@@ -540,7 +542,11 @@ TEST(EnumTable, ScriptIndicesKeepTheirChoices) {
       if (p.type != gi::ParamType::Enum) continue;
       SCOPED_TRACE(d.cliName + " --" + p.name);
       ASSERT_EQ(expected.count(p.name), 1u) << "a new enumeration: add its choices above";
-      EXPECT_EQ(p.choices, expected.at(p.name));
+      const L& all = expected.at(p.name);
+      if (d.cliName == "obscurance" && p.name == "estimator")  // the first two: strata tests visibility only
+        EXPECT_EQ(p.choices, L(all.begin(), all.begin() + 2));
+      else
+        EXPECT_EQ(p.choices, all);
       seen.insert(p.name);
     }
   EXPECT_EQ(seen.size(), expected.size());
