@@ -154,10 +154,14 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
 // or spot light, the sky and the sun), or none when the photons carry it.
 // The sky through the mesh's openings (a window) is sampled through them as
 // luminaires, as radiosity does (gi/sky.h).
-std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress) {
+// `stdError`: the sampled direct light's standard error per vertex (with
+// more luminaires than light sampling takes one by one: its 1,600 squares
+// read 9% off in RMS, up to 44%, with an error bar of 0; an outside audit).
+std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& progress, std::vector<float>& stdError) {
   std::vector<glm::vec3> Hd(r.s.vertexCount(), glm::vec3(0.f));
+  stdError.assign(r.s.vertexCount(), 0.f);
   if (!r.opt.directLight) return Hd;
-  Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress);
+  Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress, VertexPart(), nullptr, &stdError);
   const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
   const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed, VertexPart(),
                                          Progress(nullptr), &r.openings);
@@ -356,8 +360,8 @@ Totals totalsOver(const std::vector<glm::vec3>& B, const std::vector<float>& std
   }
   return {n ? lum / double(n) : 0.0, n ? std::sqrt(err2 / double(n)) : 0.0};
 }
-Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const PhotonEstimate& e, bool directApart,
-               VertexRadiometry& out) {
+Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, const std::vector<float>& HdError,
+               const PhotonEstimate& e, bool directApart, VertexRadiometry& out) {
   const size_t nv = Hd.size();
   out.B.assign(nv, glm::vec3(0.f));
   if (directApart) out.Bdirect.assign(nv, glm::vec3(0.f));
@@ -376,7 +380,8 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
       out.split.caustic[i] = mat.rho[i] * part(kPathCaustic);
       out.split.indirect[i] = mat.rho[i] * part(kPathIndirect);
     }
-    out.stdError[i] = float(luminance(mat.rho[i]) * e.noise[i]);
+    const double hd = i < HdError.size() ? double(HdError[i]) : 0.0;
+    out.stdError[i] = float(luminance(mat.rho[i]) * std::sqrt(double(e.noise[i]) * e.noise[i] + hd * hd));
   }
   return totalsOver(out.B, out.stdError, mat.valid);
 }
@@ -436,7 +441,8 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   const PhotonRun run{s, caster, opt, mat, origins, eps, specular, projection, vertexPaths, r2max, openings};
 
   Timer directTimer;
-  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15));
+  std::vector<float> HdError;
+  const std::vector<glm::vec3> Hd = directAtVertices(run, progress.sub(0.0, 0.15), HdError);
   const double directSeconds = directTimer.seconds();
   PhotonTraceStats ts;
   PhotonEstimate photons;
@@ -454,7 +460,7 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
     photons = kNearestEstimate(run, progress, ts, st, maps);
   }
   if (opt.lightPathSplit) out.split.assign(nv);
-  const Totals totals = combine(mat, Hd, photons, opt.directLight, out);
+  const Totals totals = combine(mat, Hd, HdError, photons, opt.directLight, out);
   if (needPhotons) photonStats(run, ts, photons, st);
   st.add("direct_light_seconds", directSeconds);
   st.add("seconds", timer.seconds());

@@ -102,8 +102,9 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
       {.name = "vertex_output", .label = "Vertex values",
        .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
                "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
-               "gathered from the patch solution with rays from the vertex (no light leaking under objects that cut "
-               "through patches). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of "
+               "gathered from the patch solution with rays from the vertex (no staircase; but a patch that reaches "
+               "under a wall into a dark room still carries its light there: the gather reads it, about 1.7% of the "
+               "lit room on the shadow-leak scene; refine removes it). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of "
                "the incident patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity "
                "(the classical look of the course's images).",
        .type = ParamType::Enum, .def = kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather),

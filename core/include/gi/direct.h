@@ -108,10 +108,16 @@ std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster&
 // The same at every vertex (used for the per-vertex output), or at the
 // vertices of one part (the others 0); with luminaires, one point with up
 // to lightSamples shadow rays per luminaire in penumbra.
+// `stdError` (if given): each vertex's standard error of the luminance of
+// H where the light is sampled (more luminaires than Luminaires::
+// kMaxLuminaires: power sampling with MIS, the sample variance of its
+// light_samples estimates); 0 with luminaires (exact form factors, shadow
+// rays in penumbra only).
 std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
                                               const Progress& progress = Progress(nullptr),
                                               const VertexPart& part = VertexPart(),
-                                              const SkyOpenings* portals = nullptr);
+                                              const SkyOpenings* portals = nullptr,
+                                              std::vector<float>* stdError = nullptr);
 
 // One gather ray's hit: the face, the point and its distance, and which
 // vertex cast it as its how-manyth ray (so that what the hit samples in
