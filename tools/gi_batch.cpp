@@ -239,6 +239,19 @@ std::string fileDigest(const fs::path& p) {
   if (in.bad()) return "";
   return std::to_string(size) + ":" + hex64(h);
 }
+// The result PLY's digest and its new layers' (photon mapping's photons
+// beside it, listed under "layers" in the summary), "" if one cannot be read.
+std::string outputDigest(const fs::path& ply, const json& layers) {
+  std::string d = fileDigest(ply);
+  if (d.empty() || layers.is_null()) return d;
+  if (!layers.is_array()) return "";
+  for (const json& l : layers) {
+    const std::string one = l.is_string() ? fileDigest(l.get<std::string>()) : "";
+    if (one.empty()) return "";
+    d += ";" + one;
+  }
+  return d;
+}
 
 // What decides a mesh's result: the program's version, the filter, every
 // parameter given, and the input file (name, size, modification time).
@@ -457,8 +470,9 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     };
     const bool same = text("params_hash") == hash;
     const std::string tag = "[" + std::to_string(k + 1) + "/" + std::to_string(jobs.size()) + "] " + job.input + ": ";
+    const json oldLayers = old.is_object() && old.contains("layers") ? old["layers"] : json();
     if (same && text("status") == "ok" && fs::exists(ply) && !text("output_digest").empty() &&
-        text("output_digest") == fileDigest(ply)) {
+        text("output_digest") == outputDigest(ply, oldLayers)) {
       ++before;
       raysAll += number("rays");
       computeAll += number("seconds");
@@ -486,7 +500,7 @@ int run(const Args& a, const std::vector<std::string>& extras) {
       s.update(r);
       s["status"] = "ok";
       s["output"] = ply.string();
-      s["output_digest"] = fileDigest(ply);
+      s["output_digest"] = outputDigest(ply, s.contains("layers") ? s["layers"] : json());
       ++baked;
       rays += r.value("rays", 0.0);
       raysAll += r.value("rays", 0.0);

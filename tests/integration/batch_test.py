@@ -124,6 +124,21 @@ def case_basic(a, tmp):
           "a truncated result is baked again, the others not (%s)" % {k: rep[k] for k in ("baked", "done_before")})
     check(os.path.getsize(victim) > 1000, "the truncated result was rewritten whole")
 
+    # A result's new layer (photon mapping's photons beside it) is in the digest too.
+    lit = os.path.join(tmp, "lit_meshes")
+    copy_meshes(a.meshes, lit, ["cornell_box"])
+    lout = os.path.join(tmp, "lit_out")
+    lcmd = [a.gi, "batch", "photonmap", "--dir", lit, "-o", lout, "--photons", "2000", "--light_samples", "4",
+            "--photon_layer", "true", "--json"]
+    rep = json.loads(run(lcmd).stdout)
+    layer = os.path.join(lout, "cornell_box.Photons.ply")
+    check(rep["baked"] == 1 and os.path.exists(layer), "photon mapping with its layer baked (%s)" % rep)
+    with open(layer, "r+b") as f:
+        f.truncate(100)
+    rep = json.loads(run(lcmd).stdout)
+    check(rep["baked"] == 1 and rep["done_before"] == 0 and os.path.getsize(layer) > 100,
+          "a truncated layer file is baked again (%s)" % {k: rep[k] for k in ("baked", "done_before")})
+
     cmd[cmd.index("16")] = "12"
     rep = json.loads(run(cmd).stdout)
     check(rep["baked"] == len(names) - 1 and rep["done_before"] == 1,
