@@ -149,6 +149,7 @@ void runAmbient(FilterKind kind, FilterInput& in, FilterResult& res, const Progr
   const auto caster = makeEmbreeCaster(scene, opt.batch);
   const double bvhSeconds = bvh.seconds();
   AmbientResult r = computeAmbient(scene, *caster, opt, progress);
+  if (auto near = detail::nearSurfacesWarning(scene, *caster)) r.stats.warn(*near);
   if (!order.identity()) {
     const Timer back;
     r.value = toMeshOrder(r.value, order);
@@ -232,6 +233,7 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   opt.vertices = in.vertices;
   if (opt.tracedSelected) opt.selectedVertices = selectedVertices(in);
   PathTraceResult r = pathTrace(in.scene, *caster, opt, progress);
+  if (auto near = detail::nearSurfacesWarning(in.scene, *caster)) r.stats.warn(*near);
   res.stats = std::move(r.stats);
   res.attributes.push_back(vectorAttribute("Radiosity", r.B));
   res.attributes.push_back(firstPassCausticsAttribute(in.scene.vertexCount(), true));
@@ -275,6 +277,7 @@ void runRadiosity(FilterInput& in, FilterResult& res, const Progress& progress) 
       checkRadiosityMemory(in.scene.faceCount(), opt);  // before the ray-casting structure is built
       const auto caster = makeEmbreeCaster(in.scene);
       r = solveRadiosity(in.scene, *caster, opt, progress);
+      if (auto near = detail::nearSurfacesWarning(in.scene, *caster)) r.stats.warn(*near);
     }
   } catch (const std::invalid_argument& e) {
     if (!capped) throw;
@@ -331,6 +334,7 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
   const bool layer = in.values.getBool("photon_layer");
   PhotonMapContents maps;
   VertexRadiometry r = computePhotonMap(in.scene, *caster, opt, progress, layer ? &maps : nullptr);
+  if (auto near = detail::nearSurfacesWarning(in.scene, *caster)) r.stats.warn(*near);
   res.stats = std::move(r.stats);
   if (layer && opt.progressive)
     res.stats.warn("photon_layer: progressive photon mapping keeps no photon map, so no layer was added");

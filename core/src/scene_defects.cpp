@@ -1,8 +1,13 @@
 #include "scene_defects.h"
 
 #include <algorithm>
+#include <cmath>
+#include <atomic>
 #include <cstdio>
 #include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace gi::detail {
 
@@ -130,6 +135,43 @@ void copyDuplicates(FilterResult& res) {
     if (!res.faceQuality.empty()) res.faceQuality[f] = float(quality[o] / area[o]);
     if (!res.faceRadiometry.empty()) res.faceRadiometry[f] = glm::vec3(radiometry[o] / area[o]);
   }
+}
+
+std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& caster) {
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  const std::vector<glm::vec3> n = vertexNormalsForRays(s, &ok);
+  const float eps = float(sceneScale(s).rayEpsilon);
+  std::vector<uint8_t> used(s.vertexCount(), 0);
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (ok[f])
+      for (int k = 0; k < 3; ++k) used[s.triangles[f][k]] = 1;
+  std::atomic<size_t> near{0};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.vertexCount(), 1 << 12), [&](const tbb::blocked_range<size_t>& r) {
+    size_t count = 0;
+    for (size_t v = r.begin(); v < r.end(); ++v) {
+      const float len = glm::length(n[v]);
+      if (!used[v] || !(len > 0.f) || !std::isfinite(len)) continue;
+      Ray ray;
+      ray.d = n[v] / len;
+      ray.o = s.positions[v];
+      ray.tnear = 0.01f * eps;  // not the vertex's own faces, nor a surface touching it
+      ray.tfar = kNearOffsets * eps;
+      const Hit h = caster.intersect(ray);
+      if (!h.valid() || h.face >= s.faceCount()) continue;
+      const glm::uvec3& t = s.triangles[h.face];
+      if (t.x == v || t.y == v || t.z == v) continue;
+      if (glm::dot(ray.d, h.ng) < 0.f) ++count;  // its front towards the vertex
+    }
+    near += count;
+  });
+  if (near == 0) return std::nullopt;
+  char b[480];
+  std::snprintf(b, sizeof b,
+                "%zu vertices face another surface closer than %g ray offsets (%.3g in mesh units) along their "
+                "normal: surfaces closer than the offset (%.3g) do not see each other, and the light and occlusion "
+                "between them are biased; let such surfaces touch (shared vertices) or keep them farther apart",
+                size_t(near), double(kNearOffsets), double(kNearOffsets * eps) * s.unit, double(eps) * s.unit);
+  return std::string(b);
 }
 
 }  // namespace gi::detail

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "gi/filter_run.h"
+#include "gi/raycaster.h"
 
 namespace gi::detail {
 
@@ -24,5 +25,14 @@ uint32_t originalFace(const FilterResult& res, uint32_t face);
 // The warning for a bounding box more than 100 times the extent of the bulk of
 // the vertices, or none.
 std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport& rep);
+// The warning for vertices facing another surface closer than
+// kNearOffsets ray offsets along their normal (one ray each), or none:
+// surfaces closer than the offset do not see each other, and values near
+// them are biased from about ten offsets down (an outside audit: two
+// facing squares 1e-5 of the diagonal apart read AO 1 for 0). A surface at
+// the vertex itself (a two-sided face's reversed copy, one touching it)
+// is not counted.
+inline constexpr float kNearOffsets = 10.f;
+std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& caster);
 
 }  // namespace gi::detail

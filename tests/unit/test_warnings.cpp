@@ -699,3 +699,40 @@ TEST(SceneWarnings, EmittersThatEmitNothingAreSaidSo) {
     EXPECT_NE(r.setupLog.find("emitter faces emitting nothing"), std::string::npos) << param << ": " << r.setupLog;
   }
 }
+
+// Two facing squares closer than the ray offset do not see each other (an
+// outside audit: AO 1 where 0 is right, radiosity and the reference 0 for
+// 0.5, without a word): every lighting filter now warns of vertices facing
+// another surface within 10 offsets; the same squares 0.01 apart (700
+// offsets), or a box's walls meeting at its edges, give no such warning.
+TEST(SceneWarnings, SurfacesWithinTheRayOffsetAreWarned) {
+  auto plates = [](double gap) {
+    scenes::SceneFile sf;
+    std::vector<glm::dvec3> pts;
+    std::vector<glm::uvec3> tris;
+    const int n = 4;
+    for (int side = 0; side < 2; ++side) {
+      const uint32_t base = uint32_t(pts.size());
+      for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) pts.push_back({double(i) / n, side ? gap : 0.0, double(j) / n});
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const uint32_t a = base + uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n) + 2, d = a + uint32_t(n) + 1;
+          if (side) tris.push_back({a, b, c}), tris.push_back({a, c, d});  // facing -y
+          else tris.push_back({a, c, b}), tris.push_back({a, d, c});       // facing +y
+        }
+    }
+    sf.scene = Scene::fromAbsolute(pts, tris);
+    return sf;
+  };
+  for (const double gap : {1e-5, 0.01}) {
+    FilterInput in = test::filterInput(FilterKind::AmbientOcclusion, plates(gap));
+    in.values.set("rays_per_vertex", 16);
+    const FilterResult r = runFilter(FilterKind::AmbientOcclusion, in);
+    EXPECT_EQ(warned(r.stats, "closer than 10 ray offsets"), gap < 1e-3) << gap << ": " << all(r.stats);
+  }
+  FilterInput box = test::filterInput(FilterKind::PathTracedReference, scenes::cornellBox(100.0));
+  box.values.set("samples_per_vertex", 4);
+  const FilterResult r = runFilter(FilterKind::PathTracedReference, box);
+  EXPECT_FALSE(warned(r.stats, "ray offsets")) << all(r.stats);
+}
