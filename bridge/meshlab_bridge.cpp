@@ -96,6 +96,9 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
   // layer's displayed result is found from its attribute, as the CLI does).
   if (layers.size() == 1) b.attrs.vertexColorGiven.clear(), b.attrs.faceColorGiven.clear();
   dropFullColorMasks(b.attrs);
+  // MeshLab's coordinates are floats: far from the origin they have
+  // already rounded the geometry (gi/scene.h).
+  if (auto far = coarseFloatsWarning(pts)) b.warnings.push_back("the mesh: " + *far);
   b.scene = Scene::fromAbsolute(pts, std::move(tris));
   return b;
 }

@@ -31,6 +31,7 @@ struct BridgeScene {
   Scene scene;
   MeshAttributes attrs;
   std::vector<LayerPart> parts;
+  std::vector<std::string> warnings;  // what the run's log should warn of (coordinates too coarse to trust)
 };
 
 // Layers taking part: the current one, or every visible one. Throws

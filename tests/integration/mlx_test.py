@@ -44,6 +44,19 @@ def case_ao(c):
     p = subprocess.run([c.gi, "ao", full, "-q", "--rays_per_vertex", "16", "-o", os.path.join(c.tmp, "ao_again.ply")],
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     check(p.returncode == 0, "gi reads the PLY meshlabserver wrote with flags and face attributes (%s)" % p.stderr.strip())
+    # The same floor and wall 1e7 from the origin, as MeshLab holds them (floats): the geometry is already
+    # rounded (a float step of 1 there), which the log now says.
+    ply = read_ply(os.path.join(c.meshes, "floor_wall.ply"))
+    far = os.path.join(c.tmp, "far.ply")
+    with open(far, "w") as fh:
+        fh.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
+                 "element face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(ply["vertex"]), len(ply["face"])))
+        for r in ply["vertex"]:
+            fh.write("%r %r %r\n" % (r["x"] + 1e7, r["y"], r["z"]))
+        for t in ply["face"]:
+            fh.write("3 %s\n" % " ".join(str(i) for i in t["vertex_indices"]))
+    log = c.server(far, c.script("ao_far", "ao", "--rays_per_vertex", "8"), os.path.join(c.tmp, "far_out.ply"))
+    check("coordinates are floats as far as 1e+07" in log, "MeshLab's float coordinates far from the origin are warned of")
 
 
 def split_floor_wall(c):

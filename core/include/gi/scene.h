@@ -2,6 +2,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -121,6 +122,13 @@ struct SceneScale {
   double rayEpsilon = 0.0;  // offset for ray origins (local units)
 };
 SceneScale sceneScale(const Scene& s);
+// The warning for absolute positions that are all floats with a float step
+// at the largest coordinate above 1e-4 of their bounding box's diagonal
+// (a mesh stored as floats far from the origin: its geometry already
+// rounded), or none. The CLI's readers and MeshLab's bridge (whose meshes
+// are floats) give it.
+std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pts);
+
 // The bbox diagonal in world units (analyzeScene(s).diagonal without the rest of the analysis).
 inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
