@@ -15,6 +15,7 @@
 #include "gi/luminaires.h"
 #include "gi/sampling.h"
 #include "gi/sky.h"
+#include "gi/vertex_graph.h"
 
 namespace gi {
 
@@ -466,13 +467,7 @@ namespace {
 // catches them.
 void poolOverRings(const Scene& s, const std::vector<uint8_t>& valid, int samples, std::vector<float>& se) {
   const size_t nv = se.size();
-  std::vector<std::vector<uint32_t>> next(nv);
-  const auto ok = usableFaceMask(s);
-  for (size_t f = 0; f < s.faceCount(); ++f) {
-    if (!ok[f]) continue;
-    const glm::uvec3& t = s.triangles[f];
-    for (int k = 0; k < 3; ++k) next[t[k]].push_back(t[(k + 1) % 3]), next[t[k]].push_back(t[(k + 2) % 3]);
-  }
+  const VertexGraph g = VertexGraph::build(s);
   std::vector<double> own(nv), mean(nv);
   for (size_t v = 0; v < nv; ++v) own[v] = double(se[v]) * se[v] * samples;
   mean = own;
@@ -481,8 +476,8 @@ void poolOverRings(const Scene& s, const std::vector<uint8_t>& valid, int sample
     for (size_t v = 0; v < nv; ++v) {
       double sum = mean[v];
       size_t n = 1;
-      for (uint32_t u : next[v])
-        if (valid[u]) sum += mean[u], ++n;
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k)
+        if (valid[g.nbr[k]]) sum += mean[g.nbr[k]], ++n;
       wider[v] = sum / double(n);
     }
     mean.swap(wider);
