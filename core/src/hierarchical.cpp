@@ -62,7 +62,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // The seen share of each triangle (1 where none is given), its seen area,
   // and the direct light of its seen part.
   const bool partSeen = !set.seen.empty();
-  if (partSeen && set.seen.size() != nf) throw std::logic_error("seen shares: one per triangle");
+  if (partSeen && (set.seen.size() != nf || set.seenPoints.size() != nf))
+    throw std::logic_error("seen shares and points: one per triangle");
+  if (partSeen) g.seen = &set.seen, g.seenPoints = &set.seenPoints;
   auto seenShare = [&](size_t f) { return partSeen ? double(set.seen[f]) : 1.0; };
   if (partSeen)
     for (size_t f = 0; f < nf; ++f) S[f] = seenShare(f) > 0 ? S[f] / float(seenShare(f)) : glm::vec3(0.f);
@@ -78,6 +80,20 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
     seenA[k] = nd.leaf() ? g.A[t.order[nd.first]] * seenShare(t.order[nd.first]) : seenA[nd.left] + seenA[nd.right];
     seenOf[k] = nd.A > 0 ? seenA[k] / nd.A : 1.0;
   }
+  // Whether a node gathers at points on its seen part (moveToSeenParts);
+  // one none of whose points lies there spreads what its buried points
+  // gather over its seen part, as all nodes did before.
+  std::vector<uint8_t> gathersOnSeen(nn, 1);
+  if (partSeen)
+    parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
+      NodePointSet pts;
+      uint32_t faces[kPoints];
+      for (size_t k = b; k < e; ++k) {
+        if (seenOf[k] >= 1.0) continue;
+        nodePoints(g, t, t.nodes[k], pts.x, pts.n, faces);
+        gathersOnSeen[k] = moveToSeenParts(g, faces, pts);
+      }
+    });
   sol.R = S;
   sol.H.assign(nf, glm::vec3(0.f));
   if (nn == 0 || !(P > 0)) return sol;
@@ -246,9 +262,9 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
             h += double(l.F) * r;
           }
         }
-        // A link's factor is a mean over the whole receiver, whose buried
-        // points it never reaches: what it brings falls on the seen part.
-        Hg[k] = seenOf[k] > 0 ? h / seenOf[k] : glm::dvec3(0.0);
+        // A link's factor is the mean over the receiver's points, which lie
+        // on its seen part (what it brings falls there) unless none does.
+        Hg[k] = gathersOnSeen[k] ? h : seenOf[k] > 0 ? h / seenOf[k] : glm::dvec3(0.0);
       }
     });
     for (size_t k = 0; k < nn; ++k) {  // preorder: parents first

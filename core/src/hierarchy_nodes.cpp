@@ -143,6 +143,35 @@ void nodePoints(const Geometry& g, const Tree& t, const Node& nd, glm::dvec3 x[k
   }
 }
 
+bool moveToSeenParts(const Geometry& g, const uint32_t faces[kPoints], NodePointSet& e) {
+  if (!g.seen) return true;
+  bool keep[kPoints];
+  uint32_t usedFace[kPoints], used[kPoints];  // per triangle met, its open points taken so far
+  int nUsed = 0, kept = 0;
+  for (int k = 0; k < kPoints; ++k) {
+    const uint32_t f = faces[k];
+    const float a = (*g.seen)[f];
+    keep[k] = a >= 1.f;
+    if (a > 0.f && a < 1.f && !(*g.seenPoints)[f].empty()) {
+      const std::vector<glm::vec3>& open = (*g.seenPoints)[f];
+      int u = 0;
+      while (u < nUsed && usedFace[u] != f) ++u;
+      if (u == nUsed) usedFace[nUsed] = f, used[nUsed++] = 0;
+      e.x[k] = glm::dvec3(open[used[u]++ % open.size()]);
+      keep[k] = true;
+    }
+    kept += keep[k];
+  }
+  if (kept == 0) return false;
+  for (int k = 0; k < kPoints; ++k) {
+    if (keep[k]) continue;
+    int j = (k + 1) % kPoints;
+    while (!keep[j]) j = (j + 1) % kPoints;
+    e.x[k] = e.x[j];
+    e.n[k] = e.n[j];
+  }
+  return true;
+}
 
 bool boxBehind(const Node& box, const glm::dvec3& x0, const glm::vec3& n) {
   double best = -1e300;

@@ -416,7 +416,7 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
   Timer seenTimer;
   const PatchSeen seen = patchSeenFractions(s, caster, opt.formFactors.seed, &u.Hd);
   seenPartsDirect(s, caster, opt, opt.formFactors.seed, seen, direct);
-  if (seen.any()) hs.seen = seen.fraction;
+  if (seen.any()) hs.seen = seen.fraction, hs.seenPoints = seen.seenPoints;
   const double seenSeconds = seenTimer.seconds();
   // Progress: direct light 0-20%, the hierarchy to 70% (to 100% without per-vertex values), the vertices after.
   const bool vertices = opt.vertexOutput != RadiosityVertexOutput::PatchAverage;

@@ -72,9 +72,11 @@ struct HierarchySettings {
   uint32_t seed = 0;          // of those rays
   // Per triangle, the share of its area the scene sees (gi/patch_seen.h);
   // empty: all of every triangle. The solution is then the radiosity of
-  // the seen parts: a node's gathered light is spread over its seen part
-  // and a source's mean taken over its seen part.
+  // the seen parts: a node gathers at points on its seen part (the points
+  // found open on its partly buried triangles, seenPoints, one list per
+  // triangle or empty) and a source's mean is taken over its seen part.
   std::vector<float> seen;
+  std::vector<std::vector<glm::vec3>> seenPoints;
 };
 
 struct HierarchicalSolution {
