@@ -147,6 +147,7 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
 
 AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const AmbientOptions& optWorld,
                              const Progress& progress) {
+  checkCasterFor(scene, caster);
   AmbientOptions opt = checkedOptions(optWorld);
   opt.maxDistance = optWorld.maxDistance / scene.unit;  // local units (Scene::unit)
   Timer timer;

@@ -16,6 +16,7 @@ class BruteForceCaster final : public RayCaster {
  public:
   // The faces with a reversed copy, as the Embree caster finds them.
   explicit BruteForceCaster(const Scene& s) : s_(s), ok_(usableFaceMask(s)), twins_(sceneFaceTwins(s)) {}
+  size_t sceneFaces() const override { return ok_.size(); }
   Hit intersect(const Ray& r) const override {
     Hit best;
     best.t = r.tfar;

@@ -101,6 +101,7 @@ inline void toRTC(const Ray& r, RTCRay& e) {
 
 class EmbreeCaster final : public RayCaster {
  public:
+  size_t sceneFaces() const override { return faceCount_; }
   EmbreeCaster(const Scene& s, BatchMode mode) : device_(&errors_), scene_(device_.get()), mode_(mode) {
     check("creating the scene");
     const auto ok = usableFaceMask(s);

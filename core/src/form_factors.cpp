@@ -16,8 +16,31 @@
 
 namespace gi {
 
+void checkFormFactorSettings(const FormFactors::Settings& set) {
+  const std::vector<ParamSpec> t = formFactorSpecs();
+  // The table's lower bounds are the dialog's advice; the library takes any
+  // count that gives a row (the tests use a few rays).
+  auto atLeast = [&](const char* name, int v, int lo) {
+    const double hi = findSpec(t, name)->max;
+    if (v < lo || v > hi)
+      throw std::invalid_argument(std::string("parameter '") + name + "' = " + std::to_string(v) + " is outside [" +
+                                  std::to_string(lo) + ", " + std::to_string(int64_t(hi)) + "]");
+  };
+  // Each method's own settings (Auto: Monte Carlo's or the analytic ones).
+  const FormFactorMethod m = set.method;
+  const bool auto_ = m == FormFactorMethod::Auto;
+  if (auto_ || m == FormFactorMethod::MonteCarlo) atLeast("rays_per_patch", set.raysPerPatch, 1);
+  if (auto_ || m == FormFactorMethod::Analytic) atLeast("analytic_points", set.analyticPoints, 1);
+  if (m == FormFactorMethod::Hemicube) {
+    atLeast("hemicube_resolution", set.hemicubeResolution, 4);
+    atLeast("hemicube_points", set.hemicubePoints, 1);
+  }
+}
+
 FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings)
     : s_(s), caster_(caster), set_(settings), eps_(float(sceneScale(s).rayEpsilon)) {
+  checkCasterFor(s, caster);
+  checkFormFactorSettings(settings);
   ok_ = usableFaceMask(s);
   area_.resize(s.faceCount());
   normal_.resize(s.faceCount());
@@ -26,9 +49,9 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
   centroid_.assign(s.faceCount(), glm::dvec3(0.0));
   radius_.assign(s.faceCount(), 0.0);
   for (size_t f = 0; f < s.faceCount(); ++f) {
+    // An unusable face's corners may lie outside the vertices: not read.
     area_[f] = ok_[f] ? faceArea(s, f) : 0.0;
-    const glm::vec3 n = faceNormalUnnormalized(s, f);
-    normal_[f] = ok_[f] ? glm::normalize(n) : glm::vec3(0.f);
+    normal_[f] = ok_[f] ? glm::normalize(faceNormalUnnormalized(s, f)) : glm::vec3(0.f);
     const auto& t = s.triangles[f];
     if (ok_[f]) {
       centroid_[f] = (glm::dvec3(s.positions[t.x]) + glm::dvec3(s.positions[t.y]) + glm::dvec3(s.positions[t.z])) / 3.0;
@@ -98,6 +121,8 @@ void FormFactors::useSeenParts(std::vector<float> a) {
 }
 
 FormFactorRow FormFactors::row(uint32_t i) const {
+  if (i >= ok_.size())
+    throw std::out_of_range("form-factor row " + std::to_string(i) + " of " + std::to_string(ok_.size()) + " patches");
   if (!ok_[i]) return {};
   FormFactorRow r;
   switch (set_.method) {

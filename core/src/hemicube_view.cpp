@@ -77,6 +77,7 @@ bool crossCell(const HemicubeCells& c, double X, double Y, int& face, size_t& k)
 }  // namespace
 
 HemicubeView hemicubeView(const Scene& s, const RayCaster& caster, uint32_t face, int resolution, int nusseltResolution) {
+  checkCasterFor(s, caster);
   if (face >= s.faceCount()) throw std::invalid_argument("face " + std::to_string(face) + " does not exist");
   FormFactors::Settings set;
   set.method = FormFactorMethod::Hemicube;

@@ -40,6 +40,7 @@ constexpr double kHierarchicalBalanceWarning = 0.05;
 HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, const std::vector<glm::vec3>& Hd,
                                        const HierarchySettings& set, int bounces, double tolerance, int maxIterations,
                                        const Progress& progress) {
+  checkCasterFor(s, caster);
   Timer timer;
   const size_t nf = s.faceCount();
   if (Hd.size() != nf) throw std::logic_error("direct irradiance has the wrong size");

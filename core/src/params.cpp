@@ -79,6 +79,14 @@ static std::string exact(float x) {  // a vector's component: the shortest text 
   return std::string(b, r.ptr);
 }
 
+void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name, double value) {
+  const ParamSpec* s = findSpec(specs, name);
+  if (!s) throw std::logic_error("no parameter '" + name + "' in the table");
+  if (!std::isfinite(value) || value < s->min || value > s->max)
+    throw std::invalid_argument("parameter '" + name + "' = " + exact(value) + " is outside [" + exact(s->min) + ", " +
+                                exact(s->max) + "]");
+}
+
 std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal) {
   for (const auto& s : specs) {
     if (!v.has(s.name)) return "parameter '" + s.name + "' is missing";

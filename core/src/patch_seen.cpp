@@ -41,6 +41,7 @@ bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::v
 
 PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t seed,
                              const std::vector<glm::vec3>* direct, const Progress& progress) {
+  checkCasterFor(s, caster);
   const size_t n = s.faceCount();
   const auto ok = usableFaceMask(s);
   const float eps = float(sceneScale(s).rayEpsilon);

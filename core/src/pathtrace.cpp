@@ -151,11 +151,23 @@ Cov sampleCov(const Accum& a) {
 
 PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTraceOptions& optWorld,
                           const Progress& progress) {
+  checkCasterFor(s, caster);
   PathTraceOptions opt = optWorld;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
   opt.point.check();
   if (opt.samplesPerVertex < 1 || opt.minSamples < 2 || opt.maxSamples < opt.minSamples)
     throw std::invalid_argument("samples_per_vertex must be >= 1 and 2 <= min_samples <= max_samples");
+  {  // the table's ranges, for a library caller (a NaN sky made every vertex NaN with a standard error of 0)
+    const std::vector<ParamSpec> t = PathTraceOptions::specs();
+    requireInRange(t, "target_relative_error", opt.targetRelativeError);
+    requireInRange(t, "max_depth", opt.maxDepth);
+    SkySun outside;
+    outside.skyRadiance = opt.skyRadiance;
+    outside.sunDirection = opt.sunDirection;
+    outside.sunIrradiance = opt.sunIrradiance;
+    outside.sunAngularRadiusDeg = opt.sunAngularRadiusDeg;
+    outside.check();
+  }
   Timer timer;
   // The shared integrator (path_integrator.h): every vertex continues,
   // Russian roulette, one light sample per light at every vertex.

@@ -486,6 +486,7 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                   const Progress& progress, PhotonMapContents* maps) {
+  checkCasterFor(s, caster);
   // A vertex of a two-sided surface (each face with a reversed copy) has no
   // normal: it is split into its two sides, each estimated as a vertex of
   // its own (the same place, the side's normal, reflectance and emission;

@@ -505,8 +505,9 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
 }
 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {
+  checkCasterFor(s, caster);
+  checkRadiosityOptions(opt);
   const FormFactors::Settings& ffs = opt.formFactors;
-  if (ffs.raysPerPatch < 1) throw std::invalid_argument("rays_per_patch must be >= 1");
   checkRadiosityMemory(s.faceCount(), opt);  // either solver: before any work
   const std::optional<std::string> narrow =
       narrowPatchWarning(s, narrowPatchCount(s), "their patch values (face output, patch averages)");

@@ -169,6 +169,24 @@ bool usesHierarchy(size_t patches, const RadiosityOptions& opt) {
          (opt.solver == RadiositySolver::Auto && patches >= kHierarchicalAutoPatches);
 }
 
+void checkRadiosityOptions(const RadiosityOptions& o) {
+  const std::vector<ParamSpec> t = RadiosityOptions::specs();
+  requireInRange(t, "light_samples", o.lightSamples);
+  requireInRange(t, "bounces", o.bounces);
+  requireInRange(t, "tolerance", o.tolerance);
+  requireInRange(t, "max_iterations", o.maxIterations);
+  requireInRange(t, "hierarchy_epsilon", o.hierarchyEpsilon);
+  requireInRange(t, "link_rays", o.linkRays);
+  requireInRange(t, "closure_rays", o.closureRays);
+  requireInRange(t, "max_links", o.maxLinks);
+  requireInRange(t, "gather_rays", o.gatherRays);
+  requireInRange(t, "gather_share_rings", o.gatherShareRings);
+  if (!(o.memoryBudgetMB > 0) || !std::isfinite(o.memoryBudgetMB))
+    throw std::invalid_argument("memory_budget_mb must be a finite number of megabytes > 0");
+  checkFormFactorSettings(o.formFactors);
+  o.outside.check();
+}
+
 void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt) {
   const double MB = 1048576.0, n = double(patches);
   const bool hierarchy = usesHierarchy(patches, opt);

@@ -246,6 +246,7 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
 }  // namespace
 
 RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions& optWorld, const Progress& progress) {
+  checkCasterFor(s, caster);
   // Lengths and the point light in the scene's local units (Scene::unit); the
   // camera stays in world coordinates and maps its rays itself.
   RenderOptions o = optWorld;

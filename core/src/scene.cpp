@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "gi/color.h"
 #include "gi/params.h"
+#include "gi/raycaster.h"
 
 namespace gi {
 
@@ -182,7 +184,30 @@ double faceArea(const Scene& s, size_t f) {
 }
 
 
+void checkSceneArrays(const Scene& s) {
+  const size_t nf = s.faceCount();
+  auto one = [nf](const char* name, size_t n) {
+    if (n != 0 && n != nf)
+      throw std::invalid_argument(std::string("Scene::") + name + " has " + std::to_string(n) + " entries for " +
+                                  std::to_string(nf) + " faces: give one per face, or none");
+  };
+  one("rho", s.rho.size());
+  one("emission", s.emission.size());
+  one("material", s.material.size());
+  one("ior", s.ior.size());
+  one("roughness", s.roughness.size());
+  one("leftOut", s.leftOut.size());
+}
+
+void checkCasterFor(const Scene& s, const RayCaster& caster) {
+  const size_t n = caster.sceneFaces();
+  if (n != RayCaster::kUnknownFaces && n != s.faceCount())
+    throw std::invalid_argument("the ray caster was built for a scene of " + std::to_string(n) + " faces, not this one of " +
+                                std::to_string(s.faceCount()) + ": build it from the scene it is used with");
+}
+
 std::vector<uint8_t> usableFaceMask(const Scene& s) {
+  checkSceneArrays(s);
   const size_t nv = s.positions.size();
   std::vector<uint8_t> ok(s.faceCount(), 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.faceCount(), 1 << 14), [&](const tbb::blocked_range<size_t>& r) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "gi/color.h"
 #include "gi/direct.h"
@@ -12,6 +13,16 @@ namespace gi {
 bool SkySun::sky() const { return luminance(skyRadiance) > 0.f; }
 bool SkySun::sun() const { return luminance(sunIrradiance) > 0.f; }
 float SkySun::sunCos() const { return std::cos(glm::radians(sunAngularRadiusDeg)); }
+
+void SkySun::check() const {
+  auto colour = [](const glm::vec3& c) { return finite3(c) && c.r >= 0.f && c.g >= 0.f && c.b >= 0.f; };
+  if (!colour(skyRadiance)) throw std::invalid_argument("the sky's radiance must be finite and >= 0 in every channel");
+  if (!colour(sunIrradiance)) throw std::invalid_argument("the sun's irradiance must be finite and >= 0 in every channel");
+  if (!sun()) return;
+  if (!finite3(sunDirection) || !(std::fabs(glm::length(sunDirection) - 1.f) < 1e-3f))
+    throw std::invalid_argument("sun_direction must be a finite vector of unit length (gi::unitDirection makes one)");
+  requireInRange(specs(), "sun_angular_radius", sunAngularRadiusDeg);
+}
 
 std::vector<ParamSpec> SkySun::specs() {
   return {

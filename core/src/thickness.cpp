@@ -199,6 +199,7 @@ RobustMean robustMean(std::vector<float>& L, bool reject) {
 
 ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, const ThicknessOptions& opt,
                                  const Progress& progress) {
+  checkCasterFor(scene, caster);
   checkOptions(opt);
   Timer timer;
   const SceneReport rep = analyzeScene(scene);

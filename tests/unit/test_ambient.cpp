@@ -263,6 +263,8 @@ TEST(AmbientOcclusionStress, BadGeometryNeverGivesNaN) {
   s.triangles.push_back({0u, 0u, 1u});              // repeated index
   s.triangles.push_back({0u, 1u, 999999u});         // out of range
   s.triangles.push_back({2u, 2u, 2u});
+  if (!s.rho.empty()) s.rho.resize(s.faceCount(), glm::vec3(0.5f));  // per-face arrays: one per face
+  if (!s.emission.empty()) s.emission.resize(s.faceCount(), glm::vec3(0.f));
   const AmbientResult r = runAO(s, 64);
   for (float v : r.value) { ASSERT_TRUE(std::isfinite(v)); ASSERT_GE(v, 0.f); ASSERT_LE(v, 1.f); }
   EXPECT_EQ(r.stats.get("skipped_invalid"), 2.0);  // the NaN and the isolated vertex

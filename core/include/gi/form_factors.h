@@ -87,17 +87,27 @@ class FormFactors {
     uint32_t seed = 0;
     int hemicubePoints = 1;  // hemicube views per patch (1: the centre; more: placed adaptively)
   };
+  // Keeps references to the scene and the caster: both must outlive it
+  // (temporaries are refused at compile time). Throws std::invalid_argument
+  // for settings checkFormFactorSettings refuses or a caster built for
+  // another scene.
   FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings);
   FormFactors(const Scene& s, const RayCaster& caster, int raysPerPatch, uint32_t seed)
       : FormFactors(s, caster, Settings{FormFactorMethod::MonteCarlo, raysPerPatch, 4, 128, seed}) {}
-  FormFactorRow row(uint32_t i) const;  // computed on the fly, deterministic per (i, seed)
+  FormFactors(Scene&&, const RayCaster&, const Settings&) = delete;
+  FormFactors(const Scene&, RayCaster&&, const Settings&) = delete;
+  FormFactors(Scene&&, const RayCaster&, int, uint32_t) = delete;
+  FormFactors(const Scene&, RayCaster&&, int, uint32_t) = delete;
+  // Computed on the fly, deterministic per (i, seed); i < patchCount(), else
+  // std::out_of_range (as area).
+  FormFactorRow row(uint32_t i) const;
   // From now on row(i) is the row of the seen part of patch i, a share
   // a[i] of its area (gi/patch_seen.h): F_ij / a_i, the row summing to at
   // most 1 (one hemicube at the centre keeps its point's row), without the
   // patches of share 0 (light landing there leaves).
   void useSeenParts(std::vector<float> a);
   size_t patchCount() const { return area_.size(); }
-  double area(uint32_t i) const { return area_[i]; }
+  double area(uint32_t i) const { return area_.at(i); }
   uint64_t raysCast() const;
   // Analytic: the pairs with F provably below kNegligibleF, taken at the
   // source's centroid with one visibility ray.
@@ -155,6 +165,12 @@ struct FormFactorReport {
   int reciprocityChecked = 0;
   double seconds = 0;
 };
+// Refuses (std::invalid_argument) settings of the chosen method that leave
+// a row without samples: rays_per_patch (Monte Carlo, Auto),
+// analytic_points (analytic, Auto) or hemicube_points below 1, a hemicube
+// below 4 cells a side, or any above its parameter's range.
+void checkFormFactorSettings(const FormFactors::Settings& settings);
+
 FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,
                                    uint32_t face, int reciprocityChecks = 16);
 std::vector<ParamSpec> formFactorSpecs();

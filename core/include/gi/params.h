@@ -83,6 +83,11 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v);
 // an enum's name or index). Throws std::invalid_argument with a sentence.
 ParamValue parseValue(const ParamSpec& spec, const std::string& text, double diagonal);
 const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name);
+// A library caller fills the options structs directly, past the table's
+// checks: each filter's entry point refuses a number outside the table's
+// range for `name` (or not finite) with std::invalid_argument, in the words
+// validate() uses.
+void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name, double value);
 
 // One table per enumeration: each value with the choice the dialog shows (and
 // scripts and the CLI accept) and the short name the log uses, so that the

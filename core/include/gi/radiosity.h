@@ -153,6 +153,13 @@ bool usesHierarchy(size_t patches, const RadiosityOptions& opt);
 // and what to change. What is left of the budget bounds the hierarchy's
 // links or the flat form-factor matrix (kept in memory only if it fits).
 void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt);
+// Refuses (std::invalid_argument) options a library caller set outside the
+// parameter table's ranges (rays, bounces, tolerance, iterations, links,
+// the sky and sun), a memory budget that is not a positive number, and form
+// factors without rays, points or cells: what the front ends' checks
+// refuse, and what gave NaN vertices (gather_rays 0) or the direct light
+// alone (a NaN tolerance). solveRadiosity calls it first.
+void checkRadiosityOptions(const RadiosityOptions& opt);
 int workerThreads();  // the threads parallel loops may use now
 
 // Sweeps enough for the residual to fall below `tolerance` when each sweep

@@ -57,7 +57,16 @@ class RayCaster {
     (void)face;
     return kNoHit;
   }
+  // The face count of the scene it was built for (kUnknownFaces: not known).
+  static constexpr size_t kUnknownFaces = ~size_t(0);
+  virtual size_t sceneFaces() const { return kUnknownFaces; }
 };
+
+// Throws std::invalid_argument where the caster was built for a scene of
+// another face count: its hits would name faces the scene does not have (a
+// library caller's mistake; every entry point taking a scene and a caster
+// checks it).
+void checkCasterFor(const Scene& s, const RayCaster& caster);
 
 struct Rng;
 // Whether x (normal n) sees a random point of triangle (a, b, c) drawn with

@@ -133,6 +133,11 @@ std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pt
 inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
+// Throws std::invalid_argument where a per-face array (rho, emission,
+// material, ior, roughness, leftOut) is neither empty nor one entry per
+// face: a library caller's mistake that would read past the array.
+// usableFaceMask checks it, so every computation does.
+void checkSceneArrays(const Scene& s);
 // All three components finite (no NaN, no Inf).
 inline bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 // The point of triangle (a, b, c) nearest to p (Ericson 2005, "Real-Time

@@ -49,6 +49,10 @@ struct SkySun {
   bool sun() const;
   bool any() const { return sky() || sun(); }
   float sunCos() const;  // cos alpha: the sun's cone
+  // Throws std::invalid_argument for a sky or sun colour that is not finite
+  // or below 0, a sun direction that is not a finite unit vector where the
+  // sun shines, or an angular radius outside the table's range.
+  void check() const;
   // sky_color, sky_irradiance, sun_direction, sun_color, sun_irradiance,
   // sun_angular_radius: the names, help and ranges every filter shares.
   static std::vector<ParamSpec> specs();
