@@ -161,6 +161,7 @@ void mergeSideErrors(std::vector<float>& error, const VertexSides& sides) {
 }
 
 VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const DirectOptions& opt, const Progress& progress) {
+  checkCasterFor(s, caster);
   if (opt.lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   Timer timer;
   const EmitterSampler lights(s);
@@ -467,23 +468,11 @@ namespace {
 // catches them.
 void poolOverRings(const Scene& s, const std::vector<uint8_t>& valid, int samples, std::vector<float>& se) {
   const size_t nv = se.size();
-  const VertexGraph g = VertexGraph::build(s);
-  std::vector<double> own(nv), mean(nv);
-  for (size_t v = 0; v < nv; ++v) own[v] = double(se[v]) * se[v] * samples;
-  mean = own;
-  for (int ring = 0; ring < 2; ++ring) {  // a mean over the 1-ring, twice: about two rings
-    std::vector<double> wider(nv);
-    for (size_t v = 0; v < nv; ++v) {
-      double sum = mean[v];
-      size_t n = 1;
-      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k)
-        if (valid[g.nbr[k]]) sum += mean[g.nbr[k]], ++n;
-      wider[v] = sum / double(n);
-    }
-    mean.swap(wider);
-  }
+  std::vector<double> var(nv);
+  for (size_t v = 0; v < nv; ++v) var[v] = double(se[v]) * se[v] * samples;
+  atLeastRingMean(VertexGraph::build(s), valid, var);
   for (size_t v = 0; v < nv; ++v)
-    if (valid[v]) se[v] = float(std::sqrt(std::max(own[v], mean[v]) / samples));
+    if (valid[v]) se[v] = float(std::sqrt(var[v] / samples));
 }
 }  // namespace
 

@@ -27,6 +27,14 @@ struct PhotonOnly {
   int minHitsLeft = 0;
   bool widen = true;      // search past the 2k nearest while fewer than k are on this side
   uint32_t skipEvery = 0;  // if > 0: the map's photons i (photon(i)) with i % skipEvery == 0 left out
+  // If set: only the photons a ray from `from` (the estimate's point lifted
+  // off its surface) reaches, each lifted by eps along its normal. Where
+  // another surface rises inside the estimate's sphere, photons behind it
+  // lit the point through it: a floor vertex under a glossy block read the
+  // caustic the block throws around its foot (an outside audit).
+  const RayCaster* visibleFrom = nullptr;
+  glm::vec3 from{0.f};
+  float eps = 0.f;
 };
 
 class PhotonMap {
@@ -159,6 +167,7 @@ class PhotonMap {
         if (only.skipEvery && idx[m] % only.skipEvery == 0) continue;
         if (!((only.paths >> ph.path) & 1u) || (only.minHitsLeft > 0 && left_ && (*left_)[i] < only.minHitsLeft))
           continue;
+        if (only.visibleFrom && !visible(only, ph)) continue;
         q.ph[q.used] = &ph;
         q.d2[q.used] = d2[m];
         ++q.used;
@@ -172,6 +181,16 @@ class PhotonMap {
       // Enough candidates for k on this side at the share seen, with a margin.
       want = std::min<size_t>({size(), std::max(want * 2, want * size_t(k) * 5 / (size_t(q.used) * 4)), kMaxQuery});
     }
+  }
+  static bool visible(const PhotonOnly& only, const Photon& ph) {
+    const glm::vec3 d = ph.p + ph.normal() * only.eps - only.from;
+    const float len = glm::length(d);
+    if (!(len > 0.f)) return true;
+    Ray r;
+    r.o = only.from;
+    r.d = d / len;
+    r.tfar = len * (1.f - 1e-4f);
+    return !only.visibleFrom->occluded(r);
   }
   const GatherSurface& surface_;
   const std::vector<uint8_t>* left_;

@@ -114,14 +114,16 @@ static std::vector<uint32_t> vertexSheets(const Scene& s, const std::vector<uint
   return sheet;
 }
 
-GatherSurface::GatherSurface(const Scene& s) {
+GatherSurface::GatherSurface(const Scene& s, bool specular) {
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   vertexSheet_ = vertexSheets(s, ok);
   std::vector<glm::vec3> centroid;
+  bool anySpecular = false;
   for (size_t f = 0; f < s.faceCount(); ++f) {
     // Photons are stored on diffuse faces only.
-    if (!ok[f] || isCausticSurface(s.faceMaterial(f))) continue;
+    if (ok[f] && !specular && isCausticSurface(s.faceMaterial(f))) anySpecular = true;
+    if (!ok[f] || isCausticSurface(s.faceMaterial(f)) != specular) continue;
     const auto& t = s.triangles[f];
     sheet_.push_back(vertexSheet_[t.x]);
     a_.push_back(s.positions[t.x]);
@@ -141,6 +143,7 @@ GatherSurface::GatherSurface(const Scene& s) {
     nodes_.reserve(2 * order_.size() / 4 + 2);
     build(0, uint32_t(order_.size()), centroid);
   }
+  if (anySpecular) specular_ = std::shared_ptr<const GatherSurface>(new GatherSurface(s, true));
 }
 
 // Median split on the longest axis of the centroids' box; leaves of up to 4 faces.
@@ -268,8 +271,17 @@ double GatherSurface::area(const glm::vec3& x, const glm::vec3& n, float r, bool
   return A;
 }
 
+// Where only diffuse faces counted, a floor under a glossy block kept the
+// photons around the block's foot (the reference 0 there; 0.026 on average
+// over the floor under the shipped glossy block, the lit floor 0.40, 90 of
+// 91 vertices beyond 3 standard errors; an outside audit).
 bool GatherSurface::otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet,
                                        float cosTurn) const {
+  return facesWithin(x, n, r, sheet, cosTurn) || (specular_ && specular_->facesWithin(x, n, r, sheet, cosTurn));
+}
+
+bool GatherSurface::facesWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet,
+                                float cosTurn) const {
   if (nodes_.empty() || !(r > 0.f)) return false;
   const float r2 = r * r, rise = 1e-4f * r, ownRise = 0.1f * r;
   const glm::dvec3 xd(x);

@@ -10,6 +10,7 @@
 // Internal to the photon-mapping sources.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -20,7 +21,7 @@ namespace gi {
 
 class GatherSurface {
  public:
-  explicit GatherSurface(const Scene& s);
+  explicit GatherSurface(const Scene& s) : GatherSurface(s, false) {}
   // Of all the diffuse faces.
   double totalArea() const { return nodes_.empty() ? 0.0 : nodes_[0].area; }
 
@@ -40,8 +41,9 @@ class GatherSurface {
   // The sheet of vertex v (kNoSheet for one no usable face holds).
   static constexpr uint32_t kNoSheet = 0xffffffffu;
   uint32_t vertexSheet(size_t v) const { return v < vertexSheet_.size() ? vertexSheet_[v] : kNoSheet; }
-  // Whether a counted face (diffuse, any orientation) within r of x rises
-  // above x's tangent plane (on n's side) and belongs to another sheet than
+  // Whether a face (diffuse, any orientation; or a mirror's, glass' or
+  // glossy surface's, which hold no photons but hide the same light) within
+  // r of x rises above x's tangent plane (on n's side) and belongs to another sheet than
   // `sheet` (an object standing on the surface, a lamp just below a ceiling:
   // by more than 1e-4 r) or turns more than acos(cosTurn) from n (a wall
   // meeting the floor, welded or not: by more than r / 10; a convex surface
@@ -54,6 +56,10 @@ class GatherSurface {
   bool otherSurfaceWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet, float cosTurn) const;
 
  private:
+  // specular: of the mirror, glass and glossy faces instead (otherSurfaceWithin's only).
+  GatherSurface(const Scene& s, bool specular);
+  bool facesWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet, float cosTurn) const;
+  std::shared_ptr<const GatherSurface> specular_;  // null where the scene has none
   // A bounding-volume hierarchy over the faces. A node wholly inside the ball
   // whose faces share one normal adds its area at once: on the planar walls
   // of most scenes only the faces the sphere cuts are clipped.

@@ -60,4 +60,23 @@ VertexGraph VertexGraph::build(const Scene& s, const std::vector<uint8_t>* usabl
   return g;
 }
 
+void atLeastRingMean(const VertexGraph& g, const std::vector<uint8_t>& use, std::vector<double>& x) {
+  const size_t nv = x.size();
+  std::vector<double> mean = x;
+  for (int ring = 0; ring < 2; ++ring) {  // a mean over the 1-ring, twice: about two rings
+    std::vector<double> wider(nv);
+    for (size_t v = 0; v < nv; ++v) {
+      if (!use[v]) continue;
+      double sum = mean[v];
+      size_t n = 1;
+      for (uint32_t k = g.offset[v]; k < g.offset[v + 1]; ++k)
+        if (use[g.nbr[k]]) sum += mean[g.nbr[k]], ++n;
+      wider[v] = sum / double(n);
+    }
+    mean.swap(wider);
+  }
+  for (size_t v = 0; v < nv; ++v)
+    if (use[v]) x[v] = std::max(x[v], mean[v]);
+}
+
 }  // namespace gi

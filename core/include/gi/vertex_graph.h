@@ -16,4 +16,12 @@ struct VertexGraph {
   size_t degree(uint32_t v) const { return offset[v + 1] - offset[v]; }
 };
 
+// Per vertex, at least the mean of x over about two rings around it (the
+// 1-ring's mean, the vertex included, taken twice; only vertices marked in
+// `use` take part and change): the error bars' variance where a vertex's
+// own few samples are skewed low (a luminaire picked rarely, a small bright
+// patch most gather rays miss) while its neighbours', which see nearly the
+// same light, catch what it missed.
+void atLeastRingMean(const VertexGraph& g, const std::vector<uint8_t>& use, std::vector<double>& x);
+
 }  // namespace gi
