@@ -20,7 +20,9 @@
 // or spot light, the sky and the sun), the caustic photons read at y, and
 // the rest from one cosine ray from y to z, read from the photons with two
 // or more hits left (one reflection at z, one at y, one at x: max_depth
-// stays exact). One ray a near hit is enough: a vertex averages many. The
+// stays exact). One ray a near hit is enough: a vertex averages many. A far
+// hit reads H(y) with its direct part by light sampling at y as well: the
+// direct photons' estimate blurs a shadow edge the vertex sees. The
 // estimates the rays read are kept at a subset of the photons (below).
 #include <algorithm>
 #include <atomic>
@@ -80,7 +82,8 @@ namespace {
 class SiteIrradiance {
  public:
   struct Site {
-    glm::vec3 H{0.f}, caustic{0.f}, two{0.f};  // all photons, the caustic ones, those with 2 or more hits left
+    glm::vec3 H{0.f}, caustic{0.f}, direct{0.f}, two{0.f};  // all photons, the caustic ones, the direct ones,
+                                                             // those with 2 or more hits left
     float radius = 0.f;
     int used = 0;  // photons the estimate read
   };
@@ -127,6 +130,7 @@ class SiteIrradiance {
     st.H = scale_ * all_.irradiance(y, n, k_, r2max_, PhotonKernel::Uniform, nullptr, &st.used, parts, rest,
                                     &st.radius, &st.two);
     st.caustic = scale_ * parts[kCausticPhoton];
+    st.direct = scale_ * parts[kDirectPhoton];
     st.two *= scale_;
     return st;
   }
@@ -191,12 +195,18 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
   const auto value = [&](const PhotonGatherHit& g) -> glm::vec3 {
     const SiteIrradiance::Site e = at(g.point, g.normal);
     count(e.used);
-    // A far hit, or max_depth 0 (no reflection may be added at y).
-    if (!(g.t < e.radius) || opt.maxDepth < 1) return s.faceRho(g.face) * e.H;
-    relit.fetch_add(1, std::memory_order_relaxed);
+    // max_depth 0: no reflection may be added at y.
+    if (opt.maxDepth < 1) return s.faceRho(g.face) * e.H;
     const glm::vec3 o = g.point + g.normal * r.eps;
-    glm::vec3 Hy = directAt(g.point, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, o, g.normal) +
-                   skySunIrradianceAt(opt.outside, r.caster, o, g.normal, 4, g.key) + e.caustic;
+    const glm::vec3 direct = directAt(g.point, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, o, g.normal) +
+                             skySunIrradianceAt(opt.outside, r.caster, o, g.normal, 4, g.key);
+    // A far hit: the photons' estimate, but for the direct light, taken at
+    // y itself (the direct photons' estimate blurs a shadow edge over the
+    // radius: a wall lit by a floor on which it casts the sun's shadow read
+    // +10.6% on average, +19% near the floor; an outside audit).
+    if (!(g.t < e.radius)) return s.faceRho(g.face) * (e.H - e.direct + direct);
+    relit.fetch_add(1, std::memory_order_relaxed);
+    glm::vec3 Hy = direct + e.caustic;
     Rng rng(hash3(g.key, 0x6eu, 0x2bu));
     Ray ray;
     ray.o = o;

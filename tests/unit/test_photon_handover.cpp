@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "gi/color.h"
+#include "gi/pathtrace.h"
 #include "gi/photon.h"
 #include "gi/raycaster.h"
 #include "gi/scenes.h"
+#include "gi/sky.h"
 
 using namespace gi;
 
@@ -95,4 +98,44 @@ TEST(PhotonHandOver, FinalGatherErrorBarsHoldUnderASpot) {
   ASSERT_GT(n, 40);
   EXPECT_LT(z2 / n, 1.5);
   EXPECT_LE(beyond3, 1);
+}
+
+// A wall lit only by a floor on which it casts the sun's shadow: the final
+// gather's rays read the estimate where they land, and the direct photons'
+// estimate blurs the shadow edge over its radius. The wall read +10.6% on
+// average against the reference (+19% near the floor), its error bars
+// (about 40%) hiding it (an outside audit). Now every gather hit takes its
+// direct light by light sampling at the hit: +0.6%. The wall's mean
+// against the path tracer's (512 paths at each of its vertices), within 3%.
+TEST(PhotonHandOver, GatherReadsTheSunsShadowEdgeSharp) {
+  const Scene s = scenes::byName("floor_wall").scene;
+  auto caster = makeEmbreeCaster(s);
+  auto wall = std::make_shared<std::vector<uint8_t>>(s.vertexCount(), 0);
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    const glm::dvec3 p = s.origin + glm::dvec3(s.positions[v]);
+    (*wall)[v] = std::fabs(p.x) < 1e-6 && p.z > 1e-6 && std::fabs(p.y) < 8.0;
+  }
+  SkySun sun;
+  sun.sunIrradiance = glm::vec3(3.f);
+  sun.sunDirection = glm::normalize(glm::vec3(-1.f, 0.f, 1.f));
+  PhotonOptions o;
+  o.outside = sun;
+  const VertexRadiometry pm = computePhotonMap(s, *caster, o);
+  PathTraceOptions po;
+  po.samplesPerVertex = 512;
+  po.sunIrradiance = sun.sunIrradiance;
+  po.sunDirection = sun.sunDirection;
+  po.tracedSelected = true;
+  po.selectedVertices = wall;
+  const PathTraceResult ref = pathTrace(s, *caster, po);
+  double a = 0, b = 0, se2 = 0;
+  int n = 0;
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    if (!(*wall)[v]) continue;
+    a += luminance(pm.B[v]), b += luminance(ref.B[v]), se2 += double(ref.stdError[v]) * ref.stdError[v], ++n;
+  }
+  std::printf("%d wall vertices: photon map / reference - 1 = %+.4f (reference's standard error %.4f)\n", n, a / b - 1,
+              std::sqrt(se2) / b);
+  ASSERT_GT(n, 300);
+  EXPECT_LT(std::fabs(a / b - 1), 0.03);
 }
