@@ -1,6 +1,7 @@
 #include "atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -46,6 +47,42 @@ bool syncFile(const std::string& path) {
   return ::close(fd) == 0 && ok;
 }
 
+// The temporaries being written, for the signal handler: fixed slots whose
+// paths it reads without allocating (unlink is async-signal-safe).
+constexpr int kSlots = 32;
+constexpr size_t kPathBytes = 4096;
+struct Slot {
+  std::atomic<bool> claimed{false}, ready{false};  // taken by a writer; its path complete
+  char path[kPathBytes];
+};
+Slot g_slots[kSlots];
+
+// Claims a slot for `tmp` (none free or too long a path: not listed).
+int listTemporary(const std::string& tmp) {
+  if (tmp.size() >= kPathBytes) return -1;
+  for (int k = 0; k < kSlots; ++k) {
+    bool expected = false;
+    Slot& s = g_slots[k];
+    if (!s.claimed.compare_exchange_strong(expected, true)) continue;
+    std::memcpy(s.path, tmp.c_str(), tmp.size() + 1);
+    s.ready.store(true);
+    return k;
+  }
+  return -1;
+}
+void unlistTemporary(int k) {
+  if (k < 0) return;
+  g_slots[k].ready.store(false);
+  g_slots[k].claimed.store(false);
+}
+
+extern "C" void removeTemporariesAndStop(int sig) {
+  for (Slot& s : g_slots)
+    if (s.ready.load()) ::unlink(s.path);
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
 std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
   if (from.empty()) return s;
   for (size_t k = s.find(from); k != std::string::npos; k = s.find(from, k + to.size())) s.replace(k, from.size(), to);
@@ -75,6 +112,10 @@ void writeAtomically(const std::string& path, const std::function<void(const std
   }
   const std::string tmp = createTemporary(fs::path(target));
   if (tmp.empty()) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  struct Listed {
+    int slot;
+    ~Listed() { unlistTemporary(slot); }
+  } listed{listTemporary(tmp)};
   try {
     if (exists) ::chmod(tmp.c_str(), st.st_mode & 07777);  // the permissions of the file it replaces
     write(tmp);
@@ -97,6 +138,18 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
     f.close();
     if (!f) throw std::runtime_error("cannot write " + temp + ": " + std::strerror(errno));
   });
+}
+
+void removeTemporariesOnSignals() {
+  struct sigaction sa {};
+  sa.sa_handler = removeTemporariesAndStop;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    // A signal the caller ignores (nohup, a shell's background job) stays ignored.
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &sa, nullptr);
+  }
 }
 
 std::string cannotCreateBeside(const std::string& path) {

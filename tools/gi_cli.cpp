@@ -6,7 +6,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -293,10 +295,6 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   std::vector<files::Named> outputs = resultOutputs(a, r);
   if (caching) outputs.push_back({cached, "--cache"});
   files::check(inputs, outputs);
-  if (caching) {
-    io::writeResultFile(cached, key, r);
-    r.stats.note("cached as " + cached);
-  }
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
   std::vector<std::string> layerFiles;
@@ -307,6 +305,17 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     r.stats.note("the new layers are written only beside an output (-o)");
   }
   writeOutputFiles(r, files::atomicWriter());
+  // The cache last, and optional: a cache that cannot take the result (a
+  // full disk) warns and loses nothing else (it threw away a 22 s reference
+  // before its output was written; an outside audit).
+  if (caching) {
+    try {
+      io::writeResultFile(cached, key, r);
+      r.stats.note("cached as " + cached);
+    } catch (const std::exception& e) {
+      r.stats.warn(std::string("the result was not cached: ") + e.what());
+    }
+  }
   r.stats.add("total_seconds", timer.seconds());
   const auto lines = r.logLines(desc.meshlabName);
   if (a.json) {
@@ -538,8 +547,20 @@ int runCli(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  io::removeTemporariesOnSignals();
   cluster::start(&argc, &argv);
-  const int status = runCli(argc, argv);
+  int status = runCli(argc, argv);
   cluster::stop();
+  // What went to standard output (--json, gi script, gi filters) must have
+  // arrived: a full disk or a closed pipe is an error, not exit 0 over an
+  // empty or cut-off file (an outside audit: `gi script render > f.mlx` on a
+  // full disk left 4,096 of 4,163 bytes and exit 0).
+  std::cout.flush();
+  errno = 0;
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    std::fprintf(stderr, "gi: error: cannot write to standard output: %s\n",
+                 errno ? std::strerror(errno) : "write error");
+    if (status == 0) status = 1;
+  }
   return status;
 }

@@ -125,6 +125,11 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
       st.warn("sun_angular_radius 0 is a point sun: all " + std::to_string(o.sunRays) +
               " sun rays per vertex follow one direction (hard shadows; one ray gives the same)");
   }
+  if (o.mode == AmbientMode::Occlusion && o.targetError == 0.0 && o.estimator == AOEstimator::PerVertex &&
+      o.raysPerVertex < 8)
+    st.warn("rays_per_vertex = " + std::to_string(o.raysPerVertex) + ": each vertex's value is one of " +
+            std::to_string(o.raysPerVertex + 1) + " levels, its standard error up to " +
+            num(0.5 / std::sqrt(double(o.raysPerVertex))) + "; 16 rays or more give a usable estimate");
   if (o.targetError > 0.0) {
     size_t unmet = 0, traced = 0;
     float worst = 0.f;

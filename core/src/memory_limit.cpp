@@ -7,7 +7,10 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <cstdlib>
 #include <string>
+
+#include <sys/resource.h>
 
 namespace gi {
 
@@ -111,11 +114,35 @@ std::atomic<int> g_share{1};
 void shareMemoryWith(int processes) { g_share = std::max(processes, 1); }
 int memoryShare() { return g_share; }
 
+namespace {
+
+// What the address-space limit (ulimit -v, RLIMIT_AS) leaves this process
+// beyond what it maps now (VmSize), or -1 where there is none. Past it an
+// allocation fails with std::bad_alloc: "out of memory" without the need
+// and the parameter to lower (an outside audit, under ulimit -v).
+double addressSpaceRoom() {
+  rlimit r{};
+  if (getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return -1;
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  double mapped = 0;
+  while (std::getline(f, line))
+    if (line.rfind("VmSize:", 0) == 0) {
+      mapped = 1024.0 * std::atof(line.c_str() + 7);
+      break;
+    }
+  return std::max(0.0, double(r.rlim_cur) - mapped);
+}
+
+}  // namespace
+
 size_t availableMemoryBytes() {
   const long long kb = meminfoKB("MemAvailable");
   double avail = kb >= 0 ? double(kb) * 1024.0 : 0.0;
   const double room = cgroupRoom();
   if (room >= 0) avail = avail > 0 ? std::min(avail, room) : room;
+  const double space = addressSpaceRoom();
+  if (space >= 0) avail = avail > 0 ? std::min(avail, space) : space;
   return size_t(avail / double(g_share.load()));
 }
 
