@@ -63,9 +63,10 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // The seen share of each triangle (1 where none is given), its seen area,
   // and the direct light of its seen part.
   const bool partSeen = !set.seen.empty();
-  if (partSeen && (set.seen.size() != nf || set.seenPoints.size() != nf))
-    throw std::logic_error("seen shares and points: one per triangle");
-  if (partSeen) g.seen = &set.seen, g.seenPoints = &set.seenPoints;
+  if (partSeen && (set.seen.size() != nf || (!set.seenPoints.empty() && set.seenPoints.size() != nf)))
+    throw std::invalid_argument("HierarchySettings: seen shares and seen points must be one per triangle");
+  // Without the open points a node spreads what it gathers over its seen part.
+  if (partSeen && !set.seenPoints.empty()) g.seen = &set.seen, g.seenPoints = &set.seenPoints;
   auto seenShare = [&](size_t f) { return partSeen ? double(set.seen[f]) : 1.0; };
   if (partSeen)
     for (size_t f = 0; f < nf; ++f) S[f] = seenShare(f) > 0 ? S[f] / float(seenShare(f)) : glm::vec3(0.f);
@@ -85,7 +86,8 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // one none of whose points lies there spreads what its buried points
   // gather over its seen part, as all nodes did before.
   std::vector<uint8_t> gathersOnSeen(nn, 1);
-  if (partSeen)
+  if (partSeen && !g.seen) std::fill(gathersOnSeen.begin(), gathersOnSeen.end(), uint8_t(0));
+  if (g.seen)
     parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
       NodePointSet pts;
       uint32_t faces[kPoints];

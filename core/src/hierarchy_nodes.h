@@ -100,8 +100,10 @@ struct NodePointSet {
 // A receiver's points on the part of it the scene sees (Geometry::seen):
 // a point on a partly buried triangle moves to one of the points found open
 // on it (each triangle's in turn), a point on a wholly buried one takes the
-// place of the next point kept. What a link brings is then the mean over
-// the seen part, as the flat solvers' rows are; the points anywhere on the
+// place of the next point kept. What a link brings is then taken on the
+// seen part, as the flat solvers' rows are (for a triangle, the mean over
+// its seen part; a cluster's points keep the weights their triangles' whole
+// areas gave them, so its mean is the seen part's only roughly); the points anywhere on the
 // triangle, their passing share divided by the seen share, made a ratio of
 // two estimates from different points (a floor triangle a few percent seen
 // beside the Cornell box's short block: 0.71 where the floor's brightest

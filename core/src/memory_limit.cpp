@@ -142,7 +142,7 @@ size_t availableMemoryBytes() {
   const double room = cgroupRoom();
   if (room >= 0) avail = avail > 0 ? std::min(avail, room) : room;
   const double space = addressSpaceRoom();
-  if (space >= 0) avail = avail > 0 ? std::min(avail, space) : space;
+  if (space >= 0) avail = avail > 0 ? std::min(avail, std::max(space, 1.0)) : std::max(space, 1.0);  // 0: unknown
   return size_t(avail / double(g_share.load()));
 }
 

@@ -82,7 +82,10 @@ static std::string exact(float x) {  // a vector's component: the shortest text 
 void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name, double value) {
   const ParamSpec* s = findSpec(specs, name);
   if (!s) throw std::logic_error("no parameter '" + name + "' in the table");
-  if (!std::isfinite(value) || value < s->min || value > s->max)
+  // As validate(): a bound handed through single precision passes (MeshLab's
+  // dialog holds 1e-12 as 9.99999996e-13).
+  const bool below = value < s->min && float(value) < float(s->min), above = value > s->max && float(value) > float(s->max);
+  if (!std::isfinite(value) || below || above)
     throw std::invalid_argument("parameter '" + name + "' = " + exact(value) + " is outside [" + exact(s->min) + ", " +
                                 exact(s->max) + "]");
 }

@@ -414,6 +414,8 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   opt.point.check();
   if (opt.photons < 1 || opt.kNearest < 1 || opt.kNearest > 512 || opt.causticK < 1 || opt.causticK > 512 || opt.passes < 1)
     throw std::invalid_argument("photons and passes must be >= 1, k_nearest and caustic_k in [1, 512]");
+  requireInRange(PhotonOptions::specs(), "gather_rays", opt.gatherRays);  // 0 gave NaN at every gathered vertex
+  opt.outside.check();
   Timer timer;
   VertexRadiometry out;
   RunStats& st = out.stats;

@@ -240,6 +240,7 @@ PhotonOnly seenFrom(const PhotonRun& r, size_t i) {
   o.visibleFrom = &r.caster;
   o.from = r.origins[i];
   o.eps = r.eps;
+  o.widen = false;  // the 2k nearest at most, each one ray (a widening search cast them again each round)
   return o;
 }
 

@@ -47,6 +47,7 @@ void validate(const RenderOptions& o) {
   if (!(o.whittedMinWeight >= 0.f && o.whittedMinWeight <= 1.f))
     throw std::invalid_argument("whitted_min_weight must lie in [0, 1]");
   o.point.check();
+  o.outside().check();
   if (!o.renderImage && !o.vertexRadiance) throw std::invalid_argument("neither an image nor vertex radiance was asked for");
 }
 

@@ -16,6 +16,7 @@
 #include "gi/ambient.h"
 #include "gi/form_factors.h"
 #include "gi/pathtrace.h"
+#include "gi/photon.h"
 #include "gi/radiosity.h"
 #include "gi/raycaster.h"
 #include "gi/scenes.h"
@@ -185,4 +186,26 @@ TEST(LibraryMisuse, PathTracerRefusesWhatTheTableRefuses) {
     const std::string why = refusal([&] { pathTrace(s, *caster, o); });
     EXPECT_NE(why.find(name), std::string::npos) << name << ": " << why;
   }
+}
+
+// Photon mapping: gather_rays 0 gave NaN at every gathered vertex, a NaN sky
+// ran. And a bound handed through single precision passes, as the front
+// ends' check lets it (MeshLab's dialog holds tolerance 1e-12 as
+// 9.99999996e-13).
+TEST(LibraryMisuse, PhotonMapRefusesAndBoundsSurviveSinglePrecision) {
+  const Scene s = plates();
+  auto caster = makeEmbreeCaster(s);
+  PhotonOptions o;
+  o.photons = 1000;
+  o.finalGather = true;
+  o.gatherRays = 0;
+  EXPECT_NE(refusal([&] { computePhotonMap(s, *caster, o); }).find("gather_rays"), std::string::npos);
+  o.gatherRays = 4;
+  o.outside.skyRadiance = glm::vec3(NAN);
+  EXPECT_NE(refusal([&] { computePhotonMap(s, *caster, o); }).find("sky's radiance"), std::string::npos);
+  RadiosityOptions r;
+  r.tolerance = double(float(1e-12));
+  ASSERT_LT(r.tolerance, 1e-12);
+  r.vertexOutput = RadiosityVertexOutput::PatchAverage;
+  EXPECT_EQ(refusal([&] { solveRadiosity(s, *caster, r); }), "");
 }

@@ -87,8 +87,9 @@ class FormFactors {
     uint32_t seed = 0;
     int hemicubePoints = 1;  // hemicube views per patch (1: the centre; more: placed adaptively)
   };
-  // Keeps references to the scene and the caster: both must outlive it
-  // (temporaries are refused at compile time). Throws std::invalid_argument
+  // Keeps references to the scene and the caster: both must outlive it (a
+  // temporary Scene or caster passed directly does not compile, but
+  // `*makeEmbreeCaster(s)` written inline still dangles: keep the unique_ptr). Throws std::invalid_argument
   // for settings checkFormFactorSettings refuses or a caster built for
   // another scene.
   FormFactors(const Scene& s, const RayCaster& caster, const Settings& settings);
@@ -168,7 +169,7 @@ struct FormFactorReport {
 // Refuses (std::invalid_argument) settings of the chosen method that leave
 // a row without samples: rays_per_patch (Monte Carlo, Auto),
 // analytic_points (analytic, Auto) or hemicube_points below 1, a hemicube
-// below 4 cells a side, or any above its parameter's range.
+// below 4 cells a side.
 void checkFormFactorSettings(const FormFactors::Settings& settings);
 
 FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, const FormFactors::Settings& settings,
