@@ -224,8 +224,14 @@ class Integrator {
   EmitterSampler emitters_;
   std::vector<glm::vec3> faceN_;
   float eps_;
+  // Hits farther than this (twice the diagonal: only rays from outside the
+  // scene, a camera's) are put back onto their face's plane (surfaceAt).
+  float farT_;
   bool hasSky_ = false, hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
-  float sunCos_ = 1.f, sunPdf_ = 0.f;
+  // The sun's disk: its versine 1 - cos a (sampling) and sin^2 a (whether a
+  // ray meets it, tested in double), both exact where cos a is 1 in float.
+  float sunVersine_ = 0.f, sunPdf_ = 0.f;
+  double sunSin2_ = 0.0;
   glm::vec3 sunL_{0.f};
 };
 

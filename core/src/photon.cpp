@@ -386,23 +386,6 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
   return totalsOver(out.B, out.stdError, mat.valid);
 }
 
-// Where the openings are the only way in from outside (no cosine rays
-// kept: gi/sky.h), the sky's and the sun's photons aim at a sphere around
-// their portals instead of the scene's: the same lines through the
-// openings, none spent on the outsides of the walls. True where it did.
-bool aimAtOpenings(const SkyOpenings& openings, const Scene& s, PhotonOptions& opt) {
-  if (!opt.outside.any() || !openings.any() || openings.rest) return false;
-  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-  for (const SkyPortal& p : openings.portals)
-    for (const glm::dvec3& c : p.corners) lo = glm::min(lo, c), hi = glm::max(hi, c);
-  const glm::dvec3 centre = 0.5 * (lo + hi);
-  double r = 0;
-  for (const SkyPortal& p : openings.portals)
-    for (const glm::dvec3& c : p.corners) r = std::max(r, glm::length(c - centre));
-  opt.outsideAimCentre = glm::vec3(centre);
-  opt.outsideAimRadius = float(r * 1.001 + sceneScale(s).rayEpsilon);
-  return true;
-}
 
 // The photon map at every vertex with a normal (computePhotonMap splits the
 // two-sided ones first).
@@ -485,6 +468,21 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
 }
 
 }  // namespace
+
+// gi/photon.h; the openings as findSkyOpenings found them (no cosine rays kept: gi/sky.h).
+bool aimAtOpenings(const SkyOpenings& openings, const Scene& s, PhotonOptions& opt) {
+  if (!opt.outside.any() || !openings.any() || openings.rest) return false;
+  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
+  for (const SkyPortal& p : openings.portals)
+    for (const glm::dvec3& c : p.corners) lo = glm::min(lo, c), hi = glm::max(hi, c);
+  const glm::dvec3 centre = 0.5 * (lo + hi);
+  double r = 0;
+  for (const SkyPortal& p : openings.portals)
+    for (const glm::dvec3& c : p.corners) r = std::max(r, glm::length(c - centre));
+  opt.outsideAimCentre = glm::vec3(centre);
+  opt.outsideAimRadius = float(r * 1.001 + sceneScale(s).rayEpsilon);
+  return true;
+}
 
 VertexRadiometry computePhotonMap(const Scene& s, const RayCaster& caster, const PhotonOptions& opt,
                                   const Progress& progress, PhotonMapContents* maps) {

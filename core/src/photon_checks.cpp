@@ -18,6 +18,14 @@ std::string num(double v) {
 
 }  // namespace
 
+std::optional<std::string> smallKWarning(const std::string& name, int k) {
+  // k Phi / A(r_k): A(r_k) / lambda is Gamma(k)-distributed, so the
+  // estimate's mean (k / (k - 1)) is infinite at k = 1, its variance at k = 2.
+  if (k > 2) return std::nullopt;
+  return name + " = " + std::to_string(k) + ": the k-nearest estimate k Phi / (pi r_k^2) has " +
+         (k == 1 ? "no finite mean" : "no finite variance") + " (r_k is random); use k >= 16";
+}
+
 void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, double unit, RunStats& st) {
   // The mean distance between photons, sqrt(area / photons): a radius below
   // it holds about pi (r / spacing)^2 < pi photons, mostly 0 or 1.
@@ -45,12 +53,9 @@ void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGathe
     st.warn("the photon map holds no photons (" + std::to_string(opt.photons) +
             " photon paths): the light beyond the direct light is missing; shoot more photons");
   if (c.kNearestEstimates) {
-    // k Phi / A(r_k): A(r_k) / lambda is Gamma(k)-distributed, so the
-    // estimate's mean (k / (k - 1)) is infinite at k = 1, its variance at k = 2.
     auto kCheck = [&](const char* name, int k, size_t photons, const char* map) {
-      if (k <= 2)
-        st.warn(std::string(name) + " = " + std::to_string(k) + ": the k-nearest estimate k Phi / (pi r_k^2) has " +
-                (k == 1 ? "no finite mean" : "no finite variance") + " (r_k is random); use k >= 16");
+      if (const auto w = smallKWarning(name, k))
+        st.warn(*w);
       else if (photons > 0 && photons < size_t(k))
         st.warn(std::string(name) + " " + std::to_string(k) + " exceeds the " + std::to_string(photons) + " photons of the " +
                 map + ": every estimate spans them all (one blurred average); shoot more photons");

@@ -17,6 +17,7 @@
 #include "gi/emitters.h"
 #include "gi/memory_limit.h"
 #include "gi/scene_setup.h"
+#include "gi/specular.h"
 #include "render_internal.h"
 
 namespace gi {
@@ -322,9 +323,22 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
     st.add("mean_radiance", lum / double(n));
     // Every pixel black: nothing lit in view (an eye inside an object sees
     // only back faces, which are black; or the camera looks away).
-    if (n > 0 && !(lum > 0))
-      st.warn("the image is black: no eye ray reached a lit surface (is the camera inside an object, or looking "
-              "away from the scene?)");
+    if (n > 0 && !(lum > 0)) {
+      // Whitted's and the distributed view's shadow rays stop at mirrors
+      // and glass, and their paths have no diffuse bounce: a room lit only
+      // through a glass window is black there (an outside audit: the
+      // warning named only the camera).
+      bool specular = false;
+      for (size_t f = 0; f < s.faceCount() && !specular; ++f) specular = isCausticSurface(s.faceMaterial(f));
+      const bool direct = o.mode == RenderMode::Whitted || o.mode == RenderMode::Distributed ||
+                          (o.mode == RenderMode::PathTraced && o.maxDiffuseBounces == 0);
+      st.warn(std::string("the image is black: no eye ray reached a lit surface (is the camera inside an object, or "
+                          "looking away from the scene?") +
+              (specular && direct ? " Or is the light in view only reached through mirrors or glass? This mode's "
+                                    "shadow rays stop at them and it follows no diffuse bounce: try the path-traced "
+                                    "or two-pass mode)"
+                                  : ")"));
+    }
     st.add("rms_std_error", std::sqrt(err2 / double(n)));
     st.add("mean_relative_std_error", relN ? rel / double(relN) : 0.0);
     if (o.mode == RenderMode::PathTraced)

@@ -79,6 +79,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.photons = o.causticPhotons;
     po.causticK = o.causticK;
     po.point = o.point;
+    po.outside = o.outside();
     po.seed = o.seed;
     // The eye pass's limit: a caustic through k mirrors or glass is k reflections.
     po.maxDepth = std::min(o.maxDepth, 1000);
@@ -87,18 +88,37 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     if (memory.imageBytes > 0)
       po.memoryRemedy += ", or width and height (the image takes another " + memoryAmount(memory.imageBytes) + ")";
     PhotonTraceStats ts;
-    std::vector<Photon> photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+    std::vector<Photon> photons;
+    if (po.outside.any()) {
+      // Projection aims from points on the lights, and the sky and the sun
+      // have none in the scene: as photon mapping does with them, the map
+      // takes the global trace's photons that came through mirrors, glass
+      // or glossy faces (the sky's and the sun's aimed at the openings where
+      // those are the only way in). Without this the sun through a glass
+      // window or off a mirror was black where the final gather reads the
+      // map (an outside review).
+      aimAtOpenings(findSkyOpenings(s, caster, po.outside, o.seed), s, po);
+      std::vector<Photon> all = tracePhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+      for (const Photon& p : all)
+        if (p.path == kCausticPhoton) photons.push_back(p);
+      stats.note("caustic photons from the global trace (caustic_photons paths from every light): with a sky or a "
+                 "sun the projection towards mirrors and glass is not used");
+    } else {
+      photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+    }
     const size_t stored = photons.size();
     tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
     if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons), s);
-    stats.add("caustic_photons_aimed", double(ts.causticEmitted));
+    stats.add("caustic_photons_aimed", double(po.outside.any() ? ts.emitted : ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
     if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors, glass or glossy faces");
     // As photon mapping warns (photon_checks.cpp); the view said nothing
     // until 5 December 2026 (caustic_photons 1: the brightest pixel 4 times
     // too bright).
-    if (stored && stored < size_t(o.causticK))
+    if (const auto w = smallKWarning("caustic_k", o.causticK))
+      stats.warn(*w);
+    else if (stored && stored < size_t(o.causticK))
       stats.warn("caustic_k " + std::to_string(o.causticK) + " exceeds the " + std::to_string(stored) +
                  " photons of the caustic map: every estimate spans them all (one blurred average); raise "
                  "caustic_photons");

@@ -75,6 +75,13 @@ glm::vec3 uniformCone(glm::vec2 u, float cosMax) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
+glm::vec3 uniformConeVersine(glm::vec2 u, float versine) {
+  const float t = u.x * versine;  // 1 - z
+  const float r = std::sqrt(std::fmax(0.f, t * (2.f - t)));  // 1 - z^2 without cancellation
+  const float phi = 6.283185307f * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), 1.f - t};
+}
+
 glm::vec2 uniformTriangle(glm::vec2 u) {
   // Heitz 2019, "A Low-Distortion Map Between Triangle and Square".
   float b0, b1;

@@ -34,6 +34,8 @@
 // filter and the progressive flux are normalised the same way.
 #pragma once
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -142,6 +144,17 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 // emitted photon than the global pass gives when the specular objects are small.
 std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                         size_t count, const Progress& progress, PhotonTraceStats& stats);
+
+// Where the openings are the only way in from outside (findSkyOpenings), the
+// sky's and the sun's photons aim at a sphere around their portals instead
+// of the scene's (opt.outsideAimCentre and outsideAimRadius): the same lines
+// through the openings, none spent on the outsides of the walls. True where
+// it did.
+bool aimAtOpenings(const SkyOpenings& openings, const Scene& s, PhotonOptions& opt);
+
+// The warning for a k-nearest density estimate k Phi / (pi r_k^2) whose k
+// leaves it without a finite mean (k = 1) or variance (k = 2), or none.
+std::optional<std::string> smallKWarning(const std::string& name, int k);
 
 // Area of the triangle abc inside the ball of centre x and radius r (exact:
 // the triangle clipped to the disk in which the sphere cuts its plane). The

@@ -213,6 +213,10 @@ glm::vec3 uniformSphere(glm::vec2 u);      // pdf = 1 / (4 pi)
 glm::vec3 uniformHemisphere(glm::vec2 u);  // pdf = 1 / (2 pi)
 // Uniform in a cone of half-angle with cos = cosMax around +z; pdf = 1 / (2 pi (1 - cosMax)).
 glm::vec3 uniformCone(glm::vec2 u, float cosMax);
+// The same cone given by its versine 1 - cos(half-angle): exact for cones
+// too narrow for cosMax in single precision (1 - cosMax is 0 below 0.014
+// degrees, 0.5% off at the sun's 0.27).
+glm::vec3 uniformConeVersine(glm::vec2 u, float versine);
 // Uniform point on a triangle: barycentrics (b1, b2) (Heitz 2019 low-distortion warp).
 glm::vec2 uniformTriangle(glm::vec2 u);
 
