@@ -85,8 +85,7 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   // Whether a node gathers at points on its seen part (moveToSeenParts);
   // one none of whose points lies there spreads what its buried points
   // gather over its seen part, as all nodes did before.
-  std::vector<uint8_t> gathersOnSeen(nn, 1);
-  if (partSeen && !g.seen) std::fill(gathersOnSeen.begin(), gathersOnSeen.end(), uint8_t(0));
+  std::vector<uint8_t> gathersOnSeen(nn, uint8_t(!partSeen || g.seen));
   if (g.seen)
     parallelBlocks(nn, Progress(nullptr), "", [&](size_t b, size_t e) {
       NodePointSet pts;

@@ -161,12 +161,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     const std::vector<ParamSpec> t = PathTraceOptions::specs();
     requireInRange(t, "target_relative_error", opt.targetRelativeError);
     requireInRange(t, "max_depth", opt.maxDepth);
-    SkySun outside;
-    outside.skyRadiance = opt.skyRadiance;
-    outside.sunDirection = opt.sunDirection;
-    outside.sunIrradiance = opt.sunIrradiance;
-    outside.sunAngularRadiusDeg = opt.sunAngularRadiusDeg;
-    outside.check();
+    opt.outside().check();
   }
   Timer timer;
   // The shared integrator (path_integrator.h): every vertex continues,

@@ -311,8 +311,16 @@ std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<ui
     if (ok[f])
       for (int k = 0; k < 3; ++k) onFace[s.triangles[f][k]] = 1;
   std::vector<glm::vec3> n = s.vertexNormals;
-  for (size_t i = 0; i < n.size(); ++i)  // zero, NaN or Inf: no normal
-    n[i] = onFace[i] ? unitKeepingBits(n[i]).value_or(glm::vec3(0.f)) : glm::vec3(0.f);
+  std::vector<size_t> replaced;  // zero, NaN or Inf on a usable face: the faces' normal
+  for (size_t i = 0; i < n.size(); ++i) {
+    const std::optional<glm::vec3> u = onFace[i] ? unitKeepingBits(n[i]) : std::nullopt;
+    if (onFace[i] && !u) replaced.push_back(i);
+    n[i] = u.value_or(glm::vec3(0.f));
+  }
+  if (!replaced.empty()) {
+    const std::vector<glm::vec3> computed = computeVertexNormals(s, &ok);
+    for (size_t i : replaced) n[i] = unitKeepingBits(computed[i]).value_or(glm::vec3(0.f));
+  }
   return n;
 }
 

@@ -287,9 +287,10 @@ TEST(Scene, VertexNormalsOfClosedCubePointOutwards) {
 }  // namespace
 
 // A caller's vertex normals reach the ray estimators at unit length (scaled
-// in double; unit ones keep their bits), or as zero where they are zero or
-// not finite, or the vertex is on no usable face (it is then invalid);
-// without them, the computed ones.
+// in double; unit ones keep their bits), as the faces' normal where they are
+// zero or not finite (an exporter's 0 0 0 read 0 with an error of 0), or as
+// zero where the vertex is on no usable face (it is then invalid); without
+// them, the computed ones.
 TEST(Scene, VertexNormalsForRaysAreUnitOrZero) {
   gi::Scene s;
   s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {1, 2, 0}, {5, 5, 5}};
@@ -304,8 +305,11 @@ TEST(Scene, VertexNormalsForRaysAreUnitOrZero) {
   EXPECT_NEAR(n[1].y, 0.8f, 1e-7f);
   EXPECT_EQ(n[1].z, 0.f);
   EXPECT_EQ(n[2], unit);  // the same bits
-  EXPECT_EQ(n[3], glm::vec3(0.f));
-  EXPECT_EQ(n[4], glm::vec3(0.f));
-  EXPECT_EQ(n[5], glm::vec3(0.f));
+  s.vertexNormals.clear();
+  const std::vector<glm::vec3> faces = gi::computeVertexNormals(s);
+  EXPECT_EQ(n[3], faces[3]);  // inf, NaN and 0: the faces' normal
+  EXPECT_EQ(n[4], faces[4]);
+  EXPECT_EQ(n[5], faces[5]);
+  EXPECT_NEAR(glm::length(n[5]), 1.f, 1e-6f);
   EXPECT_EQ(n[6], glm::vec3(0.f));  // isolated
 }

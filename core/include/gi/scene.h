@@ -80,9 +80,10 @@ std::vector<glm::vec3> computeVertexNormals(const Scene& s, const std::vector<ui
 // The vertex normals every per-vertex estimator uses: s.vertexNormals if it
 // has one per vertex (a library caller's own), each scaled to unit length in
 // double (the estimators' frames, ray origins and open-vertex proofs assume
-// it) and set to zero where it is zero or not finite, or where the vertex is
+// it); where it is zero or not finite (an exporter's 0 0 0 for "none") the
+// faces' normal as computeVertexNormals gives it; zero where the vertex is
 // on no usable face, as a computed one would be (such a vertex then counts
-// as invalid); else computeVertexNormals(s, usable).
+// as invalid). Without s.vertexNormals: computeVertexNormals(s, usable).
 std::vector<glm::vec3> vertexNormalsForRays(const Scene& s, const std::vector<uint8_t>* usable = nullptr);
 
 struct SceneReport {
