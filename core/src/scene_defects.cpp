@@ -160,7 +160,10 @@ std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& 
       if (!h.valid() || h.face >= s.faceCount()) continue;
       const glm::uvec3& t = s.triangles[h.face];
       if (t.x == v || t.y == v || t.z == v) continue;
-      if (glm::dot(ray.d, h.ng) < 0.f) ++count;  // its front towards the vertex
+      // Either side: another surface's back this close (a ceiling just
+      // above a light's back) lets the vertex's lifted origins pass it as
+      // well as its front does.
+      if (glm::dot(ray.d, h.ng) != 0.f) ++count;
     }
     near += count;
   });

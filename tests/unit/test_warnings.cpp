@@ -705,8 +705,12 @@ TEST(SceneWarnings, EmittersThatEmitNothingAreSaidSo) {
 // 0.5, without a word): every lighting filter now warns of vertices facing
 // another surface within 10 offsets; the same squares 0.01 apart (700
 // offsets), or a box's walls meeting at its edges, give no such warning.
+// The other square's back counts too (a ceiling just above a light's back:
+// a copy of the Cornell box far away grew the offset past the gap, and the
+// ceiling above the light's edge read 3 times its value unwarned; an outside
+// audit).
 TEST(SceneWarnings, SurfacesWithinTheRayOffsetAreWarned) {
-  auto plates = [](double gap) {
+  auto plates = [](double gap, bool sameWay = false) {
     scenes::SceneFile sf;
     std::vector<glm::dvec3> pts;
     std::vector<glm::uvec3> tris;
@@ -718,19 +722,21 @@ TEST(SceneWarnings, SurfacesWithinTheRayOffsetAreWarned) {
       for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
           const uint32_t a = base + uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n) + 2, d = a + uint32_t(n) + 1;
-          if (side) tris.push_back({a, b, c}), tris.push_back({a, c, d});  // facing -y
+          if (side && !sameWay) tris.push_back({a, b, c}), tris.push_back({a, c, d});  // facing -y
           else tris.push_back({a, c, b}), tris.push_back({a, d, c});       // facing +y
         }
     }
     sf.scene = Scene::fromAbsolute(pts, tris);
     return sf;
   };
-  for (const double gap : {1e-5, 0.01}) {
-    FilterInput in = test::filterInput(FilterKind::AmbientOcclusion, plates(gap));
-    in.values.set("rays_per_vertex", 16);
-    const FilterResult r = runFilter(FilterKind::AmbientOcclusion, in);
-    EXPECT_EQ(warned(r.stats, "closer than 10 ray offsets"), gap < 1e-3) << gap << ": " << all(r.stats);
-  }
+  for (const bool sameWay : {false, true})
+    for (const double gap : {1e-5, 0.01}) {
+      FilterInput in = test::filterInput(FilterKind::AmbientOcclusion, plates(gap, sameWay));
+      in.values.set("rays_per_vertex", 16);
+      const FilterResult r = runFilter(FilterKind::AmbientOcclusion, in);
+      EXPECT_EQ(warned(r.stats, "closer than 10 ray offsets"), gap < 1e-3)
+          << gap << (sameWay ? ", the other's back" : ", facing") << ": " << all(r.stats);
+    }
   FilterInput box = test::filterInput(FilterKind::PathTracedReference, scenes::cornellBox(100.0));
   box.values.set("samples_per_vertex", 4);
   const FilterResult r = runFilter(FilterKind::PathTracedReference, box);

@@ -60,14 +60,7 @@ struct PathTraceOptions {
   glm::vec3 sunIrradiance{0.f};    // on a surface facing the sun, W/m^2
   float sunAngularRadiusDeg = 0.27f;
   // The sky and the sun above as gi/sky.h's settings (fromParams reads them so).
-  SkySun outside() const {
-    SkySun o;
-    o.skyRadiance = skyRadiance;
-    o.sunDirection = sunDirection;
-    o.sunIrradiance = sunIrradiance;
-    o.sunAngularRadiusDeg = sunAngularRadiusDeg;
-    return o;
-  }
+  SkySun outside() const { return {skyRadiance, sunDirection, sunIrradiance, sunAngularRadiusDeg}; }
   PointLight point;                // optional point or spot light (relative to the scene origin, world units)
   VertexPart vertices;             // which vertices to compute (a split run); the others are left 0
   size_t tracedVertices = 0;       // > 0: only a random sample of this many vertices (the others 0)

@@ -98,14 +98,7 @@ struct RenderOptions {
   glm::vec3 sunIrradiance{0.f};
   float sunAngularRadiusDeg = 0.27f;
   // The sky and the sun above as gi/sky.h's settings (fromParams reads them so).
-  SkySun outside() const {
-    SkySun o;
-    o.skyRadiance = skyRadiance;
-    o.sunDirection = sunDirection;
-    o.sunIrradiance = sunIrradiance;
-    o.sunAngularRadiusDeg = sunAngularRadiusDeg;
-    return o;
-  }
+  SkySun outside() const { return {skyRadiance, sunDirection, sunIrradiance, sunAngularRadiusDeg}; }
   PointLight point;
   uint32_t seed = 0;
   // Memory the image and the caustic photons may take (gi/memory_limit.h);
