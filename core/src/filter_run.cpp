@@ -35,6 +35,7 @@ using detail::vectorAttribute;
 using detail::firstPassCausticsAttribute;
 using detail::copyDuplicates;
 using detail::leaveOutDuplicates;
+using detail::overlappingEmittersWarning;
 using detail::strayExtentWarning;
 
 // Validation, the scene conventions and the scene report: steps 1 and 2.
@@ -78,6 +79,9 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   else if (res.report.duplicateFaces) leaveOutDuplicates(in, res);
   if (kind != FilterKind::ErrorMap)
     if (auto w = strayExtentWarning(in.scene, res.report)) res.setupWarnings.push_back(*w);
+  if (kind == FilterKind::Radiosity || kind == FilterKind::PhotonMapping || kind == FilterKind::PathTracedReference ||
+      kind == FilterKind::RayTracedView)
+    if (auto w = overlappingEmittersWarning(in.scene)) res.setupWarnings.push_back(*w);
   // A face turned over shows its black back to what its neighbours light,
   // and the vertices it shares read dark (an outside audit: half a Cornell
   // box's faces turned over left 477 of 1,010 lit vertices below 0.01, with

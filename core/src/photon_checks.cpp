@@ -49,9 +49,18 @@ void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGathe
   // kept one (with the direct light sampled, the map keeps only photons
   // after a bounce), and the result is the direct light alone with no more
   // than a note (an outside audit: photons 1 left a closed room 23% dark).
-  if (c.mapPhotons == 0 && c.reflects)
+  // From many paths an empty map says that no light reaches a second
+  // surface after a diffuse reflection (a plane under the sky): nothing is
+  // missing, and the warning said it was (an outside audit); from few, the
+  // light may be there and unsampled.
+  constexpr int kManyPaths = 10000;
+  if (c.mapPhotons == 0 && c.reflects && opt.photons < kManyPaths)
     st.warn("the photon map holds no photons (" + std::to_string(opt.photons) +
             " photon paths): the light beyond the direct light is missing; shoot more photons");
+  else if (c.mapPhotons == 0 && c.reflects)
+    st.note("the photon map holds no photons from " + std::to_string(opt.photons) +
+            " photon paths: no light reaches another surface after a diffuse reflection (an open scene); the result "
+            "is the direct light");
   if (c.kNearestEstimates) {
     auto kCheck = [&](const char* name, int k, size_t photons, const char* map) {
       if (const auto w = smallKWarning(name, k))

@@ -115,6 +115,10 @@ static std::vector<uint32_t> vertexSheets(const Scene& s, const std::vector<uint
 }
 
 GatherSurface::GatherSurface(const Scene& s, bool specular) {
+  {
+    const double eps = sceneScale(s).rayEpsilon;
+    minRadius2_ = std::max(1e-30f, float(eps * eps));
+  }
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   vertexSheet_ = vertexSheets(s, ok);

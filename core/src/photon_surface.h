@@ -24,6 +24,11 @@ class GatherSurface {
   explicit GatherSurface(const Scene& s) : GatherSurface(s, false) {}
   // Of all the diffuse faces.
   double totalArea() const { return nodes_.empty() ? 0.0 : nodes_[0].area; }
+  // The smallest squared radius a density estimate divides by: the ray
+  // offset's (photons closer than it are one place to the tracer). Without
+  // it, k photons at one point (a 0.5-degree spot's directions collapsed
+  // in single precision) read k Phi / 0: 1e22 (an outside audit).
+  float minRadius2() const { return minRadius2_; }
 
   // A(x, r) over the faces facing n's side (m.n >= 0.5). *flat: whether all
   // of them lie in one plane through x (then A(rho) = A(r) rho^2 / r^2 for
@@ -58,6 +63,7 @@ class GatherSurface {
  private:
   // specular: of the mirror, glass and glossy faces instead (otherSurfaceWithin's only).
   GatherSurface(const Scene& s, bool specular);
+  float minRadius2_ = 1e-30f;
   bool facesWithin(const glm::vec3& x, const glm::vec3& n, float r, uint32_t sheet, float cosTurn) const;
   std::shared_ptr<const GatherSurface> specular_;  // null where the scene has none
   // A bounding-volume hierarchy over the faces. A node wholly inside the ball

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
+#include <string>
 #include <stdexcept>
 
 #include <tbb/global_control.h>
@@ -16,6 +18,7 @@
 #include "gi/direct.h"
 #include "gi/emitters.h"
 #include "gi/form_factor_analytic.h"
+#include "gi/luminaires.h"
 #include "gi/patch_seen.h"
 #include "gi/sampling.h"
 #include "radiosity_course.h"
@@ -26,6 +29,12 @@
 namespace gi {
 
 namespace {
+
+std::string shortPercent(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f", v);
+  return b;
+}
 
 using radiosity::gather;
 using radiosity::RowFn;
@@ -116,13 +125,19 @@ struct DirectSetup {
     for (size_t i = 0; i < u.n; ++i) received += u.A[i] * luminance(u.Hd[i]);
     st.add("direct_received_power_W", received * u.unit2);
     if (u.P > 0 && received > 1.01 * u.P) {
-      char b[400];
-      std::snprintf(b, sizeof b,
-                    "the patches receive %.1f%% more direct light than the lights and the sky send: their direct "
-                    "light, sampled on the lights (more than 256 luminaires), overstates it next to edges they "
-                    "share with a light; raise light_samples (the vertex values compute it at each vertex)",
-                    100.0 * (received / u.P - 1.0));
-      st.warn(b);
+      // Sampled light points apply only beyond kMaxLuminaires; with fewer
+      // the excess is surfaces that overlap (it named the sampling with 7
+      // luminaires; an outside audit).
+      const bool sampled = stats.get("luminaires", 0.0) > double(Luminaires::kMaxLuminaires);
+      st.warn("the patches receive " + shortPercent(100.0 * (received / u.P - 1.0)) +
+              "% more direct light than the lights and the sky send: " +
+              (sampled ? "their direct light, sampled on the lights (more than " +
+                             std::to_string(Luminaires::kMaxLuminaires) +
+                             " luminaires), overstates it next to edges they share with a light (raise light_samples; "
+                             "the vertex values compute it at each vertex), or "
+                       : std::string()) +
+              "surfaces overlap in one plane (a face and a copy of it triangulated otherwise) and receive the same "
+              "light twice (remove such copies)");
     }
   }
 };
@@ -144,7 +159,7 @@ DirectSetup directSetup(const Scene& s, const RayCaster& caster, const Radiosity
 // and converged: a solve stopped early has said so already); `tolerance`:
 // the one it converged to.
 void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R, bool complete, double tolerance,
-                 RunStats& st) {
+                 std::optional<FormFactorMethod> method, RunStats& st) {
   double absorbed = 0, escaped = u.P;
   for (size_t i = 0; i < u.n; ++i) {
     if (u.A[i] == 0) continue;
@@ -173,13 +188,26 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
                   100.0 * balance, tolerance);
     st.note(b);
   } else if (complete && balance > 0.01) {
-    char b[320];
-    std::snprintf(b, sizeof b,
-                  "energy balance off by %.1f%%: the power absorbed and escaping differs from the power emitted "
-                  "(form-factor rows summing above 1, as the analytic quadrature gives beside contacts, magnified at "
-                  "high reflectance): use Monte Carlo or hemicube form factors, or more analytic points",
-                  100.0 * balance);
-    st.warn(b);
+    // What to do depends on the method that made the rows (it advised
+    // Monte Carlo to a Monte Carlo run whose rows cannot sum above 1; an
+    // outside audit): surfaces that overlap in one plane (a face and a copy
+    // of it triangulated otherwise) receive the same light twice with any.
+    const char* cause =
+        !method ? "form-factor rows summing above 1, or surfaces overlapping in one plane (a face and a copy of it "
+                  "triangulated otherwise) receiving the same light twice"
+        : *method == FormFactorMethod::Analytic
+            ? "form-factor rows summing above 1, as the analytic quadrature gives beside contacts, magnified at high "
+              "reflectance; or surfaces overlapping in one plane (a face and a copy of it triangulated otherwise) "
+              "receiving the same light twice: use Monte Carlo or hemicube form factors or more analytic points, "
+              "and remove such copies"
+        : *method == FormFactorMethod::Hemicube
+            ? "the hemicube's cells aliasing small or near patches, magnified at high reflectance; or surfaces "
+              "overlapping in one plane (a face and a copy of it triangulated otherwise) receiving the same light "
+              "twice: raise hemicube_resolution, and remove such copies"
+            : "surfaces overlapping in one plane (a face and a copy of it triangulated otherwise) receiving the "
+              "same light twice (Monte Carlo rows never sum above 1): remove such copies";
+    st.warn("energy balance off by " + shortPercent(100.0 * balance) +
+            "%: the power absorbed and escaping differs from the power emitted (" + cause + ")");
   }
 }
 
@@ -187,10 +215,11 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
 // reflected radiosity Rgather, one sweep behind R when a bounce count is
 // fixed: the gather adds that bounce), B = E + R per face and per vertex.
 void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std::vector<glm::vec3>& R,
-                    std::vector<glm::vec3> Rgather, bool fixedBounces, double tolerance, RadiosityResult& res) {
+                    std::vector<glm::vec3> Rgather, bool fixedBounces, double tolerance,
+                    std::optional<FormFactorMethod> method, RadiosityResult& res) {
   const bool complete = std::none_of(res.stats.warnings.begin(), res.stats.warnings.end(),
                                      [](const std::string& w) { return w.rfind("not converged", 0) == 0; });
-  energyStats(u, row, R, complete && !fixedBounces, tolerance, res.stats);
+  energyStats(u, row, R, complete && !fixedBounces, tolerance, method, res.stats);
   res.Rgather = std::move(Rgather);
   res.Hindirect.assign(u.n, glm::vec3(0.f));
   for (size_t i = 0; i < u.n; ++i)
@@ -206,8 +235,9 @@ void finishSolution(const Scene& s, const Setup& u, const RowFn& row, const std:
 // rho H_direct, by the chosen solver (Jacobi whenever a bounce count is
 // fixed); rows from `row`, held in memory when `transpose` (progressive
 // refinement may then read columns).
+// `method`: the one that made the rows, where known (its remedies).
 RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool transpose, RadiositySolver solver,
-                      const RadiosityOptions& opt, const Progress& progress) {
+                      const RadiosityOptions& opt, std::optional<FormFactorMethod> method, const Progress& progress) {
   const int bounces = opt.bounces, maxIter = opt.maxIterations;
   const double tol = opt.tolerance;
   RadiosityResult res;
@@ -254,7 +284,7 @@ RadiosityResult solve(const Scene& s, const Setup& u, const RowFn& row, bool tra
   if (!opt.ambientTerm || solver != RadiositySolver::Progressive) res.ambient = glm::vec3(0.f);
   else res.stats.add("ambient_term", luminance(res.ambient));
   snap.finish(R, res.ambient);
-  finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, stop.fixed, tol, res);
+  finishSolution(s, u, row, R, stop.fixed ? std::move(prevR) : R, stop.fixed, tol, method, res);
   if (skippedBlack) res.stats.note(std::to_string(skippedBlack) + " black patches (rho = 0) skipped as receivers");
   return res;
 }
@@ -352,7 +382,7 @@ RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors&
   size_t entries = 0;
   for (const auto& r : rows) entries += r.j.size();
   RadiosityResult res = solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver,
-                              opt, progress.sub(0.8, 1.0));
+                              opt, ff.method(), progress.sub(0.8, 1.0));
   if (!opt.exportSystem.empty()) {
     std::vector<double> area(u.A);
     for (double& a : area) a *= u.unit2;
@@ -377,7 +407,7 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
   if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
   thread_local FormFactorRow scratch;
   RadiosityResult res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; },
-                              false, solver, opt, progress.sub(0.1, 1.0));
+                              false, solver, opt, ff.method(), progress.sub(0.1, 1.0));
   if (!opt.exportSystem.empty())
     res.stats.warn("export_system needs the form-factor matrix in memory (raise memory_budget_mb): nothing exported");
   res.stats.note("form factors on the fly: the matrix (estimated " + megabytes(mem.matrix) + " MB) and the rest (" +
@@ -501,7 +531,8 @@ RadiosityResult solveWithRows(const Scene& s, const std::vector<FormFactorRow>& 
   const RadiositySolver solver = opt.solver == RadiositySolver::Auto ? RadiositySolver::GaussSeidel : opt.solver;
   if (solver == RadiositySolver::Hierarchical)
     throw std::invalid_argument("the hierarchical solver builds its own links: use solveHierarchical");
-  return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, opt, progress);
+  return solve(s, u, [&rows](uint32_t i) -> const FormFactorRow& { return rows[i]; }, true, solver, opt,
+               std::nullopt, progress);
 }
 
 RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const RadiosityOptions& opt, const Progress& progress) {

@@ -353,6 +353,8 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   if (o.mode == RenderMode::PathTraced || o.mode == RenderMode::Distributed) {
     paths::LightSettings lights;
     lights.point = o.point;
+    lights.sunIrradiance = o.sunIrradiance;
+    lights.sunAngularRadiusDeg = o.sunAngularRadiusDeg;
     if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
   }
   if (o.mode != RenderMode::PathTraced)

@@ -76,7 +76,7 @@ glm::vec3 CausticMap::irradiance(const glm::vec3& x, const glm::vec3& n, int k, 
     // the gather radius if the search ended inside it, else the farthest candidate.
     r2 = found < want && r2max < HUGE_VALF ? r2max : d2[found - 1];
   }
-  r2 = std::max(r2, 1e-30f);
+  r2 = std::max(r2, impl_->surface.minRadius2());  // the ray offset's (photon_surface.h)
   const float r = std::sqrt(r2);
   constexpr float c = 1.1f;
   // The k-th photon on the disk's edge is left out, as in PhotonMap::irradiance

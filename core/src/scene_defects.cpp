@@ -9,6 +9,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "gi/color.h"
+#include "point_cloud.h"
+
 namespace gi::detail {
 
 namespace {
@@ -175,6 +178,64 @@ std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& 
                 "between them are biased; let such surfaces touch (shared vertices) or keep them farther apart",
                 size_t(near), double(kNearOffsets), double(kNearOffsets * eps) * s.unit, double(eps) * s.unit);
   return std::string(b);
+}
+
+std::optional<std::string> overlappingEmittersWarning(const Scene& s) {
+  const std::vector<uint8_t> ok = usableFaceMask(s);
+  const size_t nf = s.faceCount();
+  bool anyEmitter = false;
+  for (size_t f = 0; f < nf && !anyEmitter; ++f) anyEmitter = ok[f] && luminance(s.faceEmission(f)) > 0.f;
+  if (!anyEmitter) return std::nullopt;
+  const double eps = sceneScale(s).rayEpsilon;
+  const std::vector<glm::vec3> N = unitFaceNormals(s);
+  PointCloud cloud;
+  std::vector<uint32_t> faceOf;
+  auto corner = [&](size_t f, int k) { return glm::dvec3(s.positions[s.triangles[f][k]]); };
+  for (size_t f = 0; f < nf; ++f)
+    if (ok[f]) {
+      cloud.pts.push_back(glm::vec3((corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3.0));
+      faceOf.push_back(uint32_t(f));
+    }
+  PointTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  tree.buildIndex();
+  std::vector<uint8_t> over(nf, 0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, faceOf.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<std::pair<uint32_t, float>> found;
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const uint32_t b = faceOf[k];
+      const glm::dvec3 p0 = corner(b, 0), p1 = corner(b, 1), p2 = corner(b, 2);
+      const glm::dvec3 c = (p0 + p1 + p2) / 3.0;
+      const double radius = std::max({glm::length(p0 - c), glm::length(p1 - c), glm::length(p2 - c)}) + eps;
+      const float q[3] = {float(c.x), float(c.y), float(c.z)};
+      found.clear();
+      tree.radiusSearch(q, float(radius * radius), found, nanoflann::SearchParams());
+      const bool bEmits = luminance(s.faceEmission(b)) > 0.f;
+      const glm::dvec3 n(N[b]);
+      const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0;
+      const double d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
+      const double den = d00 * d11 - d01 * d01;
+      if (!(den > 0.0)) continue;
+      for (const auto& [idx, d2] : found) {
+        const uint32_t a = faceOf[idx];
+        if (a == b || (!bEmits && !(luminance(s.faceEmission(a)) > 0.f))) continue;
+        if (glm::dot(glm::dvec3(N[a]), n) < 0.9999) continue;  // another plane, or a two-sided copy
+        const glm::dvec3 x = glm::dvec3(cloud.pts[idx]) - p0;
+        if (std::fabs(glm::dot(x, n)) > eps) continue;
+        const double d20 = glm::dot(x, e1), d21 = glm::dot(x, e2);
+        const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+        constexpr double kInside = 1e-6;  // strictly inside: neighbours in one plane share only edges
+        if (v > kInside && w > kInside && 1.0 - v - w > kInside) over[a] = 1;
+      }
+    }
+  });
+  size_t count = 0;
+  for (uint8_t o : over) count += o;
+  if (count == 0) return std::nullopt;
+  return std::to_string(count) +
+         " faces lie on another face in the same plane, facing the same way, where one of them emits (a lamp "
+         "listed twice and triangulated otherwise, or lying in the ceiling's plane): both copies emit, or they "
+         "hide each other by turns, and the light is wrong (a lamp modelled twice is twice as bright); remove "
+         "the copies, or lift the lamp off the surface";
 }
 
 }  // namespace gi::detail

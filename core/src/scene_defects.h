@@ -34,5 +34,13 @@ std::optional<std::string> strayExtentWarning(const Scene& s, const SceneReport&
 // is not counted.
 inline constexpr float kNearOffsets = 10.f;
 std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& caster);
+// The warning for emitting faces that overlap another face in one plane,
+// facing the same way (a lamp listed twice, triangulated otherwise; a lamp
+// quad lying in the ceiling's plane), or none: copies with the same corners
+// are left out (leaveOutDuplicates), but these both emit, or hide each
+// other by turns, and an outside audit found a lamp modelled twice doubling
+// every value without a word. A face overlaps another where its centroid
+// lies inside it, within the ray offset of its plane.
+std::optional<std::string> overlappingEmittersWarning(const Scene& s);
 
 }  // namespace gi::detail

@@ -59,14 +59,18 @@ struct PointLight {
   glm::vec3 spotDirection{0.f, -1.f, 0.f};
   float spotAngleDeg = 180.f;       // half angle of the cone; 180 = a point light
   bool on() const;
-  float cosSpot() const;            // cosine of the half angle
   // Throws std::invalid_argument when the light is on and its half angle is
   // not an angle or is below kMinSpotAngleDeg: single precision holds no
   // direction but the axis in such a cone (the cosine of 0.01 degrees
   // rounds to 1), which then carried no power and read as no light at all.
   void check() const;
   static constexpr double kMinSpotAngleDeg = 0.1;
-  bool shinesTowards(const glm::vec3& d) const { return glm::dot(d, spotDirection) >= cosSpot(); }
+  // Whether d lies in the cone, tested in double (|d x s|^2 <= sin^2 a where
+  // a < 90 degrees): a single-precision cosine of a cone of 0.1 degrees is
+  // a few percent off its area.
+  bool shinesTowards(const glm::vec3& d) const;
+  // 1 - cos(half angle), exact for narrow cones (uniformConeVersine).
+  double spotVersine() const;
 };
 // Irradiance I cos / r^2 from the point light at x (unit normal n), 0 if the
 // shadow ray is blocked or x lies outside the spot's cone.
