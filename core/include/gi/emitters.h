@@ -1,6 +1,7 @@
 // Sampling points on area emitters in proportion to their emitted power,
 // shared by direct lighting and photon emission.
 #pragma once
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,7 +85,19 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
 
 // Multiple importance sampling, power heuristic (Veach 1997): the weight of a
 // sample drawn with density a against another strategy of density b.
-inline float powerHeuristic(float a, float b) { return a * a / (a * a + b * b); }
+// Densities that are infinite, overflow when squared, or are both 0 are
+// weighed by their ratio (a point on an emitter's own plane sees it at a
+// cosine of about 0: a light sample's density was infinite, and inf / inf
+// made the sample NaN and the vertex "not a number"; an outside audit).
+inline float powerHeuristic(float a, float b) {
+  const float a2 = a * a, b2 = b * b;
+  if (std::isfinite(a2) && std::isfinite(b2) && a2 + b2 > 0.f) return a2 / (a2 + b2);
+  if (!(a > 0.f)) return 0.f;  // this strategy cannot draw the sample (or a NaN density)
+  if (!(b > 0.f)) return 1.f;
+  const float r = b / a;
+  if (std::isnan(r)) return 0.5f;  // both infinite
+  return 1.f / (1.f + r * r);
+}
 
 // One power-sampled emitter point's irradiance at x (unit normal n),
 // weighted for MIS against cosine-weighted direction sampling; 0 if the
