@@ -348,7 +348,7 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
   return L + trace(st, nullptr, smp, c, parts);
 }
 
-std::string unsampledLightPaths(const Scene& s, const LightSettings& lights) {
+std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, bool sunMet) {
   const bool sun = luminance(lights.sunIrradiance) > 0.f;
   if (!lights.point.on() && !sun) return "";
   bool specular = false;
@@ -367,7 +367,12 @@ std::string unsampledLightPaths(const Scene& s, const LightSettings& lights) {
   // degrees (1 in 800) the paths find it and the bars hold.
   const double half = 0.5 * double(lights.sunAngularRadiusDeg) * M_PI / 180.0;
   const double omega = 4.0 * M_PI * std::sin(half) * std::sin(half);
-  if (sun && omega < M_PI / 800.0) {
+  if (sun && !sunMet) {
+    w += std::string(w.empty() ? "" : "; ") +
+         "the sun's light reflected or refracted by mirrors or glass onto other surfaces (sunlight through a glass "
+         "pane, a mirror's sun patch) is missing: this mode's shadow rays stop at mirrors and glass; the "
+         "path-traced or two-pass mode computes it";
+  } else if (sun && omega < M_PI / 800.0) {
     char chance[96];
     if (omega > 0.0) std::snprintf(chance, sizeof chance, "only by meeting its disk, 1 direction in %.3g", M_PI / omega);
     else std::snprintf(chance, sizeof chance, "never (a sharp sun, radius 0, is a direction no path meets)");

@@ -111,7 +111,10 @@ struct LightSettings {
 // (L S+ D: a path from the surface meets the mirror in one direction and must
 // then hit a point exactly, which no sampled direction does; pbrt and every
 // unidirectional path tracer miss it too). Photon mapping finds it.
-std::string unsampledLightPaths(const Scene& s, const LightSettings& lights);
+// `sunMet`: whether paths continue off mirrors and glass and can meet the
+// sun's disk (the reference and the path-traced view; the distributed view's
+// shadow rays stop at them and it never finds the sun through them).
+std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, bool sunMet = true);
 
 // Warns (st) where paths cut at the depth limit (maxDepth, -1 = none but
 // `cap`) may miss more light than the mean relative error: `cut` of `paths`;

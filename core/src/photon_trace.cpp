@@ -98,8 +98,8 @@ class PhotonLights {
     versSpot_ = o.point.spotVersine();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
     pointPower_ = double(luminance(o.point.intensity)) * 2.0 * M_PI * versSpot_;
-    if (!(pointPower_ > 0.0)) pointPower_ = 0.0;
-    inner_ = area_.totalPower() + pointPower_;
+    if (!(pointPower_ > 0.0) || o.outsideLightsOnly) pointPower_ = 0.0;
+    inner_ = o.outsideLightsOnly ? 0.0 : area_.totalPower() + pointPower_;
     total_ = inner_ + skyPower_ + sunPower_;
     spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
     // The faces the point light lies on (within the ray epsilon; the default

@@ -355,7 +355,8 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
     lights.point = o.point;
     lights.sunIrradiance = o.sunIrradiance;
     lights.sunAngularRadiusDeg = o.sunAngularRadiusDeg;
-    if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
+    if (const std::string w = paths::unsampledLightPaths(s, lights, o.mode == RenderMode::PathTraced); !w.empty())
+      st.warn(w);
   }
   if (o.mode != RenderMode::PathTraced)
     st.note("error estimate from the spread of QMC pixel samples (an upper bound rather than an error bar)");

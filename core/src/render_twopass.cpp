@@ -79,7 +79,6 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     po.photons = o.causticPhotons;
     po.causticK = o.causticK;
     po.point = o.point;
-    po.outside = o.outside();
     po.seed = o.seed;
     // The eye pass's limit: a caustic through k mirrors or glass is k reflections.
     po.maxDepth = std::min(o.maxDepth, 1000);
@@ -88,28 +87,34 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     if (memory.imageBytes > 0)
       po.memoryRemedy += ", or width and height (the image takes another " + memoryAmount(memory.imageBytes) + ")";
     PhotonTraceStats ts;
-    std::vector<Photon> photons;
-    if (po.outside.any()) {
+    std::vector<Photon> photons =
+        traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.25), ts);
+    const SkySun outside = o.outside();
+    if (outside.any()) {
       // Projection aims from points on the lights, and the sky and the sun
-      // have none in the scene: as photon mapping does with them, the map
-      // takes the global trace's photons that came through mirrors, glass
-      // or glossy faces (the sky's and the sun's aimed at the openings where
-      // those are the only way in). Without this the sun through a glass
-      // window or off a mirror was black where the final gather reads the
-      // map (an outside review).
-      aimAtOpenings(findSkyOpenings(s, caster, po.outside, o.seed), s, po);
-      std::vector<Photon> all = tracePhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+      // have none in the scene: as photon mapping does with them, their
+      // caustic photons come from a trace of their own (caustic_photons
+      // paths, aimed at the openings where those are the only way in), kept
+      // where they came through mirrors, glass or glossy faces. Without
+      // them the sun through a glass window or off a mirror was black where
+      // the final gather reads the map (an outside review).
+      PhotonOptions out = po;
+      out.outside = outside;
+      out.outsideLightsOnly = true;
+      aimAtOpenings(findSkyOpenings(s, caster, outside, o.seed), s, out);
+      PhotonTraceStats tsOut;
+      const std::vector<Photon> all =
+          tracePhotons(s, caster, out, 0, size_t(o.causticPhotons), progress.sub(0.25, 0.5), tsOut);
+      size_t kept = 0;
       for (const Photon& p : all)
-        if (p.path == kCausticPhoton) photons.push_back(p);
-      stats.note("caustic photons from the global trace (caustic_photons paths from every light): with a sky or a "
-                 "sun the projection towards mirrors and glass is not used");
-    } else {
-      photons = traceCausticPhotons(s, caster, po, 0, size_t(o.causticPhotons), progress.sub(0.0, 0.5), ts);
+        if (p.path == kCausticPhoton) photons.push_back(p), ++kept;
+      stats.add("caustic_photons_sky_sun_paths", double(tsOut.emitted));
+      stats.add("caustic_photons_sky_sun_stored", double(kept));
     }
     const size_t stored = photons.size();
     tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
     if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons), s);
-    stats.add("caustic_photons_aimed", double(po.outside.any() ? ts.emitted : ts.causticEmitted));
+    stats.add("caustic_photons_aimed", double(ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
     if (!stored) stats.note("no caustic photon reached a diffuse surface through mirrors, glass or glossy faces");

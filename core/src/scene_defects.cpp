@@ -4,9 +4,11 @@
 #include <cmath>
 #include <atomic>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include "gi/color.h"
@@ -180,53 +182,100 @@ std::optional<std::string> nearSurfacesWarning(const Scene& s, const RayCaster& 
   return std::string(b);
 }
 
+namespace {
+
+// Points of a triangle at barycentrics away from its centroid and its
+// medians: two copies of a quad split along its two diagonals put each
+// centroid exactly on the other copy's diagonal edge, where no
+// strictly-inside test sees it (a review).
+constexpr double kProbe[3][3] = {{0.6, 0.3, 0.1}, {0.1, 0.6, 0.3}, {0.3, 0.1, 0.6}};
+
+// The usable faces' centroids `faces` in a kd-tree.
+struct CentroidTree {
+  PointCloud cloud;
+  std::vector<uint32_t> faces;
+  std::unique_ptr<PointTree> tree;
+};
+
+}  // namespace
+
 std::optional<std::string> overlappingEmittersWarning(const Scene& s) {
   const std::vector<uint8_t> ok = usableFaceMask(s);
   const size_t nf = s.faceCount();
+  std::vector<uint8_t> emits(nf, 0);
   bool anyEmitter = false;
-  for (size_t f = 0; f < nf && !anyEmitter; ++f) anyEmitter = ok[f] && luminance(s.faceEmission(f)) > 0.f;
+  for (size_t f = 0; f < nf; ++f) {
+    emits[f] = ok[f] && luminance(s.faceEmission(f)) > 0.f;
+    anyEmitter = anyEmitter || emits[f];
+  }
   if (!anyEmitter) return std::nullopt;
   const double eps = sceneScale(s).rayEpsilon;
   const std::vector<glm::vec3> N = unitFaceNormals(s);
-  PointCloud cloud;
-  std::vector<uint32_t> faceOf;
   auto corner = [&](size_t f, int k) { return glm::dvec3(s.positions[s.triangles[f][k]]); };
+  auto centroid = [&](size_t f) { return (corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3.0; };
+  // Two trees: the emitters' centroids and the others'. Every pair with an
+  // emitter in it is then found from one side: an emitter's ball finds the
+  // faces whose centroid lies in it, a face's ball the emitters' centroids
+  // (a lamp smaller than the ceiling cell it lies in). Querying every face
+  // against every centroid cost n^2 on a fan of slivers (a review).
+  CentroidTree trees[2];  // [0] the others, [1] the emitters
   for (size_t f = 0; f < nf; ++f)
     if (ok[f]) {
-      cloud.pts.push_back(glm::vec3((corner(f, 0) + corner(f, 1) + corner(f, 2)) / 3.0));
-      faceOf.push_back(uint32_t(f));
+      CentroidTree& t = trees[emits[f]];
+      t.cloud.pts.push_back(glm::vec3(centroid(f)));
+      t.faces.push_back(uint32_t(f));
     }
-  PointTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
-  std::vector<uint8_t> over(nf, 0);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, faceOf.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<std::pair<uint32_t, float>> found;
-    for (size_t k = r.begin(); k < r.end(); ++k) {
-      const uint32_t b = faceOf[k];
-      const glm::dvec3 p0 = corner(b, 0), p1 = corner(b, 1), p2 = corner(b, 2);
-      const glm::dvec3 c = (p0 + p1 + p2) / 3.0;
-      const double radius = std::max({glm::length(p0 - c), glm::length(p1 - c), glm::length(p2 - c)}) + eps;
-      const float q[3] = {float(c.x), float(c.y), float(c.z)};
-      found.clear();
-      tree.radiusSearch(q, float(radius * radius), found, nanoflann::SearchParams());
-      const bool bEmits = luminance(s.faceEmission(b)) > 0.f;
-      const glm::dvec3 n(N[b]);
-      const glm::dvec3 e1 = p1 - p0, e2 = p2 - p0;
-      const double d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
-      const double den = d00 * d11 - d01 * d01;
-      if (!(den > 0.0)) continue;
-      for (const auto& [idx, d2] : found) {
-        const uint32_t a = faceOf[idx];
-        if (a == b || (!bEmits && !(luminance(s.faceEmission(a)) > 0.f))) continue;
-        if (glm::dot(glm::dvec3(N[a]), n) < 0.9999) continue;  // another plane, or a two-sided copy
-        const glm::dvec3 x = glm::dvec3(cloud.pts[idx]) - p0;
-        if (std::fabs(glm::dot(x, n)) > eps) continue;
-        const double d20 = glm::dot(x, e1), d21 = glm::dot(x, e2);
-        const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
-        constexpr double kInside = 1e-6;  // strictly inside: neighbours in one plane share only edges
-        if (v > kInside && w > kInside && 1.0 - v - w > kInside) over[a] = 1;
+  for (CentroidTree& t : trees) {
+    if (t.faces.empty()) continue;  // (a tree of no points is not searched)
+    t.tree = std::make_unique<PointTree>(3, t.cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    t.tree->buildIndex();
+  }
+  // Whether face a lies on face b: one plane within the ray offset, facing
+  // the same way, and one of a's probe points strictly inside b.
+  auto liesOn = [&](uint32_t a, uint32_t b) {
+    if (a == b || glm::dot(glm::dvec3(N[a]), glm::dvec3(N[b])) < 0.9999) return false;
+    const glm::dvec3 p0 = corner(b, 0), e1 = corner(b, 1) - p0, e2 = corner(b, 2) - p0, n(N[b]);
+    const double d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2), d11 = glm::dot(e2, e2);
+    const double den = d00 * d11 - d01 * d01;
+    if (!(den > 0.0)) return false;
+    for (const auto& w : kProbe) {
+      const glm::dvec3 x = w[0] * corner(a, 0) + w[1] * corner(a, 1) + w[2] * corner(a, 2) - p0;
+      if (std::fabs(glm::dot(x, n)) > eps) return false;
+      const double d20 = glm::dot(x, e1), d21 = glm::dot(x, e2);
+      const double v = (d11 * d20 - d01 * d21) / den, u = (d00 * d21 - d01 * d20) / den;
+      constexpr double kInside = 1e-6;
+      if (v > kInside && u > kInside && 1.0 - v - u > kInside) return true;
+    }
+    return false;
+  };
+  // Marks gathered per task (no two tasks write one flag).
+  tbb::combinable<std::vector<uint32_t>> marks;
+  auto search = [&](const CentroidTree& from, const CentroidTree& in, bool both) {
+    if (from.faces.empty() || in.faces.empty()) return;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, from.faces.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      std::vector<std::pair<uint32_t, float>> found;
+      std::vector<uint32_t>& mine = marks.local();
+      for (size_t k = r.begin(); k < r.end(); ++k) {
+        const uint32_t b = from.faces[k];
+        const glm::dvec3 c = centroid(b);
+        const double radius =
+            std::max({glm::length(corner(b, 0) - c), glm::length(corner(b, 1) - c), glm::length(corner(b, 2) - c)}) + eps;
+        const float q[3] = {float(c.x), float(c.y), float(c.z)};
+        found.clear();
+        in.tree->radiusSearch(q, float(radius * radius), found, nanoflann::SearchParams(32, 0.f, false));
+        for (const auto& hit : found) {
+          const uint32_t a = in.faces[hit.first];
+          if (liesOn(a, b) || (both && liesOn(b, a))) mine.push_back(a), mine.push_back(b);
+        }
       }
-    }
+    });
+  };
+  search(trees[1], trees[0], true);   // emitters' balls, the others' centroids
+  search(trees[1], trees[1], true);   // emitters among themselves
+  search(trees[0], trees[1], true);   // the others' balls, the emitters' centroids
+  std::vector<uint8_t> over(nf, 0);
+  marks.combine_each([&](const std::vector<uint32_t>& v) {
+    for (uint32_t f : v) over[f] = 1;
   });
   size_t count = 0;
   for (uint8_t o : over) count += o;

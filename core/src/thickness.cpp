@@ -33,10 +33,13 @@ struct VertexThickness {
 };
 
 // The faces at each vertex's position (its own and those of other vertices
-// at the same point, as an unwelded mesh has them), sorted: own[start[v],
-// start[v + 1]).
+// at the same point, as an unwelded mesh has them), one sorted list per
+// position: faces[start[g], start[g + 1]) for g = group[v] (a list per
+// vertex cost k^2 at a point k unwelded faces share; a review).
 struct FacesAtVertex {
-  std::vector<uint32_t> start, own;
+  std::vector<uint32_t> group, start, faces;
+  const uint32_t* begin(size_t v) const { return faces.data() + start[group[v]]; }
+  const uint32_t* end(size_t v) const { return faces.data() + start[group[v] + 1]; }
 };
 
 class ThicknessKernel {
@@ -171,25 +174,18 @@ FacesAtVertex facesAtVertices(const Scene& scene) {
     group[order[k]] = groups;
   }
   if (!order.empty()) ++groups;
-  std::vector<uint32_t> gStart(size_t(groups) + 1, 0), gFaces;
+  FacesAtVertex out;
+  out.start.assign(size_t(groups) + 1, 0);
   for (const glm::uvec3& t : scene.triangles)
     for (int c = 0; c < 3; ++c)
-      if (t[c] < nv) ++gStart[group[t[c]] + 1];
-  for (size_t g = 0; g < groups; ++g) gStart[g + 1] += gStart[g];
-  gFaces.resize(gStart[groups]);
-  std::vector<uint32_t> fill(gStart.begin(), gStart.end() - 1);
-  for (size_t f = 0; f < scene.triangles.size(); ++f)
+      if (t[c] < nv) ++out.start[group[t[c]] + 1];
+  for (size_t g = 0; g < groups; ++g) out.start[g + 1] += out.start[g];
+  out.faces.resize(out.start[groups]);
+  std::vector<uint32_t> fill(out.start.begin(), out.start.end() - 1);
+  for (size_t f = 0; f < scene.triangles.size(); ++f)  // in face order: each group's list comes out sorted
     for (int c = 0; c < 3; ++c)
-      if (scene.triangles[f][c] < nv) gFaces[fill[group[scene.triangles[f][c]]]++] = uint32_t(f);
-  FacesAtVertex out;
-  out.start.resize(nv + 1, 0);
-  for (size_t v = 0; v < nv; ++v) out.start[v + 1] = out.start[v] + (gStart[group[v] + 1] - gStart[group[v]]);
-  out.own.resize(out.start[nv]);
-  for (size_t v = 0; v < nv; ++v) {
-    auto b = out.own.begin() + out.start[v];
-    std::copy(gFaces.begin() + gStart[group[v]], gFaces.begin() + gStart[group[v] + 1], b);
-    std::sort(b, out.own.begin() + out.start[v + 1]);
-  }
+      if (scene.triangles[f][c] < nv) out.faces[fill[group[scene.triangles[f][c]]]++] = uint32_t(f);
+  out.group = std::move(group);
   return out;
 }
 
@@ -289,9 +285,8 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
     std::vector<float> lengths, scratch;
     for (size_t i = b; i < e; ++i) {
       if (!valid[i]) continue;
-      const uint32_t* own = at.own.data();
-      const VertexThickness t = kernel.run(uint32_t(i), scene.positions[i], origins[i], normals[i],
-                                           own + at.start[i], own + at.start[i + 1], lengths, scratch);
+      const VertexThickness t = kernel.run(uint32_t(i), scene.positions[i], origins[i], normals[i], at.begin(i),
+                                           at.end(i), lengths, scratch);
       ownExits[i] = t.ownFaces;
       res.value[i] = float(t.value * scene.unit);  // world units (Scene::unit)
       res.stdError[i] = float(t.stdError * scene.unit);

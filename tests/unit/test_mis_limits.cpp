@@ -25,6 +25,7 @@ TEST(MisLimits, PowerHeuristicAtInfiniteAndZeroDensities) {
   EXPECT_EQ(powerHeuristic(0.f, 0.f), 0.f);
   EXPECT_EQ(powerHeuristic(0.f, 2.f), 0.f);
   EXPECT_NEAR(powerHeuristic(1e30f, 1e30f), 0.5f, 1e-6f);  // squares overflow
+  EXPECT_NEAR(powerHeuristic(1.5e19f, 1.5e19f), 0.5f, 1e-6f);  // only their sum does
   EXPECT_NEAR(powerHeuristic(2e30f, 1e30f), 0.8f, 1e-6f);
 }
 

@@ -71,6 +71,16 @@ TEST(Overlap, EmittersOverlappingInOnePlaneAreWarned) {
   Builder twice = room(0.9);                // the lamp again, as 2 x 2 cells
   twice.quad({-0.3, 0.9, -0.3}, {0.3, 0.9, -0.3}, {0.3, 0.9, 0.3}, {-0.3, 0.9, 0.3}, 2, true);
   EXPECT_TRUE(warnsOfOverlap(twice));
+  // The lamp again split along its other diagonal: each copy's centroids lie
+  // on the other's diagonal edge, which a centroid test alone missed (a review).
+  Builder crossed = room(0.9);
+  crossed.quad({0.3, 0.9, -0.3}, {0.3, 0.9, 0.3}, {-0.3, 0.9, 0.3}, {-0.3, 0.9, -0.3}, 1, true);
+  EXPECT_TRUE(warnsOfOverlap(crossed));
+  // A small lamp inside one ceiling cell, in the ceiling's plane (its ball
+  // holds no ceiling centroid; the cell's holds the lamp's).
+  Builder small = room(0.9);
+  small.quad({0.55, 1, 0.55}, {0.6, 1, 0.55}, {0.6, 1, 0.6}, {0.55, 1, 0.6}, 1, true);
+  EXPECT_TRUE(warnsOfOverlap(small));
   Builder rug = room(0.9);  // a rug on the floor, emitting nothing: its light is right, no warning
   rug.quad({-0.5, 0, -0.5}, {-0.5, 0, 0.5}, {0.5, 0, 0.5}, {0.5, 0, -0.5}, 3, false);
   EXPECT_FALSE(warnsOfOverlap(rug));

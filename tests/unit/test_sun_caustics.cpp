@@ -51,3 +51,26 @@ TEST(SunCaustics, MissingThroughMirrorsAndGlassIsSaid) {
   EXPECT_FALSE(saysSo(caustic, 5.f));  // about 1 direction in 130: found
   EXPECT_FALSE(saysSo(plain, 0.27f));  // no mirror or glass
 }
+
+// The distributed view never finds the sun through mirrors or glass (its
+// shadow rays stop at them), whatever the sun's size: it says so at 5
+// degrees too, where the path tracer finds it (a review), and says nothing
+// without mirror or glass.
+TEST(SunCaustics, DistributedViewSaysSoAtAnySize) {
+  auto distributed = [](const Scene& s, float sunDeg) {
+    auto caster = makeEmbreeCaster(s);
+    RenderOptions r;
+    r.mode = RenderMode::Distributed;
+    r.samplesPerPixel = 1;
+    r.camera = Camera::lookAt({0, 0, -2000}, {0, 0, 0}, {0, 1, 0}, 40, 8, 8);
+    r.sunIrradiance = glm::vec3(3.f);
+    r.sunAngularRadiusDeg = sunDeg;
+    for (const std::string& w : render(s, *caster, r).stats.warnings)
+      if (w.find("the sun's light reflected or refracted") != std::string::npos &&
+          w.find("this mode's shadow rays stop") != std::string::npos)
+        return true;
+    return false;
+  };
+  EXPECT_TRUE(distributed(scenes::causticCornell(50.0, 20.0, 2, 1.5f), 5.f));
+  EXPECT_FALSE(distributed(scenes::cornellBox(100.0).scene, 5.f));
+}

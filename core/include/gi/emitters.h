@@ -91,7 +91,7 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
 // made the sample NaN and the vertex "not a number"; an outside audit).
 inline float powerHeuristic(float a, float b) {
   const float a2 = a * a, b2 = b * b;
-  if (std::isfinite(a2) && std::isfinite(b2) && a2 + b2 > 0.f) return a2 / (a2 + b2);
+  if (std::isfinite(a2 + b2) && a2 + b2 > 0.f) return a2 / (a2 + b2);
   if (!(a > 0.f)) return 0.f;  // this strategy cannot draw the sample (or a NaN density)
   if (!(b > 0.f)) return 1.f;
   const float r = b / a;

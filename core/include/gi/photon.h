@@ -55,6 +55,9 @@ struct PhotonOptions {
   int kNearest = 64;          // photons per global-map estimate
   int causticK = 128;         // photons per caustic-map estimate
   bool causticProjection = true;  // caustic photons aimed at the mirrors and glass (else: the global pass's)
+  // Photons from the sky and the sun only (tracePhotons): the two-pass
+  // view's caustic map adds theirs to the projected ones of the other lights.
+  bool outsideLightsOnly = false;
   double maxRadius = 0.0;     // 0 = unlimited; else gather radius cap (absolute)
   int maxDepth = 32;          // bounces (diffuse and specular) before a path stops for sure
   bool directLight = true;    // direct light by light sampling at vertices; photons for the rest
