@@ -41,6 +41,7 @@ struct Job {
   Texts overrides;    // this manifest line's parameters
   std::string where;  // "manifest line 7" (for messages)
   std::string stem;   // output name: OUT/stem.ply, OUT/stem.json
+  std::string base;   // the manifest's folder: files its line's parameters name are relative to it
 };
 
 std::string oneLine(std::string s) {
@@ -148,9 +149,16 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
       throw std::invalid_argument(where + e.what());
     }
     if (w.empty() || w[0][0] == '#') continue;
+    // A word from # on ends the line (a comment after a mesh's parameters).
+    for (size_t k = 1; k < w.size(); ++k)
+      if (w[k][0] == '#') {
+        w.resize(k);
+        break;
+      }
     Job j;
     j.input = fs::path(w[0]).is_absolute() || base.empty() ? w[0] : (base / w[0]).string();
     j.overrides = parameterPairs(w, 1, specs, filter, where);
+    j.base = base.string();
     j.where = where;
     jobs.push_back(j);
   }
@@ -253,16 +261,40 @@ std::string outputDigest(const fs::path& ply, const json& layers) {
   return d;
 }
 
+// The files a mesh's parameters name (the values as given; one that does
+// not parse fails that mesh alone, when it is computed).
+FilterFiles plannedFiles(const FilterDesc& d, const Texts& params) {
+  const auto specs = filterSpecs(d.kind);
+  ParamValues v = defaultValues(specs, 1.0);
+  for (const auto& [n, t] : params) {
+    try {
+      v.set(n, parseValue(*findSpec(specs, n), t, 1.0));
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  try {
+    return filterFiles(d.kind, v);
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
 // What decides a mesh's result: the program's version, the filter, every
-// parameter given, and the input file (name, size, modification time).
-std::string jobHash(const std::string& filter, const Texts& params, const std::string& input) {
+// parameter given, the input file and the files the parameters name (an
+// error map's reference): each file's name, size and modification time (a
+// reference computed anew was taken as done before; an outside audit).
+std::string jobHash(const FilterDesc& d, const Texts& params, const std::string& input) {
   std::ostringstream o;
-  o << "gi " << GI_VERSION << "\nfilter " << filter << "\n";
+  o << "gi " << GI_VERSION << "\nfilter " << d.cliName << "\n";
   for (const auto& [k, v] : params) o << k << "=" << v << "\n";
-  std::error_code ec;
-  const auto size = fs::file_size(input, ec);
-  const auto time = fs::last_write_time(input, ec).time_since_epoch().count();
-  o << "input " << fs::path(input).filename().string() << " " << (ec ? 0 : size) << " " << (ec ? 0 : time) << "\n";
+  const auto stamp = [&](const char* what, const std::string& path) {
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    const auto time = fs::last_write_time(path, ec).time_since_epoch().count();
+    o << what << " " << fs::path(path).filename().string() << " " << (ec ? 0 : size) << " " << (ec ? 0 : time) << "\n";
+  };
+  stamp("input", input);
+  for (const NamedFile& f : plannedFiles(d, params).reads) stamp(f.parameter.c_str(), f.path);
   return hashText(o.str());
 }
 
@@ -329,32 +361,29 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
 // computed (io/output_files.h).
 void checkFiles(const Args& a, const FilterDesc& d, const Texts& common, const std::vector<Job>& jobs, size_t shard,
                 size_t shards, bool explicitShard) {
-  const auto specs = filterSpecs(d.kind);
   std::vector<files::Named> inputs, outputs;
   if (!a.manifest.empty()) inputs.push_back({a.manifest, "--manifest"});
   if (!a.paramsFile.empty()) inputs.push_back({a.paramsFile, "--params"});
   for (const Job& j : jobs) {
     inputs.push_back({j.input, ""});
-    // The files its parameters name (the values as given; one that does not parse fails that mesh alone).
-    ParamValues v = defaultValues(specs, 1.0);
     Texts params = common;
     for (const auto& [n, t] : j.overrides) params[n] = t;
-    for (const auto& [n, t] : params) {
-      try {
-        v.set(n, parseValue(*findSpec(specs, n), t, 1.0));
-      } catch (const std::invalid_argument&) {
-      }
-    }
-    FilterFiles plan;
-    try {
-      plan = filterFiles(d.kind, v);
-    } catch (const std::exception&) {
-    }
+    const FilterFiles plan = plannedFiles(d, params);
+    // A batch writes each mesh's result and summary; a file named by a
+    // parameter is one path for every mesh (radiosity's residual_csv and
+    // export_system were dropped without a word; an outside audit).
+    if (!plan.writes.empty())
+      throw std::invalid_argument(j.where + "--" + plan.writes.front().parameter + " writes a file at one path (" +
+                                  plan.writes.front().path + "): run '" + d.cliName + "' per mesh for it, not in a batch");
     for (const NamedFile& f : plan.reads) inputs.push_back({f.path, "--" + f.parameter});
     const std::string ply = (fs::path(a.outDir) / (j.stem + ".ply")).string();
-    if (a.reportOnly) continue;
+    const std::string summary = (fs::path(a.outDir) / (j.stem + ".json")).string();
+    if (a.reportOnly) {  // read, not written: the report must not take one's place
+      inputs.push_back({summary, "the summary of " + j.input});
+      continue;
+    }
     outputs.push_back({ply, "the result of " + j.input});
-    outputs.push_back({(fs::path(a.outDir) / (j.stem + ".json")).string(), "the summary of " + j.input});
+    outputs.push_back({summary, "the summary of " + j.input});
     for (const std::string& name : plan.layers) outputs.push_back({layerPath(ply, name), "a layer of " + j.input});
   }
   outputs.push_back({(fs::path(a.outDir) / reportName(a, shard, shards, explicitShard)).string(), "the report"});
@@ -414,10 +443,26 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   // Every mesh takes these: a value that cannot be read is said once, before
   // any mesh is loaded (it failed each mesh in turn). Ranges that depend on
   // the mesh (percentages of its diagonal) are checked per mesh.
-  for (const auto& [k, v] : common) (void)parseValue(*findSpec(specs, k), v, 1.0);
+  // Their ranges too, but for those in shares of a mesh's diagonal: a batch
+  // re-run with a typo failed every mesh in turn.
+  {
+    ParamValues v = defaultValues(specs, 1.0);
+    for (const auto& [k, t] : common) v.set(k, parseValue(*findSpec(specs, k), t, 1.0));
+    if (auto err = validate(specs, v, 0.0)) throw std::invalid_argument(*err + " (every mesh takes it)");
+  }
 
   if (a.manifest.empty() == a.dir.empty()) throw std::invalid_argument("give either --manifest FILE or --dir DIR");
   std::vector<Job> jobs = a.manifest.empty() ? readFolder(a.dir, a.glob) : readManifest(a.manifest, specs, d.cliName);
+  // A manifest line's files (an error map's reference) are relative to the
+  // manifest, as its meshes are (they were relative to the working folder).
+  for (Job& j : jobs) {
+    if (j.base.empty()) continue;
+    Texts params = common;
+    for (const auto& [n, t] : j.overrides) params[n] = t;
+    for (const NamedFile& f : plannedFiles(d, params).reads)
+      if (auto it = j.overrides.find(f.parameter); it != j.overrides.end() && !fs::path(it->second).is_absolute())
+        it->second = (fs::path(j.base) / it->second).string();
+  }
   std::map<std::string, std::string> byStem;
   for (Job& j : jobs) {
     j.stem = fs::path(j.input).stem().string();
@@ -453,7 +498,7 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     ++meshes;
     Texts params = common;
     for (const auto& [n, v] : job.overrides) params[n] = v;
-    const std::string hash = jobHash(d.cliName, params, job.input);
+    const std::string hash = jobHash(d, params, job.input);
     const fs::path ply = fs::path(a.outDir) / (job.stem + ".ply"), sum = fs::path(a.outDir) / (job.stem + ".json");
     const json old = readJson(sum);
     // A summary's fields read only with the type they are written with (a
@@ -513,7 +558,17 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     }
     if (s["status"] == "failed") {
       ++failed;
-      fs::remove(ply, ec);  // no result from other parameters beside a failure
+      // An earlier run's result stays (a failed re-run deleted finished
+      // results; an outside audit); the summary says it is not this run's
+      // and keeps that run's summary, so its parameters stay known.
+      if (fs::exists(ply, ec)) {
+        s["earlier_result"] = ply.string() + " is not this run's result: it is kept from an earlier run";
+        if (text("status") == "ok") s["earlier_run"] = old;
+        else if (old.is_object() && old.contains("earlier_run")) s["earlier_run"] = old["earlier_run"];
+        std::string e = s["error"].get<std::string>();
+        if (!e.empty() && e.back() == '.') e.pop_back();
+        s["error"] = e + " (the earlier result " + ply.filename().string() + " is kept)";
+      }
       failures.push_back({{"input", job.input}, {"error", s["error"]}});
       if (!a.quiet) std::cerr << tag << "FAILED: " << s["error"].get<std::string>() << "\n";
     }

@@ -71,23 +71,7 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
 }
 
 bool PointLight::on() const { return luminance(intensity) > 0.f; }
-double PointLight::spotVersine() const {
-  const double half = 0.5 * double(std::clamp(spotAngleDeg, 0.f, 180.f)) * M_PI / 180.0;
-  return 2.0 * std::sin(half) * std::sin(half);
-}
-
-bool PointLight::shinesTowards(const glm::vec3& d) const {
-  if (spotAngleDeg >= 180.f) return true;
-  const glm::dvec3 a(d), s(spotDirection);
-  const double c = glm::dot(a, s), ll = glm::dot(a, a) * glm::dot(s, s);
-  const double angle = double(spotAngleDeg) * M_PI / 180.0;
-  if (spotAngleDeg <= 90.f) {
-    const glm::dvec3 x = glm::cross(a, s);
-    const double sn = std::sin(angle);
-    return c > 0.0 && glm::dot(x, x) <= sn * sn * ll;
-  }
-  return c >= std::cos(angle) * std::sqrt(ll);
-}
+Cone PointLight::spot() const { return Cone(spotDirection, double(std::clamp(spotAngleDeg, 0.f, 180.f))); }
 
 void PointLight::check() const {
   if (!on()) return;
@@ -105,7 +89,7 @@ glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, con
   const float r = std::sqrt(r2);
   w /= r;
   const float cx = glm::dot(n, w);
-  if (cx <= 0.f || !L.shinesTowards(-w)) return glm::vec3(0.f);
+  if (cx <= 0.f || !L.spot().contains(-w)) return glm::vec3(0.f);
   Ray ray;
   ray.o = x;
   ray.d = w;

@@ -45,7 +45,8 @@ std::vector<ParamSpec> ErrorMapOptions::specs() {
                "z-score (value - reference) / sqrt(s_ref^2 + s_value^2): about N(0,1) where the value is right, "
                "so |z| > 3 (0.27% of vertices by chance) marks a real error. A difference where the reference is 0 "
                "(relative) or has an error bar of 0 (z-score) is unbounded: written as +-3.4e38, the ramp's ends, "
-               "with a warning; where the two agree, 0.",
+               "with a warning; where the two agree, 0. A z-score without any error bar (a reference of one path "
+               "a vertex) is refused.",
        .type = ParamType::Enum, .def = kErrorMeasures.index(ErrorMeasure::Difference),
        .choices = kErrorMeasures.choices()},
       {.name = "color_range", .label = "Colour range",
@@ -91,9 +92,10 @@ std::string fmt(double x) {
 
 ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float>& reference,
                         const std::vector<float>& sigmaRef, const std::vector<float>& sigmaValue,
-                        ErrorMeasure measure, double colorRange) {
+                        ErrorMeasure measure, double colorRange, const std::vector<float>& traced) {
   const size_t n = value.size();
-  if (reference.size() != n || (!sigmaRef.empty() && sigmaRef.size() != n) || (!sigmaValue.empty() && sigmaValue.size() != n))
+  if (reference.size() != n || (!sigmaRef.empty() && sigmaRef.size() != n) || (!sigmaValue.empty() && sigmaValue.size() != n) ||
+      (!traced.empty() && traced.size() != n))
     throw std::logic_error("error map: arrays of different lengths");
   if (measure == ErrorMeasure::ZScore && sigmaRef.empty() && sigmaValue.empty())
     throw std::invalid_argument("a z-score needs a standard error: name the reference's (reference_error) or the "
@@ -101,7 +103,11 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   ErrorMapResult out;
   out.error.assign(n, 0.f);
   double sumD2 = 0, sumR2 = 0, sumD = 0, maxAbs = 0, sumZ2 = 0;
-  size_t used = 0, notFinite = 0, noBar = 0, beyond3 = 0, zCount = 0, saturated = 0;
+  size_t used = 0, notFinite = 0, noBar = 0, beyond3 = 0, zCount = 0, saturated = 0, untraced = 0;
+  // A partial reference's untraced vertices hold 0, no value: they were
+  // compared as 0 (rms 2.2 on a box whose traced vertices agreed; an outside
+  // audit).
+  auto isTraced = [&](size_t i) { return traced.empty() || traced[i] > 0.5f; };
   // A difference where the reference is 0 (relative) or both error bars are
   // 0 (z-score): the error is unbounded. It was written as 0, white, "no
   // error", which hid a radiosity light leak into a half the reference sees
@@ -110,6 +116,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   std::vector<size_t> unbounded;
   for (size_t i = 0; i < n; ++i) {
     const double v = value[i], r = reference[i];
+    if (!isTraced(i)) { ++untraced; continue; }
     if (!std::isfinite(v) || !std::isfinite(r)) { ++notFinite; continue; }
     const double d = v - r;
     sumD2 += d * d, sumR2 += r * r, sumD += d, maxAbs = std::max(maxAbs, std::abs(d));
@@ -146,11 +153,15 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     out.error[i] = float(e);
   }
   // With no error bar anywhere (a reference of one path a vertex) the bars
-  // are unknown, not 0: no z is written at all (said below).
-  const bool noZ = measure == ErrorMeasure::ZScore && zCount == 0;
+  // are unknown, not 0, and no z-score is defined: refused, as a map of 0s
+  // painted every vertex white, "no error", where the values differed (an
+  // outside audit; it had warned in the log).
+  if (measure == ErrorMeasure::ZScore && zCount == 0 && unbounded.size() + noBar > 0)
+    throw std::invalid_argument(
+        "no vertex has an error bar (all are 0, negative or missing): no z-score is defined; choose the difference "
+        "or the relative error, or give a reference with error bars (more than one path a vertex)");
   const float top = std::numeric_limits<float>::max();
-  if (!noZ)
-    for (size_t i : unbounded) out.error[i] = value[i] > reference[i] ? top : -top;
+  for (size_t i : unbounded) out.error[i] = value[i] > reference[i] ? top : -top;
   // The colour range: given, or the 99th percentile of |error| (z: 3),
   // without the errors at the float's ends.
   double R = colorRange;
@@ -173,10 +184,11 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   // Unbounded errors beside bounded ones that are all 0: any range puts
   // them at the ramp's end (R = 0 painted them white, "no error": an
   // outside review).
-  if (!(R > 0.0) && !noZ && !unbounded.empty()) R = 1.0;
+  if (!(R > 0.0) && !unbounded.empty()) R = 1.0;
   out.range = R;
   out.color.resize(n);
-  for (size_t i = 0; i < n; ++i) out.color[i] = divergingColor(R > 0.0 ? out.error[i] / R : 0.0);
+  for (size_t i = 0; i < n; ++i)
+    out.color[i] = isTraced(i) ? divergingColor(R > 0.0 ? out.error[i] / R : 0.0) : kUntracedColor;
 
   RunStats& st = out.stats;
   st.add("vertices", double(used));
@@ -187,12 +199,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     st.note("no relative RMS error: the reference is 0 at every vertex and the value is not");
   st.add("max_abs_error", maxAbs);
   st.add("mean_error", used ? sumD / double(used) : 0.0);
-  if (noZ && (unbounded.size() + noBar) > 0) {
-    // rms_z 0 would read as a perfect agreement (a reference of one path a
-    // vertex writes error bars of 0: an outside sweep, 5 December 2026).
-    st.warn("no vertex has an error bar (all are 0 or missing): no z-score is defined and none is reported; "
-            "rms_error and max_abs_error still are");
-  } else if (measure == ErrorMeasure::ZScore) {
+  if (measure == ErrorMeasure::ZScore) {
     st.add("rms_z", zCount ? std::sqrt(sumZ2 / double(zCount)) : 0.0);
     st.add("fraction_abs_z_above_3", zCount ? double(beyond3) / double(zCount) : 0.0);
     st.note("|z| > 3 at " + std::to_string(beyond3) + " of " + std::to_string(zCount) +
@@ -205,15 +212,20 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   if (saturated)
     st.warn(std::to_string(saturated) + " errors beyond single precision were written as +-" +
             fmt(double(std::numeric_limits<float>::max())));
-  if (!noZ && !unbounded.empty())
+  if (!unbounded.empty())
     st.warn(std::to_string(unbounded.size()) + " vertices differ from a reference " +
             (measure == ErrorMeasure::Relative ? "of 0" : "whose error bars are 0 (and the value's too)") +
             ": their " + kErrorMeasures.logName(measure) + " is unbounded, written as +-" + fmt(double(top)) +
             " (the colour ramp's ends; left out of the statistics but rms_error and max_abs_error)");
+  if (untraced)
+    st.note(std::to_string(untraced) + " vertices the reference did not trace (ReferenceTraced 0): no reference "
+            "value, left out of every statistic, written as 0 in grey");
+  if (used == 0 && untraced)
+    st.warn("the reference traced none of the vertices compared: no error is measured");
   if (notFinite)
     st.warn(std::to_string(notFinite) + " vertices where the value or the reference is not a finite number: 0 "
             "written, left out of every statistic");
-  if (noBar && !noZ)
+  if (noBar)
     st.warn(std::to_string(noBar) + " vertices with a negative or non-finite error bar: no z-score, 0 written");
   return out;
 }
@@ -285,8 +297,10 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   std::vector<float> sv;
   if (!o.valueError.empty()) sv = attributeValues(in.attributes, o.valueError, mesh, "", true);
 
-  std::vector<float> r, sr;
+  std::vector<float> r, sr, traced;
   std::string from;
+  // The reference filter's mark of the vertices it traced (a partial reference).
+  const std::string kTracedAttribute = "ReferenceTraced";
   if (o.source == ReferenceSource::Attribute) {
     if (!o.file.empty()) res.stats.warn("reference_file is not read: the reference comes from an attribute of the mesh");
     r = attributeValues(in.attributes, o.reference, mesh,
@@ -294,6 +308,7 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(in.attributes, o.referenceError))
       sr = attributeValues(in.attributes, o.referenceError, mesh, "", true);
     from = "attribute " + o.reference;
+    if (const VertexAttribute* t = find(in.attributes, kTracedAttribute)) traced = scalarValues(*t);
   } else {
     if (o.file.empty()) throw std::invalid_argument("reference_file is empty: name the reference PLY");
     if (!in.readVertexFile) throw std::invalid_argument("this front end cannot read a reference file");
@@ -311,6 +326,7 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(f.attributes, o.referenceError))
       sr = attributeValues(f.attributes, o.referenceError, o.file, "", true);
     from = o.file + " (" + o.reference + ")";
+    if (const VertexAttribute* t = find(f.attributes, kTracedAttribute)) traced = scalarValues(*t);
   }
   if (o.measure == ErrorMeasure::ZScore && sr.empty() && sv.empty())
     throw std::invalid_argument("a z-score needs a standard error, and the reference has no attribute '" +
@@ -321,7 +337,8 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   if (o.measure != ErrorMeasure::ZScore && !o.valueError.empty())
     res.stats.warn("value_error is used only by the z-score");
   if (v.size() != nv || r.size() != nv) throw std::logic_error("error map: attribute of the wrong size");
-  ErrorMapResult e = errorMap(v, r, sr, sv, o.measure, o.colorRange);
+  if (!traced.empty() && traced.size() != nv) traced.clear();
+  ErrorMapResult e = errorMap(v, r, sr, sv, o.measure, o.colorRange, traced);
   res.vertexQuality = std::move(e.error);
   res.vertexColor = std::move(e.color);
   res.stats.numbers = std::move(e.stats.numbers);

@@ -183,6 +183,11 @@ void outputAmbient(FilterKind kind, FilterInput& in, FilterResult& res) {
       kind == FilterKind::AmbientOcclusion ? kAOColorMappings.get(v, "color_mapping") : AOColorMapping::Grey;
   if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(res.vertexQuality);
   else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, res.vertexQuality);
+  // Colours painted by the result are no reflectance for a later lighting
+  // filter: the value as an attribute marks them (kResultAttributes).
+  if (mapping != AOColorMapping::KeepColor)
+    res.attributes.push_back(scalarAttribute(
+        kind == FilterKind::AmbientOcclusion ? "AmbientOcclusion" : "AmbientObscurance", res.vertexQuality));
   if (const VertexAttribute* bent = res.attribute("BentNormal"); bent && v.getBool("bent_normals_to_vertex_normals"))
     res.vertexNormal = vectors(bent);
 }
@@ -497,7 +502,10 @@ void outputFilter(FilterKind kind, FilterInput& in, FilterResult& res) {
     case FilterKind::AmbientOcclusion:
     case FilterKind::AmbientObscurance:
     case FilterKind::SkyLighting: outputAmbient(kind, in, res); break;
-    case FilterKind::Thickness: res.vertexColor = greyColors(relativeToPercentile(res.vertexQuality, 0.99)); break;
+    case FilterKind::Thickness:
+      res.vertexColor = greyColors(relativeToPercentile(res.vertexQuality, 0.99));
+      res.attributes.push_back(scalarAttribute("Thickness", res.vertexQuality));  // marks the colours (kResultAttributes)
+      break;
     case FilterKind::PathTracedReference: radiometric(res, out, in.values.getFloat("exposure"), "Radiosity"); break;
     case FilterKind::Radiosity:
       radiometric(res, out, in.values.getFloat("exposure"), "Radiosity");

@@ -59,15 +59,14 @@ Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& 
   // infinite and every path's value NaN (a reference of zeros; found 5
   // December 2026). Below 1e-12 sr (a = 3.2e-5 degrees) the sun is taken
   // as the point it then is: one shadow ray, its radiance's limit.
-  const double halfAngle = 0.5 * double(L_.sunAngularRadiusDeg) * M_PI / 180.0;
-  const double omega = 4.0 * M_PI * std::sin(halfAngle) * std::sin(halfAngle);
+  sunCone_ = Cone(L_.sunDirection, double(L_.sunAngularRadiusDeg));
+  const double omega = sunCone_.solidAngle();
   sunDisk_ = hasSun_ && omega > 1e-12;
-  sunVersine_ = float(2.0 * std::sin(halfAngle) * std::sin(halfAngle));
-  sunSin2_ = std::sin(2.0 * halfAngle) * std::sin(2.0 * halfAngle);
   sunPdf_ = sunDisk_ ? float(1.0 / omega) : 0.f;
   sunL_ = sunDisk_ ? L_.sunIrradiance * float(double(sunDiskScale(L_.sunAngularRadiusDeg)) / omega)
                    : glm::vec3(0.f);  // E / (pi sin^2 a)
   hasPoint_ = L_.point.on();
+  spot_ = L_.point.spot();
 }
 
 bool Integrator::emits(uint32_t face) const { return positive(s_.faceEmission(face)); }
@@ -111,16 +110,11 @@ Ray Integrator::shadowRay(const glm::vec3& x, const glm::vec3& n, const glm::vec
 
 glm::vec3 Integrator::escaped(const glm::vec3& d, bool delta, float pdfPrev, float nLPrev) const {
   glm::vec3 L = L_.skyRadiance;
-  if (sunDisk_ && glm::dot(d, L_.sunDirection) > 0.f) {
-    // Inside the disk where |d x s|^2 <= sin^2 a |d|^2, in double: a float
-    // cos test admitted a cone wider than the disk whose solid angle sunL_
-    // divides by (the sun 6.5 times too bright in mirrors at 0.01 degrees,
-    // 0.8% at 0.27; an outside review).
-    const glm::dvec3 dd(d), sd(L_.sunDirection);
-    const glm::dvec3 c = glm::cross(dd, sd);
-    if (glm::dot(c, c) <= sunSin2_ * glm::dot(dd, dd) * glm::dot(sd, sd))
-      L += sunL_ * (delta ? 1.f : powerHeuristic(pdfPrev, nLPrev * sunPdf_));
-  }
+  // Inside the disk, tested in double: a float cos test admitted a cone
+  // wider than the disk whose solid angle sunL_ divides by (the sun 6.5
+  // times too bright in mirrors at 0.01 degrees, 0.8% at 0.27; an outside
+  // review).
+  if (sunDisk_ && sunCone_.contains(d)) L += sunL_ * (delta ? 1.f : powerHeuristic(pdfPrev, nLPrev * sunPdf_));
   return L;
 }
 
@@ -167,7 +161,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
       }
     }
     if (sunDisk_) {
-      const glm::vec3 w = Frame(L_.sunDirection).toWorld(uniformConeVersine(smp.next2D(), sunVersine_));
+      const glm::vec3 w = Frame(L_.sunDirection).toWorld(uniformConeVersine(smp.next2D(), float(sunCone_.versine())));
       const float cx = glm::dot(n, w);
       const glm::vec3 f = cx > 0.f ? b.f(w) : glm::vec3(0.f);
       if (positive(f)) {
@@ -193,7 +187,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
       const float r = std::sqrt(r2);
       w /= r;
       const float cx = glm::dot(n, w);
-      const glm::vec3 f = cx > 0.f && L_.point.shinesTowards(-w) ? b.f(w) : glm::vec3(0.f);
+      const glm::vec3 f = cx > 0.f && spot_.contains(-w) ? b.f(w) : glm::vec3(0.f);
       if (positive(f)) {
         const Ray ray = shadowRay(x, n, w, L_.point.position, lift, 0.f);
         ++c.shadow;
@@ -351,9 +345,7 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
 std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, bool sunMet) {
   const bool sun = luminance(lights.sunIrradiance) > 0.f;
   if (!lights.point.on() && !sun) return "";
-  bool specular = false;
-  for (size_t f = 0; f < s.faceCount() && !specular; ++f) specular = isSpecular(s.faceMaterial(f));
-  if (!specular) return "";
+  if (!anyFaceMaterial(s, isSpecular)) return "";
   std::string w;
   if (lights.point.on())
     w = "the point light's light reflected or refracted by mirrors or glass onto other surfaces (caustics, "
@@ -365,8 +357,7 @@ std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, boo
   // sun through a glass pane read 14 times too dark in the reference, with
   // error bars that did not show it (an outside audit); from about 2
   // degrees (1 in 800) the paths find it and the bars hold.
-  const double half = 0.5 * double(lights.sunAngularRadiusDeg) * M_PI / 180.0;
-  const double omega = 4.0 * M_PI * std::sin(half) * std::sin(half);
+  const double omega = Cone(lights.sunDirection, double(lights.sunAngularRadiusDeg)).solidAngle();
   if (sun && !sunMet) {
     w += std::string(w.empty() ? "" : "; ") +
          "the sun's light reflected or refracted by mirrors or glass onto other surfaces (sunlight through a glass "

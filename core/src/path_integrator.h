@@ -231,10 +231,10 @@ class Integrator {
   // scene, a camera's) are put back onto their face's plane (surfaceAt).
   float farT_;
   bool hasSky_ = false, hasSun_ = false, sunDisk_ = false, hasPoint_ = false;
-  // The sun's disk: its versine 1 - cos a (sampling) and sin^2 a (whether a
-  // ray meets it, tested in double), both exact where cos a is 1 in float.
-  float sunVersine_ = 0.f, sunPdf_ = 0.f;
-  double sunSin2_ = 0.0;
+  // The sun's disk and the spot's cone, tested and sampled in double
+  // (exact where cos a is 1 in float).
+  Cone sunCone_, spot_;
+  float sunPdf_ = 0.f;
   glm::vec3 sunL_{0.f};
 };
 

@@ -126,12 +126,6 @@ PhotonOptions PhotonOptions::fromParams(const ParamValues& v, const glm::dvec3& 
 
 namespace {
 
-bool anySpecular(const Scene& s) {
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isCausticSurface(s.faceMaterial(f))) return true;
-  return false;
-}
-
 bool anyDiffuseReflection(const Scene& s) {
   for (size_t f = 0; f < s.faceCount(); ++f)
     if (s.faceMaterial(f) == Material::Diffuse && luminance(s.faceRho(f)) > 0.f) return true;
@@ -406,7 +400,7 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   const size_t nv = s.vertexCount();
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
-  const bool specular = anySpecular(s);
+  const bool specular = anyFaceMaterial(s, isCausticSurface);
   // What the scene needs: photons carry caustics (specular faces) and
   // diffuse interreflection (rho > 0); with the direct light apart and
   // neither, there is nothing for them to do.

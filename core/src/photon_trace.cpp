@@ -95,9 +95,9 @@ class PhotonLights {
       sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk * sunScale_ : 0.0;
     }
     o.point.check();
-    versSpot_ = o.point.spotVersine();
+    spot_ = o.point.spot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
-    pointPower_ = double(luminance(o.point.intensity)) * 2.0 * M_PI * versSpot_;
+    pointPower_ = double(luminance(o.point.intensity)) * spot_.solidAngle();
     if (!(pointPower_ > 0.0) || o.outsideLightsOnly) pointPower_ = 0.0;
     inner_ = o.outsideLightsOnly ? 0.0 : area_.totalPower() + pointPower_;
     total_ = inner_ + skyPower_ + sunPower_;
@@ -163,7 +163,7 @@ class PhotonLights {
     return {L.p, L.n, L.E * float(M_1_PI), L.pdfArea * float(1.0 - pPoint), false};
   }
   // Whether the point or spot light shines towards d.
-  bool inSpot(const glm::vec3& d) const { return o_.point.shinesTowards(d); }
+  bool inSpot(const glm::vec3& d) const { return spot_.contains(d); }
 
   struct Emission {
     glm::vec3 o, d, power, n;
@@ -183,8 +183,8 @@ class PhotonLights {
       // Flux per photon: I * solid angle / (p_choice * count).
       // By the versine: a cone of 0.5 degrees sampled by its float cosine
       // put 156 of 200k photons on the axis itself (an outside audit).
-      e.d = Frame(spotFrame_).toWorld(uniformConeVersine(u1, float(versSpot_)));
-      e.power = lp.L * float(2.0 * M_PI * versSpot_) / float(lp.pdf * count);
+      e.d = Frame(spotFrame_).toWorld(uniformConeVersine(u1, float(spot_.versine())));
+      e.power = lp.L * float(spot_.solidAngle()) / float(lp.pdf * count);
     } else {
       // L cos / (pdf_A * (cos / pi) * count) = pi L / (pdf_A count).
       e.d = Frame(lp.n).toWorld(cosineHemisphere(u1));
@@ -224,7 +224,8 @@ class PhotonLights {
   glm::vec3 centre_{0.f}, aimCentre_{0.f};
   float radius_ = 0.f, aimRadius_ = 0.f, aimDistance_ = 0.f;
   double skyPower_ = 0.0, sunPower_ = 0.0, inner_ = 0.0;
-  double pointPower_ = 0.0, total_ = 0.0, versSpot_ = 2.0;
+  double pointPower_ = 0.0, total_ = 0.0;
+  Cone spot_;  // the point light's cone
   double sunScale_ = 1.0;
   glm::vec3 spotFrame_;
   std::vector<glm::vec3> pointOn_;  // unit normals of the faces the point light lies on

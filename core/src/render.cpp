@@ -328,8 +328,7 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
       // and glass, and their paths have no diffuse bounce: a room lit only
       // through a glass window is black there (an outside audit: the
       // warning named only the camera).
-      bool specular = false;
-      for (size_t f = 0; f < s.faceCount() && !specular; ++f) specular = isCausticSurface(s.faceMaterial(f));
+      const bool specular = anyFaceMaterial(s, isCausticSurface);
       const bool direct = o.mode == RenderMode::Whitted || o.mode == RenderMode::Distributed ||
                           (o.mode == RenderMode::PathTraced && o.maxDiffuseBounces == 0);
       st.warn(std::string("the image is black: no eye ray reached a lit surface (is the camera inside an object, or "
@@ -363,8 +362,7 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   if (o.mode == RenderMode::Whitted) {
     st.add("area_lights", double(ctx.areaLightCount()));
     if (luminance(o.skyRadiance) > 0.f) st.note("Whitted: the sky is seen but lights no diffuse surface");
-    if (!s.material.empty() &&
-        std::any_of(s.material.begin(), s.material.end(), [](Material m) { return m == Material::Glossy; }))
+    if (anyFaceMaterial(s, [](Material m) { return m == Material::Glossy; }))
       st.note("Whitted: glossy faces reflect one ray in the mirror direction weighted by their Fresnel factor (a "
               "sharp mirror; the distributed and path-traced modes sample their lobe)");
     if (o.sunIrradiance != glm::vec3(0.f) && o.sunAngularRadiusDeg > 0.f)

@@ -51,12 +51,6 @@ void checkPerVertex(const std::vector<glm::vec3>& v, size_t nv, const char* what
                                 " negative or non-finite channels (a radiosity is a finite value >= 0)");
 }
 
-bool anySpecularFace(const Scene& s) {
-  for (size_t f = 0; f < s.faceCount(); ++f)
-    if (isCausticSurface(s.faceMaterial(f))) return true;
-  return false;
-}
-
 }  // namespace
 
 void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, const RenderOptions& o,
@@ -73,7 +67,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
   size_t negative = 0;
   for (size_t i = 0; i < nv; ++i) tp.R[i] = glm::max(o.firstPassB[i] - mat.E[i], glm::vec3(0.f));
   const bool wantCaustics = o.twoPass == TwoPassDiffuse::Caustics || o.twoPass == TwoPassDiffuse::FinalGather;
-  if (wantCaustics && anySpecularFace(s)) {
+  if (wantCaustics && anyFaceMaterial(s, isCausticSurface)) {
     Timer t;
     PhotonOptions po;
     po.photons = o.causticPhotons;

@@ -134,7 +134,7 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
       const float r = std::sqrt(r2);
       w /= r;
       const float cx = glm::dot(n, w);
-      if (cx > 0.f && o_.point.shinesTowards(-w)) {
+      if (cx > 0.f && spot_.contains(-w)) {
         const Ray ray = shadowRay(x, n, w, o_.point.position, eps(), 0.f);
         H += o_.point.intensity * (cx / r2) * whittedTransmittance(ray, c);
       }

@@ -82,6 +82,26 @@ glm::vec3 uniformConeVersine(glm::vec2 u, float versine) {
   return {r * std::cos(phi), r * std::sin(phi), 1.f - t};
 }
 
+Cone::Cone(const glm::vec3& axis, double halfAngleDeg) : axis_(axis) {
+  const double a = halfAngleDeg * M_PI / 180.0;
+  versine_ = 2.0 * std::sin(0.5 * a) * std::sin(0.5 * a);
+  sin2_ = std::sin(a) * std::sin(a);
+  cos_ = std::cos(a);
+  narrow_ = halfAngleDeg <= 90.0;
+  all_ = halfAngleDeg >= 180.0;
+}
+
+bool Cone::contains(const glm::vec3& d) const {
+  if (all_) return true;
+  const glm::dvec3 a(d), &s = axis_;
+  const double c = glm::dot(a, s), ll = glm::dot(a, a) * glm::dot(s, s);
+  if (narrow_) {
+    const glm::dvec3 x = glm::cross(a, s);
+    return c > 0.0 && glm::dot(x, x) <= sin2_ * ll;
+  }
+  return c >= cos_ * std::sqrt(ll);
+}
+
 glm::vec2 uniformTriangle(glm::vec2 u) {
   // Heitz 2019, "A Low-Distortion Map Between Triangle and Square".
   float b0, b1;

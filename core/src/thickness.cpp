@@ -125,67 +125,73 @@ class ThicknessKernel {
   float sinAlpha_;
 };
 
-// Vertices at one position take one normal, the sum of theirs: the solid's
-// inward direction there, which is what the shape diameter measures (a mesh
-// with its faces unwelded gives each corner of a cube the normal of one
-// face, whose cone met the neighbouring faces at the corner: thickness
-// 0.0003 where the welded cube reads 2.46; an outside audit).
-void weldNormals(const Scene& scene, std::vector<glm::vec3>& normals) {
+// Vertices at one position share a group (exact float positions, -0 and +0
+// as one); a non-finite position, which no usable face has, is a group of
+// its own. Both the normals' welding and the faces at a vertex use them.
+struct PositionGroups {
+  std::vector<uint32_t> group;
+  uint32_t count = 0;
+};
+
+PositionGroups positionGroups(const Scene& scene) {
   const size_t nv = scene.vertexCount();
+  PositionGroups g;
+  g.group.assign(nv, 0);
   std::vector<uint32_t> order;
   order.reserve(nv);
   for (size_t i = 0; i < nv; ++i)
-    if (finite3(scene.positions[i]) && glm::dot(normals[i], normals[i]) > 0.5f) order.push_back(uint32_t(i));
-  auto key = [&](uint32_t i) {
-    const glm::vec3& p = scene.positions[i];
-    return std::array<float, 3>{p.x + 0.f, p.y + 0.f, p.z + 0.f};  // -0 and +0 as one
-  };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
-  for (size_t first = 0, k = 1; k <= order.size(); ++k) {
-    if (k < order.size() && key(order[k]) == key(order[first])) continue;
-    if (k - first > 1) {
-      glm::dvec3 sum(0.0);
-      for (size_t j = first; j < k; ++j) sum += glm::dvec3(normals[order[j]]);
-      const double l = glm::length(sum);
-      // Normals that cancel (a two-sided surface's own vertices) keep theirs.
-      if (l > 1e-3) for (size_t j = first; j < k; ++j) normals[order[j]] = glm::vec3(sum / l);
-    }
-    first = k;
-  }
-}
-
-FacesAtVertex facesAtVertices(const Scene& scene) {
-  const size_t nv = scene.vertexCount();
-  // Vertices at one position share a group (exact float positions, as weldNormals).
-  // (Non-finite positions, which no usable face has, each a group of their own.)
-  std::vector<uint32_t> order, group(nv);
-  order.reserve(nv);
-  uint32_t groups = 0;
-  for (size_t i = 0; i < nv; ++i)
     if (finite3(scene.positions[i])) order.push_back(uint32_t(i));
-    else group[i] = groups++;
+    else g.group[i] = g.count++;
   auto key = [&](uint32_t i) {
     const glm::vec3& p = scene.positions[i];
     return std::array<float, 3>{p.x + 0.f, p.y + 0.f, p.z + 0.f};
   };
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return key(a) < key(b); });
   for (size_t k = 0; k < order.size(); ++k) {
-    if (k > 0 && key(order[k]) != key(order[k - 1])) ++groups;
-    group[order[k]] = groups;
+    if (k > 0 && key(order[k]) != key(order[k - 1])) ++g.count;
+    g.group[order[k]] = g.count;
   }
-  if (!order.empty()) ++groups;
+  if (!order.empty()) ++g.count;
+  return g;
+}
+
+// Vertices at one position take one normal, the sum of theirs: the solid's
+// inward direction there, which is what the shape diameter measures (a mesh
+// with its faces unwelded gives each corner of a cube the normal of one
+// face, whose cone met the neighbouring faces at the corner: thickness
+// 0.0003 where the welded cube reads 2.46; an outside audit).
+void weldNormals(const PositionGroups& g, std::vector<glm::vec3>& normals) {
+  std::vector<glm::dvec3> sum(g.count, glm::dvec3(0.0));
+  std::vector<uint32_t> members(g.count, 0);
+  auto has = [&](size_t i) { return glm::dot(normals[i], normals[i]) > 0.5f; };
+  for (size_t i = 0; i < normals.size(); ++i)
+    if (has(i)) {
+      sum[g.group[i]] += glm::dvec3(normals[i]);
+      ++members[g.group[i]];
+    }
+  for (size_t i = 0; i < normals.size(); ++i) {
+    const uint32_t k = g.group[i];
+    if (!has(i) || members[k] < 2) continue;
+    const double l = glm::length(sum[k]);
+    // Normals that cancel (a two-sided surface's own vertices) keep theirs.
+    if (l > 1e-3) normals[i] = glm::vec3(sum[k] / l);
+  }
+}
+
+FacesAtVertex facesAtVertices(const Scene& scene, const PositionGroups& g) {
+  const size_t nv = scene.vertexCount();
   FacesAtVertex out;
-  out.start.assign(size_t(groups) + 1, 0);
+  out.start.assign(size_t(g.count) + 1, 0);
   for (const glm::uvec3& t : scene.triangles)
     for (int c = 0; c < 3; ++c)
-      if (t[c] < nv) ++out.start[group[t[c]] + 1];
-  for (size_t g = 0; g < groups; ++g) out.start[g + 1] += out.start[g];
-  out.faces.resize(out.start[groups]);
+      if (t[c] < nv) ++out.start[g.group[t[c]] + 1];
+  for (size_t k = 0; k < g.count; ++k) out.start[k + 1] += out.start[k];
+  out.faces.resize(out.start[g.count]);
   std::vector<uint32_t> fill(out.start.begin(), out.start.end() - 1);
   for (size_t f = 0; f < scene.triangles.size(); ++f)  // in face order: each group's list comes out sorted
     for (int c = 0; c < 3; ++c)
-      if (scene.triangles[f][c] < nv) out.faces[fill[group[scene.triangles[f][c]]]++] = uint32_t(f);
-  out.group = std::move(group);
+      if (scene.triangles[f][c] < nv) out.faces[fill[g.group[scene.triangles[f][c]]]++] = uint32_t(f);
+  out.group = g.group;
   return out;
 }
 
@@ -259,8 +265,9 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   const SceneReport rep = analyzeScene(scene);
   if (rep.usableFaces() == 0) throw std::invalid_argument("the mesh has no usable triangles (" + rep.summary() + ")");
   const size_t nv = scene.vertexCount();
+  const PositionGroups groups = positionGroups(scene);
   std::vector<glm::vec3> normals = vertexNormalsForRays(scene);
-  weldNormals(scene, normals);
+  weldNormals(groups, normals);
   std::vector<glm::vec3> inward(nv);
   for (size_t i = 0; i < nv; ++i) inward[i] = -normals[i];
   // Origins just inside the surface (and into the incident faces at borders).
@@ -278,7 +285,7 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
                glm::dot(n, n) > 0.5f;
   }
   const ThicknessKernel kernel(caster, opt);
-  const FacesAtVertex at = facesAtVertices(scene);
+  const FacesAtVertex at = facesAtVertices(scene, groups);
   std::vector<int> ownExits(nv, 0);
   Timer traceTimer;
   parallelBlocks(nv, progress, "casting rays", [&](size_t b, size_t e) {

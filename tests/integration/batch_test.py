@@ -12,6 +12,9 @@ Cases (all by default):
   shards  --shard I/N and a Slurm array's environment: each mesh in exactly
           one shard; --report-only over all of them
   inputs  --dir/--glob, a JSON parameter file, and one-line errors
+  keep    a failing re-run keeps the earlier results; a reference file is an
+          input of the error map (relative to the manifest, in the hash); a
+          file at one path is refused; --report-only beside a mesh "report"
 
 usage: batch_test.py --gi GI --meshes TEST_MESHES_DIR [case ...]
 """
@@ -266,7 +269,80 @@ def case_inputs(a, tmp):
     one_line(["--params", deep, "--dir", meshes, "-o", out], "nested deeper", "a parameter file nested 200,000 deep")
 
 
-CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs}
+def case_keep(a, tmp):
+    meshes = os.path.join(tmp, "keep_meshes")
+    names = copy_meshes(a.meshes, meshes, SMALL[:3])
+    out = os.path.join(tmp, "keep_out")
+    cmd = [a.gi, "batch", "ao", "--dir", meshes, "-o", out, "--rays_per_vertex", "8", "--json"]
+    rep = json.loads(run(cmd, expect=0).stdout)
+    check(rep["baked"] == len(names), "baked %d" % rep["baked"])
+    plys = {n: os.path.join(out, n + ".ply") for n in names}
+    stamps = {n: stamp(p) for n, p in plys.items()}
+    # A typo in a value every mesh takes: refused before any work (each mesh
+    # failed in turn and its finished result was deleted; an outside audit).
+    bad = cmd[:]
+    bad[bad.index("8")] = "0"
+    p = run(bad)
+    check(p.returncode == 1 and p.stderr.count("\n") == 1 and "rays_per_vertex" in p.stderr,
+          "an out-of-range common value: one line before any work (%s)" % p.stderr.strip())
+    check(all(os.path.exists(p) and stamp(p) == stamps[n] for n, p in plys.items()), "every result kept")
+    # A mesh that fails in a later run (its input gone): its earlier result stays, the summary says so.
+    gone = os.path.join(meshes, names[0] + ".ply")
+    os.rename(gone, gone + ".away")
+    other = cmd[:]
+    other[other.index("8")] = "9"
+    other[other.index("--dir"):other.index("--dir") + 2] = ["--manifest", os.path.join(meshes, "list.txt")]
+    with open(os.path.join(meshes, "list.txt"), "w") as f:
+        f.write("".join("%s.ply   # mesh %d\n" % (n, k) for k, n in enumerate(names)))
+    p = run(other)
+    rep = json.loads(p.stdout)
+    check(p.returncode == 1 and rep["failed"] == 1 and rep["baked"] == len(names) - 1,
+          "one mesh failed, the others baked; a comment after a line's name is no parameter (%s)" %
+          {k: rep[k] for k in ("failed", "baked")})
+    s = load(os.path.join(out, names[0] + ".json"))
+    check(os.path.exists(plys[names[0]]) and stamp(plys[names[0]]) == stamps[names[0]],
+          "the failed mesh's earlier result is kept")
+    check(s["status"] == "failed" and "is kept" in s["error"] and s.get("earlier_run", {}).get("status") == "ok" and
+          s["earlier_run"]["parameters"]["rays_per_vertex"] == "8",
+          "its summary says so and keeps the earlier run's (%s)" % s["error"])
+    os.rename(gone + ".away", gone)
+    # The error map's reference file: relative to the manifest, and part of
+    # the hash (a reference computed anew was taken as done before).
+    refdir = os.path.join(tmp, "keep_ref")
+    os.makedirs(refdir)
+    shutil.copy(os.path.join(a.meshes, "cornell_box.ply"), os.path.join(refdir, "box.ply"))
+    box = os.path.join(refdir, "box.ply")
+    ref = os.path.join(refdir, "ref.ply")
+    run([a.gi, "reference", box, "-o", ref, "--samples_per_vertex", "4", "--seed", "1"], expect=0)
+    run([a.gi, "radiosity", box, "-o", os.path.join(refdir, "lit.ply")], expect=0)
+    with open(os.path.join(refdir, "list.txt"), "w") as f:
+        f.write('lit.ply --reference_source "PLY file" --reference_file ref.ply --reference_attribute Reference\n')
+    emout = os.path.join(tmp, "keep_em")
+    em = [a.gi, "batch", "errormap", "--manifest", os.path.join(refdir, "list.txt"), "-o", emout, "--json"]
+    rep = json.loads(run(em, expect=0).stdout)
+    check(rep["baked"] == 1, "the error map's reference_file is found beside the manifest (%s)" % rep)
+    first = load(os.path.join(emout, "lit.json"))["stats"]["rms_error"]
+    time.sleep(0.05)
+    run([a.gi, "reference", box, "-o", ref, "--samples_per_vertex", "4", "--seed", "2"], expect=0)
+    rep = json.loads(run(em, expect=0).stdout)
+    second = load(os.path.join(emout, "lit.json"))["stats"]["rms_error"]
+    check(rep["baked"] == 1 and rep["done_before"] == 0 and second != first,
+          "a reference computed anew is compared anew (rms %g, then %g)" % (first, second))
+    # A parameter that writes one file for every mesh is refused.
+    p = run([a.gi, "batch", "radiosity", "--dir", meshes, "-o", os.path.join(tmp, "keep_csv"), "--residual_csv", "r.csv"])
+    check(p.returncode == 1 and p.stderr.count("\n") == 1 and "residual_csv" in p.stderr,
+          "residual_csv in a batch: one line (%s)" % p.stderr.strip())
+    # --report-only writes report.json: not over the summary of a mesh named report.
+    shutil.copy(os.path.join(meshes, names[1] + ".ply"), os.path.join(meshes, "report.ply"))
+    run(cmd, expect=0)
+    summary = os.path.join(out, "report.json")
+    before = load(summary)
+    p = run([a.gi, "batch", "ao", "--dir", meshes, "-o", out, "--rays_per_vertex", "8", "--report-only"])
+    check(p.returncode == 1 and load(summary) == before and "report.json" in p.stderr,
+          "--report-only beside a mesh named report: refused, its summary kept (%s)" % p.stderr.strip())
+
+
+CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs, "keep": case_keep}
 
 
 def main():

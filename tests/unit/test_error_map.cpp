@@ -239,15 +239,22 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   EXPECT_NE(negative.stats.warnings[0].find("1 vertices with a negative or non-finite error bar"), std::string::npos)
       << negative.stats.warnings[0];
   // Error bars of 0 everywhere (a reference of one path a vertex): no
-  // z-score anywhere, said by a warning of the filter (its estimate's
-  // warnings never reached the filter's log until 5 December 2026), and no
-  // rms_z of 0 that would read as a perfect agreement.
+  // z-score is defined anywhere. Refused: a map of 0s painted every vertex
+  // white, "no error", where every value differed (an outside audit), and
+  // an rms_z of 0 would read as a perfect agreement.
   const std::vector<VertexAttribute> noBars = {{kQualityAttribute, 1, value}, {"Reference", 1, refv},
                                                {"Zero", 1, std::vector<float>(nv, 0.f)}};
-  const FilterResult none = errorMapOf(sf, noBars, {{"reference_error", "Zero"}, {"error_measure", "2"}});
-  ASSERT_EQ(none.stats.warnings.size(), 1u);
-  EXPECT_NE(none.stats.warnings[0].find("no z-score is defined"), std::string::npos);
-  EXPECT_TRUE(std::isnan(none.stats.get("rms_z", std::nan(""))));
+  try {
+    (void)errorMapOf(sf, noBars, {{"reference_error", "Zero"}, {"error_measure", "2"}});
+    ADD_FAILURE() << "a z-score map without error bars was written";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no z-score is defined"), std::string::npos) << e.what();
+  }
+  // The same values agreeing exactly: z = 0 / 0 nowhere needed, a map of 0s.
+  const std::vector<VertexAttribute> agree = {{kQualityAttribute, 1, refv}, {"Reference", 1, refv},
+                                              {"Zero", 1, std::vector<float>(nv, 0.f)}};
+  const FilterResult same = errorMapOf(sf, agree, {{"reference_error", "Zero"}, {"error_measure", "2"}});
+  EXPECT_EQ(same.vertexQuality[1], 0.f);
   const std::vector<VertexAttribute> zero = {{kQualityAttribute, 1, value}, {"Reference", 1, std::vector<float>(nv, 0.f)}};
   const FilterResult r0 = errorMapOf(sf, zero, {});
   EXPECT_TRUE(std::isnan(r0.stats.get("relative_rms_error", std::nan(""))));
@@ -316,4 +323,43 @@ TEST(ErrorMap, UnboundedErrorsAreShownNotHidden) {
   EXPECT_EQ(lone.error[0], top);
   EXPECT_EQ(lone.color[0].r, red.r);
   EXPECT_EQ(lone.color[0].g, red.g);
+}
+
+// A partial reference (traced_vertices, traced_selected) holds 0 at the
+// vertices it did not trace, marked by ReferenceTraced 0: those have no
+// reference value. They were compared as 0 (an outside audit: rms 2.2 and
+// 92 of 96 vertices "unbounded" on a box whose traced vertices agreed);
+// now left out of every statistic, written as 0 in grey, and counted.
+TEST(ErrorMap, PartialReferenceComparesTracedVerticesOnly) {
+  const auto sf = scenes::cornellBox(150.0);
+  const size_t nv = sf.scene.vertexCount();
+  std::vector<float> value(nv, 2.f), ref(nv, 0.f), traced(nv, 0.f), bars(nv, 0.1f);
+  size_t nTraced = 0;
+  for (size_t i = 0; i < nv; i += 3) ref[i] = 2.f, traced[i] = 1.f, ++nTraced;
+  value[0] = 2.5f;  // one traced vertex off by 0.5
+  const std::vector<VertexAttribute> attrs = {{kQualityAttribute, 1, value},
+                                              {"Reference", 1, ref},
+                                              {"ReferenceStdError", 1, bars},
+                                              {"ReferenceTraced", 1, traced}};
+  for (const char* measure : {"0", "1", "2"}) {
+    const FilterResult r = errorMapOf(sf, attrs, {{"error_measure", measure}});
+    EXPECT_TRUE(r.stats.warnings.empty()) << measure << ": " << r.stats.warnings.front();
+    EXPECT_EQ(r.stats.get("vertices"), double(nTraced)) << measure;
+    EXPECT_NEAR(r.stats.get("max_abs_error"), 0.5, 1e-6) << measure;
+    EXPECT_NEAR(r.stats.get("rms_error"), 0.5 / std::sqrt(double(nTraced)), 1e-6) << measure;
+    bool noted = false;
+    for (const std::string& n : r.stats.notes) noted |= n.find(std::to_string(nv - nTraced) + " vertices the reference did not trace") == 0;
+    EXPECT_TRUE(noted) << measure;
+    for (size_t i = 1; i < nv; ++i) {
+      ASSERT_EQ(r.vertexQuality[i], 0.f) << measure << " vertex " << i;
+      if (traced[i] == 0.f) {
+        ASSERT_EQ(r.vertexColor[i].r, kUntracedColor.r) << measure << " vertex " << i;
+      }
+    }
+    EXPECT_GT(r.vertexQuality[0], 0.f) << measure;
+  }
+  // Without the mark every vertex is compared (a reference of the whole mesh).
+  const FilterResult all = errorMapOf(sf, {attrs[0], attrs[1], attrs[2]}, {});
+  EXPECT_EQ(all.stats.get("vertices"), double(nv));
+  EXPECT_GT(all.stats.get("rms_error"), 1.0);
 }

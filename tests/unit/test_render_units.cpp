@@ -8,6 +8,8 @@
 #include <string>
 
 #include "gi/filter_files.h"
+#include "gi/ambient.h"
+#include "gi/filters.h"
 #include "gi/filter_run.h"
 #include "gi/render.h"
 #include "render_test_helpers.h"
@@ -147,6 +149,42 @@ TEST(RenderUnits, AutoReflectancePassesOverAResultsColours) {
     if (withResult) {
       EXPECT_NEAR(B->values[0], rho * M_PI, 0.01 * rho * M_PI);
     }
+  }
+}
+
+// Ambient occlusion, obscurance and thickness paint their greys into the
+// vertex colours: radiosity's 'Auto' reflectance took them as the surface's
+// (AO 0 inside a closed box made every wall black; an outside audit). Their
+// value left as an attribute marks the colours; AO's 'Keep colour' paints
+// none and leaves the mesh's colours its reflectance.
+TEST(RenderUnits, AutoReflectancePassesOverAmbientGreys) {
+  struct Case {
+    FilterKind kind;
+    AOColorMapping mapping;
+    const char* attribute;
+  };
+  for (const Case c : {Case{FilterKind::AmbientOcclusion, AOColorMapping::Grey, "AmbientOcclusion"},
+                       Case{FilterKind::AmbientOcclusion, AOColorMapping::MultiplyColor, "AmbientOcclusion"},
+                       Case{FilterKind::AmbientOcclusion, AOColorMapping::KeepColor, nullptr},
+                       Case{FilterKind::AmbientObscurance, AOColorMapping::Grey, "AmbientObscurance"},
+                       Case{FilterKind::Thickness, AOColorMapping::Grey, "Thickness"}}) {
+    FilterInput first = skyFloor(c.kind);
+    first.attrs.vertexColor.assign(first.scene.vertexCount(), glm::u8vec3(30, 100, 200));
+    if (c.kind == FilterKind::AmbientOcclusion) first.values.set("color_mapping", kAOColorMappings.index(c.mapping));
+    const std::string what = std::string(filterDesc(c.kind).cliName) + " " + kAOColorMappings.logName(c.mapping);
+    const FilterResult r = runFilter(c.kind, first);
+    FilterInput again = skyFloor(FilterKind::Radiosity);
+    again.attrs.vertexColor.clear();
+    if (r.vertexColor.empty()) again.attrs.vertexColor = first.attrs.vertexColor;
+    for (const Rgb8& col : r.vertexColor) again.attrs.vertexColor.push_back({col.r, col.g, col.b});
+    again.attributes = r.attributes;
+    std::string names;
+    for (const VertexAttribute& a : r.attributes) names += a.name + " ";
+    EXPECT_EQ(r.attribute(c.attribute ? c.attribute : "AmbientOcclusion") != nullptr, c.attribute != nullptr) << what << ": " << names;
+    const FilterResult r2 = runFilter(FilterKind::Radiosity, again);
+    EXPECT_NE(r2.setupLog.find(c.attribute ? "reflectance from constant" : "reflectance from vertex colour"),
+              std::string::npos)
+        << what << ": " << r2.setupLog;
   }
 }
 

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "gi/sampling.h"
 #include "gi/scene.h"
 
 namespace gi {
@@ -66,12 +67,11 @@ struct PointLight {
   // rounds to 1), which then carried no power and read as no light at all.
   void check() const;
   static constexpr double kMinSpotAngleDeg = 0.1;
-  // Whether d lies in the cone, tested in double (|d x s|^2 <= sin^2 a where
-  // a < 90 degrees): a single-precision cosine of a cone of 0.1 degrees is
-  // a few percent off its area.
-  bool shinesTowards(const glm::vec3& d) const;
-  // 1 - cos(half angle), exact for narrow cones (uniformConeVersine).
-  double spotVersine() const;
+  // The spot's cone around spotDirection (all directions for a point
+  // light), tested and sampled in double precision (gi/sampling.h's Cone):
+  // a single-precision cosine of a cone of 0.1 degrees is a few percent off
+  // its area. Build it once outside a loop over shadow rays.
+  Cone spot() const;
 };
 // Irradiance I cos / r^2 from the point light at x (unit normal n), 0 if the
 // shadow ray is blocked or x lies outside the spot's cone.

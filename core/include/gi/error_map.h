@@ -59,11 +59,15 @@ struct ErrorMapResult {
 };
 
 // The error of `value` against `reference` (same length); `sigmaRef` and
-// `sigmaValue` (empty: none) are their standard errors. Throws
-// std::invalid_argument for a z-score without any standard error.
+// `sigmaValue` (empty: none) are their standard errors; `traced` (empty:
+// all) is the reference's ReferenceTraced: a vertex it marks 0 has no
+// reference value, is left out of every statistic and written as 0 in grey.
+// Throws std::invalid_argument for a z-score without any standard error.
 ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float>& reference,
                         const std::vector<float>& sigmaRef, const std::vector<float>& sigmaValue,
-                        ErrorMeasure measure, double colorRange);
+                        ErrorMeasure measure, double colorRange, const std::vector<float>& traced = {});
+// The colour of a vertex the reference did not trace.
+inline constexpr Rgb8 kUntracedColor{128, 128, 128};
 
 // The diverging ramp at t in [-1, 1] (clamped): blue, white at 0, red.
 Rgb8 divergingColor(double t);

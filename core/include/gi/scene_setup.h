@@ -35,10 +35,14 @@ struct MeshAttributes {
   std::vector<uint8_t> faceColorGiven, vertexColorGiven;
 };
 
-// The per-vertex attributes an earlier lighting filter leaves, whose
-// presence marks the vertex colours as a display of that result (radiosity,
-// photon mapping, the reference, sky lighting, a view's vertex radiance).
-inline constexpr const char* kResultAttributes[] = {"Radiosity", "Irradiance", "Radiance", "Reference"};
+// The per-vertex attributes an earlier filter leaves, whose presence marks
+// the vertex colours as a display of that result (radiosity, photon
+// mapping, the reference, sky lighting, a view's vertex radiance; ambient
+// occlusion, obscurance and thickness where they paint the colours: their
+// greys were read as reflectance, AO's 0 inside a closed box as black
+// walls; an outside audit).
+inline constexpr const char* kResultAttributes[] = {"Radiosity",        "Irradiance",        "Radiance", "Reference",
+                                                    "AmbientOcclusion", "AmbientObscurance", "Thickness"};
 
 // Appends part b's colours (faces nf0.., vertices nv0..) to a's, with the
 // given-masks above: a part without face or vertex colours gets the filler

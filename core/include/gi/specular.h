@@ -36,5 +36,13 @@ inline bool isSpecular(Material m) { return m == Material::Mirror || m == Materi
 // glossy faces (gi/glossy.h), counted as S; photons are stored, and radiosity
 // lives, on the other (diffuse) faces only.
 inline bool isCausticSurface(Material m) { return m != Material::Diffuse; }
+// Whether any face of the scene has a material `test` accepts (isSpecular,
+// isCausticSurface): one pass over the faces.
+template <class Test>
+bool anyFaceMaterial(const Scene& s, Test test) {
+  for (size_t f = 0; f < s.faceCount(); ++f)
+    if (test(s.faceMaterial(f))) return true;
+  return false;
+}
 
 }  // namespace gi
