@@ -98,7 +98,12 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
   dropFullColorMasks(b.attrs);
   // MeshLab's coordinates are floats: far from the origin they have
   // already rounded the geometry (gi/scene.h).
-  if (auto far = coarseFloatsWarning(pts)) b.warnings.push_back("the mesh: " + *far);
+  // (A file's double coordinates are rounded too: the gi tool reads them
+  // in double; an outside audit found the light 26% larger at 1e6.)
+  if (auto far = coarseFloatsWarning(pts))
+    b.warnings.push_back("the mesh: " + *far + "; MeshLab holds coordinates as floats and rounds them on loading, even "
+                         "from a file with double coordinates: move the mesh near the origin before loading it, or "
+                         "run the gi command-line tool, which reads them in double");
   b.scene = Scene::fromAbsolute(pts, std::move(tris));
   return b;
 }
@@ -146,6 +151,12 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
       case ParamType::Enum: v.set(s.name, in.getEnum(n)); break;
       case ParamType::Color: {
         QColor c = in.getColor(n);
+        // A channel outside 0..255 in a hand-edited .mlx makes Qt's colour
+        // invalid, which reads as black: a reflectance of 0 without a word
+        // (an outside audit).
+        if (!c.isValid())
+          throw std::invalid_argument("parameter '" + s.name + "' is not a colour (each channel, alpha included, "
+                                      "must lie in 0..255)");
         v.set(s.name, glm::vec3(c.red() / 255.f, c.green() / 255.f, c.blue() / 255.f));
         break;
       }

@@ -301,7 +301,8 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
                            "loading");
   out.scene = Scene::fromAbsolute(p.points, std::move(tris));
   out.points = p.points;
-  if (auto far = coarseFloatsWarning(p.points)) out.warnings.push_back(name + ": " + *far);  // gi/scene.h
+  if (auto far = coarseFloatsWarning(p.points))  // gi/scene.h
+    out.warnings.push_back(name + ": " + *far + "; write the file with double coordinates, or move the mesh near the origin");
   out.scene.vertexNormals = p.normals;
   out.attrs.vertexColor = p.vertexColor;
   out.attrs.vertexSelected = p.vertexSelected;

@@ -307,7 +307,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
         continue;
       }
       if (status[i] != kTrace) continue;
-      const VertexOut o = kernel.run(uint32_t(part.meshIndex(i)), origins[i], normals[i]);  // keyed by the mesh's index
+      const VertexOut o = kernel.run(uint32_t(part.meshIndex(i)), origins[i], normals[i], origins[i] - scene.positions[i]);  // keyed by the mesh's index
       res.value[i] = o.value;
       res.stdError[i] = o.stdError;
       res.rays[i] = o.rays;
@@ -328,7 +328,8 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
         const glm::vec3 oA = sideOrigins[i], oB = oA + eps * (sides.n[1][k] - sides.n[0][k]);
         // Side B's rays keyed apart from every vertex's own (indices below nv).
         const uint32_t key = uint32_t(part.meshIndex(i));
-        const VertexOut a = kernel.run(key, oA, sides.n[0][k]), c = kernel.run(uint32_t(nv) + key, oB, sides.n[1][k]);
+        const glm::vec3& p = scene.positions[i];
+        const VertexOut a = kernel.run(key, oA, sides.n[0][k], oA - p), c = kernel.run(uint32_t(nv) + key, oB, sides.n[1][k], oB - p);
         res.value[i] = 0.5f * (a.value + c.value);
         res.stdError[i] = 0.5f * std::sqrt(a.stdError * a.stdError + c.stdError * c.stdError);
         res.rays[i] = a.rays + c.rays;

@@ -30,7 +30,7 @@ constexpr int kRound = 32;
 // Rays [start, start + count) of the sequence of the mesh's vertex vi, the
 // same as the per-vertex estimator's (key, warp and frame), added to r.
 void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint32_t vi, const glm::vec3& org,
-              const glm::vec3& n, uint32_t start, uint32_t count, VertexRays& r) {
+              const glm::vec3& offset, const glm::vec3& n, uint32_t start, uint32_t count, VertexRays& r) {
   const Frame frame(n);
   SobolOwenStream seq(hash3(vi, o.seed, 0x41u));
   seq.seek(start);
@@ -52,9 +52,7 @@ void castRays(const RayCaster& caster, const AmbientOptions& o, float tfar, uint
       caster.occludedFan(org, dirs, size_t(m), tfar, occ);
     }
     for (int j = 0; j < m; ++j) {
-      const double f = obscurance ? (hits[j].valid() ? std::pow(std::min(1.0, double(hits[j].t) / o.maxDistance),
-                                                                 double(o.falloffExponent))
-                                                     : 1.0)
+      const double f = obscurance ? obscuranceOf(hits[j], dirs[j], offset, o.maxDistance, double(o.falloffExponent))
                                   : (occ[j] ? 0.0 : 1.0);
       r.sum += f;
       if (o.bentNormals && f > 0.0) r.bent += dirs[j] * float(f);
@@ -239,7 +237,7 @@ SharedStats computeSharedAmbient(const Scene& scene, const RayCaster& caster, co
     parallelBlocks(nv, bar.sub(0.0, 0.8), "casting rays", [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i)
         if (want[i] > rays[i].n)
-          castRays(caster, o, tfar, uint32_t(part.meshIndex(i)), origins[i], normals[i], rays[i].n,
+          castRays(caster, o, tfar, uint32_t(part.meshIndex(i)), origins[i], origins[i] - scene.positions[i], normals[i], rays[i].n,
                    want[i] - rays[i].n, rays[i]);
     }, slices(work, size_t(1) << 20));
     if (split) {

@@ -167,7 +167,8 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   const EmitterSampler lights(s);
   if (lights.empty())
     throw std::invalid_argument("the scene has no emitters: select the light's faces (or mark them by face quality) "
-                                "and choose the matching 'Emitters' option");
+                                "and choose the matching 'Emitters' option, with emitter_intensity above 0 and an "
+                                "emitter_color that is not black");
   const SceneReport rep = analyzeScene(s);
   const float eps = float(rep.rayEpsilon);
   const VertexMaterial mat = vertexMaterial(s);

@@ -20,14 +20,18 @@ namespace gi {
 // float step at the largest one exceeds 1e-4 of the bounding box's
 // diagonal (fewer than 10,000 steps across the mesh).
 std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pts) {
-  if (pts.empty()) return std::nullopt;
-  glm::dvec3 lo(pts[0]), hi(pts[0]);
+  const glm::dvec3 huge(std::numeric_limits<double>::max());
+  glm::dvec3 lo(huge), hi(-huge);
   double far = 0;
   for (const glm::dvec3& q : pts) {
+    // A non-finite coordinate is no distance (it read "as far as inf, where
+    // a float's step is -nan"): the scene's own checks say it.
+    if (!std::isfinite(q.x + q.y + q.z)) continue;
     if (double(float(q.x)) != q.x || double(float(q.y)) != q.y || double(float(q.z)) != q.z) return std::nullopt;
     lo = glm::min(lo, q), hi = glm::max(hi, q);
     far = std::max({far, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
   }
+  if (!(hi.x >= lo.x)) return std::nullopt;  // no finite point
   const float f = float(far);
   const double diagonal = glm::length(hi - lo),
                step = double(std::nextafter(f, std::numeric_limits<float>::infinity())) - double(f);
@@ -35,8 +39,7 @@ std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pt
   char b[400];
   std::snprintf(b, sizeof b,
                 "its coordinates are floats as far as %.3g from the origin, where a float's step is %.3g, %.2g%% of "
-                "the mesh's diagonal (%.3g): the file has already rounded the geometry (faces may have collapsed "
-                "or tilted); write it with double coordinates, or moved near the origin",
+                "the mesh's diagonal (%.3g): the geometry is already rounded (faces may have collapsed or tilted)",
                 far, step, 100.0 * step / diagonal, diagonal);
   return std::string(b);
 }

@@ -95,6 +95,15 @@ class PhotonLights {
       sunPower_ = o.outside.sun() ? double(luminance(o.outside.sunIrradiance)) * disk * sunScale_ : 0.0;
     }
     o.point.check();
+    // Photons leave the point light itself: a ray from beyond 2^40 local
+    // units (about 1e12 times the scene's size) is no float ray, and the
+    // run stopped with an internal error (an outside audit: a light at
+    // 1e30). Such a light lights nothing measurable: said as a parameter.
+    if (luminance(o.point.intensity) > 0.f && !o.outsideLightsOnly &&
+        !(glm::all(glm::lessThanEqual(glm::abs(o.point.position), glm::vec3(1099511627776.f)))))
+      throw std::invalid_argument("point_position lies too far from the scene (more than about 1e12 times its "
+                                  "size) for photons to start there in single precision: its light there is nil; "
+                                  "move it closer or set point_intensity to 0");
     spot_ = o.point.spot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.
     pointPower_ = double(luminance(o.point.intensity)) * spot_.solidAngle();

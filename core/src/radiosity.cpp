@@ -91,8 +91,9 @@ Setup setup(const Scene& s, const std::vector<glm::vec3>& Hd, const std::vector<
   }
   if (!(u.P > 0))
     throw std::invalid_argument("the scene has no emitters and no sky or sun reaching a surface: select the light's "
-                                "faces (or mark them by face quality) and choose the matching 'Emitters' option, or "
-                                "set sky_irradiance or sun_irradiance");
+                                "faces (or mark them by face quality) and choose the matching 'Emitters' option, with "
+                                "emitter_intensity above 0 and an emitter_color that is not black, or set "
+                                "sky_irradiance or sun_irradiance");
   return u;
 }
 

@@ -57,6 +57,20 @@ def case_ao(c):
             fh.write("3 %s\n" % " ".join(str(i) for i in t["vertex_indices"]))
     log = c.server(far, c.script("ao_far", "ao", "--rays_per_vertex", "8"), os.path.join(c.tmp, "far_out.ply"))
     check("coordinates are floats as far as 1e+07" in log, "MeshLab's float coordinates far from the origin are warned of")
+    check("even from a file with double coordinates" in log and "gi command-line tool" in log,
+          "the warning says MeshLab rounded them and names the cures")
+    # A colour channel beyond 255 in a hand-edited script: Qt's colour is then
+    # invalid and read as black (a reflectance of 0, without a word); refused.
+    import re
+    script = c.script("rho_300", "radiosity")
+    with open(script) as fh:
+        text = fh.read()
+    text, n = re.subn(r'(<Param type="RichColor" r=")\d+("[^>]*name="reflectance")', r"\g<1>300\2", text)
+    check(n == 1, "the script holds the reflectance's red channel")
+    with open(script, "w") as fh:
+        fh.write(text)
+    log = c.server(os.path.join(c.meshes, "cornell_box.ply"), script, os.path.join(c.tmp, "rho_300.ply"), expect_ok=False)
+    check("'reflectance' is not a colour" in log, "a colour channel of 300 is refused with its name")
 
 
 def split_floor_wall(c):
