@@ -57,8 +57,12 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
     // Vertex colours that display an earlier result on this layer (its
     // attribute, which readAttributes drops where not every layer has it).
     std::string shows;
+    std::vector<glm::u8vec3> layerColors;
+    if (vc)
+      for (const CVertexO& v : m.vert)
+        if (!v.IsD()) layerColors.emplace_back(v.cC()[0], v.cC()[1], v.cC()[2]);
     for (const char* name : kResultAttributes)
-      if (shows.empty() && vcg::tri::HasPerVertexAttribute(m, name)) shows = name;
+      if (shows.empty() && vcg::tri::HasPerVertexAttribute(m, name) && colorsDisplay(name, layerColors)) shows = name;
     if (layers.size() > 1 && b.attrs.vertexColorShows.empty()) b.attrs.vertexColorShows = shows;
     for (size_t i = 0; i < m.vert.size(); ++i) {
       const CVertexO& v = m.vert[i];

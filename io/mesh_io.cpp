@@ -511,15 +511,15 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
   // Colours with the masks of which parts gave them (the reflectance rule
   // then holds per part); a part whose vertex colours display a result
   // (its attribute, which the merge below may drop as not common) gives none.
-  auto shows = [](const std::vector<VertexAttribute>& attributes) -> std::string {
+  auto shows = [](const LoadedMesh& m) -> std::string {
     for (const char* name : kResultAttributes)
-      for (const VertexAttribute& a : attributes)
-        if (a.name == name) return name;
+      for (const VertexAttribute& a : m.attributes)
+        if (a.name == name && colorsDisplay(name, m.attrs.vertexColor)) return name;
     return "";
   };
   if (into.attrs.vertexColorShows.empty() && into.attrs.vertexColorGiven.empty())
-    into.attrs.vertexColorShows = shows(into.attributes);
-  appendColors(into.attrs, nf0, nv0, other.attrs, nf1, nv1, shows(other.attributes));
+    into.attrs.vertexColorShows = shows(into);
+  appendColors(into.attrs, nf0, nv0, other.attrs, nf1, nv1, shows(other));
   merge(into.attrs.faceQuality, other.attrs.faceQuality, nf0, nf1, 0.f);
   merge(into.attrs.faceSelected, other.attrs.faceSelected, nf0, nf1, uint8_t(0));
   merge(into.attrs.vertexSelected, other.attrs.vertexSelected, nv0, nv1, uint8_t(0));

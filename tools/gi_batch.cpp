@@ -149,12 +149,16 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
       throw std::invalid_argument(where + e.what());
     }
     if (w.empty() || w[0][0] == '#') continue;
-    // A word from # on ends the line (a comment after a mesh's parameters).
-    for (size_t k = 1; k < w.size(); ++k)
+    // A # where a parameter's name would come ends the line (a comment
+    // after a mesh's parameters); a value may start with one (a colour
+    // #ff8800).
+    for (size_t k = 1; k < w.size();) {
       if (w[k][0] == '#') {
         w.resize(k);
         break;
       }
+      k += w[k].rfind("--", 0) == 0 && w[k].find('=') == std::string::npos ? 2 : 1;
+    }
     Job j;
     j.input = fs::path(w[0]).is_absolute() || base.empty() ? w[0] : (base / w[0]).string();
     j.overrides = parameterPairs(w, 1, specs, filter, where);
@@ -280,21 +284,20 @@ FilterFiles plannedFiles(const FilterDesc& d, const Texts& params) {
 }
 
 // What decides a mesh's result: the program's version, the filter, every
-// parameter given, the input file and the files the parameters name (an
-// error map's reference): each file's name, size and modification time (a
-// reference computed anew was taken as done before; an outside audit).
+// parameter given, the input file (its name, size and modification time)
+// and the files the parameters name (an error map's reference: its size
+// and the hash of its bytes, which a copy keeping the time, or a rewrite
+// within the file system's clock step, cannot hide; a reference computed
+// anew was taken as done before, an outside audit).
 std::string jobHash(const FilterDesc& d, const Texts& params, const std::string& input) {
   std::ostringstream o;
   o << "gi " << GI_VERSION << "\nfilter " << d.cliName << "\n";
   for (const auto& [k, v] : params) o << k << "=" << v << "\n";
-  const auto stamp = [&](const char* what, const std::string& path) {
-    std::error_code ec;
-    const auto size = fs::file_size(path, ec);
-    const auto time = fs::last_write_time(path, ec).time_since_epoch().count();
-    o << what << " " << fs::path(path).filename().string() << " " << (ec ? 0 : size) << " " << (ec ? 0 : time) << "\n";
-  };
-  stamp("input", input);
-  for (const NamedFile& f : plannedFiles(d, params).reads) stamp(f.parameter.c_str(), f.path);
+  std::error_code ec;
+  const auto size = fs::file_size(input, ec);
+  const auto time = fs::last_write_time(input, ec).time_since_epoch().count();
+  o << "input " << fs::path(input).filename().string() << " " << (ec ? 0 : size) << " " << (ec ? 0 : time) << "\n";
+  for (const NamedFile& f : plannedFiles(d, params).reads) o << f.parameter << " " << fileDigest(f.path) << "\n";
   return hashText(o.str());
 }
 
@@ -396,7 +399,8 @@ void addOptions(CLI::App* sub, Args& a) {
   sub->add_option("filter", a.filter, "filter subcommand name (" + cliFilterNames() + "); optional with --params naming it");
   sub->add_option("--manifest", a.manifest, "file listing one mesh a line, each optionally followed by its own "
                                             "parameters (--name value); relative paths are relative to the "
-                                            "manifest; # starts a comment line");
+                                            "manifest; # starts a comment, on a line of its own or where a "
+                                            "parameter's name would come");
   sub->add_option("--dir", a.dir, "folder whose meshes matching --glob are the batch (instead of --manifest)");
   sub->add_option("--glob", a.glob, "file-name pattern in --dir [default: *.ply]");
   sub->add_option("-o,--output-dir", a.outDir, "folder for NAME.ply, NAME.json per mesh and the report (created if "

@@ -261,9 +261,11 @@ class AmbientKernel {
       // say little of a shadow's edge nearby: the Laplace bound of their
       // visibility, times the disk's cosine, stands in as for AO's rays (an
       // outside audit: 8 sun rays, all blocked, in a penumbra read 0.334
-      // low with an error of 0.024).
-      double perRay = w.stdError();
-      if (w.n >= 1 && (lit == 0 || lit == w.n)) {
+      // low with an error of 0.024) -- unless the sky's rays all escaped
+      // (nothing above to cast a shadow; an open plane stays exact). A sharp
+      // sun's rays are one ray: exact.
+      double perRay = o_.sunAngularRadiusDeg > 0.f ? w.stdError() : 0.0;
+      if (o_.sunAngularRadiusDeg > 0.f && w.n >= 1 && (lit == 0 || lit == w.n) && out.value < 1.f) {
         const double p = (lit + 1.0) / (w.n + 2.0);
         perRay = std::max(perRay, std::max(0.0, double(glm::dot(n, o_.sunDirection))) * std::sqrt(p * (1.0 - p) / w.n));
       }

@@ -299,7 +299,8 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
 
   std::vector<float> r, sr, traced;
   std::string from;
-  // The reference filter's mark of the vertices it traced (a partial reference).
+  // The reference filter's mark of the vertices it traced (a partial
+  // reference), for its own attribute Reference only.
   const std::string kTracedAttribute = "ReferenceTraced";
   if (o.source == ReferenceSource::Attribute) {
     if (!o.file.empty()) res.stats.warn("reference_file is not read: the reference comes from an attribute of the mesh");
@@ -308,7 +309,8 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(in.attributes, o.referenceError))
       sr = attributeValues(in.attributes, o.referenceError, mesh, "", true);
     from = "attribute " + o.reference;
-    if (const VertexAttribute* t = find(in.attributes, kTracedAttribute)) traced = scalarValues(*t);
+    if (const VertexAttribute* t = find(in.attributes, kTracedAttribute); t && o.reference == "Reference")
+      traced = scalarValues(*t);
   } else {
     if (o.file.empty()) throw std::invalid_argument("reference_file is empty: name the reference PLY");
     if (!in.readVertexFile) throw std::invalid_argument("this front end cannot read a reference file");
@@ -326,7 +328,8 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(f.attributes, o.referenceError))
       sr = attributeValues(f.attributes, o.referenceError, o.file, "", true);
     from = o.file + " (" + o.reference + ")";
-    if (const VertexAttribute* t = find(f.attributes, kTracedAttribute)) traced = scalarValues(*t);
+    if (const VertexAttribute* t = find(f.attributes, kTracedAttribute); t && o.reference == "Reference")
+      traced = scalarValues(*t);
   }
   if (o.measure == ErrorMeasure::ZScore && sr.empty() && sv.empty())
     throw std::invalid_argument("a z-score needs a standard error, and the reference has no attribute '" +

@@ -60,7 +60,8 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
   // (radiosity, photon mapping, the reference, sky lighting, a view's vertex
   // radiance) are not the surfaces' colours.
   for (const char* shown : kResultAttributes)
-    if (in.attrs.vertexColorShows.empty() && in.attribute(shown)) in.attrs.vertexColorShows = shown;
+    if (in.attrs.vertexColorShows.empty() && in.attribute(shown) && colorsDisplay(shown, in.attrs.vertexColor))
+      in.attrs.vertexColorShows = shown;
   if (v.has("reflectance_source"))
     if (auto err = applySceneConventions(in.scene, in.attrs, v, v.has("emitter_source"), &res.setupLog))
       throw std::invalid_argument(*err);
@@ -183,9 +184,11 @@ void outputAmbient(FilterKind kind, FilterInput& in, FilterResult& res) {
       kind == FilterKind::AmbientOcclusion ? kAOColorMappings.get(v, "color_mapping") : AOColorMapping::Grey;
   if (mapping == AOColorMapping::Grey) res.vertexColor = greyColors(res.vertexQuality);
   else if (mapping == AOColorMapping::MultiplyColor) res.vertexColor = multiplyColors(in.attrs.vertexColor, res.vertexQuality);
-  // Colours painted by the result are no reflectance for a later lighting
-  // filter: the value as an attribute marks them (kResultAttributes).
-  if (mapping != AOColorMapping::KeepColor)
+  // Greys painted by the result are no reflectance for a later lighting
+  // filter: the value as an attribute marks them (kResultAttributes,
+  // colorsDisplay). 'Multiply colour' leaves the surface's colours, darkened
+  // as asked: a later filter's reflectance, as any colours.
+  if (mapping == AOColorMapping::Grey)
     res.attributes.push_back(scalarAttribute(
         kind == FilterKind::AmbientOcclusion ? "AmbientOcclusion" : "AmbientObscurance", res.vertexQuality));
   if (const VertexAttribute* bent = res.attribute("BentNormal"); bent && v.getBool("bent_normals_to_vertex_normals"))
@@ -250,8 +253,10 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   res.attributes.push_back(scalarAttribute("StdError", r.stdError));
   res.attributes.push_back(scalarAttribute("StdErrorH", r.stdErrorH));
   res.attributes.push_back(scalarAttribute("Paths", std::vector<float>(r.samples.begin(), r.samples.end())));
-  if (opt.tracedVertices > 0 || opt.tracedSelected)
-    res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
+  // Every run marks its traced vertices (a whole run's too: a partial run's
+  // mark, left on the mesh, hid all but its vertices from a later error map
+  // of a whole reference; a review).
+  res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
   // The same value and error bar under names no other filter writes: they
   // stay on the mesh while a method under test overwrites quality, Radiosity
   // and StdError, for 'GI: Error Map' to compare with.

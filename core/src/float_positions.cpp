@@ -26,7 +26,7 @@ std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pt
   for (const glm::dvec3& q : pts) {
     // A non-finite coordinate is no distance (it read "as far as inf, where
     // a float's step is -nan"): the scene's own checks say it.
-    if (!std::isfinite(q.x + q.y + q.z)) continue;
+    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) continue;
     if (double(float(q.x)) != q.x || double(float(q.y)) != q.y || double(float(q.z)) != q.z) return std::nullopt;
     lo = glm::min(lo, q), hi = glm::max(hi, q);
     far = std::max({far, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});

@@ -33,7 +33,10 @@ constexpr int kBalanceRounds = 8;
 // Closure rays in all, at most, where they serve the energy account alone.
 constexpr double kAccountRays = 8e6;
 // An energy balance off by more than this warns (see the energy account).
-constexpr double kHierarchicalBalanceWarning = 0.05;
+// Lowered from 5% after an outside audit: a sealed room parted by a block
+// read +4.3% on average (+9% at one patch) at rho 0.991, with a balance of
+// 4.3% and no word; shadow_leak's 2.9% is a real +2.7% of absorbed power.
+constexpr double kHierarchicalBalanceWarning = 0.02;
 
 }  // namespace
 
@@ -446,22 +449,27 @@ HierarchicalSolution solveHierarchical(const Scene& s, const RayCaster& caster, 
   if (set.enteringPower > 0) sol.stats.add("sky_sun_power_W", set.enteringPower * unit2);  // as the flat solvers say
   sol.stats.add("absorbed_power_W", absorbed * unit2);
   sol.stats.add("reflected_power_W", reflected * unit2);
+  const bool converged = fixed || sol.residual < tolerance;
   if (set.closureRays > 0 && !fixed) {  // what escapes is known from the closure rays; all bounces
     sol.stats.add("escaped_power_W", escaped * unit2);
     const double balance = std::fabs(P - absorbed - escaped) / P;
     sol.stats.add("energy_balance_error", balance);
+    // With its sign (it was lost): > 0, light created; < 0, lost.
+    sol.stats.add("energy_created_fraction", (absorbed + escaped - P) / P);
     // Where the links cannot be closed (occluders, open rooms) their sums
     // stand, and at high reflectance what they create or lose is magnified
     // by 1 / (1 - rho): a sealed room parted by a block read 109% (twice the
     // physical maximum) at rho 0.991 with no word. The indicator itself is
     // rough (5.8% where the absorbed power was 1.2% off), hence 5%.
-    if (balance > kHierarchicalBalanceWarning) {
+    // A solve stopped at max_iterations has said so: its missing light is
+    // no fault of the links (they were blamed; an outside audit).
+    if (balance > kHierarchicalBalanceWarning && converged) {
       char b[400];
       std::snprintf(b, sizeof b,
                     "energy balance off by %.1f%% (the rays' count of what escapes against the power absorbed): the "
-                    "hierarchical links create or lose light here (their sums are not closed where occluders stand, "
-                    "and high reflectance magnifies it); the flat solvers (Gauss-Seidel) conserve it",
-                    100.0 * balance);
+                    "hierarchical links %s light here (their sums are not closed where occluders stand, and high "
+                    "reflectance magnifies it); the flat solvers (Gauss-Seidel) conserve it",
+                    100.0 * balance, absorbed + escaped > P ? "create" : "lose");
       sol.stats.warn(b);
     }
   }

@@ -101,8 +101,8 @@ class PhotonLights {
     // 1e30). Such a light lights nothing measurable: said as a parameter.
     if (luminance(o.point.intensity) > 0.f && !o.outsideLightsOnly &&
         !(glm::all(glm::lessThanEqual(glm::abs(o.point.position), glm::vec3(1099511627776.f)))))
-      throw std::invalid_argument("point_position lies too far from the scene (more than about 1e12 times its "
-                                  "size) for photons to start there in single precision: its light there is nil; "
+      throw std::invalid_argument("point_position lies too far from the scene (more than 2^40 = 1.1e12 of its local "
+                                  "units) for photons to start there in single precision: its light there is nil; "
                                   "move it closer or set point_intensity to 0");
     spot_ = o.point.spot();
     // Power of an isotropic point light of intensity I: 4 pi I; of a spot of half angle a: 2 pi (1 - cos a) I.

@@ -175,6 +175,8 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
   st.add("escaped_power_W", escaped * u.unit2);
   const double balance = std::fabs(u.P - absorbed - escaped) / u.P;
   st.add("energy_balance_error", balance);
+  // With its sign (it was lost; an outside audit): > 0, light created; < 0, lost.
+  st.add("energy_created_fraction", (absorbed + escaped - u.P) / u.P);
   // The shipped scenes balance within 0.14% at the defaults; a converged
   // solution of all bounces off by more than 1% creates or loses light: rows
   // of F summing above 1 (the analytic quadrature beside contacts, magnified
@@ -207,8 +209,8 @@ void energyStats(const Setup& u, const RowFn& row, const std::vector<glm::vec3>&
               "twice: raise hemicube_resolution, and remove such copies"
             : "surfaces overlapping in one plane (a face and a copy of it triangulated otherwise) receiving the "
               "same light twice (Monte Carlo rows never sum above 1): remove such copies";
-    st.warn("energy balance off by " + shortPercent(100.0 * balance) +
-            "%: the power absorbed and escaping differs from the power emitted (" + cause + ")");
+    st.warn("energy balance off by " + shortPercent(100.0 * balance) + "%: the power absorbed and escaping " +
+            (absorbed + escaped > u.P ? "exceeds" : "falls short of") + " the power emitted (" + cause + ")");
   }
 }
 

@@ -83,12 +83,16 @@ glm::vec3 uniformConeVersine(glm::vec2 u, float versine) {
 }
 
 Cone::Cone(const glm::vec3& axis, double halfAngleDeg) : axis_(axis) {
+  all_ = halfAngleDeg >= 180.0;
+  if (all_) {  // a point light: no trigonometry (built per shadow ray by pointLightIrradiance)
+    versine_ = 2.0, sin2_ = 0.0, cos_ = -1.0, narrow_ = false;
+    return;
+  }
   const double a = halfAngleDeg * M_PI / 180.0;
   versine_ = 2.0 * std::sin(0.5 * a) * std::sin(0.5 * a);
   sin2_ = std::sin(a) * std::sin(a);
   cos_ = std::cos(a);
   narrow_ = halfAngleDeg <= 90.0;
-  all_ = halfAngleDeg >= 180.0;
 }
 
 bool Cone::contains(const glm::vec3& d) const {

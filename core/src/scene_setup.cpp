@@ -207,6 +207,11 @@ std::vector<ParamSpec> displaySpecs() {
            .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e12}};
 }
 
+bool colorsDisplay(const std::string& name, const std::vector<glm::u8vec3>& colors) {
+  if (name != "AmbientOcclusion" && name != "AmbientObscurance" && name != "Thickness") return true;
+  return std::all_of(colors.begin(), colors.end(), [](const glm::u8vec3& c) { return c.r == c.g && c.g == c.b; });
+}
+
 namespace {
 
 // rho per face from the chosen source (rho >= 1 limited to 0.999), *msg the

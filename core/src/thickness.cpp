@@ -319,7 +319,7 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   st.add("rays", rays);
   st.add("seconds", timer.seconds());
   st.add("rays_per_second", traceSeconds > 0 ? rays / traceSeconds : 0.0);
-  st.add("mean", counted ? sum / double(counted) : 0.0);
+  st.add("mean_of_measured", counted ? sum / double(counted) : 0.0);  // no_opposite_side vertices left out (they read 0)
   st.add("rms_relative_error_estimate", counted ? std::sqrt(relVar / double(counted)) : 0.0);
   st.add("no_opposite_side", double(noHit));
   double ownRays = 0;

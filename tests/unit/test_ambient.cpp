@@ -382,6 +382,22 @@ TEST(SkyLighting, SunErrorBarsHoldInAPenumbraWithFewRays) {
   ASSERT_GT(count, 100);
   EXPECT_LT(std::sqrt(z2 / count), 1.5) << count << " vertex-seeds";
   EXPECT_LT(zMax, 5.0);
+  // Nothing above (an open plane): no shadow to miss, the sun's bar stays its
+  // rays' spread; a sharp sun's one direction is exact, even from one ray (a
+  // review: 1.5% of the sun and the whole sun).
+  auto plane = scenes::openPlane(1.0, 4);
+  auto planeCaster = makeEmbreeCaster(plane.scene);
+  o.sunDirection = glm::vec3(0.f, 0.f, 1.f);
+  o.sunIrradiance = 3.f;
+  for (const float radius : {0.f, 0.27f, 5.f})
+    for (const int rays : {1, 64}) {
+      o.sunAngularRadiusDeg = radius;
+      o.sunRays = rays;
+      if (radius > 0.f && rays == 1) continue;  // one ray of a disk: the spread is unknown
+      const AmbientResult r = computeAmbient(plane.scene, *planeCaster, o);
+      for (size_t i = 0; i < r.value.size(); ++i)
+        ASSERT_LE(r.stdError[i], 1e-3f * 3.f) << "radius " << radius << ", " << rays << " rays, vertex " << i;
+    }
 }
 
 // Sun only, on an open plane: E = E_sun cos(theta) for a sun 60 degrees from

@@ -358,6 +358,17 @@ TEST(ErrorMap, PartialReferenceComparesTracedVerticesOnly) {
     }
     EXPECT_GT(r.vertexQuality[0], 0.f) << measure;
   }
+  // A whole reference marks every vertex it traced (a partial run's mark
+  // left on the mesh hid all but its vertices from the map of a later whole
+  // reference; a review).
+  const FilterResult whole = reference(sf, 1, 2);
+  const VertexAttribute* mark = whole.attribute("ReferenceTraced");
+  ASSERT_NE(mark, nullptr);
+  EXPECT_EQ(std::count(mark->values.begin(), mark->values.end(), 1.f), std::ptrdiff_t(nv));
+  // The mark applies to the reference filter's own attribute only.
+  std::vector<VertexAttribute> mine = attrs;
+  mine[1].name = "MyReference";
+  EXPECT_EQ(errorMapOf(sf, mine, {{"reference_attribute", "MyReference"}}).stats.get("vertices"), double(nv));
   // Without the mark every vertex is compared (a reference of the whole mesh).
   const FilterResult all = errorMapOf(sf, {attrs[0], attrs[1], attrs[2]}, {});
   EXPECT_EQ(all.stats.get("vertices"), double(nv));

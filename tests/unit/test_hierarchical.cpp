@@ -299,7 +299,14 @@ TEST(HierarchicalRadiosity, EnergyBalanceSaysWhatTheLinksCreate) {
   const RadiosityResult cornell = solveRadiosity(box.scene, *boxCaster, o);
   EXPECT_LT(cornell.stats.get("energy_balance_error"), 0.01);
   for (const std::string& w : cornell.stats.warnings) EXPECT_EQ(w.find("energy balance"), std::string::npos) << w;
-  for (const std::string& w : hier.stats.warnings) EXPECT_EQ(w.find("energy balance"), std::string::npos) << w;
+  // The shadow leak's links create 2.6% (the warning's threshold was 5%
+  // until an outside audit found a sealed room 4.3% bright without a word):
+  // said, as light created, with its sign in energy_created_fraction.
+  bool said = false;
+  for (const std::string& w : hier.stats.warnings) said = said || w.find("energy balance off by") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_NEAR(hier.stats.get("energy_created_fraction"), balance, 1e-12);
+  EXPECT_LT(flat.stats.get("energy_created_fraction", 1.0), 1e-3);
 
   test::SceneBuilder b;
   const glm::vec3 rho(0.991f);

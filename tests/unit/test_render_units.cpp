@@ -155,8 +155,10 @@ TEST(RenderUnits, AutoReflectancePassesOverAResultsColours) {
 // Ambient occlusion, obscurance and thickness paint their greys into the
 // vertex colours: radiosity's 'Auto' reflectance took them as the surface's
 // (AO 0 inside a closed box made every wall black; an outside audit). Their
-// value left as an attribute marks the colours; AO's 'Keep colour' paints
-// none and leaves the mesh's colours its reflectance.
+// value left as an attribute marks the colours while they are still greys;
+// AO's 'Keep colour' and 'Multiply colour' leave the surface's colours (the
+// latter darkened as asked), and colours painted since the run are the
+// surface's again.
 TEST(RenderUnits, AutoReflectancePassesOverAmbientGreys) {
   struct Case {
     FilterKind kind;
@@ -164,7 +166,7 @@ TEST(RenderUnits, AutoReflectancePassesOverAmbientGreys) {
     const char* attribute;
   };
   for (const Case c : {Case{FilterKind::AmbientOcclusion, AOColorMapping::Grey, "AmbientOcclusion"},
-                       Case{FilterKind::AmbientOcclusion, AOColorMapping::MultiplyColor, "AmbientOcclusion"},
+                       Case{FilterKind::AmbientOcclusion, AOColorMapping::MultiplyColor, nullptr},
                        Case{FilterKind::AmbientOcclusion, AOColorMapping::KeepColor, nullptr},
                        Case{FilterKind::AmbientObscurance, AOColorMapping::Grey, "AmbientObscurance"},
                        Case{FilterKind::Thickness, AOColorMapping::Grey, "Thickness"}}) {
@@ -185,6 +187,13 @@ TEST(RenderUnits, AutoReflectancePassesOverAmbientGreys) {
     EXPECT_NE(r2.setupLog.find(c.attribute ? "reflectance from constant" : "reflectance from vertex colour"),
               std::string::npos)
         << what << ": " << r2.setupLog;
+    if (!c.attribute) continue;
+    // Painted since: the marker no longer holds.
+    FilterInput painted = skyFloor(FilterKind::Radiosity);
+    painted.attrs.vertexColor.assign(painted.scene.vertexCount(), glm::u8vec3(30, 100, 200));
+    painted.attributes = r.attributes;
+    const FilterResult r3 = runFilter(FilterKind::Radiosity, painted);
+    EXPECT_NE(r3.setupLog.find("reflectance from vertex colour"), std::string::npos) << what << ": " << r3.setupLog;
   }
 }
 

@@ -43,6 +43,12 @@ struct MeshAttributes {
 // walls; an outside audit).
 inline constexpr const char* kResultAttributes[] = {"Radiosity",        "Irradiance",        "Radiance", "Reference",
                                                     "AmbientOcclusion", "AmbientObscurance", "Thickness"};
+// Whether vertex colours `colors` display the result attribute `name` a
+// mesh holds: the lighting results' always; AO's, obscurance's and
+// thickness's only while every colour is still a grey (r = g = b), as those
+// filters paint them: colours painted since, or a property of that name
+// another tool wrote beside real colours, stay the surface's.
+bool colorsDisplay(const std::string& name, const std::vector<glm::u8vec3>& colors);
 
 // Appends part b's colours (faces nf0.., vertices nv0..) to a's, with the
 // given-masks above: a part without face or vertex colours gets the filler
