@@ -36,8 +36,8 @@ std::vector<ParamSpec> ErrorMapOptions::specs() {
                "ReferenceStdError; in its own PLY also StdError). Needed for z-scores; empty: none.",
        .type = ParamType::String, .defText = "ReferenceStdError"},
       {.name = "reference_file", .label = "Reference PLY file",
-       .help = "With 'Reference from' = PLY file: the file (absolute path, or relative to the working folder). It "
-               "must have the mesh's vertex count.",
+       .help = "With 'Reference from' = PLY file: the file (absolute path, or relative to the working folder; on a "
+               "line of a gi batch manifest, to the manifest). It must have the mesh's vertex count.",
        .type = ParamType::String, .defText = ""},
       {.name = "error_measure", .label = "Error written",
        .help = "What goes to vertex quality: the difference value - reference (units of the value), the relative "

@@ -306,6 +306,15 @@ def case_keep(a, tmp):
           s["earlier_run"]["parameters"]["rays_per_vertex"] == "8",
           "its summary says so and keeps the earlier run's (%s)" % s["error"])
     os.rename(gone + ".away", gone)
+    # A value may start with # (a colour): only a # where a name would come is a comment.
+    sky = os.path.join(meshes, "sky.txt")
+    with open(sky, "w") as f:
+        f.write("%s.ply --sky_color #ff8800   # orange sky\n" % names[1])
+    rep = json.loads(run([a.gi, "batch", "sky", "--manifest", sky, "-o", os.path.join(tmp, "keep_sky"), "--rays_per_vertex",
+                          "8", "--json"], expect=0).stdout)
+    s = load(os.path.join(tmp, "keep_sky", names[1] + ".json"))
+    check(rep["baked"] == 1 and s["parameters"].get("sky_color") == "#ff8800",
+          "a colour #ff8800 on a manifest line is a value, the # after it a comment (%s)" % s.get("parameters"))
     # The error map's reference file: relative to the manifest, and part of
     # the hash (a reference computed anew was taken as done before).
     refdir = os.path.join(tmp, "keep_ref")
