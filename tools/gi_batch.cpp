@@ -291,7 +291,7 @@ FilterFiles plannedFiles(const FilterDesc& d, const Texts& params) {
 // anew was taken as done before, an outside audit).
 std::string jobHash(const FilterDesc& d, const Texts& params, const std::string& input) {
   std::ostringstream o;
-  o << "gi " << GI_VERSION << "\nfilter " << d.cliName << "\n";
+  o << "gi " << programIdentity() << "\nfilter " << d.cliName << "\n";
   for (const auto& [k, v] : params) o << k << "=" << v << "\n";
   std::error_code ec;
   const auto size = fs::file_size(input, ec);

@@ -241,7 +241,9 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   FilterResult r = prepareFilter(kind, in);
   // The scene's hash only where a result file records it (a pass over every byte of the mesh).
   const bool keyed = !a.cacheDir.empty() || !a.saveResult.empty();
-  const io::ResultKey key{desc.cliName, a.input, keyed ? sceneHash(in.scene) : 0, describe(specs, in.values)};
+  // The program's identity with the parameters: a result of another build is not reused.
+  const io::ResultKey key{desc.cliName, a.input, keyed ? sceneHash(in.scene) : 0,
+                          "program=" + programIdentity() + " " + describe(specs, in.values)};
   const std::string cached = a.cacheDir.empty() ? "" : io::resultCachePath(a.cacheDir, key);
   bool reused = false;
   std::error_code noFile;

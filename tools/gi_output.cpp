@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
@@ -98,6 +101,24 @@ std::vector<std::string> writeLayerPlys(const std::string& outputPly, const Filt
     io::writePly(paths.back(), L.mesh, MeshAttributes{}, L.quality, L.color, extras);
   }
   return paths;
+}
+
+const std::string& programIdentity() {
+  static const std::string id = [] {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    std::vector<char> buf(1 << 16);
+    bool read = false;
+    while (in) {
+      in.read(buf.data(), std::streamsize(buf.size()));
+      for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[size_t(i)])) * 1099511628211ull;
+      read = read || in.gcount() > 0;
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
+    return std::string(GI_VERSION) + (read ? std::string(" ") + hex : std::string());
+  }();
+  return id;
 }
 
 }  // namespace gi

@@ -30,4 +30,10 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
 // quality, normals. Returns the paths written.
 std::vector<std::string> writeLayerPlys(const std::string& outputPly, const FilterResult& r);
 
+// What identifies this program's results: its version and the hash of its
+// own executable's bytes, read once. A rebuild may compute otherwise (the
+// version alone never changed, and `--cache` and `gi batch` reused results
+// of an older build; a review).
+const std::string& programIdentity();
+
 }  // namespace gi
