@@ -256,6 +256,16 @@ def case_inputs(a, tmp):
     with open(bad, "w") as f:
         f.write("# only a comment\n")
     one_line(["ao", "--manifest", bad, "-o", out], "lists no mesh", "a manifest that lists no mesh")
+    # Under mpirun a build without MPI would run the whole job in every
+    # process (two processes baked one shard at once): refused in one line.
+    # (A build with MPI is tested under a real mpirun by mpi_test.py: its
+    # MPI_Init would look for the launcher this variable names.)
+    linked = subprocess.run(["ldd", a.gi], capture_output=True, text=True).stdout
+    if "libmpi" not in linked:
+        env = dict(os.environ, OMPI_COMM_WORLD_SIZE="2")
+        p = run([a.gi, "batch", "ao", "--dir", meshes, "-o", os.path.join(tmp, "never_mpi")], env=env)
+        check(p.returncode == 1 and p.stderr.count("\n") == 1 and "built without MPI" in p.stderr,
+              "several processes of mpirun, a build without MPI: one line (%s)" % p.stderr.strip())
     # A value no mesh can take is said once, before any mesh is loaded.
     fresh = os.path.join(tmp, "never_written")
     one_line(["ao", "--dir", meshes, "-o", fresh, "--rays_per_vertex", "nan"], "rays_per_vertex",
