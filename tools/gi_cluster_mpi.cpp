@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gi/memory_limit.h"
+#include "gi/params.h"
 #include "gi_cluster.h"
 
 namespace gi::cluster {
@@ -169,6 +170,27 @@ void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress
                                 "radiosity can be split)");
   if (split.chunk < 1) throw std::invalid_argument("--chunk must be at least 1");
   if (firstFailure(true) != INT_MAX) throw Quiet();
+  // Every rank must compute the same job: the filter, its parameters, the
+  // split and the scene (an outside audit: a rank given another --chunk,
+  // --seed or a stale copy of the mesh of the same vertex count wrote wrong
+  // values without a word; ranks running different filters overran rank 0's
+  // gather buffer).
+  {
+    const std::string job = std::to_string(int(kind)) + "\n" + describe(filterSpecs(kind), in.values) + "\n" +
+                            std::to_string(split.chunk) + (split.interleaved ? " interleaved\n" : " contiguous\n");
+    unsigned long long h = 1469598103934665603ull;
+    for (unsigned char c : job) h = (h ^ c) * 1099511628211ull;
+    h ^= (unsigned long long)sceneHash(in.scene) * 0x9e3779b97f4a7c15ull;
+    unsigned long long lo = 0, hi = 0;
+    MPI_Allreduce(&h, &lo, 1, MPI_UNSIGNED_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(&h, &hi, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+    if (lo != hi) {
+      if (g_rank == 0)
+        throw std::invalid_argument("the ranks were given different jobs (another filter, parameter, --split or "
+                                    "--chunk, or another mesh): every rank must run the same command on the same files");
+      throw Quiet();
+    }
+  }
 
   VertexPart part;
   part.part = uint32_t(g_rank);

@@ -108,6 +108,18 @@ def main():
         warnings = json.loads(p.stdout).get("warnings", []) if p.returncode == 0 else [p.stderr[-500:]]
         check(any("to each of the 4 ranks on this machine" in w for w in warnings),
               "4 ranks share the machine's memory: %s" % warnings)
+        # Ranks given different jobs (another --chunk on one, another filter
+        # on one) are refused in one line: they wrote wrong values, or
+        # overran rank 0's buffer (an outside audit).
+        base = [a.gi, "ao", cornell, "--rays_per_vertex", "8", "-o", os.path.join(tmp, "mixed.ply"), "-q"]
+        one = mpirun(a, 1)
+        for what, other in (("another --chunk", base + ["--chunk", "100"]),
+                            ("another filter", [a.gi, "sky"] + base[2:])):
+            p = run(one + base + ["--chunk", "7", ":", "-np", "1"] + other)
+            lines = [l for l in p.stderr.splitlines() if l.startswith("gi:")]
+            check(p.returncode != 0 and len(lines) == 1 and "different jobs" in lines[0] and
+                  not os.path.exists(os.path.join(tmp, "mixed.ply")),
+                  "ranks given %s: one line, no file (%s)" % (what, lines))
         p = run(mpirun(a, 2) + [a.gi, "photonmap", cornell, "--emitter_source", "1", "--photons", "1000"])
         lines = [l for l in p.stderr.splitlines() if l.startswith("gi:")]
         check(p.returncode != 0 and len(lines) == 1 and "split" in lines[0],
