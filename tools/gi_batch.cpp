@@ -222,39 +222,10 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
   return {size_t(i), size_t(n)};
 }
 
-// FNV-1a, 64 bits, as 16 hex digits.
-uint64_t fnv(uint64_t h, const char* p, size_t n) {
-  for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(p[i])) * 1099511628211ull;
-  return h;
-}
-std::string hex64(uint64_t h) {
-  char b[17];
-  std::snprintf(b, sizeof b, "%016llx", (unsigned long long)h);
-  return b;
-}
-std::string hashText(const std::string& s) { return hex64(fnv(1469598103934665603ull, s.data(), s.size())); }
-
-// A result file as it was written: its size and the hash of its bytes ("" if
-// it cannot be read). A resumed batch takes a result as done only where its
-// summary records the same: one truncated or edited by hand since was
-// counted as done (an outside audit).
-std::string fileDigest(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) return "";
-  uint64_t h = 1469598103934665603ull, size = 0;
-  std::vector<char> buf(1 << 16);
-  while (in) {
-    in.read(buf.data(), std::streamsize(buf.size()));
-    const size_t got = size_t(in.gcount());
-    h = fnv(h, buf.data(), got), size += got;
-  }
-  if (in.bad()) return "";
-  return std::to_string(size) + ":" + hex64(h);
-}
 // The result PLY's digest and its new layers' (photon mapping's photons
 // beside it, listed under "layers" in the summary), "" if one cannot be read.
 std::string outputDigest(const fs::path& ply, const json& layers) {
-  std::string d = fileDigest(ply);
+  std::string d = fileDigest(ply.string());
   if (d.empty() || layers.is_null()) return d;
   if (!layers.is_array()) return "";
   for (const json& l : layers) {

@@ -16,6 +16,7 @@
 #include "gi/memory_limit.h"
 #include "gi/params.h"
 #include "gi_cluster.h"
+#include "gi_output.h"
 
 namespace gi::cluster {
 
@@ -178,9 +179,8 @@ void compute(FilterKind kind, FilterInput& in, FilterResult& res, const Progress
   {
     const std::string job = std::to_string(int(kind)) + "\n" + describe(filterSpecs(kind), in.values) + "\n" +
                             std::to_string(split.chunk) + (split.interleaved ? " interleaved\n" : " contiguous\n");
-    unsigned long long h = 1469598103934665603ull;
-    for (unsigned char c : job) h = (h ^ c) * 1099511628211ull;
-    h ^= (unsigned long long)sceneHash(in.scene) * 0x9e3779b97f4a7c15ull;
+    const uint64_t scene = sceneHash(in.scene);
+    unsigned long long h = fnv1a(fnv1a(kFnvOffset, job.data(), job.size()), &scene, sizeof scene);
     unsigned long long lo = 0, hi = 0;
     MPI_Allreduce(&h, &lo, 1, MPI_UNSIGNED_LONG_LONG, MPI_MIN, MPI_COMM_WORLD);
     MPI_Allreduce(&h, &hi, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);

@@ -103,20 +103,36 @@ std::vector<std::string> writeLayerPlys(const std::string& outputPly, const Filt
   return paths;
 }
 
+uint64_t fnv1a(uint64_t h, const void* bytes, size_t n) {
+  const unsigned char* p = static_cast<const unsigned char*>(bytes);
+  for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+std::string hex64(uint64_t h) {
+  char b[17];
+  std::snprintf(b, sizeof b, "%016llx", (unsigned long long)h);
+  return b;
+}
+
+std::string fileDigest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  uint64_t h = kFnvOffset, size = 0;
+  std::vector<char> buf(1 << 16);
+  while (in) {
+    in.read(buf.data(), std::streamsize(buf.size()));
+    const size_t got = size_t(in.gcount());
+    h = fnv1a(h, buf.data(), got), size += got;
+  }
+  if (in.bad()) return "";
+  return std::to_string(size) + ":" + hex64(h);
+}
+
 const std::string& programIdentity() {
   static const std::string id = [] {
-    uint64_t h = 1469598103934665603ull;  // FNV-1a
-    std::ifstream in("/proc/self/exe", std::ios::binary);
-    std::vector<char> buf(1 << 16);
-    bool read = false;
-    while (in) {
-      in.read(buf.data(), std::streamsize(buf.size()));
-      for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(buf[size_t(i)])) * 1099511628211ull;
-      read = read || in.gcount() > 0;
-    }
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)h);
-    return std::string(GI_VERSION) + (read ? std::string(" ") + hex : std::string());
+    const std::string digest = fileDigest("/proc/self/exe");
+    return std::string(GI_VERSION) + (digest.empty() ? std::string() : " " + digest);
   }();
   return id;
 }

@@ -1,6 +1,8 @@
 // The PLY file a run of `gi` writes (one filter on one mesh, or each mesh
 // of `gi batch`).
 #pragma once
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -30,8 +32,20 @@ void writeResultPly(const std::string& path, const Scene& input, const MeshAttri
 // quality, normals. Returns the paths written.
 std::vector<std::string> writeLayerPlys(const std::string& outputPly, const FilterResult& r);
 
-// What identifies this program's results: its version and the hash of its
-// own executable's bytes, read once. A rebuild may compute otherwise (the
+// FNV-1a, 64 bits: the hash `gi` keys its files and jobs with (a batch's
+// resume hash, its results' digests, the ranks' job under mpirun).
+constexpr uint64_t kFnvOffset = 1469598103934665603ull;
+uint64_t fnv1a(uint64_t h, const void* bytes, size_t n);
+std::string hex64(uint64_t h);  // 16 hex digits
+inline std::string hashText(const std::string& s) { return hex64(fnv1a(kFnvOffset, s.data(), s.size())); }
+// A file as it is: its size and the hash of its bytes ("" if it cannot be
+// read). A resumed batch takes a result as done only where its summary
+// records the same: one truncated or edited by hand since was counted as
+// done (an outside audit).
+std::string fileDigest(const std::string& path);
+
+// What identifies this program's results: its version and the digest of
+// its own executable, read once. A rebuild may compute otherwise (the
 // version alone never changed, and `--cache` and `gi batch` reused results
 // of an older build; a review).
 const std::string& programIdentity();
