@@ -52,10 +52,7 @@ inline int perVertexCount(const AmbientOptions& o, double target, int pilotRays,
 // (n + 2), is within twice the target, then the count it predicts. The
 // open-vertex proofs pay where this is large.
 inline int perVertexRaysWhenOpen(const AmbientOptions& o) {
-  auto laplace = [](int n) {
-    const double p = (n + 1.0) / (n + 2.0);
-    return std::sqrt(p * (1.0 - p) / n);
-  };
+  auto laplace = [](int n) { return std::sqrt(laplaceVariance(n, n) / n); };
   const int pilotMax = std::max(o.minRays, o.maxRays / 4);
   int n = 0;
   while (n < pilotMax) {
@@ -219,8 +216,7 @@ class AmbientKernel {
       // 0 stopped such vertices with errors of 20 reported standard errors.
       const double se = w.stdError();
       if (se > 0.0 || w.n < 1) return se;
-      const double p = (w.sum + 1.0) / (w.n + 2.0);
-      return std::sqrt(p * (1.0 - p) / w.n);
+      return std::sqrt(laplaceVariance(w.sum, w.n) / w.n);
     }
     if (den <= 0.0 || n < 2) return 0.0;
     // Ratio estimator R = sum(f c) / sum(c): delta-method variance of mean(f c - R c) / mean(c).
@@ -266,8 +262,7 @@ class AmbientKernel {
       // sun's rays are one ray: exact.
       double perRay = o_.sunAngularRadiusDeg > 0.f ? w.stdError() : 0.0;
       if (o_.sunAngularRadiusDeg > 0.f && w.n >= 1 && (lit == 0 || lit == w.n) && out.value < 1.f) {
-        const double p = (lit + 1.0) / (w.n + 2.0);
-        perRay = std::max(perRay, std::max(0.0, double(glm::dot(n, o_.sunDirection))) * std::sqrt(p * (1.0 - p) / w.n));
+        perRay = std::max(perRay, std::max(0.0, double(glm::dot(n, o_.sunDirection))) * std::sqrt(laplaceVariance(lit, w.n) / w.n));
       }
       sunErr = o_.sunIrradiance * sunScale_ * perRay * luminance(o_.sunColor);
     }

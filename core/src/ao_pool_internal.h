@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "gi/ao_shared.h"
+#include "gi/sampling.h"
 
 namespace gi::pooling {
 
@@ -115,8 +116,7 @@ Pooled chooseScale(const VertexRays& own, const PoolOptions& o, Ring&& ring) {
   if (own.n == 0) return p;
   auto vOf = [&o](const PoolSums& s) {
     if (!o.bounded) return s.VW / s.W;  // the pool's mean sample variance
-    const double pt = (s.Y + 1.0) / (s.W + 2.0);  // Laplace: never 0 after rays that all agreed
-    return pt * (1.0 - pt);
+    return laplaceVariance(s.Y, s.W);  // never 0 after rays that all agreed
   };
   A[0] = sums.Y / sums.W;
   VarV[0] = 1.0 / sums.W;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "gi/pathtrace.h"
+
 namespace gi {
 
 std::vector<ParamSpec> ErrorMapOptions::specs() {
@@ -301,7 +303,6 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   std::string from;
   // The reference filter's mark of the vertices it traced (a partial
   // reference), for its own attribute Reference only.
-  const std::string kTracedAttribute = "ReferenceTraced";
   if (o.source == ReferenceSource::Attribute) {
     if (!o.file.empty()) res.stats.warn("reference_file is not read: the reference comes from an attribute of the mesh");
     r = attributeValues(in.attributes, o.reference, mesh,
@@ -309,7 +310,7 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(in.attributes, o.referenceError))
       sr = attributeValues(in.attributes, o.referenceError, mesh, "", true);
     from = "attribute " + o.reference;
-    if (const VertexAttribute* t = find(in.attributes, kTracedAttribute); t && o.reference == "Reference")
+    if (const VertexAttribute* t = find(in.attributes, kReferenceTracedAttribute); t && o.reference == "Reference")
       traced = scalarValues(*t);
   } else {
     if (o.file.empty()) throw std::invalid_argument("reference_file is empty: name the reference PLY");
@@ -328,7 +329,7 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
     if (!o.referenceError.empty() && find(f.attributes, o.referenceError))
       sr = attributeValues(f.attributes, o.referenceError, o.file, "", true);
     from = o.file + " (" + o.reference + ")";
-    if (const VertexAttribute* t = find(f.attributes, kTracedAttribute); t && o.reference == "Reference")
+    if (const VertexAttribute* t = find(f.attributes, kReferenceTracedAttribute); t && o.reference == "Reference")
       traced = scalarValues(*t);
   }
   if (o.measure == ErrorMeasure::ZScore && sr.empty() && sv.empty())

@@ -256,7 +256,7 @@ void runReference(FilterInput& in, FilterResult& res, const Progress& progress) 
   // Every run marks its traced vertices (a whole run's too: a partial run's
   // mark, left on the mesh, hid all but its vertices from a later error map
   // of a whole reference; a review).
-  res.attributes.push_back(scalarAttribute("ReferenceTraced", std::vector<float>(r.traced.begin(), r.traced.end())));
+  res.attributes.push_back(scalarAttribute(kReferenceTracedAttribute, std::vector<float>(r.traced.begin(), r.traced.end())));
   // The same value and error bar under names no other filter writes: they
   // stay on the mesh while a method under test overwrites quality, Radiosity
   // and StdError, for 'GI: Error Map' to compare with.

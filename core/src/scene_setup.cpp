@@ -208,7 +208,8 @@ std::vector<ParamSpec> displaySpecs() {
 }
 
 bool colorsDisplay(const std::string& name, const std::vector<glm::u8vec3>& colors) {
-  if (name != "AmbientOcclusion" && name != "AmbientObscurance" && name != "Thickness") return true;
+  if (std::none_of(std::begin(kGreyResultAttributes), std::end(kGreyResultAttributes), [&](const char* g) { return name == g; }))
+    return true;
   return std::all_of(colors.begin(), colors.end(), [](const glm::u8vec3& c) { return c.r == c.g && c.g == c.b; });
 }
 

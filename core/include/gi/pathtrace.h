@@ -72,6 +72,10 @@ struct PathTraceOptions {
   static PathTraceOptions fromParams(const ParamValues& v, const glm::dvec3& sceneOrigin);
 };
 
+// The per-vertex attribute the reference filter writes from `traced` below
+// (1 traced, 0 not), which the error map reads.
+inline constexpr const char* kReferenceTracedAttribute = "ReferenceTraced";
+
 struct PathTraceResult {
   std::vector<glm::vec3> B;       // per vertex, W/m^2
   std::vector<glm::vec3> H;       // incident irradiance per vertex

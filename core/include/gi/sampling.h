@@ -19,6 +19,16 @@ namespace gi {
 inline constexpr double kPilotLooseness = 2.0;
 inline constexpr double kPilotMargin = 1.25;
 
+// The variance of a 0/1 variable at Laplace's rule of succession, p (1 - p)
+// with p = (k + 1) / (n + 2) after k successes in n trials (k may be a sum
+// of weights in [0, 1]): never 0, so that trials which all agreed (every ray
+// escaped past a thin occluder, every sun ray blocked in a penumbra) still
+// report an error and do not stop a vertex early.
+inline double laplaceVariance(double k, double n) {
+  const double p = (k + 1.0) / (n + 2.0);
+  return p * (1.0 - p);
+}
+
 constexpr uint32_t reverseBits(uint32_t x) {
   x = __builtin_bswap32(x);  // bytes reversed; then the bits within each byte
   x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);

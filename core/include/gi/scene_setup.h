@@ -43,6 +43,8 @@ struct MeshAttributes {
 // walls; an outside audit).
 inline constexpr const char* kResultAttributes[] = {"Radiosity",        "Irradiance",        "Radiance", "Reference",
                                                     "AmbientOcclusion", "AmbientObscurance", "Thickness"};
+// Those of them whose filters paint greys (the last three above).
+inline constexpr const char* kGreyResultAttributes[] = {"AmbientOcclusion", "AmbientObscurance", "Thickness"};
 // Whether vertex colours `colors` display the result attribute `name` a
 // mesh holds: the lighting results' always; AO's, obscurance's and
 // thickness's only while every colour is still a grey (r = g = b), as those
