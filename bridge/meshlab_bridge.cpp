@@ -164,10 +164,14 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
         v.set(s.name, glm::vec3(c.red() / 255.f, c.green() / 255.f, c.blue() / 255.f));
         break;
       }
-      case ParamType::Direction:
-      case ParamType::Point: {
+      case ParamType::Direction: {
         const Point3m p = in.getPoint3m(n);
         v.set(s.name, glm::vec3(float(p[0]), float(p[1]), float(p[2])));
+        break;
+      }
+      case ParamType::Point: {
+        const Point3m p = in.getPoint3m(n);
+        v.set(s.name, glm::dvec3(double(p[0]), double(p[1]), double(p[2])));
         break;
       }
       case ParamType::String: v.set(s.name, in.getString(n).toStdString()); break;

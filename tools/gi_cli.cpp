@@ -89,9 +89,13 @@ json valuesJson(const std::vector<ParamSpec>& specs, const ParamValues& v) {
       case ParamType::Float:
       case ParamType::Distance: j[p.name] = v.getFloat(p.name); break;
       case ParamType::Color:
-      case ParamType::Direction:
-      case ParamType::Point: {
+      case ParamType::Direction: {
         const glm::vec3 c = v.getVec(p.name);
+        j[p.name] = {c.x, c.y, c.z};
+        break;
+      }
+      case ParamType::Point: {
+        const glm::dvec3 c = v.getPoint(p.name);
         j[p.name] = {c.x, c.y, c.z};
         break;
       }

@@ -164,7 +164,7 @@ std::string mlxScript(const std::vector<ScriptStep>& steps, double diagonal) {
         }
         case ParamType::Direction:
         case ParamType::Point: {
-          const glm::vec3 d = st.values.getVec(p.name);
+          const glm::dvec3 d = p.type == ParamType::Point ? st.values.getPoint(p.name) : glm::dvec3(st.values.getVec(p.name));
           o << "  <Param type=\"RichPoint3f\" x=\"" << fnum(d.x) << "\" y=\"" << fnum(d.y) << "\" z=\"" << fnum(d.z)
             << "\" " << n << "/>\n";
           break;

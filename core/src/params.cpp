@@ -58,8 +58,8 @@ ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal) 
       case ParamType::Float: v.set(s.name, s.def); break;
       case ParamType::Distance: v.set(s.name, s.def * diagonal); break;
       case ParamType::Color:
-      case ParamType::Direction:
-      case ParamType::Point: v.set(s.name, s.defVec); break;
+      case ParamType::Direction: v.set(s.name, s.defVec); break;
+      case ParamType::Point: v.set(s.name, glm::dvec3(s.defVec)); break;
       case ParamType::String: v.set(s.name, s.defText); break;
     }
   }
@@ -138,7 +138,7 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           break;
         }
         case ParamType::Point: {
-          glm::vec3 d = v.getVec(s.name);
+          const glm::dvec3 d = v.getPoint(s.name);
           if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z))
             return "parameter '" + s.name + "' must be a finite position";
           break;
@@ -175,9 +175,13 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
         break;
       }
       case ParamType::Color:
-      case ParamType::Direction:
-      case ParamType::Point: {
+      case ParamType::Direction: {
         glm::vec3 c = v.getVec(s.name);
+        o << exact(c.x) << ',' << exact(c.y) << ',' << exact(c.z);
+        break;
+      }
+      case ParamType::Point: {
+        const glm::dvec3 c = v.getPoint(s.name);
         o << exact(c.x) << ',' << exact(c.y) << ',' << exact(c.z);
         break;
       }
@@ -265,6 +269,7 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
       case ParamType::Point: {
         auto n = splitNumbers(text);
         if (n.size() != 3) throw bad("expected x,y,z");
+        if (s.type == ParamType::Point) return glm::dvec3(n[0], n[1], n[2]);
         return glm::vec3(float(n[0]), float(n[1]), float(n[2]));
       }
       case ParamType::String: return text;

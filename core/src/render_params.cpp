@@ -186,10 +186,10 @@ RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene
     // error ... a numerical failure"; an outside audit): refused by name.
     const double reach = 1e7 * std::max(sceneDiagonal(scene), 1e-30);
     for (const char* name : {"eye", "target"})
-      if (!(glm::length(glm::dvec3(v.getVec(name)) - scene.origin) <= reach))
+      if (!(glm::length(v.getPoint(name) - scene.origin) <= reach))
         throw std::invalid_argument(std::string("parameter '") + name + "' lies more than 1e7 scene diagonals (" +
                                     std::to_string(reach) + ") from the scene");
-    o.camera = Camera::lookAt(glm::dvec3(v.getVec("eye")), glm::dvec3(v.getVec("target")), up, fov, w, h);
+    o.camera = Camera::lookAt(v.getPoint("eye"), v.getPoint("target"), up, fov, w, h);
   } else if (camera == CameraChoice::LayerCamera) {
     if (!layerCamera)
       throw std::invalid_argument("the current layer has no camera: set one from the view with Filters > Camera > "

@@ -119,7 +119,7 @@ std::vector<ParamSpec> pointLightSpecs() {
 
 PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& origin) {
   PointLight p;
-  p.position = glm::vec3(glm::dvec3(v.getVec("point_position")) - origin);
+  p.position = glm::vec3(v.getPoint("point_position") - origin);
   const glm::vec3 c = v.getVec("point_color");
   p.intensity = float(v.getFloat("point_intensity")) * glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
   p.spotDirection = v.getDirection("spot_direction");
