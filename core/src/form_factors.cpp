@@ -310,8 +310,7 @@ std::optional<std::string> narrowPatchWarning(const Scene& s, size_t narrow, con
 
 bool pairwiseUnoccluded(const Scene& s) {
   const auto ok = usableFaceMask(s);
-  double scale = 0;
-  for (const auto& p : s.positions) scale = std::max({scale, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
+  const double scale = sceneScale(s).maxAbs;  // over the vertices faces use (SceneScale)
   const double tol = 1e-5 * (scale > 0 ? scale : 1.0);
   std::vector<uint32_t> used;
   {

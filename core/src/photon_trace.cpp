@@ -70,10 +70,9 @@ class PhotonLights {
  public:
   PhotonLights(const Scene& s, const PhotonOptions& o) : area_(s), o_(o) {
     if (o.outside.any()) {
-      glm::vec3 lo(HUGE_VALF), hi(-HUGE_VALF);
-      for (const glm::vec3& p : s.positions)
-        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-      if (lo.x <= hi.x) {
+      const SceneScale sc = sceneScale(s);  // the vertices faces use
+      const glm::vec3 lo(sc.lo), hi(sc.hi);
+      if (sc.lo.x <= sc.hi.x) {
         centre_ = 0.5f * (lo + hi);
         radius_ = 0.5f * glm::length(hi - lo) * 1.01f + float(sceneScale(s).rayEpsilon);
       }

@@ -196,13 +196,12 @@ RenderOptions RenderOptions::fromParams(const ParamValues& v, const Scene& scene
                                   "Set Mesh Camera, or choose 'Frame the scene' or 'Look at'");
     o.camera = Camera::fromShot(*layerCamera, w, h);
   } else {
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-    for (const auto& p : scene.positions)
-      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) {
-        lo = glm::min(lo, scene.toWorld(p));
-        hi = glm::max(hi, scene.toWorld(p));
-      }
-    if (!(lo.x <= hi.x)) lo = hi = scene.origin;
+    const SceneScale sc = sceneScale(scene);  // the vertices faces use
+    glm::dvec3 lo = scene.origin, hi = scene.origin;
+    if (sc.lo.x <= sc.hi.x) {
+      lo = scene.toWorld(glm::vec3(sc.lo));
+      hi = scene.toWorld(glm::vec3(sc.hi));
+    }
     o.camera = Camera::frame(lo, hi, glm::dvec3(v.getVec("view_direction")), up, fov, w, h);
   }
   o.camera.setLens(v.getFloat("aperture_radius"), v.getFloat("focus_distance"));

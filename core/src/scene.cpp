@@ -486,6 +486,9 @@ SceneScale sceneScale(const Scene& s) {
     maxAbs = std::max({maxAbs, double(std::fabs(p.x)), double(std::fabs(p.y)), double(std::fabs(p.z))});
   }
   SceneScale sc;
+  sc.lo = lo;
+  sc.hi = hi;
+  sc.maxAbs = maxAbs;
   if (lo.x <= hi.x) sc.diagonal = glm::length(hi - lo);
   // Ray offsets: a small fraction of the scene size, and never below the float
   // resolution of the largest local coordinate (positions are centred).

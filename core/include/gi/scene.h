@@ -118,9 +118,17 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces = true, const std::
 std::vector<std::pair<uint32_t, uint32_t>> duplicatedFaces(const Scene& s);
 // Only the scale (one pass over the vertices): what the algorithms need for
 // their ray offsets, without the defect counts of a full report.
+// Everything that sizes a scene's geometry (a box framing it, a tolerance)
+// takes these vertices only: one vertex no face uses, far away, made the
+// shadow test take every face for one plane of a convex room (no shadow
+// rays: 199 of the Cornell box's 1,010 vertices off by more than 20%), the
+// sky's photons start on a disk around it (none stored) and a framed view
+// look at nothing (an outside audit).
 struct SceneScale {
   double diagonal = 0.0;    // bbox diagonal over the finite vertices some face uses (all if none; local units)
   double rayEpsilon = 0.0;  // offset for ray origins (local units)
+  glm::dvec3 lo{0.0}, hi{0.0};  // their bounding box (local units; lo > hi where there are none)
+  double maxAbs = 0.0;          // their largest coordinate in absolute value (local units)
 };
 SceneScale sceneScale(const Scene& s);
 // The warning for absolute positions that are all floats with a float step
