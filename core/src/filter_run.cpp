@@ -67,7 +67,7 @@ void prepare(FilterKind kind, FilterInput& in, FilterResult& res) {
       throw std::invalid_argument(*err);
   if (v.has("mirror_layers")) {
     std::string log;
-    if (auto err = applyMaterials(in.scene, in.layers, v, &log)) throw std::invalid_argument(*err);
+    if (auto err = applyMaterials(in.scene, in.layers, v, &log, &res.setupWarnings)) throw std::invalid_argument(*err);
     res.setupLog += (res.setupLog.empty() ? "" : "; ") + log;
   }
   // After the materials: a mirror's or glass layer's faces take the specular colour.

@@ -73,7 +73,8 @@ std::vector<ParamSpec> PhotonOptions::specs() {
                "glass) and read the global photon map where they land (Jensen's final gather): much smoother, at the "
                "cost of the rays. Caustics still come from the caustic map. Rays that leave the scene add nothing: "
                "the sky and the sun seen from the vertex are direct light (computed apart), seen through mirrors "
-               "and glass they are caustics (carried by photons).",
+               "and glass they are caustics (carried by photons). Needs 'Direct light by light sampling' on; progressive mode "
+               "uses it only where it hands over.",
        .type = ParamType::Bool, .def = false},
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
        .help = "Rays per vertex for the final gather.",
@@ -235,6 +236,11 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
   const PhotonOptions& opt = r.opt;
   Timer traceTimer;
   const bool gather = opt.directLight && opt.finalGather;
+  // It was dropped without a word (an outside audit): said, as progressive
+  // mode says it.
+  if (opt.finalGather && !opt.directLight)
+    st.note("final gather not used: without the direct light computed apart, every photon is read at the vertices "
+            "(the gather's rays would have to find the lights too)");
   // Crease vertices gather (the direct light apart; all light from photons
   // would need the gather to see the lights too).
   std::vector<uint8_t> crease;

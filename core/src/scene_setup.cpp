@@ -146,7 +146,7 @@ bool matchesLayerPatterns(const std::string& name, const std::string& patterns) 
 }
 
 std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange>& layers, const ParamValues& v,
-                                          std::string* log) {
+                                          std::string* log, std::vector<std::string>* warnings) {
   const std::string mirrors = v.getString("mirror_layers"), glass = v.getString("glass_layers");
   const float ior = float(v.getFloat("ior"));
   if (!(ior >= 1.f)) return std::string("the index of refraction must be >= 1");
@@ -186,6 +186,28 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
         }
       const size_t open = size_t(std::count_if(edges.begin(), edges.end(), [](const auto& e) { return e.second != 2; }));
       if (open) msg += " [not closed: " + std::to_string(open) + " border or non-manifold edges]";
+      // A closed object whose faces point inwards encloses a negative
+      // volume (the divergence theorem: V = sum over faces of a . (b x c) / 6,
+      // about the layer's first vertex for precision): light then enters
+      // it as if leaving glass, totally reflected beyond the critical angle
+      // (an outside audit: a glass slab's caustic under a point light read
+      // 0.84 to 0.014 of the exact value, the default sphere's peak 0.28 of
+      // 41.4, without a word).
+      if (!open && warnings && l.faceCount > 0 && l.faceOffset < nf) {
+        const glm::dvec3 o(s.positions[s.triangles[l.faceOffset].x]);
+        double six = 0.0, scale = 0.0;
+        for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f) {
+          const glm::dvec3 a = glm::dvec3(s.positions[s.triangles[f].x]) - o, b = glm::dvec3(s.positions[s.triangles[f].y]) - o,
+                           e = glm::dvec3(s.positions[s.triangles[f].z]) - o;
+          six += glm::dot(a, glm::cross(b, e));
+          scale += std::fabs(glm::dot(a, glm::cross(b, e)));
+        }
+        if (six < -1e-9 * scale)
+          warnings->push_back("glass layer '" + l.name + "' is turned inside out (its faces point inwards: a negative "
+                              "enclosed volume), so light meets it as if leaving the glass and the caustics and "
+                              "the light through it are wrong; invert its faces' orientation (MeshLab: Normals, "
+                              "Curvatures and Orientation > Invert Faces Orientation)");
+      }
     }
   }
   if (msg.empty()) {

@@ -742,3 +742,41 @@ TEST(SceneWarnings, SurfacesWithinTheRayOffsetAreWarned) {
   const FilterResult r = runFilter(FilterKind::PathTracedReference, box);
   EXPECT_FALSE(warned(r.stats, "ray offsets")) << all(r.stats);
 }
+
+// A closed glass layer whose faces point inwards (a negative enclosed
+// volume) is warned of, by name; the same sphere facing outwards, and an
+// inward sphere that is a mirror, are not (an outside audit: a slab turned
+// inside out gave a caustic of 0.014 to 0.84 of the exact one in silence).
+TEST(SceneWarnings, GlassTurnedInsideOutIsWarned) {
+  for (bool inward : {false, true})
+    for (const char* name : {"ball_glass", "ball_mirror"}) {
+      FilterInput in = test::filterInput(FilterKind::PhotonMapping, scenes::sphere(1.0, 2, inward));
+      in.layers = {{name, 0, in.scene.faceCount()}};
+      const auto specs = filterSpecs(FilterKind::PhotonMapping);
+      const double diag = analyzeScene(in.scene).diagonal;
+      for (const auto& [k, v] : {std::pair<const char*, const char*>{"emitter_source", "None"},
+                                 {"point_position", "0,0,3"}, {"point_intensity", "1"}, {"photons", "2000"}})
+        in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+      const FilterResult r = runFilter(FilterKind::PhotonMapping, in);
+      const bool expected = inward && std::string(name) == "ball_glass";
+      EXPECT_EQ(warned(r.stats, "glass layer 'ball_glass' is turned inside out"), expected)
+          << name << (inward ? ", inward" : ", outward") << ": " << all(r.stats);
+    }
+}
+
+// The final gather needs the direct light apart; without it the option was
+// dropped in silence (an outside audit). The log now says so.
+TEST(SceneWarnings, FinalGatherWithoutDirectLightIsSaid) {
+  for (const char* direct : {"true", "false"}) {
+    FilterInput in = test::filterInput(FilterKind::PhotonMapping, scenes::cornellBox(100.0));
+    const auto specs = filterSpecs(FilterKind::PhotonMapping);
+    const double diag = analyzeScene(in.scene).diagonal;
+    for (const auto& [k, v] : {std::pair<const char*, const char*>{"direct_light", direct}, {"final_gather", "true"},
+                               {"gather_rays", "4"}, {"photons", "5000"}})
+      in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+    const FilterResult r = runFilter(FilterKind::PhotonMapping, in);
+    bool said = false;
+    for (const auto& n : r.stats.notes) said = said || n.find("final gather not used") != std::string::npos;
+    EXPECT_EQ(said, std::string(direct) == "false") << all(r.stats);
+  }
+}

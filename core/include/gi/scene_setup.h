@@ -127,9 +127,11 @@ struct LayerRange {
 // the specular colour and index of refraction, and, if `v` has the
 // glossySpecs parameters, those matching glossy_layers as Glossy (colour and
 // roughness from them). Emitter faces stay diffuse.
-// Returns an error sentence for unusable settings; *log gets a summary.
+// Returns an error sentence for unusable settings; *log gets a summary,
+// *warnings what makes the result wrong (a closed glass layer turned inside
+// out).
 std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange>& layers, const ParamValues& v,
-                                          std::string* log = nullptr);
+                                          std::string* log = nullptr, std::vector<std::string>* warnings = nullptr);
 // True if `name` matches one of the comma-separated patterns.
 bool matchesLayerPatterns(const std::string& name, const std::string& patterns);
 
