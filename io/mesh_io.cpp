@@ -362,7 +362,14 @@ LoadedMesh loadMesh(const std::string& path) {
     failRead(path, "unsupported format '" + ext + "' (expected ply, obj, off or stl)");
   std::ifstream in(path, std::ios::binary);
   if (!in) failRead(path, "the file cannot be opened (" + std::string(std::strerror(errno)) + ")");
-  const uintmax_t size = fs::file_size(path, ec);
+  return parse(detail::readCheckedBytes(in, ext, path), ext, path, path);
+}
+
+namespace detail {
+
+std::string readCheckedBytes(std::ifstream& in, const std::string& ext, const std::string& path) {
+  std::error_code ec;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec) failRead(path, "its size cannot be read (" + ec.message() + ")");
   // Its first bytes are looked at before the rest is read: a large file that
   // is no mesh at all (a 300 MB file of zeros took 503 MB and 2.8 s to be
@@ -375,8 +382,10 @@ LoadedMesh loadMesh(const std::string& path) {
   const size_t head = size_t(std::min<uintmax_t>(size, 4096));
   in.read(bytes.data() + head, std::streamsize(size - head));
   if (!in || in.gcount() != std::streamsize(size - head)) failRead(path, "the file cannot be read (it changed while being read?)");
-  return parse(bytes, ext, path, path);
+  return bytes;
 }
+
+}  // namespace detail
 
 LoadedMesh parseMesh(std::string_view bytes, const std::string& format, const std::string& name) {
   return parse(bytes, format, name, "");

@@ -4,6 +4,7 @@
 // a whole token and finite, every index is in range.
 #pragma once
 #include <cstdint>
+#include <fstream>
 #include <map>
 #include <string>
 #include <string_view>
@@ -86,6 +87,10 @@ bool cutFace(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, st
 // The readers (each in its own file). Every one throws std::runtime_error
 // with one sentence naming `name` on any defect.
 Polygons readPly(std::string_view bytes, const std::string& name);  // ply_reader.cpp
+// The whole of an open regular file `in` of format `ext` (ply, obj, off,
+// stl), its first bytes checked before the rest is read, so that a large file
+// that is no such file is refused at once (mesh_io.cpp).
+std::string readCheckedBytes(std::ifstream& in, const std::string& ext, const std::string& path);
 Polygons readOff(std::string_view bytes, const std::string& name);  // text_formats.cpp
 
 // OBJ and STL are parsed by OpenMesh after these strict passes, which reject

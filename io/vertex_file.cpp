@@ -64,9 +64,9 @@ VertexFile readVertexFile(const std::string& path) {
   if (ext != ".ply") failRead(path, "a reference must be a PLY file (per-vertex values are read from PLY only)");
   std::ifstream in(path, std::ios::binary);
   if (!in) failRead(path, "the file cannot be opened (" + std::string(std::strerror(errno)) + ")");
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) failRead(path, "the file cannot be read");
-  if (bytes.empty()) failRead(path, "the file is empty (0 bytes)");
+  // Its head checked first, as a mesh's (a 500 MB file of zeros took 4.5 s
+  // and 994 MB to be told it is not a PLY; an outside audit).
+  const std::string bytes = detail::readCheckedBytes(in, "ply", path);
   const detail::Polygons p = detail::readPly(bytes, path);
   detail::checkPolygons(p, path);
   return {p.points.size(), detail::vertexAttributes(p), p.points};
