@@ -114,7 +114,9 @@ struct LightSettings {
 // `sunMet`: whether paths continue off mirrors and glass and can meet the
 // sun's disk (the reference and the path-traced view; the distributed view's
 // shadow rays stop at them and it never finds the sun through them).
-std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, bool sunMet = true);
+// `paths`: the paths a vertex or pixel traces (0: not known), below which a
+// wide sun is still missed.
+std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, bool sunMet = true, double paths = 0.0);
 
 // Warns (st) where paths cut at the depth limit (maxDepth, -1 = none but
 // `cap`) may miss more light than the mean relative error: `cut` of `paths`;

@@ -480,7 +480,9 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   if (!adaptive && opt.samplesPerVertex < 2 && valid > 0)
     st.warn("one path per vertex gives no error estimate: StdError and StdErrorH are written as 0 (unknown, not "
             "exact); an error map's z-scores need 2 or more");
-  if (const std::string w = paths::unsampledLightPaths(s, lights); !w.empty()) st.warn(w);
+  // The paths a traced vertex kept, on average (fixed: every vertex's).
+  if (const std::string w = paths::unsampledLightPaths(s, lights, true, valid ? samples / double(valid) : 0.0); !w.empty())
+    st.warn(w);
   if (opt.tracedSelected)
     st.note("traced the " + std::to_string(std::count(part.subset->begin(), part.subset->end(), uint8_t(1))) +
             " selected of the " + std::to_string(nv) + " vertices; the others are 0, with ReferenceTraced 0");

@@ -354,7 +354,8 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
     lights.point = o.point;
     lights.sunIrradiance = o.sunIrradiance;
     lights.sunAngularRadiusDeg = o.sunAngularRadiusDeg;
-    if (const std::string w = paths::unsampledLightPaths(s, lights, o.mode == RenderMode::PathTraced); !w.empty())
+    if (const std::string w = paths::unsampledLightPaths(s, lights, o.mode == RenderMode::PathTraced, o.samplesPerPixel);
+        !w.empty())
       st.warn(w);
   }
   if (o.mode != RenderMode::PathTraced)

@@ -21,10 +21,13 @@
 // A shadow ray goes straight through glass, losing the Fresnel reflectance
 // F at each interface it crosses (and taking the glass's tint), as classical
 // ray tracers attenuate light through transparent objects without bending
-// it (Hall and Greenberg 1983): exact for glass of index 1 and, but for the
-// pane's inner reflections, for a flat pane at any angle (F from the air
-// side at both faces); short of a lens's focusing (the caustic map and the
-// path tracer have that).
+// it (Hall and Greenberg 1983): exact for glass of index 1, and for a flat
+// pane lit by a light at infinity (the sun) but for its inner reflections.
+// A pane shifts a ray sideways, so a light at a finite distance D seen
+// through a pane of thickness t is as bright as one at D - t (1 - 1/n): an
+// outside audit measured 13% too little light under a pane 0.2 thick, 0.3
+// from a point or area light (n = 1.5), about 0.3% for 5 mm at 1 m. Short
+// also of a lens's focusing (the caustic map and the path tracer have both).
 // The sky lights nothing here (it needs sampled rays: the distributed mode);
 // it is seen only along rays that leave the scene. Glossy faces have no
 // Whitted counterpart: they reflect one ray in the mirror direction weighted
