@@ -81,6 +81,20 @@ void objAsTheFileSays(const Counts& file, const std::map<std::string, glm::dvec3
     else if (v < exact.size() && f < file.points.size()) exact[v] = file.points[f], known[v] = 1;
   }
   if (same && std::all_of(known.begin(), known.end(), [](uint8_t b) { return b != 0; })) p.points = exact;
+  // The copies themselves become the file's vertices again, so that the
+  // output's vertices are the file's, as a PLY's and an OFF's are (20
+  // triangles on one edge came out as 79 vertices for the file's 22, 19 of
+  // the file's with no face and their values on the copies, and an error map
+  // against the same mesh read from OFF refused; an outside audit).
+  const size_t nFile = file.points.size();
+  if (same && p.points.size() > nFile &&
+      std::all_of(file.corners.begin(), file.corners.end(), [&](uint32_t f) { return f < nFile; })) {
+    p.index = file.corners;
+    p.points.assign(file.points.begin(), file.points.end());
+    if (p.normals.size() > nFile) p.normals.resize(nFile);
+    if (p.vertexColor.size() > nFile) p.vertexColor.resize(nFile);
+    if (p.vertexSelected.size() > nFile) p.vertexSelected.resize(nFile);
+  }
   std::vector<glm::u8vec3> colors;
   for (const int mtl : file.faceMaterial) {
     const auto it = mtl >= 0 ? kd.find(file.materialNames[size_t(mtl)]) : kd.end();
