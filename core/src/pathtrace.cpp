@@ -244,6 +244,15 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     if (!opt.selectedVertices || opt.selectedVertices->size() != nv)
       throw std::logic_error("traced_selected needs the selection of every vertex");
     part.subset = opt.selectedVertices;
+    // A selection of vertices none of which can be traced (an isolated
+    // vertex, a mirror's) traced nothing and wrote zeros with exit 0 (an
+    // outside audit): refused, as an empty selection is.
+    bool any = false;
+    for (size_t i = 0; i < nv && !any; ++i) any = (*opt.selectedVertices)[i] && traceable[i];
+    if (!any)
+      throw std::invalid_argument("traced_selected is on but no selected vertex lies on a diffuse face that can be "
+                                  "traced (the selection holds only vertices no usable face uses, or mirror, glass "
+                                  "or glossy ones): select vertices of the diffuse surfaces");
   } else if (opt.tracedVertices > 0 && opt.tracedVertices < nv) {
     part.subset = randomVertexSubset(nv, opt.tracedVertices, opt.tracedVertexSeed);
   }

@@ -138,6 +138,24 @@ TEST(ReferenceSubset, TracedSelectedTracesOnlyTheSelection) {
       EXPECT_NE(std::string(e.what()).find("no vertex is selected"), std::string::npos) << e.what();
     }
   }
+  // Only a vertex that no face uses selected: it traced nothing and wrote
+  // zeros with success (an outside audit); refused as well.
+  FilterInput in;
+  in.scene = sf.scene;
+  in.scene.positions.push_back(sf.scene.positions[0] + glm::vec3(0.01f));
+  in.attrs = sf.attrs;
+  in.attrs.vertexSelected.assign(nv + 1, 0);
+  in.attrs.vertexSelected[nv] = 1;
+  in.layers.push_back({"mesh", 0, sf.scene.faceCount()});
+  in.values = defaultValues(filterSpecs(FilterKind::PathTracedReference), analyzeScene(in.scene).diagonal);
+  in.values.set("emitter_source", int(kEmitterSources.index(EmitterSource::QualityAbove)));
+  in.values.set("traced_selected", true);
+  try {
+    runFilter(FilterKind::PathTracedReference, in);
+    ADD_FAILURE() << "a selection of an isolated vertex was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no selected vertex lies on a diffuse face"), std::string::npos) << e.what();
+  }
 }
 
 // The PLY reader takes the selection from the vertex flags (bit 0x20, as
