@@ -87,6 +87,9 @@ bool cutFace(const std::vector<glm::dvec3>& pts, const uint32_t* v, size_t n, st
 // The readers (each in its own file). Every one throws std::runtime_error
 // with one sentence naming `name` on any defect.
 Polygons readPly(std::string_view bytes, const std::string& name);  // ply_reader.cpp
+// What the first bytes `head` of a file of `size` bytes can already rule out
+// for format `ext`, with the messages the readers give for the whole file.
+void checkHead(std::string_view head, const std::string& ext, uintmax_t size, const std::string& name);
 // The whole of an open regular file `in` of format `ext` (ply, obj, off,
 // stl), its first bytes checked before the rest is read, so that a large file
 // that is no such file is refused at once (mesh_io.cpp).

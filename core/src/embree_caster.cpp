@@ -120,10 +120,15 @@ class EmbreeCaster final : public RayCaster {
       indices_.resize(3 * primToFace_.size());
       float* vb = vertices_.data();
       uint32_t* ib = indices_.data();
+      // Only the vertices the built faces use are the scene's (a stray one
+      // no face uses, at 2e12, refused every ray-casting filter with this
+      // sentence; an outside audit): the others are written as 0, unread.
+      std::vector<uint8_t> used(s.positions.size(), 0);
+      for (uint32_t f : primToFace_) used[s.triangles[f].x] = used[s.triangles[f].y] = used[s.triangles[f].z] = 1;
       float extent = 0.f;
       for (size_t i = 0; i < s.positions.size(); ++i) {
         const auto& p = s.positions[i];
-        const bool fin = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+        const bool fin = used[i] && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
         vb[3 * i] = fin ? p.x : 0.f; vb[3 * i + 1] = fin ? p.y : 0.f; vb[3 * i + 2] = fin ? p.z : 0.f;
         if (fin) extent = std::max({extent, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
       }

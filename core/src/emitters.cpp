@@ -58,7 +58,11 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
     r.d = Frame(smp.n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
     const Hit h = caster.intersect(r);
     if (!h.valid()) ++escaped;
-    else if (glm::dot(r.d, h.ng) < 0.f || s.faceMaterial(h.face) == Material::Glass) ++front;
+    // Glass and mirrors take light on either side (a mirror turned away
+    // from the lamp still lit the floor, warned of as lost; an outside audit).
+    else if (glm::dot(r.d, h.ng) < 0.f || s.faceMaterial(h.face) == Material::Glass ||
+             s.faceMaterial(h.face) == Material::Mirror)
+      ++front;
     else ++back;
   }
   if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;

@@ -300,9 +300,9 @@ TEST(Scales, PointLightParameterFarFromTheOrigin) {
 // an outside audit). Each filter's values on the scene's own vertices are
 // compared with the same scene without the stray vertex.
 TEST(Scales, StrayVertexFarAwayChangesNothing) {
-  auto withStray = [](scenes::SceneFile sf) {
+  auto withStray = [](scenes::SceneFile sf, double far) {
     Scene& s = sf.scene;
-    s.positions.push_back(glm::vec3((glm::dvec3(1e8, 0.0, 0.0) - s.origin) / s.unit));
+    s.positions.push_back(glm::vec3((glm::dvec3(far, 0.0, 0.0) - s.origin) / s.unit));
     if (!sf.attrs.vertexColor.empty()) sf.attrs.vertexColor.push_back(sf.attrs.vertexColor.back());
     if (!sf.attrs.vertexSelected.empty()) sf.attrs.vertexSelected.push_back(0);
     if (!sf.attrs.vertexColorGiven.empty()) sf.attrs.vertexColorGiven.push_back(0);
@@ -312,6 +312,7 @@ TEST(Scales, StrayVertexFarAwayChangesNothing) {
     FilterKind kind;
     scenes::SceneFile sf;
     std::vector<std::pair<const char*, const char*>> params;
+    double far = 1e8;
   };
   const std::vector<Case> cases = {
       {FilterKind::Radiosity, scenes::cornellBox(100.0), {}},
@@ -319,10 +320,13 @@ TEST(Scales, StrayVertexFarAwayChangesNothing) {
        {{"emitter_source", "None"}, {"sky_irradiance", "100"}, {"photons", "20000"}}},
       {FilterKind::RayTracedView, scenes::cornellBox(100.0),
        {{"width", "24"}, {"height", "24"}, {"samples_per_pixel", "1"}, {"mode", "Whitted"}}},
+      // Beyond the coordinates rays can represent (it refused every
+      // ray-casting filter in the ray caster's own words).
+      {FilterKind::AmbientOcclusion, scenes::cornellBox(100.0), {{"rays_per_vertex", "16"}}, 2e13},
   };
   for (const Case& c : cases) {
     std::vector<FilterResult> r;
-    for (const auto& sf : {c.sf, withStray(c.sf)}) {
+    for (const auto& sf : {c.sf, withStray(c.sf, c.far)}) {
       FilterInput in = test::filterInput(c.kind, sf);
       const auto specs = filterSpecs(c.kind);
       const double diag = analyzeScene(in.scene).diagonal;

@@ -827,3 +827,20 @@ TEST(SceneWarnings, SunInAMirrorNeedsPathsToMeetIt) {
         << radius << " degrees, " << paths << " paths: " << all(r.stats);
   }
 }
+
+// Mirrors reflect on both sides: a lamp facing only a mirror's back lights
+// what the mirror shows, and is not "lights face no surface" (an outside
+// audit: the warning said the light was lost while the floor was lit). The
+// same plate as a diffuse one, turned away, is warned of.
+TEST(SceneWarnings, MirrorBacksDoNotLoseTheLight) {
+  for (const char* name : {"plate_mirror", "plate"}) {
+    scenes::SceneFile sf = scenes::parallelPlates(0.2, 2);
+    const size_t nf = sf.scene.faceCount();
+    for (size_t f = nf / 2; f < nf; ++f) std::swap(sf.scene.triangles[f].y, sf.scene.triangles[f].z);  // turned away
+    FilterInput in = test::filterInput(FilterKind::PathTracedReference, sf);
+    in.layers = {{"lamp", 0, nf / 2}, {name, nf / 2, nf / 2}};
+    in.values.set("samples_per_vertex", 2);
+    const FilterResult r = runFilter(FilterKind::PathTracedReference, in);
+    EXPECT_EQ(warned(r.stats, "the lights face no surface"), std::string(name) == "plate") << name << ": " << all(r.stats);
+  }
+}
