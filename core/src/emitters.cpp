@@ -9,6 +9,7 @@
 #include "gi/luminaires.h"
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
+#include "gi/specular.h"
 
 namespace gi {
 
@@ -60,9 +61,7 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
     if (!h.valid()) ++escaped;
     // Glass and mirrors take light on either side (a mirror turned away
     // from the lamp still lit the floor, warned of as lost; an outside audit).
-    else if (glm::dot(r.d, h.ng) < 0.f || s.faceMaterial(h.face) == Material::Glass ||
-             s.faceMaterial(h.face) == Material::Mirror)
-      ++front;
+    else if (glm::dot(r.d, h.ng) < 0.f || isSpecular(s.faceMaterial(h.face))) ++front;
     else ++back;
   }
   if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;

@@ -199,8 +199,9 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
         for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f) {
           const glm::dvec3 a = glm::dvec3(s.positions[s.triangles[f].x]) - o, b = glm::dvec3(s.positions[s.triangles[f].y]) - o,
                            e = glm::dvec3(s.positions[s.triangles[f].z]) - o;
-          six += glm::dot(a, glm::cross(b, e));
-          scale += std::fabs(glm::dot(a, glm::cross(b, e)));
+          const double vol = glm::dot(a, glm::cross(b, e));
+          six += vol;
+          scale += std::fabs(vol);
         }
         if (six < -1e-9 * scale)
           warnings->push_back("glass layer '" + l.name + "' is turned inside out (its faces point inwards: a negative "
