@@ -368,7 +368,10 @@ void runPhotonMap(FilterInput& in, FilterResult& res, const Progress& progress) 
 }
 
 // Step 4: every array has the output scene's size and nothing non-finite
-// leaves the engine (a NaN in MeshLab's quality breaks its colour ramps).
+// leaves the engine (a NaN in MeshLab's quality breaks its colour ramps). A
+// value beyond single precision is no answer, and zeros in its place would
+// pass for one (a scene of 1e-18 m under a lamp of 1e12 W/sr came out black
+// with exit 0): such a run is refused, the mesh left as it was.
 void finish(FilterResult& res, const Scene& out) {
   const size_t nv = out.vertexCount(), nf = out.faceCount();
   auto sized = [](size_t n, size_t want, const char* what) {
@@ -379,8 +382,9 @@ void finish(FilterResult& res, const Scene& out) {
   sized(res.vertexNormal.size(), nv, "vertex normals");
   sized(res.faceQuality.size(), nf, "face qualities");
   sized(res.faceColor.size(), nf, "face colours");
-  size_t bad = 0;
-  auto clean = [&bad](float& x) {
+  size_t bad = 0, values = 0;
+  auto clean = [&bad, &values](float& x) {
+    ++values;
     if (!std::isfinite(x)) x = 0.f, ++bad;
   };
   for (float& q : res.vertexQuality) clean(q);
@@ -402,7 +406,12 @@ void finish(FilterResult& res, const Scene& out) {
     for (glm::vec3& p : L.mesh.positions) clean(p.x), clean(p.y), clean(p.z);
     for (glm::vec3& m : L.normals) clean(m.x), clean(m.y), clean(m.z);
   }
-  if (bad) res.stats.warn(std::to_string(bad) + " non-finite values were written as 0");
+  if (bad)
+    throw std::invalid_argument(
+        "the result is not finite at " + std::to_string(bad) + " of its " + std::to_string(values) +
+        " values (beyond single precision, 3.4e38): a light too strong for the scene's size, or a point light all "
+        "but touching a vertex (irradiance grows as the inverse square of the distance); lower the light, move it "
+        "off the surface or scale the scene up");
 }
 
 }  // namespace

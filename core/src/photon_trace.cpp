@@ -109,6 +109,8 @@ class PhotonLights {
     if (!(pointPower_ > 0.0) || o.outsideLightsOnly) pointPower_ = 0.0;
     inner_ = o.outsideLightsOnly ? 0.0 : area_.totalPower() + pointPower_;
     total_ = inner_ + skyPower_ + sunPower_;
+    if (!std::isfinite(total_))  // the choice between lights would read NaN (and sample no light)
+      throw std::invalid_argument("the lights' power is beyond double precision: lower the lights");
     spotFrame_ = glm::length(o.point.spotDirection) > 0.f ? glm::normalize(o.point.spotDirection) : glm::vec3(0.f, -1.f, 0.f);
     // The faces the point light lies on (within the ray epsilon; the default
     // position is the box's corner): per pass, so boxes first, masks if near.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -130,7 +131,19 @@ PointLight pointLightFromParams(const ParamValues& v, const glm::dvec3& origin) 
 PointLight pointLightInLocalUnits(const PointLight& L, const Scene& s) {
   PointLight p = L;
   p.position = glm::vec3(glm::dvec3(L.position) / s.unit);
-  p.intensity = glm::vec3(glm::dvec3(L.intensity) / (s.unit * s.unit));
+  const glm::dvec3 local = glm::dvec3(L.intensity) / (s.unit * s.unit);
+  // Intensity over area: in a scene of 1e-18 m a lamp of 1e12 W/sr is 1e48
+  // in the scene's units, beyond single precision (photon mapping crashed on
+  // it, the reference wrote its infinite values as 0; an outside audit).
+  if (!(std::max({local.x, local.y, local.z}) <= double(std::numeric_limits<float>::max()))) {
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "point_intensity = %g W/sr is too strong for a scene %.3g across: in the scene's units (I / unit^2) it "
+                  "lies beyond single precision (3.4e38); lower it or scale the scene up",
+                  double(std::max({L.intensity.x, L.intensity.y, L.intensity.z})), s.unit * double(sceneScale(s).diagonal));
+    throw std::invalid_argument(msg);
+  }
+  p.intensity = glm::vec3(local);
   return p;
 }
 

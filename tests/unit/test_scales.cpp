@@ -379,3 +379,55 @@ TEST(Scales, UnrepresentableRaysAreAnErrorNotAnAbort) {
     }
   }
 }
+
+// A light whose result lies beyond single precision is refused, not
+// written as 0 or a crash: a plane of 1e-18 m under a lamp of 1e12 W/sr
+// 1e-18 m over it (1e48 in the scene's units) crashed photon mapping and came
+// out black from the reference with exit 0 (an outside audit). Refused from
+// the parameter where the lamp itself is beyond float in the scene's units,
+// and where only the result is: a plane 2e-13 across (its unit 2^-42) under
+// the same lamp 1.1e-14 over its middle vertex (1.9e37 and 0.05 in its units:
+// 7.7e39 W/m^2 there). The same lamp 1e-12 over it (1e36 W/m^2) and the
+// small plane under a lamp of 1e-30 W/sr are computed.
+TEST(Scales, ResultBeyondSinglePrecisionIsRefused) {
+  auto small = scenes::openPlane(2.0, 4), mid = small;
+  small.scene = test::transformed(small.scene, 1e-18, glm::dvec3(0.0));
+  mid.scene = test::transformed(mid.scene, 1e-13, glm::dvec3(0.0));
+  ASSERT_EQ(mid.scene.unit, std::ldexp(1.0, -42));
+  struct Case {
+    const scenes::SceneFile* scene;
+    const char *position, *intensity, *refusal;  // refusal: a phrase of the message, or null
+    float lo, hi;                                // else the quality's range: rho I cos / r^2 over the plane
+  };
+  const Case cases[] = {{&small, "0,0,1e-18", "1e12", "too strong for a scene 2.83e-18 across", 0.f, 0.f},
+                        {&mid, "0,0,1.1368683772161603e-14", "1e12", "not finite at", 0.f, 0.f},
+                        {&mid, "0,0,1e-12", "1e12", nullptr, 1e34f, 1e37f},
+                        {&small, "0,0,1e-18", "1e-30", nullptr, 1e4f, 1e7f}};
+  for (FilterKind kind : {FilterKind::PathTracedReference, FilterKind::PhotonMapping}) {
+    for (const Case& c : cases) {
+      FilterInput in = test::filterInput(kind, *c.scene);
+      const auto specs = filterSpecs(kind);
+      const double diag = analyzeScene(in.scene).diagonal;
+      for (const auto& [k, v] : {std::pair<const char*, const char*>{"emitter_source", "None"},
+                                 {"point_position", c.position}, {"point_intensity", c.intensity}})
+        in.values.set(k, parseValue(*findSpec(specs, k), v, diag));
+      if (kind == FilterKind::PathTracedReference) in.values.set("samples_per_vertex", 2);
+      const std::string what = std::string(filterDesc(kind).cliName) + " at " + c.position + ", " + c.intensity;
+      if (!c.refusal) {
+        const FilterResult r = runFilter(kind, in);
+        for (float q : r.vertexQuality) {
+          EXPECT_GT(q, c.lo) << what;
+          EXPECT_LT(q, c.hi) << what;
+        }
+        continue;
+      }
+      try {
+        runFilter(kind, in);
+        ADD_FAILURE() << what << ": accepted";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(c.refusal), std::string::npos) << what << ": " << e.what();
+        EXPECT_NE(std::string(e.what()).find("beyond single precision"), std::string::npos) << e.what();
+      }
+    }
+  }
+}
