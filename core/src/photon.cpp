@@ -337,8 +337,8 @@ void photonStats(const PhotonRun& r, const PhotonTraceStats& ts, PhotonEstimate&
       e.check.lostChannelShare = ts.lostRGB[c] / ts.emittedRGB[c], e.check.lostChannel = c;
   warnMeaninglessPhotonParameters(r.opt, e.check, r.s.unit, st);
   if (e.verticesWithoutPhotons)
-    st.note(std::to_string(e.verticesWithoutPhotons) +
-            " vertices reached by no photon within the gather radius: direct light only");
+    st.note(std::to_string(e.verticesWithoutPhotons) + " vertices reached by no photon within the gather radius: " +
+            (r.opt.directLight ? "direct light only" : "0 (all their light would come from photons)"));
 }
 
 // B = E + rho (H_direct + H_photons) at the vertices, with the photons'

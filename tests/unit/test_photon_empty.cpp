@@ -33,7 +33,7 @@ Scene litBox() {
 // with error bars of 0 at 2,000 photons). Here 300 photon paths in a box lit
 // on every face, a cap of 0.03: most vertices find none. Each such vertex's
 // error bar is above 0 in both modes, and the vertices with photons keep
-// theirs.
+// theirs; the log's note says what such a vertex got.
 TEST(PhotonEmpty, AVertexWithoutPhotonsHasAnErrorBar) {
   const Scene s = litBox();
   auto caster = makeEmbreeCaster(s);
@@ -57,7 +57,16 @@ TEST(PhotonEmpty, AVertexWithoutPhotonsHasAnErrorBar) {
     }
     EXPECT_GT(none, s.vertexCount() / 4) << "the test needs vertices without photons";
     EXPECT_GT(some, 0u);
+    // Without the direct light apart such a vertex reads 0 (the note said
+    // "direct light only", which it did not get).
+    EXPECT_TRUE(said(r.stats.notes, "reached by no photon within the gather radius: 0 (all their light"));
+    EXPECT_FALSE(said(r.stats.notes, "direct light only"));
   }
+  PhotonOptions o;
+  o.photons = 300;
+  o.maxRadius = 0.03;
+  EXPECT_TRUE(said(computePhotonMap(s, *caster, o).stats.notes,
+                   "reached by no photon within the gather radius: direct light only"));
 }
 
 // An open plane under a sky: no light reaches a second surface, so the
