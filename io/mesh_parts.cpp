@@ -29,10 +29,48 @@ bool stripPlus(std::string_view& t) {
 }
 }  // namespace
 
+namespace {
+// Whether a decimal number that from_chars found out of range is below the
+// smallest double rather than above the largest: its leading digit's
+// decimal exponent is negative. The exponent saturates (1e-99999999999).
+bool belowRange(std::string_view t) {
+  if (!t.empty() && t[0] == '-') t.remove_prefix(1);
+  long long lead = 0;
+  bool seen = false;  // a nonzero digit
+  size_t i = 0;
+  for (; i < t.size() && std::isdigit(static_cast<unsigned char>(t[i])); ++i)
+    if (seen) ++lead;
+    else if (t[i] != '0') seen = true;
+  if (i < t.size() && t[i] == '.')
+    for (++i; i < t.size() && std::isdigit(static_cast<unsigned char>(t[i])); ++i)
+      if (!seen) {
+        --lead;
+        if (t[i] != '0') seen = true;
+      }
+  if (!seen) return false;
+  long long e = 0;
+  if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    ++i;
+    const bool neg = i < t.size() && t[i] == '-';
+    if (i < t.size() && (t[i] == '-' || t[i] == '+')) ++i;
+    for (; i < t.size() && std::isdigit(static_cast<unsigned char>(t[i])); ++i) e = std::min(e * 10 + (t[i] - '0'), 1000000LL);
+    if (neg) e = -e;
+  }
+  return lead + e < 0;
+}
+}  // namespace
+
 bool parseDouble(std::string_view t, double& v) {
   if (!stripPlus(t)) return false;
   const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-  return ec == std::errc() && end == t.data() + t.size() && std::isfinite(v);
+  if (end != t.data() + t.size()) return false;
+  // A number too small for a double (1e-400) is 0, as a file that wrote it
+  // meant, not a value out of range.
+  if (ec == std::errc::result_out_of_range && belowRange(t)) {
+    v = t[0] == '-' ? -0.0 : 0.0;
+    return true;
+  }
+  return ec == std::errc() && std::isfinite(v);
 }
 
 bool parseInt(std::string_view t, long long& v) {
@@ -46,6 +84,14 @@ bool parseNonFinite(std::string_view t) {
   std::string s(t);
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return s == "nan" || s == "inf" || s == "infinity";
+}
+
+bool isNumber(std::string_view t) {
+  if (parseNonFinite(t)) return true;
+  if (!stripPlus(t)) return false;
+  double v = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec != std::errc::invalid_argument && end == t.data() + t.size();
 }
 
 bool fitsFloat(double v) { return std::isfinite(v) && std::fabs(v) <= double(FLT_MAX); }

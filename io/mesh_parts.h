@@ -46,6 +46,8 @@ bool parseInt(std::string_view token, long long& v);
 
 // Accepts "nan", "inf", "-inf", "infinity" (any case): for values we skip.
 bool parseNonFinite(std::string_view token);
+// Whether the token is a number of any size, or nan or inf.
+bool isNumber(std::string_view token);
 
 // The first vertex a face lists twice, or kNone (sorting for long faces, so
 // that a face of 10^6 indices is not 10^12 comparisons).

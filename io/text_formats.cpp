@@ -323,7 +323,10 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
   Lines in{bytes, name, Comments::None};
   in.next();  // solid NAME
   // solid NAME / { facet normal a b c / outer loop / vertex x y z (x3) / endloop / endfacet } / endsolid [NAME]
-  auto check = [&](std::initializer_list<const char*> words, size_t numbers) {
+  // The facet normal is not read (the normals come from the corners), so it
+  // may be any number: exporters write "nan" for a degenerate facet, and a
+  // binary STL's are taken as they come.
+  auto check = [&](std::initializer_list<const char*> words, size_t numbers, bool unread = false) {
     size_t k = 0;
     for (const char* w : words)
       if (k >= in.words.size() || in.words[k++] != w)
@@ -332,6 +335,7 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
       failRead(name, in.at() + ": expected " + std::to_string(numbers) + " numbers, found " + quoted(in.line));
     for (; k < in.words.size(); ++k) {
       double v = 0;
+      if (unread && isNumber(in.words[k])) continue;
       if (!parseDouble(in.words[k], v) || !fitsFloat(v))
         failRead(name, in.at() + ": " + quoted(in.words[k]) + " is not a finite number within float range");
     }
@@ -340,7 +344,7 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
     if (!in.next()) failRead(name, "the ASCII STL ends without 'endsolid' (truncated?)");
   };
   for (next(); in.words[0] != "endsolid"; next()) {
-    check({"facet", "normal"}, 3);
+    check({"facet", "normal"}, 3, true);
     next(), check({"outer", "loop"}, 0);
     for (int k = 0; k < 3; ++k) {
       next(), check({"vertex"}, 3);

@@ -67,8 +67,9 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
   if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;
   return "the lights face no surface: of " + std::to_string(rays) + " rays cast from their fronts, " +
          std::to_string(escaped) + " left the scene and " + std::to_string(back) + " met the back of a face (" +
-         std::to_string(front) + " a front), so their light is lost and the result stays dark. If the scene is a "
-         "room, its faces point out of it (a box built as a solid has outward normals): invert the faces' "
+         std::to_string(front) + " a front), so their light is lost: the surfaces they should light stay dark (the "
+         "lights themselves still show). If the scene is a room, its faces point out of it (a box built as a solid "
+         "has outward normals): invert the faces' "
          "orientation (MeshLab: Filters > Normals, Curvatures and Orientation > Invert Faces Orientation), or only "
          "the lights' if they alone face away";
 }

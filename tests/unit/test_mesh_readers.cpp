@@ -308,6 +308,21 @@ TEST(MeshReaders, ObjKeepsDoublePrecisionAndOnlyWholeColours) {
   EXPECT_NEAR(last.y, o + 0.1, 1e-6);
 }
 
+// An ASCII STL's facet normals are not read (nor are a binary one's), so
+// "nan" there, as exporters write for a degenerate facet, is taken: it was
+// refused, while the same file in binary loaded (an outside audit). A
+// corner's nan is still refused.
+TEST(MeshReaders, AsciiStlFacetNormalsMayBeAnyNumber) {
+  auto stl = [](const std::string& normal, const std::string& corner) {
+    return "solid s\nfacet normal " + normal + "\nouter loop\nvertex " + corner +
+           "\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
+  };
+  for (const char* n : {"nan nan nan", "-inf INF NaN", "1e400 0 0", "0 0 1"})
+    EXPECT_EQ(gi::io::parseMesh(stl(n, "0 0 0"), "stl", "n.stl").scene.faceCount(), 1u) << n;
+  EXPECT_THROW(gi::io::parseMesh(stl("0 0 1", "nan 0 0"), "stl", "c.stl"), std::runtime_error);
+  EXPECT_THROW(gi::io::parseMesh(stl("0 0 x", "0 0 0"), "stl", "x.stl"), std::runtime_error);
+}
+
 TEST(MeshReaders, AsciiStlCornersAreMerged) {
   const auto m = gi::io::parseMesh(
       "solid q\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 1 1 0\n  endloop\n"
@@ -558,4 +573,33 @@ TEST(MeshReaders, ObjNonManifoldEdgeKeepsTheFileVertices) {
   EXPECT_EQ(a.points, b.points);
   ASSERT_EQ(a.scene.faceCount(), 20u);
   for (size_t f = 0; f < 20; ++f) EXPECT_EQ(a.scene.triangles[f], b.scene.triangles[f]) << f;
+}
+
+// A number below the smallest double (1e-400, as a program printing in
+// arbitrary precision may write) is 0, and one below the smallest float
+// rounds to it, in every text format: they were refused as "not a finite
+// number" (an outside audit). Numbers beyond the largest double or float
+// are still refused.
+TEST(MeshReaders, NumbersBelowTheRangeAreZero) {
+  for (const char* tiny : {"1e-400", "-1e-400", "0.000000001e-399", "4.9e-324", "1e-50", "00.0001e-99999999999"}) {
+    const std::string t(tiny);
+    const auto ply = gi::io::parseMesh(asciiTri(t + " 0 0", "3 0 1 2 255 0 0"), "ply", "tiny.ply");
+    const auto obj = gi::io::parseMesh("v " + t + " 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "tiny.obj");
+    const auto off = gi::io::parseMesh("OFF\n3 1 0\n" + t + " 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "off", "tiny.off");
+    const auto stl = gi::io::parseMesh("solid s\nfacet normal 0 0 " + t + "\nouter loop\nvertex " + t +
+                                           " 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n",
+                                       "stl", "tiny.stl");
+    for (const auto* m : {&ply, &obj, &off, &stl}) {
+      ASSERT_EQ(m->scene.faceCount(), 1u) << tiny;
+      EXPECT_EQ(m->scene.toWorld(m->scene.positions[m->scene.triangles[0].x]).x, 0.0) << tiny;
+    }
+  }
+  for (const char* huge : {"1e400", "-1e400", "1e39"}) {
+    const std::string t(huge);
+    EXPECT_THROW(gi::io::parseMesh(asciiTri(t + " 0 0", "3 0 1 2 255 0 0"), "ply", "huge.ply"), std::runtime_error)
+        << huge;
+    EXPECT_THROW(gi::io::parseMesh("v " + t + " 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "obj", "huge.obj"),
+                 std::runtime_error)
+        << huge;
+  }
 }
