@@ -8,8 +8,10 @@
 // 0x20 is vcglib's SELECTED, as MeshLab saves a selection: a light selected
 // in MeshLab is an emitter for `gi` too); the vertex element's other float
 // and double properties are kept by name (an earlier filter's per-vertex
-// results). Every other element and property is skipped by its size, so
-// MeshLab's extras (texture coordinates) load.
+// results); triangle strips (element tristrips, list vertex_indices, -1
+// between strips, as vcglib and MeshLab read them) become triangles. Every
+// other element and property is skipped by its size, so MeshLab's extras
+// (texture coordinates) load.
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -56,7 +58,7 @@ std::pair<double, double> integerRange(Type t) {
   }
 }
 
-enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices, Flags, Keep };
+enum class Role : uint8_t { Skip, X, Y, Z, NX, NY, NZ, R, G, B, Quality, Indices, Flags, Keep, Strip };
 
 struct Property {
   std::string name;
@@ -191,10 +193,14 @@ void assignRoles(Header& h, const std::string& name) {
         else if (n == "flags" && !p.list && isInteger(p.type)) p.role = Role::Flags;
         else if (n == "vertex_indices" || n == "vertex_index") p.role = Role::Indices;
       }
+      if (e.name == "tristrips" && n == "vertex_indices") {
+        if (!p.list || !isInteger(p.type)) failRead(name, "the tristrips property 'vertex_indices' must be a list of integers");
+        p.role = Role::Strip;
+      }
       if (vertex && p.role == Role::Skip && !p.list && !isInteger(p.type)) p.role = Role::Keep;
       if (p.role == Role::Indices && (!p.list || !isInteger(p.type)))
         failRead(name, "the face property '" + n + "' must be a list of integers");
-      if (p.role != Role::Skip && p.role != Role::Indices && p.list)
+      if (p.role != Role::Skip && p.role != Role::Indices && p.role != Role::Strip && p.list)
         failRead(name, "the " + e.name + " property '" + n + "' is a list; a number was expected");
     }
     if (std::count_if(e.props.begin(), e.props.end(), [](const Property& p) { return p.role == Role::Indices; }) > 1)
@@ -319,6 +325,37 @@ uint64_t minBytes(const Element& e, Format f) {
   return n;
 }
 
+// One triangle strip: triangle j of a run is (a_j, a_j+1, a_j+2), its first
+// two corners swapped where j is odd so that every triangle turns as the
+// first; -1 ends a run. Triangles with a repeated corner (the joins strips
+// use) are left out.
+template <class Source, class What>
+void readStrip(Source& src, const Property& p, uint64_t n, uint64_t nv, Polygons& out, const std::string& name,
+               const What& what) {
+  int64_t a = -1, b = -1;
+  uint64_t run = 0;  // indices in the current run
+  for (uint64_t k = 0; k < n; ++k) {
+    double v = 0;
+    if (const Status s = src.value(p.type, v, true); s != Status::Ok)
+      failRead(name, s == Status::End ? "the file ends inside " + what() + " (truncated, or a count that lies)"
+                                      : what() + ": list 'vertex_indices' holds no integer of its type");
+    if (v == -1) {
+      run = 0;
+      continue;
+    }
+    if (v < 0 || v >= double(nv))
+      failRead(name, what() + " uses vertex index " + std::to_string(int64_t(v)) + ", outside the " +
+                         std::to_string(nv) + " vertices");
+    const int64_t c = int64_t(v);
+    if (run >= 2 && a != b && b != c && a != c) {
+      const bool odd = (run - 2) % 2 == 1;
+      for (int64_t i : {odd ? b : a, odd ? a : b, c}) out.index.push_back(uint32_t(i));
+      out.faceStart.push_back(uint32_t(out.index.size()));
+    }
+    a = b, b = c, ++run;
+  }
+}
+
 template <class Source>
 void readBody(const Header& h, Source& src, Polygons& out, const std::string& name) {
   const Element* vertex = nullptr;
@@ -372,6 +409,10 @@ void readBody(const Header& h, Source& src, Polygons& out, const std::string& na
           if (uint64_t(v) > src.maxItems(p.type))
             failRead(name, what() + ": list '" + p.name + "' claims " + std::to_string(uint64_t(v)) + " items, more than the file holds");
           const uint64_t n = uint64_t(v);
+          if (p.role == Role::Strip) {
+            readStrip(src, p, n, nv, out, name, what);
+            continue;
+          }
           if (p.role != Role::Indices) {
             if (const Status s = src.skip(p.type, n); s != Status::Ok) fail(s, p);
             continue;
@@ -458,6 +499,11 @@ Polygons readPly(std::string_view bytes, const std::string& name) {
     BinarySource src{bytes, h.bodyStart, h.format == Format::BinaryBE};
     readBody(h, src, out, name);
   }
+  const size_t faces = out.faceStart.size() - 1;
+  for (size_t n : {out.faceColor.size(), out.faceQuality.size(), out.faceSelected.size()})
+    if (n != 0 && n != faces)  // a strip's triangles have none of the face element's properties
+      failRead(name, "the file holds both triangle strips and faces with colours, quality or flags; save it with "
+                     "faces only");
   out.layers = std::move(h.layers);
   return out;
 }

@@ -320,6 +320,16 @@ Counts checkStl(std::string_view bytes, const std::string& name, bool& binary) {
     }();
     failRead(name, notAnStl(n, bytes.size()));
   }
+  // Some exporters begin a binary STL's header with "solid" too: one whose
+  // count does not match its size (truncated) is no ASCII STL either, and
+  // read as one it was "line 1 holds a control character" (an outside
+  // audit). Its NUL bytes tell it: no text holds them.
+  if (bytes.size() >= 84 && bytes.find('\0') != std::string_view::npos) {
+    uint32_t n = 0;
+    std::memcpy(&n, bytes.data() + 80, 4);
+    failRead(name, notAnStl(n, bytes.size()) + ", though its header begins with 'solid' (as some exporters write; it "
+                   "holds NUL bytes, which no ASCII STL does)");
+  }
   Lines in{bytes, name, Comments::None};
   in.next();  // solid NAME
   // solid NAME / { facet normal a b c / outer loop / vertex x y z (x3) / endloop / endfacet } / endsolid [NAME]

@@ -603,3 +603,74 @@ TEST(MeshReaders, NumbersBelowTheRangeAreZero) {
         << huge;
   }
 }
+
+// A binary STL whose header begins with "solid" (as some exporters write)
+// and whose triangle count lies (a truncated file) is said to be one: read
+// as ASCII it was "line 1 holds a control character" (an outside audit).
+// The same file with its true count loads.
+TEST(MeshReaders, BinaryStlWithASolidHeaderIsToldAsBinary) {
+  Bytes b;
+  b.s = "solid exported by a CAD program";
+  b.s.resize(80, '\0');
+  b.put(uint32_t(2));
+  for (int t = 0; t < 2; ++t) {
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, float(t)}) b.put(v);
+    b.put(uint16_t(0));
+  }
+  EXPECT_EQ(gi::io::parseMesh(b.s, "stl", "ok.stl").scene.faceCount(), 2u);
+  std::string cut = b.s.substr(0, b.s.size() - 10);
+  try {
+    gi::io::parseMesh(cut, "stl", "cut.stl");
+    ADD_FAILURE() << "a truncated binary STL was read";
+  } catch (const std::runtime_error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("a binary STL whose triangle count (2, so 184 bytes) does not match its 174 bytes"), std::string::npos) << m;
+    EXPECT_NE(m.find("header begins with 'solid'"), std::string::npos) << m;
+    EXPECT_EQ(m.find("control character"), std::string::npos) << m;
+  }
+}
+
+// Triangle strips (element tristrips, as vcglib writes them) become
+// triangles, each turning as the strip's first: the file was told "no
+// faces" (an outside audit). -1 ends a run, a join's triangles with a
+// repeated corner are left out, ASCII and binary agree, and an index out of
+// range is one sentence.
+TEST(MeshReaders, TriangleStripsBecomeTriangles) {
+  const std::string head =
+      "element vertex 6\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\n"
+      "property list int int vertex_indices\nend_header\n";
+  const float pts[6][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {0, 2}, {5, 5}};
+  const std::vector<int32_t> strip = {0, 1, 2, 3, 3, 4, -1, 5, 5};  // a join (3, 3), a run too short after -1
+  std::string ascii = "ply\nformat ascii 1.0\n" + head;
+  Bytes bin;
+  bin.s = "ply\nformat binary_little_endian 1.0\n" + head;
+  for (const auto& q : pts) {
+    ascii += std::to_string(q[0]) + " " + std::to_string(q[1]) + " 0\n";
+    bin.put(q[0]).put(q[1]).put(0.f);
+  }
+  ascii += std::to_string(strip.size());
+  bin.put(int32_t(strip.size()));
+  for (int32_t i : strip) ascii += " " + std::to_string(i), bin.put(i);
+  ascii += "\n";
+  for (const std::string& file : {ascii, bin.s}) {
+    const auto m = gi::io::parseMesh(file, "ply", "strip.ply");
+    // The run 0 1 2 3 3 4: (0 1 2), (2 1 3) swapped, (2 3 3) and (3 3 4) left out; 5 5 makes none.
+    ASSERT_EQ(m.scene.faceCount(), 2u);
+    EXPECT_EQ(m.scene.triangles[0], glm::uvec3(0, 1, 2));
+    EXPECT_EQ(m.scene.triangles[1], glm::uvec3(2, 1, 3));
+    for (const glm::uvec3& t : m.scene.triangles) {  // both face +z, as the first
+      const glm::vec3 n = glm::cross(m.scene.positions[t.y] - m.scene.positions[t.x],
+                                     m.scene.positions[t.z] - m.scene.positions[t.x]);
+      EXPECT_GT(n.z, 0.f);
+    }
+  }
+  std::string bad = ascii;
+  bad.replace(bad.rfind(" 5 5"), 4, " 5 9");
+  try {
+    gi::io::parseMesh(bad, "ply", "bad.ply");
+    ADD_FAILURE() << "an index out of range was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("tristrips 0 uses vertex index 9, outside the 6 vertices"), std::string::npos)
+        << e.what();
+  }
+}
