@@ -212,7 +212,10 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   st.add("mean_luminance_B", valid ? lum / double(valid) : 0.0);
   st.add("rms_error_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.note("direct light only (per-vertex light sampling)");
-  if (valid < nv) st.note(std::to_string(nv - valid) + " vertices without a usable face got 0");
+  size_t unlit = nv - valid;
+  const std::vector<uint8_t> copies = copyOnlyVertices(s);  // they take their originals' values
+  for (size_t i = 0; i < copies.size(); ++i) unlit -= copies[i] && !mat.valid[i];
+  if (unlit) st.note(std::to_string(unlit) + " vertices without a usable face got 0");
   return out;
 }
 

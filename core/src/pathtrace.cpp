@@ -511,8 +511,11 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
   if (twoSidedTraced)
     st.note(std::to_string(twoSidedTraced) + " vertices on a two-sided surface or where faces turned opposite ways meet (their faces' normals cancel) took the "
             "mean of their two sides (each sample a path from either side)");
-  if (valid < part.count(nv))
-    st.note(std::to_string(part.count(nv) - valid) + " vertices without a usable diffuse face (isolated, or on mirror, "
+  size_t untraced = part.count(nv) - valid;
+  const std::vector<uint8_t> copies = copyOnlyVertices(s);  // they take their originals' values
+  for (size_t i = 0; i < copies.size(); ++i) untraced -= copies[i] && part.contains(i, nv) && res.traced[i] == 0;
+  if (untraced)
+    st.note(std::to_string(untraced) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) or without a side to trace from (a fold whose faces' "
             "normals cancel) got 0");
   const bool otherLights = opt.point.on() || luminance(opt.skyRadiance) > 0.f || luminance(opt.sunIrradiance) > 0.f;

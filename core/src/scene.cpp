@@ -425,6 +425,20 @@ std::vector<std::pair<uint32_t, uint32_t>> duplicatedFaces(const Scene& s) {
   return cornerGroups(s, ok, used).duplicates;
 }
 
+std::vector<uint8_t> copyOnlyVertices(const Scene& s) {
+  if (std::find(s.leftOut.begin(), s.leftOut.end(), uint8_t(1)) == s.leftOut.end()) return {};
+  const size_t nv = s.vertexCount();
+  std::vector<uint8_t> mark(nv, 0);  // 1: on a left-out face, 2: on a face kept
+  for (size_t f = 0; f < s.faceCount(); ++f) {
+    const glm::uvec3& t = s.triangles[f];
+    if (t.x >= nv || t.y >= nv || t.z >= nv) continue;
+    const uint8_t m = f < s.leftOut.size() && s.leftOut[f] ? 1 : 2;
+    for (int k = 0; k < 3; ++k) mark[t[k]] = std::max(mark[t[k]], m);
+  }
+  for (uint8_t& m : mark) m = m == 1;
+  return mark;
+}
+
 SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<uint8_t>* usable,
                          std::vector<std::pair<uint32_t, uint32_t>>* duplicates) {
   SceneReport r;
@@ -454,7 +468,8 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
       r.emittedPower += double(luminance(E)) * faceArea(s, f) * s.unit * s.unit;
     }
   }
-  for (size_t i = 0; i < nv; ++i) r.isolatedVertices += (finite[i] && !used[i]) ? 1 : 0;
+  const std::vector<uint8_t> copies = copyOnlyVertices(s);
+  for (size_t i = 0; i < nv; ++i) r.isolatedVertices += (finite[i] && !used[i] && (copies.empty() || !copies[i])) ? 1 : 0;
   // Duplicated faces: the same three corner positions (in any order) as an
   // earlier usable face. Coplanar copies hide each other at random in ray
   // casting, so exact energy accounting does not hold for them.

@@ -329,7 +329,10 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
     st.note(num(ownRays) + " rays left through a face at their own vertex (the cone reaches past a convex corner "
             "or edge): no chord, not counted");
   st.add("skipped_invalid", double(invalid));
-  if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
+  size_t unmeasured = invalid;
+  const std::vector<uint8_t> copies = copyOnlyVertices(scene);  // they take their originals' values
+  for (size_t i = 0; i < copies.size(); ++i) unmeasured -= copies[i] && !valid[i];
+  if (unmeasured) st.note(std::to_string(unmeasured) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
                           "surface, each face with a reversed copy, the faces' normals cancel) got 0");
   if (noHit) st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0");
   const size_t traced = nv - invalid;

@@ -10,7 +10,8 @@
 // face indices and the copies come after them, so every ray, seed and
 // sample of the clean box is drawn again: the values must be the clean
 // box's to rounding, which is a test that fails by a factor of two on the
-// old code.
+// old code. The copies' own vertices are not said to be isolated or to have
+// got 0 (an outside audit).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,6 +77,7 @@ TEST(DuplicateFaces, ComputedOnceInEveryFilter) {
       {FilterKind::PhotonMapping, {{"photons", "20000"}, {"gather_rays", "16"}}},
       {FilterKind::PathTracedReference, {{"samples_per_vertex", "16"}}},
       {FilterKind::AmbientOcclusion, {{"rays_per_vertex", "32"}}},
+      {FilterKind::SkyLighting, {{"rays_per_vertex", "32"}}},
   };
   for (const Case& c : cases) {
     const FilterResult base = run(c.kind, clean, c.values);
@@ -95,6 +97,10 @@ TEST(DuplicateFaces, ComputedOnceInEveryFilter) {
         worst = std::max(worst, std::fabs(double(r.vertexQuality[v]) - base.vertexQuality[v]) /
                                     std::max(1e-3, double(base.vertexQuality[v])));
       EXPECT_LT(worst, 1e-5) << name;
+      // The copies' own vertices are neither isolated nor "got 0" (they were
+      // said to be both while they showed their originals' values).
+      EXPECT_EQ(r.report.isolatedVertices, 0u) << name;
+      for (const std::string& note : r.stats.notes) EXPECT_EQ(note.find("got 0"), std::string::npos) << name << ": " << note;
       // A copy's own vertices show their original corners' values.
       size_t copy = nv;
       for (size_t f : faces)
@@ -106,6 +112,21 @@ TEST(DuplicateFaces, ComputedOnceInEveryFilter) {
       }
     }
   }
+}
+
+// Thickness of a solid box with faces listed again on vertices of their own:
+// the same values, and the copies' vertices neither isolated nor "got 0".
+TEST(DuplicateFaces, ThicknessOfASolidWithCopies) {
+  const scenes::SceneFile clean = scenes::closedBox(1.0, 3, false);
+  const std::vector<std::pair<const char*, const char*>> values = {{"rays_per_vertex", "16"}};
+  const FilterResult base = run(FilterKind::Thickness, clean, values);
+  const scenes::SceneFile doubled = withCopies(clean, {0, 1, 2, 7}, true);
+  const FilterResult r = run(FilterKind::Thickness, doubled, values);
+  ASSERT_EQ(r.vertexQuality.size(), doubled.scene.vertexCount());
+  for (size_t v = 0; v < clean.scene.vertexCount(); ++v) EXPECT_EQ(r.vertexQuality[v], base.vertexQuality[v]) << v;
+  EXPECT_EQ(r.report.isolatedVertices, 0u);
+  for (const std::string& note : r.stats.notes) EXPECT_EQ(note.find("got 0"), std::string::npos) << note;
+  EXPECT_TRUE(r.stats.warnings.empty()) << r.stats.warnings.front();
 }
 
 // The face kept of a group is the one that emits (or is not diffuse), not

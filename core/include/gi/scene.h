@@ -142,6 +142,11 @@ std::optional<std::string> coarseFloatsWarning(const std::vector<glm::dvec3>& pt
 inline double sceneDiagonal(const Scene& s) { return sceneScale(s).diagonal * s.unit; }
 // True for a face the ray caster builds (valid indices, finite, non-degenerate).
 std::vector<uint8_t> usableFaceMask(const Scene& s);
+// 1 for the vertices that only left-out faces use (a duplicated face's copy
+// with corners of its own): no computation reaches them, and the output
+// gives them their original's values, so they are neither isolated nor "got
+// 0". Empty where no face is left out.
+std::vector<uint8_t> copyOnlyVertices(const Scene& s);
 // Throws std::invalid_argument where a per-face array (rho, emission,
 // material, ior, roughness, leftOut) is neither empty nor one entry per
 // face: a library caller's mistake that would read past the array.
