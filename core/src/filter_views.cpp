@@ -33,6 +33,7 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
   res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
   res.stats.add("seconds", rep.seconds);
   res.stats.note(out.summary);
+  if (const std::string w = cutShortWarning(rep.pairsCutShort); !w.empty()) res.stats.warn(w);
   if (const auto w = narrowPatchWarning(s, narrowPatch(s, face, sceneScale(s).rayEpsilon), "its form factors"))
     res.stats.warn(*w);
 }

@@ -45,6 +45,7 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
   normal_.resize(s.faceCount());
   rays_.assign(s.faceCount(), 0);
   farPairs_.assign(s.faceCount(), 0);
+  cutPairs_.assign(s.faceCount(), 0);
   centroid_.assign(s.faceCount(), glm::dvec3(0.0));
   radius_.assign(s.faceCount(), 0.0);
   for (size_t f = 0; f < s.faceCount(); ++f) {
@@ -70,6 +71,12 @@ FormFactors::FormFactors(const Scene& s, const RayCaster& caster, const Settings
 uint64_t FormFactors::farPairsByOnePoint() const {
   uint64_t t = 0;
   for (uint64_t r : farPairs_) t += r;
+  return t;
+}
+
+uint64_t FormFactors::pairsCutShort() const {
+  uint64_t t = 0;
+  for (uint64_t r : cutPairs_) t += r;
   return t;
 }
 
@@ -142,6 +149,7 @@ FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, cons
   const FormFactors ff(s, caster, settings);
   FormFactorReport rep;
   rep.row = ff.row(face);
+  rep.pairsCutShort = ff.pairsCutShort();
   for (float f : rep.row.F) rep.rowSum += f;
   rep.escaped = rep.row.escaped;
   std::vector<size_t> order(rep.row.j.size());
@@ -159,6 +167,13 @@ FormFactorReport formFactorsOfFace(const Scene& s, const RayCaster& caster, cons
   }
   rep.seconds = timer.seconds();
   return rep;
+}
+
+std::string cutShortWarning(uint64_t pairs) {
+  if (pairs == 0) return "";
+  return std::to_string(pairs) + " pairs of patches needed more refinement of the analytic form factor than it is "
+         "allowed (slivers, a side many thousand times the patch's width): their factors may be off by more "
+         "than 1%; Monte Carlo form factors do not depend on the patches' shape, or remesh the slivers";
 }
 
 std::vector<ParamSpec> formFactorSpecs() {

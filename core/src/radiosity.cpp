@@ -579,6 +579,7 @@ RadiosityResult solveRadiosity(const Scene& s, const RayCaster& caster, const Ra
   res.stats.note(std::string("form factors: ") + kFormFactorMethods.logName(ff.method()) +
                  (ffs.method == FormFactorMethod::Auto ? " (auto)" : "") +
                  (ff.unoccluded() ? "; visibility rays skipped: nothing can occlude in this empty convex room" : ""));
+  if (const std::string w = cutShortWarning(ff.pairsCutShort()); !w.empty()) res.stats.warn(w);
   if (ff.farPairsByOnePoint())
     res.stats.note(std::to_string(ff.farPairsByOnePoint()) +
                    " far pairs (F < 1e-7 proved by distance) by one point and one ray each, not refined");

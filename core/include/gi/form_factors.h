@@ -113,6 +113,9 @@ class FormFactors {
   // Analytic: the pairs with F provably below kNegligibleF, taken at the
   // source's centroid with one visibility ray.
   uint64_t farPairsByOnePoint() const;
+  // Analytic: the pairs whose refinement wanted more levels or splits than
+  // allowed (slivers beyond the allowance): their factors may miss the 1%.
+  uint64_t pairsCutShort() const;
   static constexpr double kNegligibleF = 1e-7;
   // The hemicube of patch i seen from its centre, as the hemicube method's
   // one-view row computes it (the same F, bit for bit), with its cells.
@@ -142,6 +145,7 @@ class FormFactors {
   std::vector<float> seen_;  // per patch, or empty: whole patches
   mutable std::vector<uint64_t> rays_;        // per patch, for the statistics
   mutable std::vector<uint64_t> farPairs_;  // per patch, for the statistics
+  mutable std::vector<uint64_t> cutPairs_;  // per patch, for the statistics
   std::vector<glm::dvec3> centroid_;
   std::vector<double> radius_;
 };
@@ -164,8 +168,11 @@ struct FormFactorReport {
   double rowSum = 0, escaped = 0;
   double maxReciprocityError = 0;  // max |A_i F_ij - A_j F_ji| / (A_i F_ij) over the checked pairs
   int reciprocityChecked = 0;
+  uint64_t pairsCutShort = 0;  // FormFactors::pairsCutShort of the face's row
   double seconds = 0;
 };
+// The log's warning where analytic pairs were cut short (none: empty).
+std::string cutShortWarning(uint64_t pairs);
 // Refuses (std::invalid_argument) settings of the chosen method that leave
 // a row without samples: rays_per_patch (Monte Carlo, Auto),
 // analytic_points (analytic, Auto) or hemicube_points below 1, a hemicube
