@@ -107,6 +107,12 @@ std::pair<std::string, Texts> readParamsFile(const std::string& path) {
     throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
   }
   if (!j.is_object()) throw std::invalid_argument("the parameter file " + path + " must hold a JSON object");
+  // A key it does not know is refused, as an unknown parameter is: a typo
+  // ("paramters") dropped every parameter in silence (an outside audit).
+  for (const auto& [k, v] : j.items())
+    if (k != "filter" && k != "parameters")
+      throw std::invalid_argument("the parameter file " + path + " has a key '" + k +
+                                  "' it does not know (it takes \"filter\" and \"parameters\")");
   if (j.contains("filter") && !j["filter"].is_string())
     throw std::invalid_argument("\"filter\" in " + path + " must be a string");
   std::string filter = j.value("filter", "");
@@ -116,6 +122,9 @@ std::pair<std::string, Texts> readParamsFile(const std::string& path) {
   for (const auto& [k, v] : p.items()) {
     if (v.is_string()) t[k] = v.get<std::string>();
     else if (v.is_boolean()) t[k] = v.get<bool>() ? "true" : "false";
+    else if (v.is_number_float() && std::isfinite(v.get<double>()) && v.get<double>() == std::trunc(v.get<double>()) &&
+             std::fabs(v.get<double>()) < 9.0e15)
+      t[k] = std::to_string(int64_t(v.get<double>()));  // 8.0 and 1e2 are the integers JSON wrote them as
     else if (v.is_number()) t[k] = v.dump();
     else if (v.is_array() && v.size() == 3) t[k] = v[0].dump() + "," + v[1].dump() + "," + v[2].dump();
     else throw std::invalid_argument("parameter " + k + " in " + path + ": expected a string, number, boolean or [x, y, z]");
@@ -197,10 +206,13 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
     if (errno == ERANGE || n > (1LL << 40) || i > (1LL << 40))
       throw std::invalid_argument("--shard '" + text + "': I and N must be below 2^40");
   } else if (std::getenv("SLURM_ARRAY_TASK_COUNT")) {
-    // Each variable an integer (a garbled one must not make every task shard 0).
+    // Each variable an integer (a garbled one must not make every task shard
+    // 0; nor an empty one, which was read as its default: an outside audit);
+    // the task's index must be set, MIN and STEP may be left out.
     auto num = [](const char* name, long long fallback) {
       const char* v = std::getenv(name);
-      if (!v || !*v) return fallback;
+      if (!v && fallback < 0) throw std::invalid_argument(std::string(name) + " is not set, though SLURM_ARRAY_TASK_COUNT is");
+      if (!v) return fallback;
       char* end = nullptr;
       errno = 0;
       const long long x = std::strtoll(v, &end, 10);
@@ -211,7 +223,7 @@ std::pair<size_t, size_t> chooseShard(const std::string& text) {
     n = num("SLURM_ARRAY_TASK_COUNT", 1);
     if (n < 1) throw std::invalid_argument("SLURM_ARRAY_TASK_COUNT = 0: the job array has no task (or pass --shard I/N)");
     const long long step = std::max(1LL, num("SLURM_ARRAY_TASK_STEP", 1));
-    const long long offset = num("SLURM_ARRAY_TASK_ID", 0) - num("SLURM_ARRAY_TASK_MIN", 0);
+    const long long offset = num("SLURM_ARRAY_TASK_ID", -1) - num("SLURM_ARRAY_TASK_MIN", 0);
     i = offset < 0 || offset % step != 0 ? -1 : offset / step;
     if (i < 0 || i >= n)
       throw std::invalid_argument("SLURM_ARRAY_TASK_ID " + std::string(std::getenv("SLURM_ARRAY_TASK_ID") ? std::getenv("SLURM_ARRAY_TASK_ID") : "?") +

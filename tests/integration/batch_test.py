@@ -233,6 +233,15 @@ def case_inputs(a, tmp):
           "--dir/--glob and a parameter file naming the filter: %d baked" % rep.get("baked", -1))
     s = load(os.path.join(out, "bowl.json"))
     check(s["filter"] == "GI: Ambient Obscurance" and "rays_per_vertex=8" in s["resolved"], "parameter file applied")
+    # A whole number written as a JSON float is that integer (8.0 was
+    # refused as "expected an integer"; an outside audit).
+    with open(params, "w") as f:
+        f.write('{"filter": "ao", "parameters": {"rays_per_vertex": 8.0, "max_rays": 1e2}}')
+    out2 = os.path.join(tmp, "input_out_float")
+    p = run([a.gi, "batch", "--dir", meshes, "--glob", "bowl.ply", "--params", params, "-o", out2, "--json"])
+    s = load(os.path.join(out2, "bowl.json")) if p.returncode == 0 else {"resolved": ""}
+    check(p.returncode == 0 and "rays_per_vertex=8," in s["resolved"] + "," and "max_rays=100" in s["resolved"],
+          "integral JSON floats taken as integers (%s)" % p.stderr.strip())
 
     def one_line(args, needle, what):
         p = run([a.gi, "batch"] + args)
@@ -277,6 +286,12 @@ def case_inputs(a, tmp):
     with open(deep, "w") as f:
         f.write('{"filter": "ao", "parameters": {"rays_per_vertex": ' + "[" * 200000 + "]" * 200000 + "}}")
     one_line(["--params", deep, "--dir", meshes, "-o", out], "nested deeper", "a parameter file nested 200,000 deep")
+    # A key the file format does not have (a typo) is refused: the whole set
+    # of parameters was dropped in silence (an outside audit).
+    for doc in ('{"filter": "ao", "paramters": {"rays_per_vertex": 8}}', '{"Filter": "sky", "parameters": {}}'):
+        with open(params, "w") as f:
+            f.write(doc)
+        one_line(["--params", params, "--dir", meshes, "-o", out], "it does not know", "a parameter file " + doc)
 
 
 def case_keep(a, tmp):

@@ -330,6 +330,13 @@ def check_side_files(gi, tmp):
          "evenly spaced", dict(array, SLURM_ARRAY_TASK_ID="1", SLURM_ARRAY_TASK_STEP="2")),
         ("SLURM_ARRAY_TASK_COUNT 0", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
          "SLURM_ARRAY_TASK_COUNT", dict(array, SLURM_ARRAY_TASK_ID="0", SLURM_ARRAY_TASK_COUNT="0")),
+        # set but empty, or the task's index missing: read as task 0 before (an outside audit)
+        ("SLURM_ARRAY_TASK_ID empty", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "SLURM_ARRAY_TASK_ID", dict(array, SLURM_ARRAY_TASK_ID="")),
+        ("SLURM_ARRAY_TASK_COUNT empty", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "SLURM_ARRAY_TASK_COUNT", dict(array, SLURM_ARRAY_TASK_ID="0", SLURM_ARRAY_TASK_COUNT="")),
+        ("SLURM_ARRAY_TASK_ID not set", ["batch", "ao", "-q", "--manifest", "missing.txt", "-o", "bout_id"],
+         "SLURM_ARRAY_TASK_ID is not set", dict(array)),
         ("a NUL byte in a manifest line", ["batch", "ao", "-q", "--manifest", "nul.txt", "-o", "bout_nul"],
          "NUL byte", None),
         # refused before any mesh is computed (each mesh's summary could not be written)
