@@ -154,6 +154,14 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     }
     out.error[i] = float(e);
   }
+  // No vertex with a finite value and reference (all NaN, or nothing traced)
+  // compares nothing: refused, as the map of 0s with rms 0 read "no error"
+  // with exit 0 (an outside audit).
+  if (used == 0)
+    throw std::invalid_argument(
+        "no vertex can be compared: " + std::to_string(notFinite) + " have a value or reference that is not a finite "
+        "number" + (untraced ? ", " + std::to_string(untraced) + " were not traced by the reference" : std::string()) +
+        "; there is no error to map");
   // With no error bar anywhere (a reference of one path a vertex) the bars
   // are unknown, not 0, and no z-score is defined: refused, as a map of 0s
   // painted every vertex white, "no error", where the values differed (an

@@ -259,6 +259,18 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   const FilterResult r0 = errorMapOf(sf, zero, {});
   EXPECT_TRUE(std::isnan(r0.stats.get("relative_rms_error", std::nan(""))));
   EXPECT_GT(r0.stats.get("rms_error"), 1.9);
+  // No vertex with a finite value: nothing to compare. Refused, as rms 0 and
+  // a white map read as a perfect agreement with exit 0 (an outside audit);
+  // one finite vertex is enough.
+  std::vector<float> nan(nv, std::nanf(""));
+  for (ErrorMeasure m : {ErrorMeasure::Difference, ErrorMeasure::Relative, ErrorMeasure::ZScore})
+    EXPECT_THROW((void)errorMap(nan, refv, sigma, {}, m, 0.0), std::invalid_argument) << int(m);
+  EXPECT_THROW((void)errorMap(value, refv, sigma, {}, ErrorMeasure::Difference, 0.0, std::vector<float>(nv, 0.f)),
+               std::invalid_argument);  // nothing traced
+  nan[3] = 2.f;
+  const ErrorMapResult one = errorMap(nan, refv, sigma, {}, ErrorMeasure::Difference, 0.0);
+  EXPECT_EQ(one.stats.get("vertices"), 1.0);
+  EXPECT_FLOAT_EQ(one.error[3], 1.f);
 }
 
 // An error beyond single precision (values near +-3e38, or a relative error
