@@ -261,8 +261,13 @@ ParamValue parseValue(const ParamSpec& s, const std::string& text, double diagon
         }
         auto n = splitNumbers(text);
         if (n.size() != 3) throw bad("expected r,g,b (0-255) or #rrggbb");
+        // Whole channels, as MeshLab's colour dialog and a script hold them: a
+        // fraction (100.4) was used here but rounded in the script, so the
+        // two gave different results; 0.5,0.5,0.5 meant as 0-1 read as
+        // nearly black (an outside audit).
         for (double c : n)
-          if (!(c >= 0.0 && c <= 255.0)) throw bad("each channel of r,g,b lies in 0-255");
+          if (!(c >= 0.0 && c <= 255.0) || c != std::floor(c))
+            throw bad("each channel of r,g,b is a whole number in 0-255 (not a 0-1 fraction)");
         return glm::vec3(float(n[0] / 255.0), float(n[1] / 255.0), float(n[2] / 255.0));
       }
       case ParamType::Direction:

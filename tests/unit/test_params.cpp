@@ -289,6 +289,12 @@ TEST(Params, ParseValueEveryType) {
     }
   }
   EXPECT_EQ(std::get<glm::vec3>(parse("tint", "0,0,255")), glm::vec3(0.f, 0.f, 1.f));
+  // Whole channels only, as MeshLab's dialog and a script hold them: 100.4
+  // was used by the CLI and rounded by its script (the two results differed),
+  // and 0.5,0.5,0.5 meant as 0-1 read as nearly black (an outside audit).
+  // A whole number written with a point (JSON's 255.0) is taken.
+  for (const char* t : {"100.4,100,100", "0.5,0.5,0.5", "1,1,0.999"}) expectParseError("tint", t);
+  EXPECT_EQ(std::get<glm::vec3>(parse("tint", "255.0,128,0.0")), orange);
 
   EXPECT_EQ(std::get<glm::vec3>(parse("dir", "0,-1,0.5")), glm::vec3(0.f, -1.f, 0.5f));
   for (const char* t : {"0,1", "0,1,x", "", "1,2,3,4"}) expectParseError("dir", t);
