@@ -125,11 +125,18 @@ void warnMeaningless(const Scene& scene, const std::vector<uint8_t>& usable, con
       st.warn("sun_angular_radius 0 is a point sun: all " + std::to_string(o.sunRays) +
               " sun rays per vertex follow one direction (hard shadows; one ray gives the same)");
   }
-  if (o.mode == AmbientMode::Occlusion && o.targetError == 0.0 && o.estimator == AOEstimator::PerVertex &&
-      o.raysPerVertex < 8)
-    st.warn("rays_per_vertex = " + std::to_string(o.raysPerVertex) + ": each vertex's value is one of " +
-            std::to_string(o.raysPerVertex + 1) + " levels, its standard error up to " +
-            num(0.5 / std::sqrt(double(o.raysPerVertex))) + "; 16 rays or more give a usable estimate");
+  // Too few rays for a usable value (said for occlusion only before: sky and
+  // obscurance at 1 ray wrote 0 or 1 in silence; an outside audit).
+  if (o.targetError == 0.0 && o.estimator == AOEstimator::PerVertex && o.raysPerVertex < 8) {
+    const std::string n = std::to_string(o.raysPerVertex), se = num(0.5 / std::sqrt(double(o.raysPerVertex)));
+    const std::string what =
+        o.mode == AmbientMode::Occlusion
+            ? "each vertex's value is one of " + std::to_string(o.raysPerVertex + 1) + " levels, its standard error up to " + se
+        : o.mode == AmbientMode::Sky ? "each vertex's sky light rests on " + n + " rays, its standard error up to " + se +
+                                           " of the sky's irradiance"
+                                     : "each vertex's value rests on " + n + " rays, its standard error up to " + se;
+    st.warn("rays_per_vertex = " + n + ": " + what + "; 16 rays or more give a usable estimate");
+  }
   if (o.targetError > 0.0) {
     size_t unmet = 0, traced = 0;
     float worst = 0.f;

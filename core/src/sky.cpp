@@ -30,7 +30,8 @@ std::vector<ParamSpec> SkySun::specs() {
        .help = "Colour of a uniform sky around the scene (sRGB).",
        .type = ParamType::Color, .defVec = glm::vec3(1.f)},
       {.name = "sky_irradiance", .label = "Sky irradiance (W/m^2)",
-       .help = "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky.",
+       .help = "Irradiance the sky gives an unoccluded surface (pi x its radiance); 0 = no sky. The sky covers the "
+               "whole sphere (no ground): a surface of any orientation with nothing around it gets all of it.",
        .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e9},
       {.name = "sun_direction", .label = "Sun direction",
        .help = "Direction towards the sun.",

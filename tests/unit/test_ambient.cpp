@@ -616,3 +616,26 @@ TEST(AmbientOcclusion, TwoSidedSurfaceTakesTheMeanOfItsSides) {
         << r.stats.line("ao");
   }
 }
+
+// Fewer than 8 rays a vertex give no usable value in any mode, and the log
+// says so with the standard error's bound (sky and obscurance at 1 ray wrote
+// 0 or 1 in silence; an outside audit); 8 rays say nothing.
+TEST(AmbientOcclusion, TooFewRaysAreSaidInEveryMode) {
+  auto sf = scenes::floorWithWall(4.0, 1.0, 8);
+  auto caster = makeEmbreeCaster(sf.scene);
+  for (AmbientMode mode : {AmbientMode::Occlusion, AmbientMode::Obscurance, AmbientMode::Sky}) {
+    for (int rays : {1, 7, 8}) {
+      AmbientOptions o;
+      o.mode = mode;
+      o.raysPerVertex = rays;
+      if (mode == AmbientMode::Obscurance) o.maxDistance = 1.0;
+      if (mode == AmbientMode::Sky) o.skyIrradiance = 1.f;
+      const AmbientResult r = computeAmbient(sf.scene, *caster, o);
+      bool said = false;
+      for (const std::string& w : r.stats.warnings)
+        said = said || (w.find("rays_per_vertex = " + std::to_string(rays)) != std::string::npos &&
+                        w.find("usable estimate") != std::string::npos);
+      EXPECT_EQ(said, rays < 8) << "mode " << int(mode) << ", " << rays << " rays";
+    }
+  }
+}
