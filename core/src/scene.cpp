@@ -332,6 +332,7 @@ namespace {
 struct CornerGroups {
   std::vector<std::pair<uint32_t, uint32_t>> duplicates;  // (copy, original)
   size_t twoSidedPairs = 0, misorientedEdges = 0;
+  size_t borderEdges = 0;  // edges (by position) of one face only
 };
 
 // ok: usable faces; used: the vertices they use.
@@ -409,6 +410,7 @@ CornerGroups cornerGroups(const Scene& s, const std::vector<uint8_t>& ok, const 
       auto end = it;
       while (end != last && (*end >> 1) == (*it >> 1)) ++end;
       if (end - it == 2 && *it == *(it + 1)) ++g.misorientedEdges;
+      if (end - it == 1) ++g.borderEdges;
       it = end;
     }
   }
@@ -479,6 +481,7 @@ SceneReport analyzeScene(const Scene& s, bool duplicateFaces, const std::vector<
     if (duplicates) *duplicates = std::move(g.duplicates);
     r.twoSidedPairs = g.twoSidedPairs;
     r.misorientedEdges = g.misorientedEdges;
+    r.borderEdges = g.borderEdges;
   }
   if (lo.x <= hi.x) { r.bboxMin = lo; r.bboxMax = hi; }
   const SceneScale sc = sceneScale(s);

@@ -98,6 +98,9 @@ struct SceneReport {
   size_t duplicateFaces = 0;       // usable faces repeating an earlier face's corners, in its turn
   size_t misorientedEdges = 0;     // edges of two faces that run along them the same way (one face turned over)
   size_t twoSidedPairs = 0;        // corners with faces of both turns (a two-sided surface's faces)
+  // Edges (by position) that only one usable face has: 0 for a closed mesh
+  // (counted with duplicateFaces; a T-junction counts as a border).
+  size_t borderEdges = 0;
   double emittedPower = 0.0;       // luminance-weighted, W
   glm::dvec3 bboxMin{0.0}, bboxMax{0.0};  // absolute, over finite vertices
   double diagonal = 0.0;           // bbox diagonal of the vertices some face uses (world units)
