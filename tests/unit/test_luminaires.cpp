@@ -233,3 +233,59 @@ TEST(Luminaires, ManyLuminairesFallBackToPowerSampling) {
   EXPECT_GT(e.H.g, 0.1f);
   EXPECT_NEAR(H[best].g / e.H.g, 1.0, 0.05);
 }
+
+// A patch far from a small light (few points: 40 r / d) with a shadow edge
+// across it: its points' visibility gave its lit share, so a patch 20% lit
+// read 4% of that on the staircase scene, whatever light_samples (an outside
+// audit). Where its first points disagree it now takes the most points
+// light_samples allows (1 per 64). The floor's two triangles (1 x 1) under a
+// 0.2 light 10 above, an occluder 5 above hiding x < 0.4: each against the
+// area-weighted mean of the same region cut into 32 x 32 cells (8 of the
+// 2,048 cells straddle the penumbra, so the reference's own error is well
+// below the 4% allowed at 4,096 samples).
+TEST(Luminaires, ShadowEdgeAcrossAFarPatchTakesMorePoints) {
+  auto scene = [](int n) {
+    std::vector<glm::dvec3> p;
+    std::vector<glm::uvec3> t;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) p.push_back({double(i) / n, double(j) / n, 0.0});
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1) + 1, d = a + uint32_t(n + 1);
+        t.push_back({a, b, c});
+        t.push_back({a, c, d});
+      }
+    const size_t floor = t.size();
+    const uint32_t l = uint32_t(p.size());
+    for (glm::dvec3 q : {glm::dvec3(0.4, 0.4, 10), glm::dvec3(0.4, 0.6, 10), glm::dvec3(0.6, 0.6, 10), glm::dvec3(0.6, 0.4, 10)})
+      p.push_back(q);
+    t.push_back({l, l + 1, l + 2});  // facing down
+    t.push_back({l, l + 2, l + 3});
+    const uint32_t o = uint32_t(p.size());
+    for (glm::dvec3 q : {glm::dvec3(-2, -2, 5), glm::dvec3(0.4, -2, 5), glm::dvec3(0.4, 3, 5), glm::dvec3(-2, 3, 5)}) p.push_back(q);
+    t.push_back({o, o + 1, o + 2});
+    t.push_back({o, o + 2, o + 3});
+    Scene s = Scene::fromAbsolute(p, t);
+    s.emission.assign(t.size(), glm::vec3(0.f));
+    s.emission[floor] = s.emission[floor + 1] = glm::vec3(1.f);
+    s.rho.assign(t.size(), glm::vec3(0.5f));
+    return std::pair{s, floor};
+  };
+  const auto [coarse, nc] = scene(1);
+  const auto [fine, nf] = scene(32);
+  ASSERT_EQ(nc, 2u);
+  auto cc = makeEmbreeCaster(coarse), fc = makeEmbreeCaster(fine);
+  const auto Hc = patchDirectIrradiance(coarse, *cc, 4096, 3), Hf = patchDirectIrradiance(fine, *fc, 4096, 3);
+  // Fine cell (i, j), triangle k: in the coarse triangle below the diagonal (k = 0) or above it (k = 1).
+  double ref[2] = {0, 0}, area[2] = {0, 0};
+  for (size_t f = 0; f < nf; ++f) {
+    const size_t k = f % 2, cell = f / 2, i = cell % 32, j = cell / 32;
+    const size_t half = i > j ? 0 : i < j ? 1 : k;
+    ref[half] += Hf[f].g, area[half] += 1;
+  }
+  for (int k = 0; k < 2; ++k) {
+    ref[k] /= area[k];
+    ASSERT_GT(ref[k], 0.0);
+    EXPECT_NEAR(Hc[size_t(k)].g / ref[k], 1.0, 0.04) << "floor triangle " << k << ": " << Hc[size_t(k)].g << " against " << ref[k];
+  }
+}

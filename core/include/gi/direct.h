@@ -82,7 +82,8 @@ void mergeSideErrors(std::vector<float>& error, const VertexSides& sides);
 // Fbar_iL the exact unoccluded factor averaged over the patch
 // (meanOverTriangle, gi/form_factor_analytic.h) and V_iL the visibility
 // found at up to P = max(1, lightSamples / 64) points x_k of the patch
-// (fewer where the patch is small against its distance to the luminaires),
+// (fewer where the patch is small against its distance to the luminaires,
+// unless its first points disagree: a shadow edge across it),
 // each with up to lightSamples / P shadow rays per luminaire in penumbra
 // (16 and the corners elsewhere): the ratio estimator of Heitz, Hill and
 // McGuire 2018, "Combining Analytic Direct Illumination and Stochastic
