@@ -183,10 +183,14 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
 std::vector<Job> readFolder(const std::string& dir, const std::string& pattern) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw std::invalid_argument("--dir " + dir + " is not a folder");
+  // Every entry the pattern matches is a job: one that is no regular file
+  // (a dangling link, a FIFO, a folder, a link in a loop) fails as that
+  // mesh, as it does from a manifest (it was skipped in silence, and a link
+  // in a loop stopped the whole batch with the library's message; an
+  // outside audit).
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.is_regular_file() && fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0)
-      names.push_back(e.path().filename().string());
+    if (fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0) names.push_back(e.path().filename().string());
   if (ec) throw std::invalid_argument("cannot list " + dir + ": " + ec.message());
   if (names.empty()) throw std::invalid_argument("no file in " + dir + " matches --glob '" + pattern + "'");
   std::sort(names.begin(), names.end());
@@ -417,8 +421,6 @@ int run(const Args& a, const std::vector<std::string>& extras) {
   }
   if (filter.empty()) throw std::invalid_argument("name the filter (gi batch ao ...) or give it in --params");
   const FilterDesc& d = findFilter(filter);
-  if (d.writes & WritesImage)
-    throw std::invalid_argument("'" + d.cliName + "' writes an image at one path: run it per mesh, not in a batch");
   const auto specs = filterSpecs(d.kind);
   Texts common;  // the parameter file's, then the command line's
   for (const auto& [k, v] : fileParams) {
@@ -450,6 +452,19 @@ int run(const Args& a, const std::vector<std::string>& extras) {
       if (auto it = j.overrides.find(f.parameter); it != j.overrides.end() && !fs::path(it->second).is_absolute())
         it->second = (fs::path(j.base) / it->second).string();
   }
+  // A filter that writes an image writes it at one path, which every mesh
+  // would overwrite: refused where one is asked for; without it the meshes'
+  // own results (the hemicube's form factors, the view's vertex values) are
+  // baked (the filters were refused whatever their parameters).
+  if (d.writes & WritesImage)
+    for (const Job& j : jobs) {
+      Texts params = common;
+      for (const auto& [n, t] : j.overrides) params[n] = t;
+      if (auto it = params.find("image_path"); it != params.end() && !it->second.empty())
+        throw std::invalid_argument((j.overrides.count("image_path") ? j.where : std::string()) + "'" + d.cliName +
+                                    "' writes its image at one path (image_path), which every mesh would overwrite: "
+                                    "run it per mesh for images, or leave image_path empty");
+    }
   std::map<std::string, std::string> byStem;
   for (Job& j : jobs) {
     j.stem = fs::path(j.input).stem().string();

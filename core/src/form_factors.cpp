@@ -220,7 +220,7 @@ std::vector<ParamSpec> formFactorSpecs() {
                "about the normal so that the cells' aliasing averages out. Cost grows in proportion; 129 views (128 "
                "cells) bring two-triangle rectangles of Howell's catalogue within 1% of their exact factor, but "
                "not patches thinner than a few cells as the views see them (a strip 0.01 high at a common edge: "
-               "-78%; plates 0.03 apart: +2.7%): use the analytic method there.",
+               "-78%; plates 0.1 to 0.01 apart: +1.2% to +2.7%): use the analytic method there.",
        .type = ParamType::Int, .def = 1, .min = 1, .max = 4096},
   };
 }

@@ -425,7 +425,11 @@ RadiosityResult solveInMemory(const Scene& s, const Setup& u, const FormFactors&
 // progressive refinement unless a bounce count is fixed (Jacobi).
 RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors& ff, const MemoryPlan& mem,
                               RadiositySolver solver, const RadiosityOptions& opt, const Progress& progress) {
-  if (solver != RadiositySolver::Progressive && opt.bounces < 0) solver = RadiositySolver::Progressive;
+  // A solver asked for by name and replaced is said as a warning (it was a
+  // note the user could miss; an outside audit); Auto's choice stays a note.
+  const bool replaced = solver != RadiositySolver::Progressive && opt.bounces < 0;
+  const RadiositySolver asked = solver;
+  if (replaced) solver = RadiositySolver::Progressive;
   thread_local FormFactorRow scratch;
   RadiosityResult res = solve(s, u, [&ff](uint32_t i) -> const FormFactorRow& { scratch = ff.row(i); return scratch; },
                               false, solver, opt, ff.method(), progress.sub(0.1, 1.0));
@@ -433,6 +437,10 @@ RadiosityResult solveOnTheFly(const Scene& s, const Setup& u, const FormFactors&
     res.stats.warn("export_system needs the form-factor matrix in memory (raise memory_budget_mb): nothing exported");
   res.stats.note("form factors on the fly: the matrix (estimated " + megabytes(mem.matrix) + " MB) and the rest (" +
                  megabytes(mem.rest) + " MB) exceed the memory budget");
+  if (replaced && opt.solver == asked)
+    res.stats.warn(std::string("solver ") + kRadiositySolvers.logName(asked) +
+                   " needs the form-factor matrix in memory, which exceeds memory_budget_mb: progressive refinement "
+                   "(rows computed as they are shot) solved it instead; raise memory_budget_mb for the solver asked");
   return res;
 }
 

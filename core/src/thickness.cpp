@@ -340,12 +340,16 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   });
   const double traceSeconds = traceTimer.seconds();
   // Summary (sequential: deterministic).
+  // A vertex with nothing measured reads 0 with an error bar of the scene's
+  // diagonal (anything up to its size), not 0 +- 0, which read as an exact
+  // thickness of 0 (an outside audit).
   double rays = 0, sum = 0, relVar = 0;
   size_t counted = 0, invalid = 0, noHit = 0, few = 0;
+  const float unknown = float(rep.diagonal);
   for (size_t i = 0; i < nv; ++i) {
     rays += res.rays[i];
-    if (!valid[i]) { ++invalid; continue; }
-    if (res.hits[i] == 0) { ++noHit; continue; }
+    if (!valid[i]) { ++invalid; res.stdError[i] = unknown; continue; }
+    if (res.hits[i] == 0) { ++noHit; res.stdError[i] = unknown; continue; }
     if (res.hits[i] * 2 < res.rays[i]) ++few;
     sum += res.value[i];
     if (res.value[i] > 0.f) relVar += double(res.stdError[i]) * res.stdError[i] / (double(res.value[i]) * res.value[i]);
@@ -370,8 +374,10 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   const std::vector<uint8_t> copies = copyOnlyVertices(scene);  // they take their originals' values
   for (size_t i = 0; i < copies.size(); ++i) unmeasured -= copies[i] && !valid[i];
   if (unmeasured) st.note(std::to_string(unmeasured) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
-                          "surface, each face with a reversed copy, the faces' normals cancel) got 0");
-  if (noHit) st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0");
+                          "surface, each face with a reversed copy, the faces' normals cancel) got 0, with the scene's diagonal as their StdError");
+  if (noHit)
+    st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0, "
+            "with the scene's diagonal as their StdError (unmeasured)");
   const size_t traced = nv - invalid;
   if (traced && (noHit + few) * 10 > traced)
     st.warn(std::to_string(noHit + few) + " of " + std::to_string(traced) +

@@ -257,7 +257,25 @@ def case_inputs(a, tmp):
     one_line(["ao", "--manifest", bad, "-o", out], "bowl.ply", "two meshes of one name")
     one_line(["ao", "-o", out], "--manifest", "neither manifest nor folder")
     one_line(["ao", "--dir", meshes, "-o", out, "--shard", "3/3"], "--shard", "a shard outside 0..N-1")
-    one_line(["render", "--dir", meshes, "-o", out], "image", "a filter that writes an image")
+    one_line(["render", "--dir", meshes, "-o", out, "--image_path", os.path.join(tmp, "v.png")], "image_path",
+             "a filter that writes an image at one path")
+    # Without an image path such a filter bakes each mesh's own results (it
+    # was refused whatever its parameters; an outside audit).
+    p = run([a.gi, "batch", "hemicube", "--dir", meshes, "--glob", "bowl.ply", "-o", os.path.join(tmp, "hemi_out"),
+             "--face_index", "0", "--hemicube_resolution", "16", "--json"])
+    check(p.returncode == 0 and json.loads(p.stdout)["baked"] == 1, "hemicube without an image in a batch (%s)" % p.stderr.strip())
+    # Entries of the folder that are no regular file fail as their meshes
+    # (a link in a loop stopped the whole batch with the library's message;
+    # a dangling link was skipped in silence; an outside audit).
+    odd = os.path.join(tmp, "odd_meshes")
+    os.makedirs(odd)
+    shutil.copy(os.path.join(a.meshes, "bowl.ply"), odd)
+    os.symlink("loop.ply", os.path.join(odd, "loop.ply"))
+    os.symlink("nowhere.ply", os.path.join(odd, "dangling.ply"))
+    p = run([a.gi, "batch", "ao", "--dir", odd, "-o", os.path.join(tmp, "odd_out"), "--rays_per_vertex", "8", "--json"])
+    rep = json.loads(p.stdout) if p.stdout.strip() else {}
+    check(p.returncode == 1 and rep.get("baked") == 1 and rep.get("failed") == 2,
+          "a link in a loop and a dangling link fail as meshes, the rest is baked (rc %d, %s)" % (p.returncode, rep))
     one_line(["ao", "--dir", meshes, "-o", out, "--rays_per_vertex"], "needs a value", "a parameter without value")
     one_line(["ao", "--dir", meshes, "-o", meshes], "overwrite", "results that would overwrite their inputs")
     one_line(["ao", "--manifest", meshes, "-o", out], "is a folder", "a folder as the manifest")

@@ -574,3 +574,20 @@ TEST(Thickness, ConvexCornerCountsNoRayLeavingAtTheVertex) {
   }
   EXPECT_GT(r.stats.get("rays_leaving_at_the_vertex"), 0.0);
 }
+
+// A vertex where nothing was measured (an open plane: every ray leaves)
+// reads 0 with the scene's diagonal as its error bar, not 0 +- 0, which read
+// as an exact thickness of 0 (an outside audit); the log says so.
+TEST(Thickness, UnmeasuredVerticesCarryAnErrorBarOfTheSceneSize) {
+  const auto sf = scenes::openPlane(2.0, 4);
+  const ThicknessResult r = runThickness(sf.scene, 16, 60.0, true);
+  const double diag = analyzeScene(sf.scene).diagonal;
+  for (size_t i = 0; i < sf.scene.vertexCount(); ++i) {
+    EXPECT_EQ(r.hits[i], 0) << i;
+    EXPECT_EQ(r.value[i], 0.f) << i;
+    EXPECT_FLOAT_EQ(r.stdError[i], float(diag)) << i;
+  }
+  bool said = false;
+  for (const std::string& n : r.stats.notes) said = said || n.find("diagonal as their StdError") != std::string::npos;
+  EXPECT_TRUE(said);
+}

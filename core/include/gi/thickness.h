@@ -40,7 +40,7 @@ struct ThicknessOptions {
 
 struct ThicknessResult {
   std::vector<float> value;     // SDF in world units; 0 where no ray found the opposite side
-  std::vector<float> stdError;  // standard error of the mean (world units)
+  std::vector<float> stdError;  // standard error of the mean (world units); the scene's diagonal where nothing was measured
   std::vector<int> rays;        // rays cast
   std::vector<int> hits;        // rays that met the back of a face (those averaged, before trimming)
   RunStats stats;
