@@ -170,6 +170,18 @@ TEST(Radiosity, DeterministicAcrossThreadCountsAndMemoryPaths) {
   EXPECT_LT(num / den, 0.05);
   for (size_t k = 1; k < c.residualHistory.size(); ++k) ASSERT_LE(c.residualHistory[k], c.residualHistory[k - 1] * (1 + 1e-9));
   { tbb::global_control g(tbb::global_control::max_allowed_parallelism, 1); EXPECT_EQ(solveRadiosity(sf.scene, *caster, o).B, c.B); }
+  // Gauss-Seidel asked for by name there is replaced by progressive
+  // refinement: a warning (it was a note; an outside audit), none for Auto.
+  auto replacedWarned = [&](RadiositySolver solver) {
+    o.solver = solver;
+    const RadiosityResult r = solveRadiosity(sf.scene, *caster, o);
+    for (const auto& w : r.stats.warnings)
+      if (w.find("progressive refinement (rows computed as they are shot) solved it instead") != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(replacedWarned(RadiositySolver::GaussSeidel));
+  EXPECT_FALSE(replacedWarned(RadiositySolver::Auto));
+  EXPECT_FALSE(replacedWarned(RadiositySolver::Progressive));
 }
 
 TEST(Radiosity, RejectsBadInput) {
