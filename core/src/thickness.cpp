@@ -378,8 +378,33 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   if (noHit)
     st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0, "
             "with the scene's diagonal as their StdError (unmeasured)");
+  // Unmeasured vertices whose opposite side lies within the ray offset: the
+  // rays start past it, so a plate thinner than the offset reads 0, and the
+  // warning below blamed an open mesh or inward normals (an outside audit: a
+  // closed 10 x 10 x t box at t = 0.9 of the offset read 0 at all 242
+  // vertices of its middle). One ray each, inwards from the vertex itself.
+  size_t thin = 0;
+  const float eps = float(rep.rayEpsilon);
+  for (size_t i = 0; i < nv; ++i) {
+    if (!valid[i] || res.hits[i] != 0) continue;
+    Ray r;
+    r.o = scene.positions[i];
+    r.d = -normals[i];
+    r.tnear = 0.05f * eps;  // past the vertex's own faces
+    r.tfar = 2.f * eps;
+    const Hit h = caster.intersect(r);
+    thin += h.valid() && glm::dot(r.d, h.ng) > 0.f;
+  }
+  if (thin) {
+    char b[360];
+    std::snprintf(b, sizeof b,
+                  "%zu unmeasured vertices have the back of a face within twice the ray offset (%.3g) behind "
+                  "them: a part thinner than the offset (1e-5 of the scene's size) reads 0 there",
+                  thin, double(eps) * scene.unit);
+    st.warn(b);
+  }
   const size_t traced = nv - invalid;
-  if (traced && (noHit + few) * 10 > traced)
+  if (traced && (noHit + few) * 10 > traced && thin * 2 < noHit)
     st.warn(std::to_string(noHit + few) + " of " + std::to_string(traced) +
             " vertices found the opposite side with fewer than half their rays (" + std::to_string(noHit) +
             " with none): the mesh is open, its normals point inwards, or it has inner shells; thickness is "
