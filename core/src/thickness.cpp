@@ -294,6 +294,31 @@ RobustMean robustMean(std::vector<float>& L, bool reject) {
   return r;
 }
 
+namespace {
+
+// The unmeasured vertices whose opposite side lies within the ray offset:
+// the rays start past it, so a plate thinner than the offset reads 0, which
+// the log blamed on an open mesh or inward normals (an outside audit: a
+// closed 10 x 10 x t box at t = 0.9 of the offset read 0 at all 242
+// vertices of its middle). One ray each, inwards from the vertex itself.
+size_t thinnerThanTheOffset(const Scene& scene, const RayCaster& caster, const std::vector<glm::vec3>& normals,
+                            const std::vector<uint8_t>& valid, const std::vector<int>& hits, float eps) {
+  size_t thin = 0;
+  for (size_t i = 0; i < scene.vertexCount(); ++i) {
+    if (!valid[i] || hits[i] != 0) continue;
+    Ray r;
+    r.o = scene.positions[i];
+    r.d = -normals[i];
+    r.tnear = 0.05f * eps;  // past the vertex's own faces
+    r.tfar = 2.f * eps;
+    const Hit h = caster.intersect(r);
+    thin += h.valid() && glm::dot(r.d, h.ng) > 0.f;
+  }
+  return thin;
+}
+
+}  // namespace
+
 ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, const ThicknessOptions& opt,
                                  const Progress& progress) {
   checkCasterFor(scene, caster);
@@ -378,23 +403,8 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
   if (noHit)
     st.note(std::to_string(noHit) + " vertices found no opposite side (every ray missed or met a front face) and got 0, "
             "with the scene's diagonal as their StdError (unmeasured)");
-  // Unmeasured vertices whose opposite side lies within the ray offset: the
-  // rays start past it, so a plate thinner than the offset reads 0, and the
-  // warning below blamed an open mesh or inward normals (an outside audit: a
-  // closed 10 x 10 x t box at t = 0.9 of the offset read 0 at all 242
-  // vertices of its middle). One ray each, inwards from the vertex itself.
-  size_t thin = 0;
   const float eps = float(rep.rayEpsilon);
-  for (size_t i = 0; i < nv; ++i) {
-    if (!valid[i] || res.hits[i] != 0) continue;
-    Ray r;
-    r.o = scene.positions[i];
-    r.d = -normals[i];
-    r.tnear = 0.05f * eps;  // past the vertex's own faces
-    r.tfar = 2.f * eps;
-    const Hit h = caster.intersect(r);
-    thin += h.valid() && glm::dot(r.d, h.ng) > 0.f;
-  }
+  const size_t thin = thinnerThanTheOffset(scene, caster, normals, valid, res.hits, eps);
   if (thin) {
     char b[360];
     std::snprintf(b, sizeof b,
