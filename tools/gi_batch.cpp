@@ -183,14 +183,17 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
 std::vector<Job> readFolder(const std::string& dir, const std::string& pattern) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw std::invalid_argument("--dir " + dir + " is not a folder");
-  // Every entry the pattern matches is a job: one that is no regular file
-  // (a dangling link, a FIFO, a folder, a link in a loop) fails as that
+  // Every entry the pattern matches but a folder is a job: one that is no
+  // regular file (a dangling link, a FIFO, a link in a loop) fails as that
   // mesh, as it does from a manifest (it was skipped in silence, and a link
   // in a loop stopped the whole batch with the library's message; an
-  // outside audit).
+  // outside audit). Folders are no meshes (an output folder inside --dir).
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0) names.push_back(e.path().filename().string());
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    std::error_code kind;
+    if (fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0 && !e.is_directory(kind))
+      names.push_back(e.path().filename().string());
+  }
   if (ec) throw std::invalid_argument("cannot list " + dir + ": " + ec.message());
   if (names.empty()) throw std::invalid_argument("no file in " + dir + " matches --glob '" + pattern + "'");
   std::sort(names.begin(), names.end());
