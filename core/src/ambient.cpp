@@ -416,8 +416,7 @@ AmbientResult computeAmbient(const Scene& scene, const RayCaster& caster, const 
   if (twoSided)
     st.note(std::to_string(twoSided) + " vertices on a two-sided surface or where faces turned opposite ways meet (their normals cancel) "
             "took the mean of their two sides" + std::string(opt.bentNormals ? " (their bent normals stay 0)" : ""));
-  const std::vector<uint8_t> copies = copyOnlyVertices(scene);
-  for (size_t i = 0; i < copies.size(); ++i) invalid -= copies[i] && part.contains(i, nv) && status[i] == kInvalid;
+  invalid -= copyOnlyAmong(scene, [&](size_t i) { return part.contains(i, nv) && status[i] == kInvalid; });
   if (invalid) st.note(std::to_string(invalid) + " vertices without a usable face, with NaN/Inf, or without a side to "
                           "cast from (a fold whose faces' normals cancel) got 0");
   if (rep.degenerateFaces + rep.invalidFaces + rep.facesOnNonFinite)

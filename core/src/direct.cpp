@@ -213,8 +213,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
   st.add("rms_error_estimate", valid ? std::sqrt(err2 / double(valid)) : 0.0);
   st.note("direct light only (per-vertex light sampling)");
   size_t unlit = nv - valid;
-  const std::vector<uint8_t> copies = copyOnlyVertices(s);  // they take their originals' values
-  for (size_t i = 0; i < copies.size(); ++i) unlit -= copies[i] && !mat.valid[i];
+  unlit -= copyOnlyAmong(s, [&](size_t i) { return !mat.valid[i]; });
   if (unlit) st.note(std::to_string(unlit) + " vertices without a usable face got 0");
   return out;
 }

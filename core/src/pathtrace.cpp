@@ -512,8 +512,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
     st.note(std::to_string(twoSidedTraced) + " vertices on a two-sided surface or where faces turned opposite ways meet (their faces' normals cancel) took the "
             "mean of their two sides (each sample a path from either side)");
   size_t untraced = part.count(nv) - valid;
-  const std::vector<uint8_t> copies = copyOnlyVertices(s);  // they take their originals' values
-  for (size_t i = 0; i < copies.size(); ++i) untraced -= copies[i] && part.contains(i, nv) && res.traced[i] == 0;
+  untraced -= copyOnlyAmong(s, [&](size_t i) { return part.contains(i, nv) && res.traced[i] == 0; });
   if (untraced)
     st.note(std::to_string(untraced) + " vertices without a usable diffuse face (isolated, or on mirror, "
             "glass or glossy faces only: no diffuse radiosity) or without a side to trace from (a fold whose faces' "

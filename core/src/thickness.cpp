@@ -4,8 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include "gi/sampling.h"
 
@@ -303,18 +307,22 @@ namespace {
 // vertices of its middle). One ray each, inwards from the vertex itself.
 size_t thinnerThanTheOffset(const Scene& scene, const RayCaster& caster, const std::vector<glm::vec3>& normals,
                             const std::vector<uint8_t>& valid, const std::vector<int>& hits, float eps) {
-  size_t thin = 0;
-  for (size_t i = 0; i < scene.vertexCount(); ++i) {
-    if (!valid[i] || hits[i] != 0) continue;
-    Ray r;
-    r.o = scene.positions[i];
-    r.d = -normals[i];
-    r.tnear = 0.05f * eps;  // past the vertex's own faces
-    r.tfar = 2.f * eps;
-    const Hit h = caster.intersect(r);
-    thin += h.valid() && glm::dot(r.d, h.ng) > 0.f;
-  }
-  return thin;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, scene.vertexCount()), size_t(0),
+      [&](const tbb::blocked_range<size_t>& range, size_t thin) {
+        for (size_t i = range.begin(); i != range.end(); ++i) {
+          if (!valid[i] || hits[i] != 0) continue;
+          Ray r;
+          r.o = scene.positions[i];
+          r.d = -normals[i];
+          r.tnear = 0.05f * eps;  // past the vertex's own faces
+          r.tfar = 2.f * eps;
+          const Hit h = caster.intersect(r);
+          thin += h.valid() && glm::dot(r.d, h.ng) > 0.f;
+        }
+        return thin;
+      },
+      std::plus<size_t>());
 }
 
 }  // namespace
@@ -396,8 +404,7 @@ ThicknessResult computeThickness(const Scene& scene, const RayCaster& caster, co
             "or edge): no chord, not counted");
   st.add("skipped_invalid", double(invalid));
   size_t unmeasured = invalid;
-  const std::vector<uint8_t> copies = copyOnlyVertices(scene);  // they take their originals' values
-  for (size_t i = 0; i < copies.size(); ++i) unmeasured -= copies[i] && !valid[i];
+  unmeasured -= copyOnlyAmong(scene, [&](size_t i) { return !valid[i]; });
   if (unmeasured) st.note(std::to_string(unmeasured) + " vertices without a usable face, with NaN/Inf, or without a normal (on a two-sided "
                           "surface, each face with a reversed copy, the faces' normals cancel) got 0, with the scene's diagonal as their StdError");
   if (noHit)

@@ -150,6 +150,15 @@ std::vector<uint8_t> usableFaceMask(const Scene& s);
 // gives them their original's values, so they are neither isolated nor "got
 // 0". Empty where no face is left out.
 std::vector<uint8_t> copyOnlyVertices(const Scene& s);
+// How many copy-only vertices satisfy pred(i): the count a "got 0" note
+// leaves out, since those vertices show their originals' values.
+template <class Pred>
+size_t copyOnlyAmong(const Scene& s, Pred pred) {
+  const std::vector<uint8_t> copies = copyOnlyVertices(s);
+  size_t n = 0;
+  for (size_t i = 0; i < copies.size(); ++i) n += copies[i] && pred(i);
+  return n;
+}
 // Throws std::invalid_argument where a per-face array (rho, emission,
 // material, ior, roughness, leftOut) is neither empty nor one entry per
 // face: a library caller's mistake that would read past the array.
