@@ -76,27 +76,57 @@ struct Tally {
 // the default 16 samples (an outside audit). Neighbouring pixels see nearly
 // the same light; where the light changes (an edge) the larger variance
 // makes the bars wider, never narrower.
+// One sample per pixel has no sample variance of its own: the error bar is
+// then the spread of the 5 x 5 pixels' values around it (their sample
+// variance, each pixel one sample), which the image's own changes (edges)
+// only widen. The file of error bars was all 0, an exact-looking result
+// beside the noisiest image there is (an outside audit).
 constexpr int kPooledPixelRadius = 2;
-void poolPixelVariances(int W, int H, int spp, std::vector<float>& se) {
-  const size_t n = se.size();
-  std::vector<double> var(n), across(n, 0.0);
-  for (size_t p = 0; p < n; ++p) var[p] = double(se[p]) * se[p] * spp;
+
+// The mean of v over the (2r + 1)^2 pixels around each pixel (those inside
+// the image): rows, then columns.
+std::vector<double> boxMean(int W, int H, const std::vector<double>& v) {
   const int r = kPooledPixelRadius;
-  for (int y = 0; y < H; ++y)  // rows, then columns: a box of (2r + 1)^2 pixels
+  std::vector<double> across(v.size(), 0.0), mean(v.size(), 0.0);
+  for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       double sum = 0;
-      for (int u = std::max(0, x - r); u <= std::min(W - 1, x + r); ++u) sum += var[size_t(y) * size_t(W) + size_t(u)];
+      for (int u = std::max(0, x - r); u <= std::min(W - 1, x + r); ++u) sum += v[size_t(y) * size_t(W) + size_t(u)];
       across[size_t(y) * size_t(W) + size_t(x)] = sum;
     }
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
       double sum = 0;
-      for (int v = std::max(0, y - r); v <= std::min(H - 1, y + r); ++v) sum += across[size_t(v) * size_t(W) + size_t(x)];
+      for (int w = std::max(0, y - r); w <= std::min(H - 1, y + r); ++w) sum += across[size_t(w) * size_t(W) + size_t(x)];
       const double count = double(std::min(W - 1, x + r) - std::max(0, x - r) + 1) *
                            double(std::min(H - 1, y + r) - std::max(0, y - r) + 1);
-      const size_t p = size_t(y) * size_t(W) + size_t(x);
-      se[p] = float(std::sqrt(std::max(var[p], sum / count) / spp));
+      mean[size_t(y) * size_t(W) + size_t(x)] = sum / count;
     }
+  return mean;
+}
+
+void poolPixelVariances(int W, int H, int spp, const Image* oneSample, std::vector<float>& se) {
+  const size_t n = se.size();
+  if (spp == 1) {
+    if (!oneSample) return;
+    std::vector<double> l(n), l2(n);
+    for (size_t p = 0; p < n; ++p) l[p] = luminance(oneSample->px[p]), l2[p] = l[p] * l[p];
+    const std::vector<double> m = boxMean(W, H, l), m2 = boxMean(W, H, l2);
+    const int r = kPooledPixelRadius;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const double count = double(std::min(W - 1, x + r) - std::max(0, x - r) + 1) *
+                             double(std::min(H - 1, y + r) - std::max(0, y - r) + 1);
+        const size_t p = size_t(y) * size_t(W) + size_t(x);
+        const double var = std::max(0.0, m2[p] - m[p] * m[p]) * (count > 1 ? count / (count - 1) : 1.0);
+        se[p] = float(std::sqrt(var));
+      }
+    return;
+  }
+  std::vector<double> var(n);
+  for (size_t p = 0; p < n; ++p) var[p] = double(se[p]) * se[p] * spp;
+  const std::vector<double> mean = boxMean(W, H, var);
+  for (size_t p = 0; p < n; ++p) se[p] = float(std::sqrt(std::max(var[p], mean[p]) / spp));
 }
 
 void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o, const Context& ctx,
@@ -175,7 +205,7 @@ void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o
     tally.counts.add(t.counts);
     tally.nonFinite += t.nonFinite;
   }
-  if (spp > 1) poolPixelVariances(W, H, spp, res.stdError);
+  poolPixelVariances(W, H, spp, o.mode == RenderMode::PathTraced ? &res.image : nullptr, res.stdError);
 }
 
 // For each vertex, the radiance it sends towards the camera: an eye ray
@@ -345,7 +375,9 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
                            relN ? rel / double(relN) : 0.0, "raise max_depth, up to 100,000", st);
   }
   st.note(std::string("mode ") + renderModeName(o.mode));
-  if (o.mode == RenderMode::PathTraced && o.samplesPerPixel < 2) st.warn("one sample per pixel gives no error estimate");
+  if (o.mode == RenderMode::PathTraced && o.samplesPerPixel < 2) 
+    st.warn("one sample per pixel: each pixel's error bar is the spread of the 5 x 5 pixels around it (wider "
+            "where the image changes; more samples give each pixel its own)");
   // The distributed view's shadow rays stop at glass as the path tracer's
   // do: a point light inside a glass sphere left its image unchanged without
   // a word (an outside sweep, 5 December 2026).

@@ -33,8 +33,9 @@ std::vector<ParamSpec> RenderOptions::specs() {
                        "1984): sampled soft shadows, glossy reflection, antialiasing and depth of field; still no "
                        "diffuse interreflection. 'Two-pass': eye rays as in 'Distributed', the diffuse light from a "
                        "first pass already on the mesh (run radiosity or photon mapping first). 'Path traced': every "
-                       "light path (Kajiya 1986), unbiased, with an error bar per pixel: the yardstick for the "
-                       "others.",
+                       "light path (Kajiya 1986) up to 'Maximum bounces', unbiased within that, with an error bar per "
+                       "pixel: the yardstick for the others (in a bright closed room raise the bounces: the log "
+                       "says when the light they cut off may exceed the error bars).",
                .type = ParamType::Enum, .def = kRenderModes.index(RenderMode::Distributed),
                .choices = kRenderModes.choices()});
   s.push_back({.name = "width", .label = "Image width (pixels)",

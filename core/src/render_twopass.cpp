@@ -66,6 +66,28 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
   tp.R.resize(nv);
   size_t negative = 0;
   for (size_t i = 0; i < nv; ++i) tp.R[i] = glm::max(o.firstPassB[i] - mat.E[i], glm::vec3(0.f));
+  // This view's own lights (a point light, the sky, the sun) reach the
+  // diffuse surfaces only through what the first pass stored of them: with
+  // 'First pass alone' not at all, with the others by their direct light,
+  // their indirect light only if the first pass had them (radiosity has no
+  // point light). A point light given here only changed nothing, silently
+  // (an outside audit).
+  if (o.point.on() || o.outside().any()) {
+    const SkySun out = o.outside();
+    std::vector<std::string> names;
+    if (o.point.on()) names.push_back("point light");
+    if (out.sky()) names.push_back("sky");
+    if (out.sun()) names.push_back("sun");
+    std::string lights = names[0];
+    for (size_t k = 1; k < names.size(); ++k) lights += (k + 1 == names.size() ? " and " : ", ") + names[k];
+    const bool one = names.size() == 1;
+    stats.note(o.twoPass == TwoPassDiffuse::Map
+                   ? "'First pass alone': the diffuse surfaces take no light from this view's " + lights +
+                         " but what the first pass stored (give it the same lights; radiosity has no point light)"
+                   : "this view's " + lights + (one ? " adds its" : " add their") + " direct light; " +
+                         (one ? "its" : "their") + " indirect light is the first pass's (give it the same lights; "
+                         "radiosity has no point light)");
+  }
   const bool wantCaustics = o.twoPass == TwoPassDiffuse::Caustics || o.twoPass == TwoPassDiffuse::FinalGather;
   if (wantCaustics && anyFaceMaterial(s, isCausticSurface)) {
     Timer t;
