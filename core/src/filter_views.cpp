@@ -146,6 +146,7 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
       res.vertexColor.push_back(displayMap(L, img.exposure));
     }
     res.attributes.push_back(vectorAttribute("Radiance", r.vertexRadiance));
+    if (!r.vertexStdError.empty()) res.attributes.push_back(scalarAttribute("StdError", r.vertexStdError));
   }
   if (opt.mode == RenderMode::PathTraced && r.stdError.size() == img.image.px.size()) {
     // Its error bars as a picture of their own, at the image's exposure: the

@@ -18,6 +18,7 @@
 #include "gi/memory_limit.h"
 #include "gi/scene_setup.h"
 #include "gi/specular.h"
+#include "gi/vertex_graph.h"
 #include "render_internal.h"
 
 namespace gi {
@@ -212,8 +213,12 @@ void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o
 // arriving at the vertex (visible or not) from the camera's side, shaded
 // with the vertex normal (a smooth surface's reflection) on the incident
 // face seen most frontally; 0 for vertices facing away from the camera.
+// Path traced with 2 or more samples, each vertex's standard error as a
+// pixel's: its own sample variance, or its two rings' mean variance where
+// that is larger (a few paths' variance is skewed low; see
+// poolPixelVariances).
 std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, const Context& ctx,
-                                      const Progress& progress, Tally& tally) {
+                                      const Progress& progress, Tally& tally, std::vector<float>& stdError) {
   const size_t nv = s.vertexCount();
   const auto ok = usableFaceMask(s);
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
@@ -237,6 +242,10 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
     if (ok[f])
       for (int k = 0; k < 3; ++k) faces[fill[s.triangles[f][k]]++] = uint32_t(f);
   std::vector<glm::vec3> out(nv, glm::vec3(0.f));
+  const int spp = o.samplesPerPixel;
+  const bool errorBars = o.mode == RenderMode::PathTraced && spp > 1;
+  std::vector<double> var(errorBars ? nv : 0, 0.0);
+  std::vector<uint8_t> traced(nv, 0);
   std::mutex m;
   const bool qmc = o.mode != RenderMode::PathTraced;
   parallelBlocks(nv, progress, "radiance towards the camera", [&](size_t b, size_t e) {
@@ -262,16 +271,27 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
       ray.o = sp.x;
       ray.d = -toCam;
       glm::dvec3 sum(0.0);
-      for (int k = 0; k < o.samplesPerPixel; ++k) {
+      double sl = 0, sl2 = 0;
+      for (int k = 0; k < spp; ++k) {
         Sampler smp(hash3(uint32_t(v), o.seed, 0x7e47u), uint32_t(k), qmc);
-        sum += glm::dvec3(sampleRadiance(ctx, o.mode, ray, sp, smp, local.counts, local.nonFinite));
+        const glm::vec3 L = sampleRadiance(ctx, o.mode, ray, sp, smp, local.counts, local.nonFinite);
+        sum += glm::dvec3(L);
+        const double l = luminance(L);
+        sl += l, sl2 += l * l;
       }
-      out[v] = glm::vec3(sum / double(o.samplesPerPixel));
+      out[v] = glm::vec3(sum / double(spp));
+      traced[v] = 1;
+      if (errorBars) var[v] = std::max(0.0, (sl2 - sl * sl / spp) / (spp - 1));
     }
     std::lock_guard<std::mutex> lock(m);
     tally.counts.add(local.counts);
     tally.nonFinite += local.nonFinite;
   });
+  if (errorBars) {
+    atLeastRingMean(VertexGraph::build(s, &ok), traced, var);
+    stdError.assign(nv, 0.f);
+    for (size_t v = 0; v < nv; ++v) stdError[v] = float(std::sqrt(var[v] / spp));
+  }
   return out;
 }
 
@@ -322,7 +342,8 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   Timer traceTimer;
   if (o.renderImage) renderImage(s, caster, o, ctx, main, res, tally);
   if (o.vertexRadiance)
-    res.vertexRadiance = vertexRadiance(s, o, ctx, o.renderImage ? progress.sub(0.9, 1.0) : main, tally);
+    res.vertexRadiance =
+        vertexRadiance(s, o, ctx, o.renderImage ? progress.sub(0.9, 1.0) : main, tally, res.vertexStdError);
   const double traceSeconds = traceTimer.seconds();
 
   const Counts& c = tally.counts;

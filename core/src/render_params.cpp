@@ -140,7 +140,8 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .type = ParamType::Int, .def = 16, .min = 1, .max = 1 << 16});
   s.push_back({.name = "vertex_radiance", .label = "Also per-vertex radiance towards the camera",
                .help = "Compute for every vertex the radiance it sends towards the camera (what a mirror vertex "
-                       "shows from this viewpoint), with the same method and samples, for the vertex colours.",
+                       "shows from this viewpoint), with the same method and samples, for the vertex colours. Path "
+                       "traced with 2 or more samples: also its standard error (the per-vertex attribute StdError).",
                .type = ParamType::Bool, .def = false});
   for (const ParamSpec& p : PathTraceOptions::specs())
     if (p.name.rfind("sky_", 0) == 0 || p.name.rfind("sun_", 0) == 0) s.push_back(p);

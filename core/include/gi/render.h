@@ -124,6 +124,8 @@ struct RenderResult {
   std::vector<uint8_t> seesEmitter;  // per pixel: its first sample's eye ray hits an emitter (for auto exposure)
   std::vector<glm::vec3> vertexRadiance;  // per vertex, towards the camera (if asked), W / (m^2 sr);
                                           // 0 where the vertex normal faces away from the camera
+  std::vector<float> vertexStdError;  // per vertex, path traced with 2 or more samples: the standard error of
+                                      // vertexRadiance's luminance (its variance at least its 2-ring's mean)
   RunStats stats;
 };
 
