@@ -528,7 +528,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
             direct.estimate(origins[i], mat.n[i], smp, uint32_t(k), budget, hash3(uint32_t(i), seed ^ uint32_t(k), 0xd7u),
                             kNoHit).H;
         sum += glm::dvec3(h);
-        const double l = luminance(h);
+        const double l = luminance(mat.rho[i] * h);  // of rho H, B's reflected light
         sl += l, sl2 += l * l;
       }
       H[i] = glm::vec3(sum / double(points));

@@ -381,7 +381,7 @@ Totals combine(const VertexMaterial& mat, const std::vector<glm::vec3>& Hd, cons
       out.split.indirect[i] = mat.rho[i] * part(kPathIndirect);
     }
     const double hd = i < HdError.size() ? double(HdError[i]) : 0.0;
-    out.stdError[i] = float(luminance(mat.rho[i]) * std::sqrt(double(e.noise[i]) * e.noise[i] + hd * hd));
+    out.stdError[i] = float(std::sqrt(double(e.noise[i]) * e.noise[i] + hd * hd));  // both of rho H's luminance
   }
   return totalsOver(out.B, out.stdError, mat.valid);
 }

@@ -227,7 +227,9 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
     // lay beyond 3 standard errors of the reference (z down to -13.6; an
     // outside audit).
     std::vector<uint8_t> gathered(s.vertexCount(), 0);
-    for (size_t v = 0; v < gathered.size(); ++v) gathered[v] = (!only || (*only)[v]) && r.mat.valid[v];
+    // (A black vertex's B = E has no reflected light and no error to take.)
+    for (size_t v = 0; v < gathered.size(); ++v)
+      gathered[v] = (!only || (*only)[v]) && r.mat.valid[v] && luminance(r.mat.rho[v]) > 0.f;
     atLeastRingMean(VertexGraph::build(s), gathered, *variance);
   }
   if (nearHits) *nearHits = relit.load();
@@ -284,7 +286,8 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
   parallelBlocks(nv, progress.sub(0.0, gatherAll ? 0.1 : 0.6), "density estimation", [&](size_t b, size_t end) {
     for (size_t i = b; i < end; ++i) {
       if (!r.mat.valid[i]) continue;
-      double e1 = 0, e2 = 0;
+      double e1 = 0, e2 = 0;  // the noise of the luminance of rho H, B's (w: rho times the luminance weights)
+      const glm::vec3 w = r.mat.rho[i] * glm::vec3(kLuminanceWeights);
       // The terms by path kind: a final gather's photons lie one diffuse
       // bounce beyond the vertex (all indirect); a map's by their tag.
       glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
@@ -295,7 +298,7 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
         int used = 0;
         float radius = 0.f;
         H = m.global->irradiance(s.positions[i], r.mat.n[i], opt.kNearest, r.r2max, PhotonKernel::Uniform, &e1,
-                                 &used, byPath, PhotonOnly(), &radius);
+                                 &used, byPath, PhotonOnly(), &radius, nullptr, w);
         bool atCrease = false;
         if (handOver) {
           if (handsOver(r, surface, crease, i, radius, atCrease)) {
@@ -315,7 +318,7 @@ PhotonEstimate estimateAtVertices(const PhotonRun& r, PhotonMaps& m, const std::
       }
       if (m.caustics)
         H += m.caustics->irradiance(s.positions[i], r.mat.n[i], opt.causticK, r.r2max, PhotonKernel::Cone, &e2,
-                                    nullptr, byPath, causticOnly);
+                                    nullptr, byPath, causticOnly, nullptr, nullptr, w);
       if (split)
         for (int k = 0; k < kPathKinds; ++k) e.byPath[k][i] = parts[k];
       e.H[i] = H;

@@ -74,8 +74,9 @@ struct PhotonGatherHit {
 // a glossy lobe by one sample of it) and, at the
 // first diffuse face, add value(hit) if the ray hit its front (0 otherwise).
 // `only` (one flag per vertex, or null for all): the vertices to gather at; the others get 0.
-// *variance (if given): per vertex, the variance of the mean of the rays'
-// luminance (their sample variance over the ray count; an upper bound for
+// *variance (if given): per vertex, the variance of the mean of the luminance
+// of rho (the vertex's reflectance) times the rays' values, B's reflected light
+// (their sample variance over the ray count; an upper bound for
 // the stratified rays), 0 where nothing was gathered.
 std::vector<glm::vec3> specularFinalGather(const Scene& s, const RayCaster& caster, const VertexMaterial& mat,
                                            const std::vector<glm::vec3>& origins, int rays, uint32_t key, float eps,
@@ -87,7 +88,7 @@ std::vector<glm::vec3> specularFinalGather(const Scene& s, const RayCaster& cast
 // The photons' irradiance at the vertices.
 struct PhotonEstimate {
   std::vector<glm::vec3> H;
-  std::vector<double> noise;  // Poisson standard error (luminance)
+  std::vector<double> noise;  // Poisson standard error of the luminance of rho H (B's reflected light)
   size_t verticesWithoutPhotons = 0;
   PhotonGatherCheck check;
   std::vector<glm::vec3> byPath[kPathKinds];  // H's terms by the photons' path kind (light_path_split, k nearest)
@@ -164,7 +165,7 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
 // same errors, the gather's own noise dominating, at 0.3 to 2.3 s more).
 struct ProgressiveResult {
   std::vector<glm::vec3> H;
-  std::vector<double> noise;  // Poisson error estimate per vertex (luminance)
+  std::vector<double> noise;  // Poisson error estimate per vertex, of the luminance of rho H
   size_t verticesWithoutPhotons = 0;
   double meanRadius = 0, meanCount = 0;
   double traceSeconds = 0, buildSeconds = 0, querySeconds = 0;

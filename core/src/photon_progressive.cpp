@@ -143,14 +143,17 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, cons
     for (auto& h : r.byPath) h.assign(nv, glm::vec3(0.f));
   double sumR = 0, sumN = 0;
   size_t valid = 0;
-  // The power a kept photon carries on average (luminance, per pass): a
-  // vertex that kept none has about one such photon's density as its
-  // standard error (it read 0: 190 of floor_wall's vertices, 159 of them
-  // beyond 4 of it against the reference; an outside audit).
-  double tauL = 0, kept = 0;
+  // The power a kept photon carries on average (per pass): a vertex that
+  // kept none has about one such photon's density as its standard error
+  // (it read 0: 190 of floor_wall's vertices, 159 of them beyond 4 of it
+  // against the reference; an outside audit). Errors are of the luminance
+  // of rho H, B's reflected light (of H's, times rho's luminance, they were
+  // 2.5 to 4 times too small where light and surface are both coloured).
+  glm::dvec3 tau(0.0);
+  double kept = 0;
   for (size_t i = 0; i < nv; ++i)
-    if (mat.valid[i] && v.N[i] > 0.0) tauL += luminance(glm::vec3(v.tau[i])), kept += v.N[i];
-  const double perPhoton = kept > 0 ? tauL / kept : 0.0;
+    if (mat.valid[i] && v.N[i] > 0.0) tau += v.tau[i], kept += v.N[i];
+  const glm::dvec3 perPhoton = kept > 0 ? tau / kept : glm::dvec3(0.0);
   for (size_t i = 0; i < nv; ++i) {
     if (!mat.valid[i]) continue;
     ++valid;
@@ -163,7 +166,7 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, cons
     const double area = v.A[i] > 0.0 ? v.A[i] : M_PI * double(v.R2[i]);
     if (v.N[i] <= 0.0) {
       r.verticesWithoutPhotons += gathers[i] ? 0 : 1;
-      if (area > 0.0) r.noise[i] = perPhoton / (area * passes);
+      if (area > 0.0) r.noise[i] = luminance(mat.rho[i] * glm::vec3(perPhoton)) / (area * passes);
       continue;
     }
     const glm::dvec3 H = v.tau[i] / (area * passes);
@@ -171,7 +174,7 @@ void estimates(const VertexMaterial& mat, const PpmVertices& v, int passes, cons
     if (split)
       for (int k = 0; k < 3; ++k) r.byPath[k][i] = glm::vec3(v.tauPath[k][i] / (area * passes));
     // About N photons kept: relative Poisson noise 1 / sqrt(N) (equal photon powers).
-    r.noise[i] = luminance(glm::vec3(H)) / std::sqrt(v.N[i]);
+    r.noise[i] = luminance(mat.rho[i] * glm::vec3(H)) / std::sqrt(v.N[i]);
   }
   r.meanRadius = valid ? sumR / double(valid) : 0.0;
   r.meanCount = valid ? sumN / double(valid) : 0.0;
@@ -345,12 +348,12 @@ std::vector<glm::vec3> specularFinalGather(
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
         }
-        const double l = luminance(glm::vec3(sum - before));
+        const double l = luminance(mat.rho[v] * glm::vec3(sum - before));  // B's reflected light: rho H
         sumL2 += l * l;
       }
       H[v] = glm::vec3(sum / double(rays));
       if (variance && rays > 1) {
-        const double m = luminance(H[v]);
+        const double m = luminance(mat.rho[v] * H[v]);
         (*variance)[v] = std::max(0.0, (sumL2 / rays - m * m) / (rays - 1));
       }
     }

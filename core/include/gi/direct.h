@@ -110,7 +110,7 @@ std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster&
 // vertices of one part (the others 0); with luminaires, one point with up
 // to lightSamples shadow rays per luminaire in penumbra.
 // `stdError` (if given): each vertex's standard error of the luminance of
-// H where the light is sampled (more luminaires than Luminaires::
+// rho H (its reflected direct light, the luminance of B less E) where the light is sampled (more luminaires than Luminaires::
 // kMaxLuminaires: power sampling with MIS, the sample variance of its
 // light_samples estimates); 0 with luminaires (exact form factors, shadow
 // rays in penumbra only).
