@@ -3,6 +3,7 @@
 #include <fnmatch.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -190,15 +191,27 @@ std::optional<std::string> applyMaterials(Scene& s, const std::vector<LayerRange
     }
     msg += std::string(msg.empty() ? "" : ", ") + "'" + l.name + "' " + (m ? "mirror" : g ? "glass" : "glossy") + " (" +
            std::to_string(count) + " faces)";
-    if (g) {  // a glass object should be closed: every edge shared by two of its faces
+    if (g) {  // a glass object should be closed: every edge (by position) shared by two of its faces
+      std::map<std::array<float, 3>, uint32_t> at;  // a welded index per position (an STL's corners are apart)
+      const auto id = [&](uint32_t v) {
+        const glm::vec3& p = s.positions[v];
+        return at.emplace(std::array<float, 3>{p.x, p.y, p.z}, uint32_t(at.size())).first->second;
+      };
       std::map<std::pair<uint32_t, uint32_t>, int> edges;
       for (size_t f = l.faceOffset; f < std::min(nf, l.faceOffset + l.faceCount); ++f)
         for (int k = 0; k < 3; ++k) {
-          uint32_t a = s.triangles[f][k], b = s.triangles[f][(k + 1) % 3];
-          edges[{std::min(a, b), std::max(a, b)}]++;
+          const uint32_t a = id(s.triangles[f][k]), b = id(s.triangles[f][(k + 1) % 3]);
+          if (a != b) edges[{std::min(a, b), std::max(a, b)}]++;
         }
       const size_t open = size_t(std::count_if(edges.begin(), edges.end(), [](const auto& e) { return e.second != 2; }));
       if (open) msg += " [not closed: " + std::to_string(open) + " border or non-manifold edges]";
+      // Refraction needs an inside: light entering an open sheet of glass
+      // never leaves it through a second face (a lone pane bends every ray
+      // that passes it). Said only in the log until an outside audit.
+      if (open && warnings)
+        warnings->push_back("glass layer '" + l.name + "' is not closed (" + std::to_string(open) +
+                            " border or non-manifold edges): light that enters it may not leave through a second "
+                            "face, and the light through it is wrong; give it a thickness (a pane is a thin box)");
       // A closed object whose faces point inwards encloses a negative
       // volume (the divergence theorem: V = sum over faces of a . (b x c) / 6,
       // about the layer's first vertex for precision): light then enters
