@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 #include <stdexcept>
 
@@ -120,6 +121,18 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
   // after radiosity the caustic map was taken out of light without caustics.
   if (const VertexAttribute* c = in.attribute("RadiosityCaustics");
       c && c->components == 1 && !c->values.empty() && opt.mode == RenderMode::TwoPass) {
+    // A flag, 0 or 1 at every vertex, as the filters of this suite write it;
+    // NaN, -5 or 1e30 were read as "no caustics" in silence (an outside audit).
+    const auto bad = std::find_if(c->values.begin(), c->values.end(), [](float x) { return x != 0.f && x != 1.f; });
+    if (bad != c->values.end()) {
+      char b[64];
+      std::snprintf(b, sizeof b, "%g", double(*bad));
+      throw std::invalid_argument(
+          "the first pass's RadiosityCaustics attribute is neither 0 nor 1 at " +
+          std::to_string(std::count_if(c->values.begin(), c->values.end(), [](float x) { return x != 0.f && x != 1.f; })) +
+          " vertices (e.g. " + b + "): it is a flag per vertex (1: the first pass holds caustics); remove it, or "
+          "rerun the first pass");
+    }
     const bool has = std::count_if(c->values.begin(), c->values.end(), [](float x) { return x > 0.5f; }) * 2 >
                      std::ptrdiff_t(c->values.size());
     if (has != opt.firstPassHasCaustics)

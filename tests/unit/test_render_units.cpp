@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "gi/filter_files.h"
@@ -280,6 +281,20 @@ TEST(RenderUnits, TwoPassTakesOutOnlyCausticsTheFirstPassHolds) {
       EXPECT_GT(v.stats.get("caustic_photons_stored"), 0.0) << line;
       EXPECT_EQ(line.find("the first pass's caustics replaced") != std::string::npos, holds) << line;
       EXPECT_EQ(line.find("RadiosityCaustics attribute") != std::string::npos, parameter != holds) << line;
+    }
+    // A flag that is neither 0 nor 1 anywhere (NaN, -5, 1e30) was read as
+    // "no caustics" in silence (an outside audit): refused, naming it.
+    for (const float bad : {std::nanf(""), -5.f, 1e30f, 0.5f}) {
+      FilterInput damaged = view;
+      for (VertexAttribute& a : damaged.attributes)
+        if (a.name == "RadiosityCaustics") a.values[1] = bad;
+      try {
+        runFilter(FilterKind::RayTracedView, damaged);
+        ADD_FAILURE() << bad << " was taken";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("RadiosityCaustics attribute is neither 0 nor 1 at 1 vertices"),
+                  std::string::npos) << e.what();
+      }
     }
   }
 }
