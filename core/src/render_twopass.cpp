@@ -129,7 +129,13 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
     }
     const size_t stored = photons.size();
     tp.r2max = o.causticMaxRadius > 0 ? float(o.causticMaxRadius * o.causticMaxRadius) : HUGE_VALF;
-    if (stored) tp.caustics = std::make_unique<CausticMap>(std::move(photons), s);
+    // Its kd-tree over millions of photons takes seconds (20 million aimed
+    // on the caustic Cornell box: 6.4 million stored, 12 s with the
+    // tracing) with nothing said: the bar looked stuck (an outside audit).
+    if (stored) {
+      progress.report(0.5, "building the caustic map (" + std::to_string(stored) + " photons)");
+      tp.caustics = std::make_unique<CausticMap>(std::move(photons), s);
+    }
     stats.add("caustic_photons_aimed", double(ts.causticEmitted));
     stats.add("caustic_photons_stored", double(stored));
     stats.add("caustic_map_seconds", t.seconds());
