@@ -92,8 +92,9 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        .type = ParamType::Int, .def = 16, .min = 1, .max = 100000},
       {.name = "max_depth", .label = "Maximum bounces",
        .help = "Bounces a path may take, diffuse or specular, counted as the reference counts them: 0 = direct "
-               "light only, k = light that reflected at most k times before the vertex (with the final gather, its "
-               "rays are the last reflection; where they pass mirrors or glass on their way, those are not counted). "
+               "light only, k = light that reflected at most k times before the vertex (with the final gather, and "
+               "at the vertices the other modes hand over to one (creases, another surface near), its rays are the "
+               "last reflection; where they pass mirrors or glass on their way, those are not counted). "
                "Russian roulette ends most paths much earlier; the power still carried by cut paths is logged.",
        .type = ParamType::Int, .def = 32, .min = 0, .max = 1000},
   };
