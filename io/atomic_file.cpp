@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 namespace gi::io {
 
@@ -83,6 +84,13 @@ extern "C" void removeTemporariesAndStop(int sig) {
   ::raise(sig);
 }
 
+// The open transaction's held-back files, in the order written.
+struct Pending {
+  std::string tmp, target, path;
+  int slot;
+};
+std::vector<Pending>* g_pending = nullptr;
+
 std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
   if (from.empty()) return s;
   for (size_t k = s.find(from); k != std::string::npos; k = s.find(from, k + to.size())) s.replace(k, from.size(), to);
@@ -120,6 +128,11 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     if (exists) ::chmod(tmp.c_str(), st.st_mode & 07777);  // the permissions of the file it replaces
     write(tmp);
     if (!syncFile(tmp)) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    if (g_pending) {  // held back until the transaction commits (still removed on a signal)
+      g_pending->push_back({tmp, target, path, listed.slot});
+      listed.slot = -1;
+      return;
+    }
     if (std::rename(tmp.c_str(), target.c_str()) != 0)
       throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
   } catch (const std::exception& e) {
@@ -138,6 +151,35 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
     f.close();
     if (!f) throw std::runtime_error("cannot write " + temp + ": " + std::strerror(errno));
   });
+}
+
+OutputTransaction::OutputTransaction() {
+  if (g_pending) throw std::logic_error("an output transaction is already open");
+  g_pending = new std::vector<Pending>();
+}
+
+OutputTransaction::~OutputTransaction() {
+  if (!g_pending) return;
+  for (const Pending& p : *g_pending) {
+    ::unlink(p.tmp.c_str());
+    unlistTemporary(p.slot);
+  }
+  delete g_pending;
+  g_pending = nullptr;
+}
+
+void OutputTransaction::commit() {
+  std::vector<Pending> files = std::move(*g_pending);
+  delete g_pending;
+  g_pending = nullptr;
+  for (size_t k = 0; k < files.size(); ++k) {
+    if (std::rename(files[k].tmp.c_str(), files[k].target.c_str()) != 0) {
+      const std::string why = std::strerror(errno);
+      for (size_t j = k; j < files.size(); ++j) ::unlink(files[j].tmp.c_str()), unlistTemporary(files[j].slot);
+      throw std::runtime_error("cannot write " + files[k].path + ": " + why);
+    }
+    unlistTemporary(files[k].slot);
+  }
 }
 
 void removeTemporariesOnSignals() {

@@ -18,6 +18,23 @@ namespace gi::io {
 void writeAtomically(const std::string& path, const std::function<void(const std::string& temp)>& write);
 void writeFileAtomically(const std::string& path, std::string_view bytes);
 
+// The outputs of one run as one change: while one is open, every file
+// writeAtomically writes is held back as its synced temporary, and commit()
+// renames them all into place; destroyed without commit (the run failed on
+// a later file: a full disk), it removes them and no target has changed. A
+// run whose image failed to write left its new PLY over the old one and a
+// PNG without its PFM (an outside audit). One at a time, in one thread.
+class OutputTransaction {
+ public:
+  OutputTransaction();
+  ~OutputTransaction();
+  OutputTransaction(const OutputTransaction&) = delete;
+  OutputTransaction& operator=(const OutputTransaction&) = delete;
+  // Throws std::runtime_error "cannot write PATH: WHY" if a rename fails
+  // (the temporaries not yet renamed are removed).
+  void commit();
+};
+
 // Why a file cannot be created beside `path` (the strerror text; empty: it
 // can): a temporary there is created and removed, which also finds a folder
 // that refuses new files to root (/proc) or a read-only file system.

@@ -301,6 +301,8 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   std::vector<files::Named> outputs = resultOutputs(a, r);
   if (caching) outputs.push_back({cached, "--cache"});
   files::check(inputs, outputs);
+  // Every output or none: each file is held back until all are written.
+  io::OutputTransaction written;
   if (!a.saveResult.empty()) io::writeResultFile(a.saveResult, key, r);
 
   std::vector<std::string> layerFiles;
@@ -311,6 +313,7 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
     r.stats.note("the new layers are written only beside an output (-o)");
   }
   writeOutputFiles(r, files::atomicWriter());
+  written.commit();
   // The cache last, and optional: a cache that cannot take the result (a
   // full disk) warns and loses nothing else (it threw away a 22 s reference
   // before its output was written; an outside audit).

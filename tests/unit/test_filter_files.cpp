@@ -177,3 +177,47 @@ TEST(AtomicFile, WritesThroughASymbolicLink) {
   EXPECT_NE(io::cannotCreateBeside((target.parent_path() / "no" / "x").string()), "");
   fs::remove_all(target.parent_path());
 }
+
+// A run's outputs change together: a failure on its last file (a full disk)
+// left the new PLY over the old one and a PNG without its PFM (an outside
+// audit). In a transaction nothing is renamed into place before commit; a
+// transaction that ends without one leaves the old files and no temporary.
+TEST(AtomicFile, OutputTransactionChangesEveryFileOrNone) {
+  const fs::path a = scratch("a.ply"), b = scratch("b.png"), fresh = scratch("new.pfm");
+  io::writeFileAtomically(a.string(), "old a");
+  io::writeFileAtomically(b.string(), "old b");
+  const auto others = [&] {
+    size_t n = 0;
+    for (const auto& e : fs::directory_iterator(a.parent_path())) n += e.path().filename().string()[0] == '.';
+    return n;
+  };
+  {
+    io::OutputTransaction t;
+    io::writeFileAtomically(a.string(), "new a");
+    io::writeFileAtomically(fresh.string(), "new pfm");
+    EXPECT_EQ(readAll(a), "old a");  // held back
+    EXPECT_FALSE(fs::exists(fresh));
+    EXPECT_THROW(io::writeAtomically(b.string(), [](const std::string& temp) {
+                   throw std::runtime_error("cannot write " + temp + ": No space left on device");
+                 }),
+                 std::runtime_error);
+  }  // no commit: the run failed
+  EXPECT_EQ(readAll(a), "old a");
+  EXPECT_EQ(readAll(b), "old b");
+  EXPECT_FALSE(fs::exists(fresh));
+  EXPECT_EQ(others(), 0u) << "a temporary was left";
+  {
+    io::OutputTransaction t;
+    io::writeFileAtomically(a.string(), "new a");
+    io::writeFileAtomically(b.string(), "new b");
+    io::writeFileAtomically(fresh.string(), "new pfm");
+    t.commit();
+  }
+  EXPECT_EQ(readAll(a), "new a");
+  EXPECT_EQ(readAll(b), "new b");
+  EXPECT_EQ(readAll(fresh), "new pfm");
+  EXPECT_EQ(others(), 0u);
+  io::writeFileAtomically(a.string(), "after");  // no transaction open: written at once
+  EXPECT_EQ(readAll(a), "after");
+  fs::remove_all(a.parent_path());
+}
