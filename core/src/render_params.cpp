@@ -96,7 +96,11 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .type = ParamType::Int, .def = -1, .min = -1, .max = 100000});
   s.push_back({.name = "light_samples", .label = "Shadow rays per light",
                .help = "Samples of each area light (and of the sun disk) at the first diffuse surface an eye ray "
-                       "meets, per eye ray; deeper surfaces take one. More: smoother soft shadows at fewer eye rays.",
+                       "meets, per eye ray; deeper surfaces take one. More: smoother soft shadows at fewer eye rays. "
+                       "They are weighed against the reflection's own sample (multiple importance sampling, Veach "
+                       "1997), so where that finds the light better (light all around: a room whose walls glow) more "
+                       "light samples give no gain, even a little more noise (an outside audit: 1.5% to 1.9% in such "
+                       "a room at 16 eye rays).",
                .type = ParamType::Int, .def = 1, .min = 1, .max = 4096});
   s.push_back({.name = "whitted_min_weight", .label = "Smallest ray weight (Whitted)",
                .help = "Whitted splits every glass hit into a reflected (Fresnel F) and a refracted (1 - F) ray; a "
