@@ -20,8 +20,10 @@ std::vector<ParamSpec> radiosityCourseSpecs() {
                "over the scene and reflected 1 / (1 - rho_avg) times, A = sum_j A_j dB_j / sum_j A_j / (1 - "
                "rho_avg) (Cohen et al. 1988, 'A progressive refinement approach to fast radiosity image "
                "generation'), so that images after few shots (a high tolerance, or the snapshots) have about the "
-               "converged brightness: for display. Off: B is the physical radiosity of the shots made so far. At "
-               "convergence the term vanishes.",
+               "converged brightness: for display. It assumes a closed room (all light stays in the scene): where "
+               "much leaves (an open floor, the Cornell box's open side) early images overshoot, which the log "
+               "warns of. Off: B is the physical radiosity of the shots made so far. At convergence the term "
+               "vanishes.",
        .type = ParamType::Bool, .def = false},
       {.name = "snapshot_steps", .label = "Snapshot steps",
        .help = "Comma-separated step counts, e.g. '0, 10, 100' (at most 64): after each, the patch-average "
