@@ -84,6 +84,7 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
     checkFiles(kind, in, md);
     FilterResult r = runFilter(kind, in, Progress(progressFrom(cb)));
     for (const std::string& w : b.warnings) r.stats.warn(w);
+    for (const std::string& n : b.notes) r.stats.note(n);
     // Everything is computed: only now does the document change. Files are
     // written whole or not at all (a full disk keeps the file that was there).
     writeOutputFiles(r, files::atomicWriter());

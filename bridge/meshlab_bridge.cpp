@@ -19,16 +19,25 @@
 
 namespace gi::ml {
 
-std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent) {
+std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent, size_t* faceless) {
   std::vector<MeshModel*> out;
+  size_t skipped = 0;
   const bool all = extent == SceneExtent::AllVisibleLayers;
   if (all) {
-    for (MeshModel* m : compat::meshes(md))
-      if (m && m->isVisible()) out.push_back(m);
+    for (MeshModel* m : compat::meshes(md)) {
+      if (!m || !m->isVisible()) continue;
+      if (m->cm.fn > 0) out.push_back(m);
+      else ++skipped;
+    }
   } else if (md.mm()) {
     out.push_back(md.mm());
   }
-  if (out.empty()) throw std::invalid_argument(all ? "no visible layer to work on" : "no current layer to work on");
+  if (faceless) *faceless = skipped;
+  if (out.empty())
+    throw std::invalid_argument(!all ? "no current layer to work on"
+                                : skipped ? "no visible layer with faces to work on (" + std::to_string(skipped) +
+                                                " without faces: point clouds are neither lit nor occlude)"
+                                          : std::string("no visible layer to work on"));
   return out;
 }
 
@@ -183,7 +192,8 @@ ParamValues readParams(const RichParameterList& in, const std::vector<ParamSpec>
 double documentDiagonal(MeshDocument& md) {
   // Over the vertices the faces use, as the engine's scale (Scene::fromAbsolute,
   // sceneScale): a vertex no face uses, far away, moves no default. A layer
-  // without faces counts by its box.
+  // without faces counts by its box only as the current one (the others,
+  // point clouds, take no part: participatingLayers).
   vcg::Box3<MESHLAB_SCALAR> box;
   for (MeshModel* m : compat::meshes(md)) {
     if (!(m == md.mm() || m->isVisible())) continue;
@@ -193,7 +203,7 @@ double documentDiagonal(MeshDocument& md) {
       for (int k = 0; k < 3; ++k) box.Add(f.cP(k));
       faces = true;
     }
-    if (!faces) box.Add(m->cm.bbox);
+    if (!faces && m == md.mm()) box.Add(m->cm.bbox);
   }
   const double d = box.IsNull() ? 1.0 : double(box.Diag());
   return d > 0 && std::isfinite(d) ? d : 1.0;
@@ -429,7 +439,11 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
   in.values = readParams(par, filterSpecs(kind));
   const SceneExtent extent =
       in.values.has("scene_extent") ? kSceneExtents.get(in.values, "scene_extent") : SceneExtent::CurrentLayer;
-  b = toScene(participatingLayers(md, extent));
+  size_t faceless = 0;
+  b = toScene(participatingLayers(md, extent, &faceless));
+  if (faceless)
+    b.notes.push_back(std::to_string(faceless) + " visible layer" + (faceless > 1 ? "s" : "") +
+                      " without faces (point clouds) left out and unchanged");
   in.scene = std::move(b.scene);  // the bridge keeps the layers' indexing, the engine the geometry
   in.attrs = b.attrs;
   for (const LayerPart& p : b.parts) in.layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});

@@ -32,11 +32,14 @@ struct BridgeScene {
   MeshAttributes attrs;
   std::vector<LayerPart> parts;
   std::vector<std::string> warnings;  // what the run's log should warn of (coordinates too coarse to trust)
+  std::vector<std::string> notes;     // and say (visible layers without faces left out)
 };
 
-// Layers taking part: the current one, or every visible one. Throws
-// std::invalid_argument if there is none.
-std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent);
+// Layers taking part: the current one, or every visible one with faces (a
+// point cloud, such as photon mapping's photon layer, is neither lit nor
+// occludes: it was written over with 0s and black; *faceless, if given,
+// gets how many were left out). Throws std::invalid_argument if there is none.
+std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent, size_t* faceless = nullptr);
 // Converts the layers (deleted elements skipped) into one scene. Throws
 // std::invalid_argument when there is nothing to work on (no faces).
 BridgeScene toScene(const std::vector<MeshModel*>& layers);

@@ -111,6 +111,24 @@ def case_layers(c):
     check(abs(r["quality"] - expect) < 0.03, "the wall layer occludes the floor layer: AO %.4f vs %.4f" % (r["quality"], expect))
     w = nearest(results[1], (0.0, 0.0, 0.5))
     check(0.0 < w["quality"] < 1.0 and w["red"] == w["green"], "the wall layer received its AO too (%.4f)" % w["quality"])
+    # A visible point cloud beside them (photon mapping's photon layer is one) takes no part and keeps its
+    # colours and quality: "All visible layers" wrote 0s and black over it (an outside audit).
+    cloud = os.path.join(c.tmp, "cloud.ply")
+    with open(cloud, "w") as fh:
+        fh.write("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                 "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float quality\nend_header\n")
+        for x in (0.2, 0.4, 0.6):
+            fh.write("%r 0.3 0.2 200 10 30 0.7\n" % x)
+    out = os.path.join(c.tmp, "cloud_out.ply")
+    p = subprocess.run([c.mlx_run, "-i", floor, "-i", wall, "-i", cloud, "-o", out, "-l", "2", "-m", "vc", "vq",
+                        "-s", script], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+    log = p.stdout.decode("utf-8", "replace")
+    if p.returncode != 0:
+        fail("meshlabserver failed with a point cloud layer:\n" + log[-2000:])
+    kept = vertices(out)
+    check(len(kept) == 3 and all((r["red"], r["green"], r["blue"]) == (200, 10, 30) and abs(r["quality"] - 0.7) < 1e-6
+                                 for r in kept), "the point cloud layer kept its colours and quality: %r" % kept[:1])
+    check("1 visible layer without faces (point clouds) left out and unchanged" in log, "the log says so")
     # Current layer only (the wall, loaded last): nothing occludes the wall's front but the floor, which is absent.
     script1 = c.script("ao_cur", "ao", "--rays_per_vertex", "256")
     out = os.path.join(c.tmp, "cur.ply")
