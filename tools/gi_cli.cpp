@@ -126,7 +126,8 @@ std::string defaultText(const ParamSpec& p) {
 void addParamOptions(CLI::App* sub, const std::vector<ParamSpec>& specs, CommonArgs& a, bool includeMeshlabOnly) {
   for (const auto& p : specs) {
     if (p.meshlabOnly && !includeMeshlabOnly) continue;
-    std::string help = p.label + ". " + p.help + " [default: " + defaultText(p) + "]";
+    const std::string range = rangeText(p);
+    std::string help = p.label + ". " + p.help + " [default: " + defaultText(p) + (range.empty() ? "" : "; " + range) + "]";
     if (p.type == ParamType::Enum) {
       help += " {";
       for (size_t i = 0; i < p.choices.size(); ++i) help += (i ? ", " : "") + p.choices[i];
@@ -366,7 +367,8 @@ int listFilters(bool asJson) {
     }
     json params = json::array();
     for (const ParamSpec& p : filterSpecs(d.kind))
-      params.push_back({{"name", p.name}, {"label", p.label}, {"default", defaultText(p)}, {"meshlab_only", p.meshlabOnly}});
+      params.push_back({{"name", p.name}, {"label", p.label}, {"default", defaultText(p)}, {"range", rangeText(p)},
+                        {"meshlab_only", p.meshlabOnly}});
     json writes = json::array();
     const std::pair<unsigned, const char*> bits[] = {
         {WritesVertexQuality, "vertex_quality"}, {WritesVertexColor, "vertex_color"}, {WritesVertexNormal, "vertex_normal"},

@@ -79,6 +79,18 @@ static std::string exact(float x) {  // a vector's component: the shortest text 
   return std::string(b, r.ptr);
 }
 
+std::string rangeText(const ParamSpec& s) {
+  switch (s.type) {
+    case ParamType::Int:
+    case ParamType::Float:
+      return s.min < s.max ? exact(s.min) + " to " + exact(s.max) : "";
+    case ParamType::Distance:
+      return s.max > 0.0 ? "0 to " + exact(s.max) + " x the bbox diagonal" : "0 or more";
+    default:
+      return "";
+  }
+}
+
 void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name, double value) {
   const ParamSpec* s = findSpec(specs, name);
   if (!s) throw std::logic_error("no parameter '" + name + "' in the table");

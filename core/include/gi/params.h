@@ -94,6 +94,11 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v);
 // an enum's name or index). Throws std::invalid_argument with a sentence.
 ParamValue parseValue(const ParamSpec& spec, const std::string& text, double diagonal);
 const ParamSpec* findSpec(const std::vector<ParamSpec>& specs, const std::string& name);
+// The range validate() enforces, for the help texts ("1 to 4096", "at most
+// 10 x the bbox diagonal"); empty where any value of the type is taken.
+// MeshLab 2020.09's number fields have no limits to show it (an outside
+// audit found the ranges stated nowhere).
+std::string rangeText(const ParamSpec& spec);
 // A library caller fills the options structs directly, past the table's
 // checks: each filter's entry point refuses a number outside the table's
 // range for `name` (or not finite) with std::invalid_argument, in the words
