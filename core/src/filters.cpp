@@ -45,7 +45,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
                    .help = "Besides the per-vertex result (area-weighted mean of the incident patches), write each "
                            "patch's radiosity to face quality and face colour: the flat-shaded look of the course's "
                            "images (a patch partly buried under another surface shows the radiosity of the part the "
-                           "scene sees).",
+                           "scene sees). The faces' own quality and colour are then gone: a later run on this "
+                           "result would take every patch brighter than the emitter threshold for a light and the "
+                           "displayed colours for reflectances (the Cornell box: 108 emitters instead of 12, 10 "
+                           "times the power); run again on the original mesh, or select the lights.",
                    .type = ParamType::Bool, .def = false});
       add(displaySpecs());
       break;
