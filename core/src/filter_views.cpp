@@ -13,9 +13,46 @@
 #include "gi/hemicube_view.h"
 #include "gi/output.h"
 #include "gi/render.h"
+#include "gi/sampling.h"
 #include "scene_defects.h"
 
 namespace gi::detail {
+
+namespace {
+
+// Why a face's row is empty: 64 cosine rays from its centre find only the
+// backs of faces (it lies inside a solid: the floor under a block) or
+// nothing (it faces away from the scene). The log said "0 faces reached,
+// lost 1" alone (an outside audit); radiosity's says which patches are
+// buried.
+std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t face) {
+  const glm::uvec3& t = s.triangles[face];
+  const glm::vec3 a = s.positions[t.x], b = s.positions[t.y], c = s.positions[t.z];
+  const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  const Frame frame(n);
+  const float eps = float(sceneScale(s).rayEpsilon);
+  int backs = 0, misses = 0;
+  constexpr int kRays = 64;
+  for (int k = 0; k < kRays; ++k) {
+    Ray ray;
+    ray.o = (a + b + c) / 3.f + n * eps;
+    ray.d = frame.toWorld(cosineHemisphere(sobolOwen2D(uint32_t(k), 0xb0b1u)));
+    const Hit h = caster.intersect(ray);
+    if (!h.valid()) ++misses;
+    else if (h.face != face && glm::dot(ray.d, glm::cross(s.positions[s.triangles[h.face].y] - s.positions[s.triangles[h.face].x],
+                                                         s.positions[s.triangles[h.face].z] - s.positions[s.triangles[h.face].x])) > 0.f)
+      ++backs;
+  }
+  if (backs == kRays)
+    return "face " + std::to_string(face) + " sees only the backs of faces: it lies inside a solid (buried under "
+           "another surface, as a floor under a block), where no light reaches; its row is 0";
+  if (misses == kRays)
+    return "face " + std::to_string(face) + " faces away from every other face: nothing is in front of it; its "
+           "row is 0";
+  return "";
+}
+
+}  // namespace
 
 void runFormFactors(FilterInput& in, FilterResult& res) {
   const Scene& s = in.scene;
@@ -34,6 +71,8 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
   res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
   res.stats.add("seconds", rep.seconds);
   res.stats.note(out.summary);
+  if (!(rep.rowSum > 0.0))
+    if (const std::string why = emptyRowReason(s, *caster, face); !why.empty()) res.stats.note(why);
   if (const std::string w = cutShortWarning(rep.pairsCutShort); !w.empty()) res.stats.warn(w);
   if (const auto w = narrowPatchWarning(s, narrowPatch(s, face, sceneScale(s).rayEpsilon), "its form factors"))
     res.stats.warn(*w);

@@ -242,3 +242,40 @@ TEST(HemicubeView, RefusesNoSelectionSeveralAndBadFaces) {
   degenerate.values.set("face_index", 4);
   EXPECT_NE(message(degenerate).find("face 4 is degenerate"), std::string::npos) << message(degenerate);
 }
+
+// An empty row says why: a Cornell box floor triangle under the short block
+// sees only the block's inside (the log said "0 faces reached, lost 1"
+// alone; an outside audit), and a lone quad seen from its back faces away
+// from everything; an open floor triangle's row is not empty and says
+// neither.
+TEST(FormFactorsView, AnEmptyRowSaysWhy) {
+  const auto noted = [](const FilterResult& r, const std::string& text) {
+    for (const std::string& n : r.stats.notes)
+      if (n.find(text) != std::string::npos) return true;
+    return false;
+  };
+  auto box = scenes::cornellBox(50.0);
+  // A floor face whose centre lies under the short block (x 82-240, z 65-225 mm) and one in the open.
+  uint32_t buried = UINT32_MAX, open = UINT32_MAX;
+  for (uint32_t f = 0; f < box.scene.faceCount(); ++f) {
+    const glm::uvec3& t = box.scene.triangles[f];
+    const glm::dvec3 c = (box.scene.toWorld(box.scene.positions[t.x]) + box.scene.toWorld(box.scene.positions[t.y]) +
+                          box.scene.toWorld(box.scene.positions[t.z])) / 3.0;
+    if (std::fabs(c.y) > 1e-3) continue;
+    if (c.x > 120 && c.x < 200 && c.z > 100 && c.z < 190) buried = f;
+    if (c.x > 400 && c.z > 400) open = f;
+  }
+  ASSERT_NE(buried, UINT32_MAX);
+  ASSERT_NE(open, UINT32_MAX);
+  for (const uint32_t f : {buried, open}) {
+    FilterInput in = test::filterInput(FilterKind::FormFactorsOfFace, box);
+    in.values.set("face_index", int(f));
+    const FilterResult r = runFilter(FilterKind::FormFactorsOfFace, in);
+    EXPECT_EQ(noted(r, "sees only the backs of faces"), f == buried) << f << ": row sum " << r.stats.get("row_sum");
+  }
+  scenes::SceneFile quad;
+  quad.scene = Scene::fromAbsolute({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 2, 3}});
+  FilterInput in = test::filterInput(FilterKind::FormFactorsOfFace, quad);
+  in.values.set("face_index", 0);
+  EXPECT_TRUE(noted(runFilter(FilterKind::FormFactorsOfFace, in), "faces away from every other face"));
+}
