@@ -145,9 +145,13 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
     marks.faces.resize(take);
     refiner.refine(marks.faces);
     changed = true;
-    log.push_back(level(k + 1) + ": " + std::to_string(take) + " faces refined (" + std::to_string(marks.byJump) +
-                  " by B jump, " + std::to_string(marks.byShadow) + " by shadow boundary), " + std::to_string(n) +
-                  " -> " + std::to_string(refiner.mesh().scene.faceCount()) + " patches");
+    // The reasons count the faces marked; the budget may refine fewer (the
+    // log read "10 faces refined (80 by B jump, ...)"; an outside audit).
+    log.push_back(level(k + 1) + ": " + std::to_string(take) +
+                  (take < wanted ? " of " + std::to_string(wanted) + " faces marked refined (" : " faces refined (") +
+                  std::to_string(marks.byJump) + " marked by B jump, " + std::to_string(marks.byShadow) +
+                  " by shadow boundary), " + std::to_string(n) + " -> " +
+                  std::to_string(refiner.mesh().scene.faceCount()) + " patches");
     if (take < wanted) {  // the budget cut this level short: the next could add only a handful
       why = "patch budget " + std::to_string(budget) + " reached (" + std::to_string(wanted - take) +
             " faces above the thresholds left unrefined)";

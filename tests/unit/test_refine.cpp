@@ -371,6 +371,11 @@ TEST(Refine, BudgetAndDepthRespectedAndDeterministic) {
   bool saysBudget = false;
   for (const auto& note : capped.result.stats.notes) saysBudget |= note.find("patch budget") != std::string::npos;
   EXPECT_TRUE(saysBudget) << capped.result.stats.line("refine");
+  // The level the budget cut says how many of the faces marked it refined
+  // (it gave the marks' reasons as if all were refined; an outside audit).
+  bool saysMarked = false;
+  for (const auto& note : capped.result.stats.notes) saysMarked |= note.find(" faces marked refined (") != std::string::npos;
+  EXPECT_TRUE(saysMarked) << capped.result.stats.line("refine");
   EXPECT_TRUE(capped.result.stats.warnings.empty()) << capped.result.stats.line("refine");
   // A budget below the input's patch count refines nothing, and says so.
   o.refinement.maxPatches = int(s.faceCount()) - 1;
