@@ -81,8 +81,9 @@ std::vector<ParamSpec> RefineOptions::specs() {
        .type = ParamType::Float, .def = 0.1, .min = 1e-4, .max = 100.0},
       {.name = "refine_shadow_threshold", .label = "Refinement: shadow boundary",
        .help = "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) "
-               "differs by more than this between two of its vertices: a shadow boundary crosses it. 1 turns this "
-               "test off.",
+               "differs by more than this between two of its vertices: a shadow boundary crosses it. The lights "
+               "here are the emitting faces; the sun's and the sky's shadows are found by the B jump test only "
+               "(refine_threshold). 1 turns this test off.",
        .type = ParamType::Float, .def = 0.3, .min = 0.0, .max = 1.0},
   };
 }
