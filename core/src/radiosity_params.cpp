@@ -106,7 +106,10 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "under a wall into a dark room still carries its light there: the gather reads it, about 1.7% of the "
                "lit room on the shadow-leak scene; refine removes it). 'Interpolated indirect': direct light at the vertex, indirect light as the mean of "
                "the incident patches'. 'Patch average': the area-weighted mean of the incident patches' radiosity "
-               "(the classical look of the course's images).",
+               "(the classical look of the course's images). These two show the classical leaks more: a vertex "
+               "under a box standing on a floor takes the light of the floor patches it shares with the open "
+               "floor (an outside audit: 45 cm inside a 1 m box, 1.5 times the floor's mean with Patch average; "
+               "refinement moves the leak to the box's rim), where the final gather reads 0.",
        .type = ParamType::Enum, .def = kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather),
        .choices = kRadiosityVertexOutputs.choices()},
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
