@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -89,7 +90,7 @@ struct Pending {
   std::string tmp, target, path;
   int slot;
 };
-std::vector<Pending>* g_pending = nullptr;
+std::optional<std::vector<Pending>> g_pending;  // engaged while a transaction is open
 
 std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
   if (from.empty()) return s;
@@ -155,23 +156,22 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
 
 OutputTransaction::OutputTransaction() {
   if (g_pending) throw std::logic_error("an output transaction is already open");
-  g_pending = new std::vector<Pending>();
+  g_pending.emplace();
 }
 
 OutputTransaction::~OutputTransaction() {
-  if (!g_pending) return;
+  if (!g_pending) return;  // committed
   for (const Pending& p : *g_pending) {
     ::unlink(p.tmp.c_str());
     unlistTemporary(p.slot);
   }
-  delete g_pending;
-  g_pending = nullptr;
+  g_pending.reset();
 }
 
 void OutputTransaction::commit() {
+  if (!g_pending) throw std::logic_error("no output transaction is open");
   std::vector<Pending> files = std::move(*g_pending);
-  delete g_pending;
-  g_pending = nullptr;
+  g_pending.reset();
   for (size_t k = 0; k < files.size(); ++k) {
     if (std::rename(files[k].tmp.c_str(), files[k].target.c_str()) != 0) {
       const std::string why = std::strerror(errno);

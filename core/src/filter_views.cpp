@@ -27,21 +27,18 @@ namespace {
 // buried.
 std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t face) {
   const glm::uvec3& t = s.triangles[face];
-  const glm::vec3 a = s.positions[t.x], b = s.positions[t.y], c = s.positions[t.z];
-  const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, face));
   const Frame frame(n);
   const float eps = float(sceneScale(s).rayEpsilon);
   int backs = 0, misses = 0;
   constexpr int kRays = 64;
   for (int k = 0; k < kRays; ++k) {
     Ray ray;
-    ray.o = (a + b + c) / 3.f + n * eps;
+    ray.o = (s.positions[t.x] + s.positions[t.y] + s.positions[t.z]) / 3.f + n * eps;
     ray.d = frame.toWorld(cosineHemisphere(sobolOwen2D(uint32_t(k), 0xb0b1u)));
     const Hit h = caster.intersect(ray);
     if (!h.valid()) ++misses;
-    else if (h.face != face && glm::dot(ray.d, glm::cross(s.positions[s.triangles[h.face].y] - s.positions[s.triangles[h.face].x],
-                                                         s.positions[s.triangles[h.face].z] - s.positions[s.triangles[h.face].x])) > 0.f)
-      ++backs;
+    else if (h.face != face && glm::dot(ray.d, faceNormalUnnormalized(s, h.face)) > 0.f) ++backs;
   }
   if (backs == kRays)
     return "face " + std::to_string(face) + " sees only the backs of faces: it lies inside a solid (buried under "
