@@ -126,9 +126,9 @@ void addParams(RichParameterList& out, const std::vector<ParamSpec>& specs, doub
   for (const ParamSpec& s : specs) {
     const QString name = QString::fromStdString(s.name), label = QString::fromStdString(s.label);
     // The script name in the help: .mlx writers and `meshlabserver -d` readers need it.
-    const std::string range = rangeText(s);
-    const QString help =
-        QString::fromStdString(s.help + " [" + (range.empty() ? "" : "range " + range + "; ") + ".mlx name: " + s.name + "]");
+    const std::string range = rangeText(s), used = usedWhenText(specs, s, true);
+    const QString help = QString::fromStdString(s.help + " [" + (range.empty() ? "" : "range " + range + "; ") +
+                                                (used.empty() ? "" : used + "; ") + ".mlx name: " + s.name + "]");
     auto toColor = [](glm::vec3 c) { return QColor(int(std::lround(c.r * 255)), int(std::lround(c.g * 255)), int(std::lround(c.b * 255))); };
     switch (s.type) {
       case ParamType::Bool: out.addParam(RichBool(name, s.def != 0.0, label, help)); break;

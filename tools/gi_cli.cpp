@@ -126,8 +126,9 @@ std::string defaultText(const ParamSpec& p) {
 void addParamOptions(CLI::App* sub, const std::vector<ParamSpec>& specs, CommonArgs& a, bool includeMeshlabOnly) {
   for (const auto& p : specs) {
     if (p.meshlabOnly && !includeMeshlabOnly) continue;
-    const std::string range = rangeText(p);
-    std::string help = p.label + ". " + p.help + " [default: " + defaultText(p) + (range.empty() ? "" : "; " + range) + "]";
+    const std::string range = rangeText(p), used = usedWhenText(specs, p, false);
+    std::string help = p.label + ". " + p.help + " [default: " + defaultText(p) + (range.empty() ? "" : "; " + range) +
+                       (used.empty() ? "" : "; " + used) + "]";
     if (p.type == ParamType::Enum) {
       help += " {";
       for (size_t i = 0; i < p.choices.size(); ++i) help += (i ? ", " : "") + p.choices[i];
@@ -366,9 +367,10 @@ int listFilters(bool asJson) {
       continue;
     }
     json params = json::array();
-    for (const ParamSpec& p : filterSpecs(d.kind))
+    const std::vector<ParamSpec> specs = filterSpecs(d.kind);
+    for (const ParamSpec& p : specs)
       params.push_back({{"name", p.name}, {"label", p.label}, {"default", defaultText(p)}, {"range", rangeText(p)},
-                        {"meshlab_only", p.meshlabOnly}});
+                        {"used_when", usedWhenText(specs, p, false)}, {"meshlab_only", p.meshlabOnly}});
     json writes = json::array();
     const std::pair<unsigned, const char*> bits[] = {
         {WritesVertexQuality, "vertex_quality"}, {WritesVertexColor, "vertex_color"}, {WritesVertexNormal, "vertex_normal"},

@@ -55,9 +55,11 @@ AmbientOptions checkedOptions(const AmbientOptions& in) {
                                   std::to_string(8 * first.strata()) + " rays with every stratum split, above "
                                   "max_rays " + std::to_string(o.maxRays) + "; raise max_rays or lower min_rays");
   }
-  if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
-  if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
-    throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");
+  if (o.estimator == AOEstimator::Shared) {  // only the shared estimator reads them
+    if (o.shareRings < 0 || o.shareRings > 64) throw std::invalid_argument("share_rings must lie in [0, 64]");
+    if (!(o.shareNormalAngleDeg >= 0.f && o.shareNormalAngleDeg <= 180.f))
+      throw std::invalid_argument("share_normal_angle must lie in [0, 180] degrees");
+  }
   if (o.mode == AmbientMode::Obscurance && !(o.falloffExponent > 0.f && std::isfinite(o.falloffExponent)))
     throw std::invalid_argument("the falloff exponent must be a finite number > 0");
   if (o.useCone) {

@@ -80,7 +80,8 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  .type = ParamType::Direction, .defVec = glm::vec3(0.f, 1.f, 0.f)});
     s.push_back({.name = "cone_angle", .label = "Cone half-angle (deg)",
                  .help = "Half-angle of the cone in degrees.",
-                 .type = ParamType::Float, .def = 45, .min = 0.5, .max = 180});
+                 .type = ParamType::Float, .def = 45, .min = 0.5, .max = 180,
+                 .usedWhen = {{"use_cone", {1}}}});
     s.push_back({.name = "color_mapping", .label = "Colour output",
                  .help = "'Grey': vertex colour = AO x 255 as grey (the usual AO display). 'Multiply colour': the "
                          "existing vertex colour times AO (in linear light). 'Keep colour': only the quality is "
@@ -150,12 +151,14 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  .help = "Shared estimator: how far a vertex may pool, in mesh rings (1 = its direct neighbours, "
                          "about 7 vertices; 3 = about 37; 5 = about 91). Larger pools more rays where the occlusion "
                          "varies slowly; the cost of pooling grows with the square of it.",
-                 .type = ParamType::Int, .def = 3, .min = 1, .max = 16});
+                 .type = ParamType::Int, .def = 3, .min = 1, .max = 16,
+                 .usedWhen = {{"estimator", {kAOEstimators.index(AOEstimator::Shared)}}}});
     s.push_back({.name = "share_normal_angle", .label = "Sharing: normal tolerance (deg)",
                  .help = "Shared estimator: only neighbours whose normal is within this angle of the vertex's pool "
                          "their rays (AO depends on the normal: its cosine lobe), and the neighbourhood grows only "
                          "through them, so it stops at creases and never reaches the other side of a thin sheet.",
-                 .type = ParamType::Float, .def = 10.0, .min = 0.0, .max = 90.0});
+                 .type = ParamType::Float, .def = 10.0, .min = 0.0, .max = 90.0,
+                 .usedWhen = {{"estimator", {kAOEstimators.index(AOEstimator::Shared)}}}});
   }
   s.push_back({.name = "ray_batching", .label = "Ray batching",
                .help = "How rays are handed to Embree: single rays sharing the vertex as origin (fastest in our "

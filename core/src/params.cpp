@@ -91,6 +91,40 @@ std::string rangeText(const ParamSpec& s) {
   }
 }
 
+bool isUsed(const std::vector<ParamSpec>& specs, const ParamSpec& spec, const ParamValues& v) {
+  for (const ParamUse& u : spec.usedWhen) {
+    const ParamSpec* c = findSpec(specs, u.param);
+    if (!c || !v.has(u.param)) continue;
+    const ParamValue& x = v.all().at(u.param);
+    int value;
+    if (const int* i = std::get_if<int>(&x); i && c->type == ParamType::Enum) value = *i;
+    else if (const bool* b = std::get_if<bool>(&x); b && c->type == ParamType::Bool) value = *b ? 1 : 0;
+    else continue;
+    if (std::find(u.values.begin(), u.values.end(), value) == u.values.end()) return false;
+  }
+  return true;
+}
+
+std::string usedWhenText(const std::vector<ParamSpec>& specs, const ParamSpec& spec, bool byLabel) {
+  std::string out;
+  for (const ParamUse& u : spec.usedWhen) {
+    const ParamSpec* c = findSpec(specs, u.param);
+    if (!c) throw std::logic_error("parameter '" + spec.name + "' depends on '" + u.param + "', not in its table");
+    std::string values;
+    for (size_t k = 0; k < u.values.size(); ++k) {
+      const int x = u.values[k];
+      std::string name;
+      if (c->type == ParamType::Bool) name = x ? "on" : "off";
+      else if (c->type == ParamType::Enum && x >= 0 && size_t(x) < c->choices.size()) name = c->choices[size_t(x)];
+      else throw std::logic_error("parameter '" + spec.name + "' depends on a value '" + u.param + "' cannot take");
+      if (byLabel) name = "'" + name + "'";
+      values += (k == 0 ? "" : k + 1 == u.values.size() ? " or " : ", ") + name;
+    }
+    out += (out.empty() ? "used only when " : " and ") + (byLabel ? "'" + c->label + "'" : u.param) + " is " + values;
+  }
+  return out;
+}
+
 void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name, double value) {
   const ParamSpec* s = findSpec(specs, name);
   if (!s) throw std::logic_error("no parameter '" + name + "' in the table");
@@ -105,12 +139,13 @@ void requireInRange(const std::vector<ParamSpec>& specs, const std::string& name
 std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal) {
   for (const auto& s : specs) {
     if (!v.has(s.name)) return "parameter '" + s.name + "' is missing";
+    const bool used = isUsed(specs, s, v);
     try {
       switch (s.type) {
         case ParamType::Bool: (void)v.getBool(s.name); break;
         case ParamType::Int: {
           int x = v.getInt(s.name);
-          if (x < s.min || x > s.max)
+          if (used && (x < s.min || x > s.max))
             return "parameter '" + s.name + "' = " + std::to_string(x) + " is outside [" + exact(s.min) + ", " + exact(s.max) + "]";
           break;
         }
@@ -120,12 +155,13 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           // RichFloat, the CLI's checks): a bound given as is must pass
           // (1e-12 arrives as 9.99999996e-13).
           const bool below = x < s.min && float(x) < float(s.min), above = x > s.max && float(x) > float(s.max);
-          if (!std::isfinite(x) || below || above)
+          if (used && (!std::isfinite(x) || below || above))
             return "parameter '" + s.name + "' = " + exact(x) + " is outside [" + exact(s.min) + ", " + exact(s.max) + "]";
           break;
         }
         case ParamType::Distance: {
           double x = v.getFloat(s.name);
+          if (!used) break;
           if (!std::isfinite(x) || x < 0.0)
             return "parameter '" + s.name + "' = " + exact(x) + " must be a finite distance >= 0";
           if (s.max > 0.0 && diagonal > 0.0 && x > s.max * diagonal * (1.0 + 1e-6))

@@ -89,7 +89,8 @@ std::vector<ParamSpec> PhotonOptions::specs() {
        .type = ParamType::Bool, .def = false},
       {.name = "passes", .label = "Progressive passes",
        .help = "Passes of 'Photons emitted' photons each (progressive mode).",
-       .type = ParamType::Int, .def = 16, .min = 1, .max = 100000},
+       .type = ParamType::Int, .def = 16, .min = 1, .max = 100000,
+       .usedWhen = {{"progressive", {1}}}},
       {.name = "max_depth", .label = "Maximum bounces",
        .help = "Bounces a path may take, diffuse or specular, counted as the reference counts them: 0 = direct "
                "light only, k = light that reflected at most k times before the vertex (with the final gather, and "
@@ -396,7 +397,8 @@ VertexRadiometry photonMapAtVertices(const Scene& s, const RayCaster& caster, co
   opt.maxRadius = optWorld.maxRadius / s.unit;
   opt.point = pointLightInLocalUnits(optWorld.point, s);
   opt.point.check();
-  if (opt.photons < 1 || opt.kNearest < 1 || opt.kNearest > 512 || opt.causticK < 1 || opt.causticK > 512 || opt.passes < 1)
+  if (opt.photons < 1 || opt.kNearest < 1 || opt.kNearest > 512 || opt.causticK < 1 || opt.causticK > 512 ||
+      (opt.progressive && opt.passes < 1))
     throw std::invalid_argument("photons and passes must be >= 1, k_nearest and caustic_k in [1, 512]");
   requireInRange(PhotonOptions::specs(), "gather_rays", opt.gatherRays);  // 0 gave NaN at every gathered vertex
   opt.outside.check();

@@ -73,12 +73,14 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "1991), exceeds this fraction of the power leaving all surfaces (emitted and reflected), or while their "
                "bounding spheres overlap. Smaller: "
                "more links, closer to the flat solution (0: every patch pair, the flat solution at its cost).",
-       .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0},
+       .type = ParamType::Float, .def = 1e-4, .min = 0, .max = 1.0,
+       .usedWhen = {{"solver", {kRadiositySolvers.index(RadiositySolver::Auto), kRadiositySolvers.index(RadiositySolver::Hierarchical)}}}},
       {.name = "link_rays", .label = "Hierarchical: visibility rays per link",
        .help = "Hierarchical solver only. Rays between paired points of a link's two nodes that exchange light; "
                "the fraction that passes scales the link's unoccluded form factor (cost: links x rays). Up to 16, a "
                "link from a cluster gathers the radiosity where its passing rays end; above, the cluster's mean.",
-       .type = ParamType::Int, .def = 4, .min = 1, .max = 1024},
+       .type = ParamType::Int, .def = 4, .min = 1, .max = 1024,
+       .usedWhen = {{"solver", {kRadiositySolvers.index(RadiositySolver::Auto), kRadiositySolvers.index(RadiositySolver::Hierarchical)}}}},
       {.name = "closure_rays", .label = "Hierarchical: closure rays per patch",
        .help = "Hierarchical solver only. The links' form factors are quadratures, so the factors of one patch's "
                "links sum only approximately to the part G of its hemisphere that meets a surface (0.94 to 1.06 "
@@ -91,14 +93,16 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "escapes) indicates how much light they create or lose (a warning above 5%: use a flat solver there). "
                "Cost: patches x rays (with occluders, where they serve the indicator alone: at most 8 million "
                "rays in all, at least 4 a patch). 0: neither.",
-       .type = ParamType::Int, .def = 64, .min = 0, .max = 65536},
+       .type = ParamType::Int, .def = 64, .min = 0, .max = 65536,
+       .usedWhen = {{"solver", {kRadiositySolvers.index(RadiositySolver::Auto), kRadiositySolvers.index(RadiositySolver::Hierarchical)}}}},
       {.name = "max_links", .label = "Hierarchical: links at most",
        .help = "Hierarchical solver only. The links stop being refined at this many (as at the memory budget), "
                "refined again best first: the link that may carry the most power is split first, so what stays "
                "coarse carries the least. Time and memory grow with the links (about 56 bytes each); fewer links "
                "cost accuracy (a 100k-triangle scan room: 12M links 1.6%, 2M links 3.1%). 0: no cap but the "
                "memory budget.",
-       .type = ParamType::Int, .def = 0, .min = 0, .max = 2000000000},
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 2000000000,
+       .usedWhen = {{"solver", {kRadiositySolvers.index(RadiositySolver::Auto), kRadiositySolvers.index(RadiositySolver::Hierarchical)}}}},
       {.name = "vertex_output", .label = "Vertex values",
        .help = "How vertex colour and quality are made from the patch solution. 'Final gather': the direct light is "
                "computed exactly at each vertex (sharp shadows, no patch staircase) and the indirect light is "
@@ -114,7 +118,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
        .choices = kRadiosityVertexOutputs.choices()},
       {.name = "gather_rays", .label = "Final-gather rays per vertex",
        .help = "Rays per vertex for the final gather of the indirect light (cosine-weighted).",
-       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20},
+       .type = ParamType::Int, .def = 256, .min = 1, .max = 1 << 20,
+       .usedWhen = {{"vertex_output", {kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather)}}}},
       {.name = "gather_share_rings", .label = "Final gather: shared with neighbours (rings)",
        .help = "Neighbouring vertices see almost the same surroundings, so each vertex may pool the gather rays of "
                "its neighbours up to this many mesh rings away (1: its direct neighbours, about 7 vertices; 2: about "
@@ -124,7 +129,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "explains. For dense meshes (a scan, a finely meshed room), where it halves the gather's error at "
                "the same rays; next to an object just above the surface or a concave edge a vertex may take some "
                "of its neighbours' light (up to several percent). 0: every vertex uses its own rays only.",
-       .type = ParamType::Int, .def = 0, .min = 0, .max = 8},
+       .type = ParamType::Int, .def = 0, .min = 0, .max = 8,
+       .usedWhen = {{"vertex_output", {kRadiosityVertexOutputs.index(RadiosityVertexOutput::FinalGather)}}}},
       seedSpec("form-factor, shadow and final-gather rays"),
       {.name = "refine", .label = "Adaptive mesh refinement",
        .help = "Subdivide patches where the solution needs it, then solve again: a patch is split 1 -> 4 at its edge "
@@ -178,12 +184,17 @@ void checkRadiosityOptions(const RadiosityOptions& o) {
   requireInRange(t, "bounces", o.bounces);
   requireInRange(t, "tolerance", o.tolerance);
   requireInRange(t, "max_iterations", o.maxIterations);
-  requireInRange(t, "hierarchy_epsilon", o.hierarchyEpsilon);
-  requireInRange(t, "link_rays", o.linkRays);
-  requireInRange(t, "closure_rays", o.closureRays);
-  requireInRange(t, "max_links", o.maxLinks);
-  requireInRange(t, "gather_rays", o.gatherRays);
-  requireInRange(t, "gather_share_rings", o.gatherShareRings);
+  // Only what the solver and the vertex output use (the table's usedWhen).
+  if (o.solver == RadiositySolver::Auto || o.solver == RadiositySolver::Hierarchical) {
+    requireInRange(t, "hierarchy_epsilon", o.hierarchyEpsilon);
+    requireInRange(t, "link_rays", o.linkRays);
+    requireInRange(t, "closure_rays", o.closureRays);
+    requireInRange(t, "max_links", o.maxLinks);
+  }
+  if (o.vertexOutput == RadiosityVertexOutput::FinalGather) {
+    requireInRange(t, "gather_rays", o.gatherRays);
+    requireInRange(t, "gather_share_rings", o.gatherShareRings);
+  }
   if (!(o.memoryBudgetMB > 0) || !std::isfinite(o.memoryBudgetMB))
     throw std::invalid_argument("memory_budget_mb must be a finite number of megabytes > 0");
   checkFormFactorSettings(o.formFactors);

@@ -43,11 +43,18 @@ void validate(const RenderOptions& o) {
   if (int(o.mode) < 0 || int(o.mode) > 3) throw std::invalid_argument("unknown render mode");
   if (o.samplesPerPixel < 1) throw std::invalid_argument("samples_per_pixel must be >= 1");
   if (o.maxDepth < 0) throw std::invalid_argument("max_depth must be >= 0");
-  if (o.maxDiffuseBounces < -1) throw std::invalid_argument("max_diffuse_bounces must be >= -1 (-1: no limit)");
-  if (o.lightSamples < 1 || o.gatherRays < 1) throw std::invalid_argument("light_samples and gather_rays must be >= 1");
-  if (o.causticPhotons < 1 || o.causticK < 1 || o.causticK > 512)
-    throw std::invalid_argument("caustic_photons must be >= 1 and caustic_k in [1, 512]");
-  if (!(o.whittedMinWeight >= 0.f && o.whittedMinWeight <= 1.f))
+  // Only what the mode uses (the table's usedWhen): a value another mode
+  // needs is not read here.
+  const bool twoPass = o.mode == RenderMode::TwoPass;
+  const bool causticMap = twoPass && (o.twoPass == TwoPassDiffuse::Caustics || o.twoPass == TwoPassDiffuse::FinalGather);
+  if (o.mode == RenderMode::PathTraced && o.maxDiffuseBounces < -1)
+    throw std::invalid_argument("max_diffuse_bounces must be >= -1 (-1: no limit)");
+  if (o.lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
+  if (twoPass && o.twoPass == TwoPassDiffuse::FinalGather && o.gatherRays < 1)
+    throw std::invalid_argument("gather_rays must be >= 1");
+  if (causticMap && (o.causticPhotons < 1 || o.causticK < 1 || o.causticK > 512 || !(o.causticMaxRadius >= 0.0)))
+    throw std::invalid_argument("caustic_photons must be >= 1, caustic_k in [1, 512] and caustic_max_radius >= 0");
+  if (o.mode == RenderMode::Whitted && !(o.whittedMinWeight >= 0.f && o.whittedMinWeight <= 1.f))
     throw std::invalid_argument("whitted_min_weight must lie in [0, 1]");
   o.point.check();
   o.outside().check();

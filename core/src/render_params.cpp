@@ -93,7 +93,8 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .help = "Diffuse surfaces a path may bounce from; -1 = no limit (the full solution). 0 gives direct "
                        "light plus mirrors, glass and glossy only: the distributed image, with error bars. 1, 2, ... "
                        "add the bounces one by one, like radiosity's bounce count.",
-               .type = ParamType::Int, .def = -1, .min = -1, .max = 100000});
+               .type = ParamType::Int, .def = -1, .min = -1, .max = 100000,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::PathTraced)}}}});
   s.push_back({.name = "light_samples", .label = "Shadow rays per light",
                .help = "Samples of each area light (and of the sun disk) at the first diffuse surface an eye ray "
                        "meets, per eye ray; deeper surfaces take one. More: smoother soft shadows at fewer eye rays. "
@@ -106,7 +107,8 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .help = "Whitted splits every glass hit into a reflected (Fresnel F) and a refracted (1 - F) ray; a "
                        "branch whose weight (product of the factors) falls below this is not traced (Hall and "
                        "Greenberg 1983). 0 traces every branch up to the maximum bounces: up to 2^depth rays.",
-               .type = ParamType::Float, .def = 0.001, .min = 0.0, .max = 1.0});
+               .type = ParamType::Float, .def = 0.001, .min = 0.0, .max = 1.0,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::Whitted)}}}});
   s.push_back({.name = "two_pass_diffuse", .label = "Diffuse light (two-pass)",
                .help = "Where the two-pass mode takes the light of a diffuse surface from (B: the first pass's "
                        "per-vertex radiosity, interpolated over each triangle). 'First pass alone': B (shadows as "
@@ -114,34 +116,40 @@ std::vector<ParamSpec> RenderOptions::specs() {
                        "the rest from B. '+ caustic map': caustics from a photon map read at each hit point (Jensen "
                        "1996). 'Final gather': direct, caustic map, and rays that read B where they land (smoothest).",
                .type = ParamType::Enum, .def = kTwoPassDiffuse.index(TwoPassDiffuse::Caustics),
-               .choices = kTwoPassDiffuse.choices()});
+               .choices = kTwoPassDiffuse.choices(),
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}}});
   s.push_back({.name = "first_pass_caustics", .label = "First pass has caustics",
                .help = "Whether the stored first pass includes caustics (photon mapping and the reference: yes; "
                        "radiosity: no). If so, and the caustic map is used, they are taken out of the stored "
                        "indirect light so as not to count twice. The filters of this suite say it themselves (the "
                        "per-vertex attribute RadiosityCaustics beside Radiosity), and then this is not used: it is "
                        "for a Radiosity attribute left by another tool.",
-               .type = ParamType::Bool, .def = true});
+               .type = ParamType::Bool, .def = true,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}}});
   s.push_back({.name = "caustic_photons", .label = "Caustic photons",
                .help = "Photons aimed at the mirrors and glass for the caustic map (two-pass). More: sharper and "
                        "less noisy caustics; about 56 bytes each once stored (refused beyond the memory available). With the photon-mapping filter's "
                        "'Photons emitted', 'Photons per caustic estimate', 'Maximum gather radius' and seed, the "
                        "caustics its first pass stored at the vertices are exactly those taken out (same photons, "
                        "same estimate).",
-               .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000});
+               .type = ParamType::Int, .def = 200000, .min = 1, .max = 100000000,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::Caustics), kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "caustic_k", .label = "Photons per caustic estimate",
                .help = "Nearest caustic photons read at each hit point (cone filter, Jensen 1996): smaller k is "
                        "sharper and noisier (relative noise about 1/sqrt(k)).",
-               .type = ParamType::Int, .def = 128, .min = 1, .max = 512});
+               .type = ParamType::Int, .def = 128, .min = 1, .max = 512,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::Caustics), kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "caustic_max_radius", .label = "Caustic gather radius",
                .help = "Caustic photons farther than this from a hit point are not read (0 = no limit): keeps "
                        "caustics from bleeding into the dark around them, and makes the search cheap far from them. "
                        "Absolute or % of the bbox diagonal.",
-               .type = ParamType::Distance, .def = 0.05, .min = 0.0, .max = 1.0});
+               .type = ParamType::Distance, .def = 0.05, .min = 0.0, .max = 1.0,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::Caustics), kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "gather_rays", .label = "Final-gather rays",
                .help = "Rays per diffuse hit (and per eye ray) for the final gather: cosine-distributed, through "
                        "mirrors and glass, reading the first pass's reflected radiosity where they land.",
-               .type = ParamType::Int, .def = 16, .min = 1, .max = 1 << 16});
+               .type = ParamType::Int, .def = 16, .min = 1, .max = 1 << 16,
+               .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "vertex_radiance", .label = "Also per-vertex radiance towards the camera",
                .help = "Compute for every vertex the radiance it sends towards the camera (what a mirror vertex "
                        "shows from this viewpoint), with the same method and samples, for the vertex colours. Path "

@@ -593,6 +593,13 @@ TEST(Params, HelpStatesTheRangeValidateEnforces) {
       if (!(p.min < p.max)) continue;
       EXPECT_NE(r, "") << d.cliName << " " << p.name;
       gi::ParamValues v = gi::defaultValues(gi::filterSpecs(d.kind), diag);
+      for (const gi::ParamUse& u : p.usedWhen) {  // the settings that use it (checked only there)
+        const gi::ParamSpec* c = gi::findSpec(gi::filterSpecs(d.kind), u.param);
+        ASSERT_TRUE(c && !u.values.empty()) << d.cliName << " " << p.name;
+        if (c->type == gi::ParamType::Bool) v.set(u.param, u.values[0] != 0);
+        else v.set(u.param, u.values[0]);
+      }
+      ASSERT_TRUE(gi::isUsed(gi::filterSpecs(d.kind), p, v)) << d.cliName << " " << p.name;
       const auto set = [&](double x) {
         if (p.type == gi::ParamType::Int) v.set(p.name, int(x));
         else v.set(p.name, x);

@@ -27,6 +27,14 @@ enum class ParamType {
   String,     // free text (e.g. layer-name patterns)
 };
 
+// A parameter that only some settings of another use: `param` (an Enum or a
+// Bool of the same table) must hold one of `values` (the choices' indices; a
+// Bool's 0 or 1). The two-pass view's caustic map is read in that mode only.
+struct ParamUse {
+  std::string param;
+  std::vector<int> values;
+};
+
 struct ParamSpec {
   std::string name;   // id in .mlx scripts and --name on the CLI
   std::string label;  // short text in the MeshLab dialog
@@ -37,6 +45,11 @@ struct ParamSpec {
   glm::vec3 defVec{0.f};                   // Color, Direction
   bool meshlabOnly = false;                // e.g. layer choice (the CLI has one scene)
   std::string defText;                     // String
+  // Settings that use it, all to hold (empty: every setting). A number a
+  // setting does not use is not range-checked there: a script written for
+  // a 2 m room (an absolute caustic radius of 0.17) must still run a 1 cm
+  // part in a mode that has no caustic map.
+  std::vector<ParamUse> usedWhen;
 };
 
 // Colours and directions in float; positions (Point) in double, so that a
@@ -83,7 +96,14 @@ std::optional<glm::vec3> unitKeepingBits(const glm::vec3& d);
 
 // Defaults of a table for a scene of the given bbox diagonal.
 ParamValues defaultValues(const std::vector<ParamSpec>& specs, double diagonal);
-// Checks presence, types and ranges; returns an error sentence or nothing.
+// Whether the values' settings use `spec` (its usedWhen all hold; a setting
+// missing from v or of another type counts as holding).
+bool isUsed(const std::vector<ParamSpec>& specs, const ParamSpec& spec, const ParamValues& v);
+// "used only when mode is Two-pass and two_pass_diffuse is A or B" (byLabel:
+// the dialog's labels, 'Rendering method' is 'Two-pass'); empty where always used.
+std::string usedWhenText(const std::vector<ParamSpec>& specs, const ParamSpec& spec, bool byLabel);
+// Checks presence, types and ranges (of a number only where isUsed); returns
+// an error sentence or nothing.
 std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const ParamValues& v, double diagonal);
 // "name=value, ..." for logs, JSON-free summaries and the key of a cached
 // result: every number as the shortest text that reads back as itself (six
