@@ -192,8 +192,12 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           break;
         }
         case ParamType::String:
-          if (v.getString(s.name).find_first_of("\n\r\"<>&") != std::string::npos)
-            return "parameter '" + s.name + "' must be one line without the characters \" < > &";
+          // One line of text: a script's attribute turns a line break or a
+          // tab into a space (XML attribute normalisation). The characters
+          // " < > & are escaped by `gi script` and read back by MeshLab.
+          for (const char c : v.getString(s.name))
+            if ((static_cast<unsigned char>(c) < 0x20) || c == 0x7f)
+              return "parameter '" + s.name + "' must be one line of text (no line breaks, tabs or control characters)";
           break;
       }
     } catch (const std::bad_variant_access&) {
@@ -233,7 +237,12 @@ std::string describe(const std::vector<ParamSpec>& specs, const ParamValues& v) 
         o << exact(c.x) << ',' << exact(c.y) << ',' << exact(c.z);
         break;
       }
-      case ParamType::String: o << '"' << v.getString(s.name) << '"'; break;
+      case ParamType::String: {  // quoted, with " and \ escaped: distinct texts stay distinct
+        o << '"';
+        for (const char c : v.getString(s.name)) o << (c == '"' || c == '\\' ? "\\" : "") << c;
+        o << '"';
+        break;
+      }
     }
   }
   return o.str();

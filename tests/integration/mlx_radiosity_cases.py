@@ -189,6 +189,16 @@ def case_raytrace(c):
                            "--image_path", ref, *size), os.path.join(c.tmp, "pt.ply"))
     _, _, pt = read_pfm(ref[:-4] + ".pfm")
     check(not [f for f in os.listdir(c.tmp) if f.endswith(".tmp")], "images written through temporaries, none left")
+    # A file name with the characters XML escapes: `gi script` writes them as entities, MeshLab reads
+    # them back, the plugin and the CLI take them (they were refused until 7 December 2026).
+    odd = os.path.join(c.tmp, 'R&D <1> "q".png')
+    c.server(box, c.script("odd", "render", "--mesh", box, "--samples_per_pixel", "1", "--image_path", odd, *size),
+             os.path.join(c.tmp, "odd.ply"))
+    check(os.path.getsize(odd) > 0 and os.path.getsize(odd[:-4] + ".pfm") > 0, "meshlabserver wrote " + odd)
+    odd_cli = os.path.join(c.tmp, 'cli R&D <1> "q".png')
+    p = subprocess.run([c.gi, "render", box, "-q", "-o", os.path.join(c.tmp, "odd_cli.ply"), "--samples_per_pixel",
+                        "1", "--image_path", odd_cli] + size, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    check(p.returncode == 0 and os.path.getsize(odd_cli) > 0, "the CLI wrote %s (%s)" % (odd_cli, p.stderr.strip()))
     # The plugin checks its output files before any work, as the CLI does (io/output_files.h): a
     # file over the one a loaded layer came from (the residual CSV: an image must be named .png, and
     # one named as the mesh is refused for that), an image in a folder that does not exist.
