@@ -12,6 +12,8 @@
 
 #include <sys/resource.h>
 
+#include <tbb/task_arena.h>
+
 namespace gi {
 
 namespace {
@@ -131,7 +133,16 @@ double addressSpaceRoom() {
       mapped = 1024.0 * std::atof(line.c_str() + 7);
       break;
     }
-  return std::max(0.0, double(r.rlim_cur) - mapped);
+  // Each worker thread a run starts after this check maps its stack and
+  // its own malloc arena (glibc reserves 64 MB of address space for each):
+  // on 2 cores one worker's 72 MB, started lazily, took the room a photon
+  // map had been allowed (13 million photons checked against 746 MB, then
+  // "out of memory"; an outside audit). Counted for every worker the
+  // threads allowed may start.
+  rlimit st{};
+  const double stack = getrlimit(RLIMIT_STACK, &st) == 0 && st.rlim_cur != RLIM_INFINITY ? double(st.rlim_cur) : 8.0 * 1048576.0;
+  const double workers = double(std::max(tbb::this_task_arena::max_concurrency() - 1, 0));
+  return std::max(0.0, double(r.rlim_cur) - mapped - workers * (64.0 * 1048576.0 + stack));
 }
 
 }  // namespace

@@ -272,10 +272,14 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
         if (p.path == kCausticPhoton) contents->caustic.push_back(p);
     }
   }
-  // What a final gather at every vertex leaves out is lost (the few vertices
-  // handed over to it in the k-nearest mode read the rest in full).
-  if (gather) ts.lostPower += ts.lastHitPower, ts.lostRGB += ts.lastHitRGB;
-  else ts.lostPower += ts.lastHitCutPower, ts.lostRGB += ts.lastHitCutRGB;
+  // What the paths carried past their last allowed hit is lost, in every
+  // mode. The final gather's map leaves that hit's photons out, but its rays
+  // are the reflection there: a photon left out at y stands for light that
+  // would reach the vertex after reflecting at y, rho times its power, the
+  // power the path carried on (an outside audit: counting the photon's own
+  // power said rho^k instead of rho^(k+1) lost, 100% at max_depth 0, where
+  // the result equals the reference's).
+  ts.lostPower += ts.lastHitCutPower, ts.lostRGB += ts.lastHitCutRGB;
   Timer queryTimer;
   HandOver ho;
   PhotonEstimate e = estimateAtVertices(r, maps, photons, surface, hitsLeft, crease, ho, progress.sub(0.55, 1.0));

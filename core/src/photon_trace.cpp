@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <stdexcept>
 
 #include "gi/color.h"
@@ -255,23 +256,44 @@ class StoreBudget {
  public:
   StoreBudget(const PhotonOptions& o, size_t paths)
       : limit_(memoryLimitOrAvailable(o.memoryLimitBytes)), paths_(paths), remedy_(o.memoryRemedy) {}
-  bool full() const { return limit_ != 0 && double(stored_.load()) * kStoredPhotonBytes > double(limit_); }
+  bool full() const {
+    return failed_.load() || (limit_ != 0 && double(stored_.load()) * kStoredPhotonBytes > double(limit_));
+  }
   void add(size_t stored, size_t paths) {
     stored_ += stored;
     traced_ += paths;
   }
+  // f, with an allocation that fails all the same (the limit's figure is
+  // an estimate; another process may take memory meanwhile) ending the
+  // trace as the limit does: check() refuses the run in one sentence, not
+  // a bare "out of memory" after minutes (an outside audit).
+  template <class F>
+  auto guard(F f) {
+    return [this, f](auto&&... a) {
+      try {
+        f(a...);
+      } catch (const std::bad_alloc&) {
+        failed_ = true;
+      }
+    };
+  }
   void check(const std::string& what) const {
+    if (failed_.load())
+      throw std::invalid_argument(what + " ran out of memory (" + memoryAmount(double(limit_)) +
+                                  " were available when it began); " + remedy());
     if (!full()) return;
     const double need = double(stored_.load()) * kStoredPhotonBytes * double(paths_) / double(std::max<size_t>(traced_, 1));
-    requireMemory(need, limit_, what,
-                  remedy_.empty() ? "lower the photons (per pass when progressive: more passes take no more memory)"
-                                  : remedy_);
+    requireMemory(need, limit_, what, remedy());
   }
 
  private:
+  std::string remedy() const {
+    return remedy_.empty() ? "lower the photons (per pass when progressive: more passes take no more memory)" : remedy_;
+  }
   size_t limit_, paths_;
   std::string remedy_;
   std::atomic<size_t> stored_{0}, traced_{0};
+  std::atomic<bool> failed_{false};
 };
 
 // Photon g of the seed's sequence: its index in a scrambled Sobol sequence
@@ -312,7 +334,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
   // max_depth counts reflections as the reference and the eye pass do (0:
   // direct light only): a path may reach hits 0 .. max_depth.
   const int hits = opt.maxDepth + 1;
-  parallelBlocks(nBlocks, progress, "tracing photons", [&](size_t b0, size_t b1) {
+  parallelBlocks(nBlocks, progress, "tracing photons", budget.guard([&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;
       auto& out = blocks[b];
@@ -358,12 +380,11 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           const uint8_t path = diffuse > 0 ? kIndirectPhoton : viaSpecular ? kCausticPhoton : kDirectPhoton;
           out.push_back({x, power, packNormal(ng), path});
           if (lastHit) {
-            // The gather's map leaves it out: its light is missing as a cut
-            // path's is (but for a caustic, which the caustic map keeps), and
-            // the path's own cut power below is part of it.
+            // The hits left after this one; at the last allowed hit (but a
+            // caustic's, which the caustic map keeps) the power the path
+            // carries on is counted apart (lastHitCutPower).
             lastBlocks[b].push_back(uint8_t(std::min(opt.maxDepth - depth, 255)));
             flaggedLast = depth == opt.maxDepth && path != kCausticPhoton;
-            if (flaggedLast) st.lastHitPower += luminance(power), st.lastHitRGB += glm::dvec3(power);
           }
           st.storedPower += luminance(power);
           (path == kDirectPhoton ? st.direct : path == kCausticPhoton ? st.caustic : st.indirect)++;
@@ -384,19 +405,26 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           else st.lastHitCutPower += luminance(power), st.lastHitCutRGB += glm::dvec3(power);
         }
       }
+      // Trimmed to what it holds: growth by doubling leaves up to twice.
+      out.shrink_to_fit();
+      if (lastHit) lastBlocks[b].shrink_to_fit();
       budget.add(out.size(), end - b * kBlock);
     }
-  });
-  budget.check("the photon map of " + std::to_string(count) + " photons");
+  }));
+  const std::string what = "the photon map of " + std::to_string(count) + " photons";
+  budget.check(what);
   // Concatenate block by block, freeing each, so the peak stays near one copy.
   size_t total = 0;
   for (const auto& b : blocks) total += b.size();
   std::vector<Photon> all;
-  all.reserve(total);
-  if (lastHit) {
-    lastHit->clear();
-    lastHit->reserve(total);
-  }
+  budget.guard([&] {
+    all.reserve(total);
+    if (lastHit) {
+      lastHit->clear();
+      lastHit->reserve(total);
+    }
+  })();
+  budget.check(what);
   for (size_t b = 0; b < nBlocks; ++b) {
     all.insert(all.end(), blocks[b].begin(), blocks[b].end());
     std::vector<Photon>().swap(blocks[b]);
@@ -414,8 +442,6 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
     stats.storedPower += t.storedPower;
     stats.lostPower += t.lostPower;
     stats.lostRGB += t.lostRGB;
-    stats.lastHitPower += t.lastHitPower;
-    stats.lastHitRGB += t.lastHitRGB;
     stats.lastHitCutPower += t.lastHitCutPower;
     stats.lastHitCutRGB += t.lastHitCutRGB;
     stats.emittedRGB += t.emittedRGB;
@@ -513,7 +539,7 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   std::vector<size_t> specular(nBlocks, 0), glossy(nBlocks, 0), missed(nBlocks, 0);
 
   StoreBudget budget(opt, count);
-  parallelBlocks(nBlocks, progress, "tracing caustic photons", [&](size_t b0, size_t b1) {
+  parallelBlocks(nBlocks, progress, "tracing caustic photons", budget.guard([&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       if (budget.full()) continue;
       const size_t end = std::min(count, (b + 1) * kBlock);
@@ -569,14 +595,17 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
           viaSpecular = true;
         }
       }
+      blocks[b].shrink_to_fit();  // growth by doubling left caustic blocks 1.56 times their photons
       budget.add(blocks[b].size(), end - b * kBlock);
     }
-  });
-  budget.check("the caustic map of " + std::to_string(count) + " photons");
+  }));
+  const std::string what = "the caustic map of " + std::to_string(count) + " photons";
+  budget.check(what);
   std::vector<Photon> all;
   size_t total = 0;
   for (const auto& b : blocks) total += b.size();
-  all.reserve(total);
+  budget.guard([&] { all.reserve(total); })();
+  budget.check(what);
   for (size_t b = 0; b < nBlocks; ++b) {
     all.insert(all.end(), blocks[b].begin(), blocks[b].end());
     std::vector<Photon>().swap(blocks[b]);

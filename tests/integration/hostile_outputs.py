@@ -438,6 +438,18 @@ def check_stdout_and_address_space(gi, tmp):
                        timeout=120, preexec_fn=small_space)
     lines = [l for l in p.stderr.decode("utf-8", "replace").splitlines() if l.strip()]
     report(failures, "image beyond ulimit -v", one_error(p.returncode, lines, "needs about"), p.returncode, lines)
+    # Photon maps about the limit (1,000,000 KiB: about 13 million stored photons' room): each run fits or is
+    # refused in one sentence. The budget took the room a worker thread mapped after its check (its stack and
+    # malloc arena, 72 MB), and 6.8 and 7.3 million photons ended in a bare "out of memory" (an outside audit).
+    def photon_space():
+        resource.setrlimit(resource.RLIMIT_AS, (1000000 << 10, 1000000 << 10))
+    for n in ("6800000", "7300000", "7800000"):
+        p = subprocess.run([gi, "photonmap", "in.ply", "--photons", n, "--light_samples", "4", "-q", "-o", "pm.ply"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=d, timeout=300, preexec_fn=photon_space)
+        lines = [l for l in p.stderr.decode("utf-8", "replace").splitlines() if l.strip()]
+        fits = p.returncode == 0 and not lines
+        problem = None if fits else one_error(p.returncode, lines, "the photon map of " + n + " photons")
+        report(failures, "photon map of %s photons under ulimit -v" % n, problem, p.returncode, lines)
     return failures
 
 

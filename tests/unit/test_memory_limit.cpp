@@ -18,6 +18,9 @@
 #include "gi/render.h"
 #include "gi/scenes.h"
 
+#include <sys/resource.h>
+#include <tbb/task_arena.h>
+
 using namespace gi;
 
 namespace {
@@ -52,6 +55,44 @@ TEST(MemoryLimit, AvailableIsTheKernelsFigure) {
   EXPECT_GT(avail, 16e6);
   EXPECT_LE(avail, total);
   EXPECT_EQ(memoryLimitOrAvailable(12345), 12345u);
+}
+
+// Under an address-space limit (ulimit -v) the room is the limit less what
+// the process maps, less what each worker thread it may start maps after
+// the check (its stack and glibc's 64 MB malloc arena): on 2 cores a photon
+// map checked against the room without them ended in "out of memory" once
+// the worker's 72 MB arrived (an outside audit). One thread: no worker.
+TEST(MemoryLimit, AddressSpaceRoomKeepsTheWorkersShare) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "the sanitizers map terabytes of shadow: no address-space limit there";
+#else
+  auto mapped = [] {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    while (std::getline(f, line))
+      if (line.rfind("VmSize:", 0) == 0) return 1024.0 * std::atof(line.c_str() + 7);
+    return 0.0;
+  };
+  rlimit old{}, stack{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &old), 0);
+  ASSERT_EQ(getrlimit(RLIMIT_STACK, &stack), 0);
+  const double room = 2e9, perWorker = 64.0 * 1048576.0 + (stack.rlim_cur == RLIM_INFINITY ? 8.0 * 1048576.0 : double(stack.rlim_cur));
+  const double limit = mapped() + room;
+  if (old.rlim_max != RLIM_INFINITY && double(old.rlim_max) < limit) GTEST_SKIP() << "a hard limit below the test's";
+  rlimit lim = old;
+  lim.rlim_cur = rlim_t(limit);
+  auto availableUnder = [&] {
+    EXPECT_EQ(setrlimit(RLIMIT_AS, &lim), 0);
+    const double a = double(availableMemoryBytes());
+    setrlimit(RLIMIT_AS, &old);
+    return a;
+  };
+  const int workers = tbb::this_task_arena::max_concurrency() - 1;
+  EXPECT_NEAR(availableUnder(), room - workers * perWorker, 16e6) << workers << " workers";
+  double one = 0;
+  tbb::task_arena(1).execute([&] { one = availableUnder(); });
+  EXPECT_NEAR(one, room, 16e6);
+#endif
 }
 
 // Ranks of one run on one machine (gi_cluster_mpi.cpp tells their count)

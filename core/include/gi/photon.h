@@ -117,11 +117,10 @@ struct PhotonTraceStats {
   // reflects more (lostPower: 5% where the result was 16.5% dark).
   glm::dvec3 lostRGB{0.0}, emittedRGB{0.0};
   // Where the hits left were asked for, lostPower leaves out the paths
-  // whose last allowed hit stored a photon (but a caustic): what a final
-  // gather loses of them is that photon's power (lastHit), what a density
-  // estimate loses the power the path still carried after it (lastHitCut).
-  double lastHitPower = 0.0, lastHitCutPower = 0.0;
-  glm::dvec3 lastHitRGB{0.0}, lastHitCutRGB{0.0};
+  // whose last allowed hit stored a photon (but a caustic): the power they
+  // still carried after it, lost in every mode (the caller adds it).
+  double lastHitCutPower = 0.0;
+  glm::dvec3 lastHitCutRGB{0.0};
 };
 
 // Traces photons `first` .. `first + count - 1` of the seed's sequence (each
