@@ -12,6 +12,7 @@
 
 #include <sys/resource.h>
 
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 namespace gi {
@@ -118,6 +119,10 @@ int memoryShare() { return g_share; }
 
 namespace {
 
+// glibc's malloc arenas of threads other than the first grow by reserving
+// 64 MB of address space at a time.
+constexpr double kArenaBytes = 64.0 * 1048576.0;
+
 // What the address-space limit (ulimit -v, RLIMIT_AS) leaves this process
 // beyond what it maps now (VmSize), or -1 where there is none. Past it an
 // allocation fails with std::bad_alloc: "out of memory" without the need
@@ -127,22 +132,24 @@ double addressSpaceRoom() {
   if (getrlimit(RLIMIT_AS, &r) != 0 || r.rlim_cur == RLIM_INFINITY) return -1;
   std::ifstream f("/proc/self/status");
   std::string line;
-  double mapped = 0;
-  while (std::getline(f, line))
-    if (line.rfind("VmSize:", 0) == 0) {
-      mapped = 1024.0 * std::atof(line.c_str() + 7);
-      break;
-    }
-  // Each worker thread a run starts after this check maps its stack and
-  // its own malloc arena (glibc reserves 64 MB of address space for each):
-  // on 2 cores one worker's 72 MB, started lazily, took the room a photon
-  // map had been allowed (13 million photons checked against 746 MB, then
-  // "out of memory"; an outside audit). Counted for every worker the
-  // threads allowed may start.
-  rlimit st{};
-  const double stack = getrlimit(RLIMIT_STACK, &st) == 0 && st.rlim_cur != RLIM_INFINITY ? double(st.rlim_cur) : 8.0 * 1048576.0;
-  const double workers = double(std::max(tbb::this_task_arena::max_concurrency() - 1, 0));
-  return std::max(0.0, double(r.rlim_cur) - mapped - workers * (64.0 * 1048576.0 + stack));
+  double mapped = 0, threads = 1;
+  while (std::getline(f, line)) {
+    if (line.rfind("VmSize:", 0) == 0) mapped = 1024.0 * std::atof(line.c_str() + 7);
+    if (line.rfind("Threads:", 0) == 0) threads = std::atof(line.c_str() + 8);
+  }
+  // What the address space the worker threads take grows by beyond what
+  // they hold: glibc gives each its own malloc arena, which grows by
+  // reserving 64 MB at a time, so up to 64 MB a worker are mapped and not
+  // yet used; a worker the run has still to start maps its stack too. On 2
+  // cores the worker's next 64 MB took the room a photon map had been
+  // allowed (13 million photons checked against 746 MB, then "out of
+  // memory"; an outside audit). Counted for the workers the threads
+  // allowed (--threads) may use.
+  const double allowed = double(std::min<size_t>(size_t(std::max(tbb::this_task_arena::max_concurrency(), 1)),
+                                                 tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const double stack = double(tbb::global_control::active_value(tbb::global_control::thread_stack_size));
+  const double workers = std::max(0.0, allowed - 1.0), toStart = std::max(0.0, allowed - threads);
+  return std::max(0.0, double(r.rlim_cur) - mapped - workers * kArenaBytes - toStart * stack);
 }
 
 }  // namespace
@@ -153,8 +160,9 @@ size_t availableMemoryBytes() {
   const double room = cgroupRoom();
   if (room >= 0) avail = avail > 0 ? std::min(avail, room) : room;
   const double space = addressSpaceRoom();
-  if (space >= 0) avail = avail > 0 ? std::min(avail, std::max(space, 1.0)) : std::max(space, 1.0);  // 0: unknown
-  return size_t(avail / double(g_share.load()));
+  if (space >= 0) avail = avail > 0 ? std::min(avail, space) : space;
+  if (!(avail > 0) && (room >= 0 || space >= 0)) return 1;  // known, and none left (0 means unknown)
+  return avail > 0 ? size_t(std::max(avail / double(g_share.load()), 1.0)) : 0;
 }
 
 size_t memoryLimitOrAvailable(size_t limit) { return limit != 0 ? limit : availableMemoryBytes(); }

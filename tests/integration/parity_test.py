@@ -157,8 +157,10 @@ def main():
             # A new layer (the photons): layer 1 in MeshLab, OUT.Photons.ply beside the CLI's output.
             new_layer = "--photon_layer" in params
             ml_layer = os.path.join(tmp, "ml_layer.ply")
-            more = ["-l", "0", "-o", ml_layer, "-l", "1", "-m", "vc", "vq", "vn"] if new_layer else []
-            run([mlx_run, "-i", mesh, "-o", ml_out, "-m"] + mask + more + ["-s", script])
+            # "-l N" right after its "-o" picks the layer; after "-m" meshlabserver reads it as a log file.
+            first = ["-o", ml_out] + (["-l", "0"] if new_layer else []) + ["-m"] + mask
+            more = ["-o", ml_layer, "-l", "1", "-m", "vc", "vq", "vn"] if new_layer else []
+            run([mlx_run, "-i", mesh] + first + more + ["-s", script])
             run([gi, name, mesh, "-o", cli_out, "-q"] + params + (["--image_path", cli_img] if images else []))
             if new_layer:
                 lm, lc = read_ply(ml_layer)["vertex"], read_ply(cli_out[:-4] + ".Photons.ply")["vertex"]
