@@ -7,11 +7,15 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -20,6 +24,46 @@ namespace gi::io {
 namespace fs = std::filesystem;
 
 namespace {
+
+// How old a temporary of a process that no longer runs must be before a
+// later write of the same file removes it: a write of another machine's
+// process into a shared folder (its PID means nothing here) is long over.
+constexpr auto kStaleAfter = std::chrono::minutes(10);
+
+// Removes the temporaries a process killed outright (SIGKILL, the kernel's
+// out-of-memory killer, a power cut) left in the folder `target` is written
+// to: ".NAME.gi-PID-N.tmp" whose PID runs no process here and that were
+// last written more than kStaleAfter ago. Each folder once per process (a
+// batch writing thousands of files into one folder reads it once). The
+// signals a run can catch remove their own (removeTemporariesAndStop).
+void removeStaleTemporaries(const fs::path& target) {
+  static std::mutex m;
+  static std::set<std::string> done;
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  {
+    std::lock_guard<std::mutex> lock(m);
+    if (!done.insert(dir.string()).second) return;
+  }
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    const size_t mark = f.rfind(".gi-");
+    if (f.size() < 10 || f[0] != '.' || mark == std::string::npos || mark < 2 || f.compare(f.size() - 4, 4, ".tmp") != 0)
+      continue;
+    const std::string tail = f.substr(mark + 4, f.size() - 4 - mark - 4);  // "PID-N"
+    const size_t dash = tail.find('-');
+    if (dash == 0 || dash == std::string::npos || dash + 1 == tail.size() || tail.find('-', dash + 1) != std::string::npos ||
+        tail.find_first_not_of("0123456789-") != std::string::npos)
+      continue;
+    const long pid = std::strtol(tail.substr(0, dash).c_str(), nullptr, 10);
+    if (pid <= 0 || pid == long(::getpid()) || !(::kill(pid_t(pid), 0) == -1 && errno == ESRCH)) continue;
+    std::error_code tec;
+    const auto written = fs::last_write_time(it->path(), tec);
+    if (tec || now - written < kStaleAfter || !it->is_regular_file(tec)) continue;
+    fs::remove(it->path(), tec);
+  }
+}
 
 // A new empty file beside `target`, hidden and unique to this process:
 // ".NAME.gi-PID-N.tmp" (NAME cut to 64 bytes, so that long names still fit).
@@ -119,6 +163,7 @@ void writeAtomically(const std::string& path, const std::function<void(const std
     write(path);
     return;
   }
+  removeStaleTemporaries(fs::path(target));
   const std::string tmp = createTemporary(fs::path(target));
   if (tmp.empty()) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
   struct Listed {

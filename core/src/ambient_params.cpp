@@ -57,7 +57,8 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
   s.push_back({.name = "max_distance", .label = obscurance ? "Maximum distance" : "Maximum ray distance",
                .help = obscurance
                            ? "Hits farther than this count as fully open (obscurance 1); nearer hits count "
-                             "min(1, d/d_max)^k. Absolute length or % of the bounding-box diagonal."
+                             "min(1, d/d_max)^k. Absolute length or % of the bounding-box diagonal; above 0 "
+                             "(0 is refused: every hit would count as fully open)."
                            : "Geometry farther than this does not occlude (0 = infinite). Rays stop there, and "
                              "vertices with no geometry above their tangent plane within this distance get 1 without "
                              "casting rays.",
@@ -95,13 +96,15 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                  .type = ParamType::Float, .def = 1.0, .min = 0.01, .max = 16});
   if (mode == AmbientMode::Sky) {
     s.push_back({.name = "sky_color", .label = "Sky colour",
-                 .help = "Colour of the uniform sky (sRGB).",
+                 .help = "Colour of the uniform sky (sRGB, converted to linear light: 128 grey is 0.216 of "
+                         "white's irradiance).",
                  .type = ParamType::Color, .defVec = glm::vec3(1.f)});
     s.push_back({.name = "sky_irradiance", .label = "Sky irradiance (W/m^2)",
                  .help = "Irradiance the uniform sky gives an unoccluded surface (pi x sky radiance).",
                  .type = ParamType::Float, .def = 1.0, .min = 0.0, .max = 1e9});
     s.push_back({.name = "sun_direction", .label = "Sun direction",
-                 .help = "Direction towards the sun.",
+                 .help = "Direction towards the sun, in the mesh's coordinates (the default assumes y is up; "
+                         "for a z-up scan give e.g. 0.3,0.2,1). Faces turned away from it get no sun.",
                  .type = ParamType::Direction, .defVec = glm::vec3(0.3f, 1.f, 0.2f)});
     s.push_back({.name = "sun_color", .label = "Sun colour",
                  .help = "Colour of the sun (sRGB): scales each channel of its irradiance (linear colour). White "

@@ -5,9 +5,11 @@
 // command-line tool uses (io/atomic_file.h): whole or not at all.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -164,6 +166,39 @@ TEST(AtomicFile, FailedWriteKeepsTheFileAndLeavesNoTemporary) {
   for (const auto& e : fs::directory_iterator(p.parent_path())) files += e.path().filename() != "keep.txt";
   EXPECT_EQ(files, 0u);
   fs::remove_all(p.parent_path());
+}
+
+// A process killed outright (SIGKILL, the out-of-memory killer) cannot
+// remove its temporary: the next run that writes into the folder removes
+// those of processes that no longer run, once they are 10 minutes old (a
+// younger one may be another machine's writer in a shared folder). Those
+// of running processes, younger ones and files not named as ours stay.
+TEST(AtomicFile, LeftoverTemporariesOfKilledRunsAreRemoved) {
+  const fs::path dir = scratch("leftovers");  // a folder of its own: each is read once per process
+  fs::create_directories(dir);
+  const fs::path p = dir / "out.ply";
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);  // a process id that runs nothing now
+  const std::string dead = std::to_string(child);
+  const auto make = [&](const std::string& name, bool old) {
+    std::ofstream(dir / name) << "part";
+    if (old) fs::last_write_time(dir / name, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  };
+  make(".out.ply.gi-" + dead + "-0.tmp", true);    // removed
+  make(".out.ply.gi-" + dead + "-1.tmp", false);   // too young
+  make(".out.ply.gi-1-2.tmp", true);               // pid 1 runs
+  make(".other.ply.gi-" + dead + "-0.tmp", true);  // another output's: removed too
+  make(".out.ply.gi-x-0.tmp", true);               // not one of ours
+  make("out.ply.gi-" + dead + "-3.tmp", true);     // not hidden: not ours
+  io::writeFileAtomically(p.string(), "new");
+  std::set<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir)) left.insert(e.path().filename().string());
+  EXPECT_EQ(left, (std::set<std::string>{"out.ply", ".out.ply.gi-" + dead + "-1.tmp", ".out.ply.gi-1-2.tmp",
+                                         ".out.ply.gi-x-0.tmp", "out.ply.gi-" + dead + "-3.tmp"}));
+  EXPECT_EQ(readAll(p), "new");
+  fs::remove_all(dir.parent_path());
 }
 
 TEST(AtomicFile, WritesThroughASymbolicLink) {
