@@ -593,8 +593,9 @@ TEST(Params, HelpStatesTheRangeValidateEnforces) {
       if (!(p.min < p.max)) continue;
       EXPECT_NE(r, "") << d.cliName << " " << p.name;
       gi::ParamValues v = gi::defaultValues(gi::filterSpecs(d.kind), diag);
+      const std::vector<gi::ParamSpec> specs = gi::filterSpecs(d.kind);
       for (const gi::ParamUse& u : p.usedWhen) {  // the settings that use it (checked only there)
-        const gi::ParamSpec* c = gi::findSpec(gi::filterSpecs(d.kind), u.param);
+        const gi::ParamSpec* c = gi::findSpec(specs, u.param);
         ASSERT_TRUE(c && !u.values.empty()) << d.cliName << " " << p.name;
         if (c->type == gi::ParamType::Bool) v.set(u.param, u.values[0] != 0);
         else v.set(u.param, u.values[0]);
