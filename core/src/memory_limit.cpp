@@ -117,6 +117,11 @@ std::atomic<int> g_share{1};
 void shareMemoryWith(int processes) { g_share = std::max(processes, 1); }
 int memoryShare() { return g_share; }
 
+int workerThreads() {
+  return std::max(1, int(std::min<size_t>(size_t(tbb::this_task_arena::max_concurrency()),
+                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+}
+
 namespace {
 
 // glibc's malloc arenas of threads other than the first grow by reserving
@@ -145,8 +150,7 @@ double addressSpaceRoom() {
   // allowed (13 million photons checked against 746 MB, then "out of
   // memory"; an outside audit). Counted for the workers the threads
   // allowed (--threads) may use.
-  const double allowed = double(std::min<size_t>(size_t(std::max(tbb::this_task_arena::max_concurrency(), 1)),
-                                                 tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const double allowed = double(workerThreads());
   const double stack = double(tbb::global_control::active_value(tbb::global_control::thread_stack_size));
   const double workers = std::max(0.0, allowed - 1.0), toStart = std::max(0.0, allowed - threads);
   return std::max(0.0, double(r.rlim_cur) - mapped - workers * kArenaBytes - toStart * stack);

@@ -11,8 +11,6 @@
 #include <string>
 #include <stdexcept>
 
-#include <tbb/global_control.h>
-#include <tbb/task_arena.h>
 
 #include "gi/color.h"
 #include "gi/direct.h"
@@ -534,11 +532,6 @@ RadiosityResult solveHierarchicalRadiosity(const Scene& s, const RayCaster& cast
 }
 
 }  // namespace
-
-int workerThreads() {
-  return std::max(1, int(std::min<size_t>(size_t(tbb::this_task_arena::max_concurrency()),
-                                          tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
-}
 
 double solverBaseBytes(size_t patches, const RadiosityOptions& opt) {
   const double n = double(patches);

@@ -24,6 +24,8 @@ size_t availableMemoryBytes();
 // The processes of this run on this machine, counting this one (default 1).
 void shareMemoryWith(int processes);
 int memoryShare();
+// The threads parallel loops may use now (the arena's and --threads' limit).
+int workerThreads();
 
 // The limit a run checks against: `limit` if nonzero (a caller's own
 // budget), else availableMemoryBytes() (0: unknown, nothing is checked).

@@ -20,6 +20,7 @@
 #include "gi/direct.h"
 #include "gi/form_factors.h"
 #include "gi/hierarchical.h"
+#include "gi/memory_limit.h"  // workerThreads
 #include "gi/params.h"
 #include "gi/raycaster.h"
 #include "gi/refine.h"
@@ -160,7 +161,6 @@ void checkRadiosityMemory(size_t patches, const RadiosityOptions& opt);
 // refuse, and what gave NaN vertices (gather_rays 0) or the direct light
 // alone (a NaN tolerance). solveRadiosity calls it first.
 void checkRadiosityOptions(const RadiosityOptions& opt);
-int workerThreads();  // the threads parallel loops may use now
 
 // Sweeps enough for the residual to fall below `tolerance` when each sweep
 // shrinks it at least by the factor r (the spectral radius bound: the
