@@ -474,7 +474,23 @@ std::vector<LayerRange> meshLayers(const LoadedMesh& m, const std::string& fileN
   return out;
 }
 
-void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
+void reframe(LoadedMesh& m) {
+  if (m.points.size() != m.scene.vertexCount()) return;  // a part without its file's coordinates: as appended
+  // The whole scene's frame from the files' own coordinates, as MeshLab's
+  // layers get theirs (one rounding to float about the union's centre):
+  // Scene::append keeps the first part's centre and rounds the others'
+  // floats a second time, one float step off where the union's box differs
+  // from the first part's (the caustic Cornell box with its glossy block
+  // below the floor's lowest vertex: photon paths through the glass
+  // flipped, up to 87% on dark vertices against the same layers in
+  // meshlabserver; an outside audit).
+  Scene frame = Scene::fromAbsolute(m.points, m.scene.triangles);
+  m.scene.origin = frame.origin;
+  m.scene.unit = frame.unit;
+  m.scene.positions = std::move(frame.positions);
+}
+
+void appendMesh(LoadedMesh& into, const LoadedMesh& other, Reframing when) {
   into.layers.clear();
   into.warnings.insert(into.warnings.end(), other.warnings.begin(), other.warnings.end());
   const size_t nf0 = into.scene.faceCount(), nv0 = into.scene.vertexCount();
@@ -511,18 +527,7 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other) {
   into.scene.append(other.scene);
   if (into.points.size() == nv0 && other.points.size() == nv1) {
     into.points.insert(into.points.end(), other.points.begin(), other.points.end());
-    // The whole scene's frame from the files' own coordinates, as MeshLab's
-    // layers get theirs (one rounding to float about the union's centre):
-    // append keeps the first part's centre and rounds the others' floats a
-    // second time, one float step off where the union's box differs from
-    // the first part's (the caustic Cornell box with its glossy block below
-    // the floor's lowest vertex: photon paths through the glass flipped, up
-    // to 87% on dark vertices against the same layers in meshlabserver; an
-    // outside audit).
-    Scene frame = Scene::fromAbsolute(into.points, into.scene.triangles);
-    into.scene.origin = frame.origin;
-    into.scene.unit = frame.unit;
-    into.scene.positions = std::move(frame.positions);
+    if (when == Reframing::Now) reframe(into);
   } else {
     into.points.clear();
   }

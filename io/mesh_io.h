@@ -51,7 +51,14 @@ std::vector<LayerRange> meshLayers(const LoadedMesh& m, const std::string& fileN
 // quality that only one of them has are filled with defaults: grey 188
 // colours, quality 0; per-vertex attributes that not both have are dropped;
 // the recorded layers are dropped: take meshLayers of each part first).
-void appendMesh(LoadedMesh& into, const LoadedMesh& other);
+// The scene's frame (origin, unit, float positions) is rebuilt from the
+// parts' double coordinates, as MeshLab's layers share one: at once
+// (Reframing::Now), or, when several parts are appended in a row, deferred
+// (Reframing::Deferred) to one call of reframe after the last; rebuilding it at
+// each part would cost the square of the part count.
+enum class Reframing { Now, Deferred };
+void appendMesh(LoadedMesh& into, const LoadedMesh& other, Reframing when = Reframing::Now);
+void reframe(LoadedMesh& m);
 
 // Writes a binary PLY: vertices with colour (uchar red/green/blue, if given) and
 // "quality" (float, if given), faces with colour and quality if attrs has them,

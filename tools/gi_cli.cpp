@@ -228,8 +228,9 @@ int runCommand(FilterKind kind, const CommonArgs& a) {
   for (const std::string& file : a.layers) {
     const io::LoadedMesh part = io::loadMesh(file);
     for (const LayerRange& l : io::meshLayers(part, baseName(file), mesh.scene.faceCount())) in.layers.push_back(l);
-    io::appendMesh(mesh, part);
+    io::appendMesh(mesh, part, io::Reframing::Deferred);
   }
+  if (!a.layers.empty()) io::reframe(mesh);
   const std::vector<glm::vec3> fileNormals = std::move(mesh.scene.vertexNormals);  // written back unchanged
   mesh.scene.vertexNormals.clear();
   in.values = resolve(specs, a, sceneDiagonal(mesh.scene));

@@ -43,4 +43,33 @@ TEST(LayerFrame, AppendedFilesShareTheWholeScenesFrame) {
   EXPECT_EQ(both.points, all);
 }
 
+TEST(LayerFrame, DeferredReframingGivesTheSameScene) {
+  // The CLI appends its --layer files with the frame deferred to one
+  // rebuild after the last (a rebuild per file costs the square of their
+  // count): the scene must be the same bits as rebuilding at every file.
+  const std::vector<std::vector<glm::dvec3>> parts = {
+      {{0.1, 6.1e-6, 0.3}, {556.3, 6.1e-6, 0.3}, {556.3, 548.7, 559.1}, {0.1, 548.7, 559.1}},
+      {{130.7, 1.4e-14, 65.1}, {82.3, 165.2, 225.3}, {240.1, 165.2, 272.9}, {290.3, 0.7, 114.6}},
+      {{-12.5, 600.25, 3.3}, {-1.75, 600.25, 3.3}, {-1.75, 611.0, 9.1}, {-12.5, 611.0, 9.1}}};
+  gi::io::LoadedMesh now = gi::io::parseMesh(obj(parts[0]), "obj", "p0.obj");
+  gi::io::LoadedMesh later = now;
+  for (size_t k = 1; k < parts.size(); ++k) {
+    const gi::io::LoadedMesh part = gi::io::parseMesh(obj(parts[k]), "obj", "p" + std::to_string(k) + ".obj");
+    gi::io::appendMesh(now, part);
+    gi::io::appendMesh(later, part, gi::io::Reframing::Deferred);
+  }
+  gi::io::reframe(later);
+  EXPECT_EQ(later.scene.origin, now.scene.origin);
+  EXPECT_EQ(later.scene.unit, now.scene.unit);
+  EXPECT_EQ(later.scene.positions, now.scene.positions);
+  EXPECT_EQ(later.scene.triangles, now.scene.triangles);
+  EXPECT_EQ(later.points, now.points);
+  // And both are the frame of all the files' coordinates at once.
+  std::vector<glm::dvec3> all;
+  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+  const gi::Scene once = gi::Scene::fromAbsolute(all, now.scene.triangles);
+  EXPECT_EQ(later.scene.origin, once.origin);
+  EXPECT_EQ(later.scene.positions, once.positions);
+}
+
 }  // namespace
