@@ -254,7 +254,8 @@ PhotonEstimate kNearestEstimate(const PhotonRun& r, const Progress& progress, Ph
                                              opt.directLight ? &hitsLeft : nullptr);
   std::vector<Photon> causticPhotons;
   if (r.projection)
-    causticPhotons = traceCausticPhotons(r.s, r.caster, opt, 0, size_t(opt.photons), progress.sub(0.45, 0.55), ts);
+    causticPhotons = traceCausticPhotons(r.s, r.caster, whileHolding(opt, photons.size()), 0, size_t(opt.photons),
+                                         progress.sub(0.45, 0.55), ts);
   const double traceSeconds = traceTimer.seconds();
   Timer buildTimer;
   const GatherSurface surface(r.s);

@@ -41,6 +41,8 @@ struct PpmVertices {
 // aimed ones (those of the global pass dropped). With `keep`, every
 // stride-th photon of the global trace (all kinds) is appended to it with
 // its power times `scale`, and the hits its path had left to keep->left.
+// heldBytes: what the run holds besides (the kept photons), which the
+// traces' memory limit leaves out.
 struct KeptPhotons {
   std::vector<Photon> photons;
   std::vector<uint8_t> left;
@@ -49,19 +51,23 @@ struct KeptPhotons {
   size_t bytes() const { return photons.capacity() * sizeof(Photon) + left.capacity(); }
 };
 std::vector<Photon> tracePass(const PhotonRun& r, int pass, const Progress& pp, PhotonTraceStats& stats,
-                              KeptPhotons* keep) {
+                              KeptPhotons* keep, double heldBytes) {
   const PhotonOptions& opt = r.opt;
   const size_t count = size_t(opt.photons);
   // The hits left are asked for whenever the direct light is apart, so the
   // lost-power account is the same in every pass (progressivePhotonMap).
   std::vector<uint8_t> left;
-  std::vector<Photon> photons = tracePhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.0, 0.6), stats,
-                                             opt.directLight ? &left : nullptr);
-  if (keep) appendEveryNth(photons, left, keep->stride, keep->scale, keep->photons, keep->left);
+  std::vector<Photon> photons = tracePhotons(r.s, r.caster, whileHolding(opt, 0, heldBytes), size_t(pass) * count,
+                                             count, pp.sub(0.0, 0.6), stats, opt.directLight ? &left : nullptr);
+  if (keep) {
+    appendEveryNth(photons, left, keep->stride, keep->scale, keep->photons, keep->left);
+    heldBytes = double(keep->bytes());
+  }
   if (r.projection) {
     auto caustic = [](const Photon& p) { return p.path == kCausticPhoton; };
     photons.erase(std::remove_if(photons.begin(), photons.end(), caustic), photons.end());
-    const auto c = traceCausticPhotons(r.s, r.caster, opt, size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
+    const auto c = traceCausticPhotons(r.s, r.caster, whileHolding(opt, photons.size(), heldBytes),
+                                       size_t(pass) * count, count, pp.sub(0.6, 0.7), stats);
     photons.insert(photons.end(), c.begin(), c.end());
   }
   return photons;
@@ -259,7 +265,9 @@ ProgressiveResult progressivePhotonMap(const PhotonRun& r, const Progress& progr
     const double passShare = (1.0 - gatherShare) / opt.passes;
     const Progress pp = progress.sub(passShare * pass, passShare * (pass + 1));
     Timer tt;
-    std::vector<Photon> photons = tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr);
+    // The photons kept for the gather are held through every pass.
+    std::vector<Photon> photons =
+        tracePass(r, pass, pp, stats, pass < keepPasses ? &kept : nullptr, double(kept.bytes()));
     out.traceSeconds += tt.seconds();
     Timer bt;
     std::unique_ptr<PhotonMap> map;

@@ -313,6 +313,14 @@ PhotonKeys photonKeys(uint32_t seed, uint64_t g, uint32_t posSalt, uint32_t dirS
 
 }  // namespace
 
+PhotonOptions whileHolding(const PhotonOptions& o, size_t heldPhotons, double otherBytes) {
+  PhotonOptions out = o;
+  if (o.memoryLimitBytes == 0) return out;
+  const double left = double(o.memoryLimitBytes) - double(heldPhotons) * kStoredPhotonBytes - otherBytes;
+  out.memoryLimitBytes = left >= 1.0 ? size_t(left) : 1;
+  return out;
+}
+
 std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                  size_t count, const Progress& progress, PhotonTraceStats& stats,
                                  std::vector<uint8_t>* lastHit) {

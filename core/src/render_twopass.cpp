@@ -114,7 +114,7 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
       // where they came through mirrors, glass or glossy faces. Without
       // them the sun through a glass window or off a mirror was black where
       // the final gather reads the map (an outside review).
-      PhotonOptions out = po;
+      PhotonOptions out = whileHolding(po, photons.size());
       out.outside = outside;
       out.outsideLightsOnly = true;
       aimAtOpenings(findSkyOpenings(s, caster, outside, o.seed), s, out);

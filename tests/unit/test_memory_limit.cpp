@@ -204,6 +204,48 @@ TEST(MemoryLimit, PhotonsRefusedOncePastTheLimit) {
   EXPECT_FALSE(traceCausticPhotons(c, *cc, q, 0, 200000, Progress(nullptr), st).empty());
 }
 
+// Photon mapping's caustic projection is traced while the global photons
+// are held: under a fixed limit it gets what they leave. Sizes from the
+// same traces run alone (deterministic): a limit above either photon set
+// but below both (the larger and half the smaller) refuses the projection,
+// naming the caustic map; 10% above both runs. The projection was checked
+// against the whole limit before, and ran there.
+TEST(MemoryLimit, CausticProjectionGetsWhatTheGlobalPhotonsLeave) {
+  const Scene c = scenes::causticCornell(50.0, 10.0, 3, 1.5f);
+  auto cc = makeEmbreeCaster(c);
+  PhotonOptions o;
+  o.photons = 40000;
+  o.lightSamples = 4;
+  ASSERT_TRUE(o.causticProjection);
+  PhotonTraceStats st;
+  const double global = double(tracePhotons(c, *cc, o, 0, 40000, Progress(nullptr), st).size()) * 56.0;
+  const double caustic = double(traceCausticPhotons(c, *cc, o, 0, 40000, Progress(nullptr), st).size()) * 56.0;
+  ASSERT_GT(caustic, 0.1 * global);  // a limit between the larger and the sum exists (about 0.19 of it)
+  const size_t between = size_t(std::max(global, caustic) + 0.5 * std::min(global, caustic));
+  o.memoryLimitBytes = between;
+  const std::string m = refusal([&] { computePhotonMap(c, *cc, o); });
+  EXPECT_TRUE(has(m, "the caustic map of 40000 photons needs about")) << m;
+  o.memoryLimitBytes = size_t(1.1 * (global + caustic));
+  EXPECT_EQ(computePhotonMap(c, *cc, o).H.size(), c.vertexCount());
+  // The same account in each progressive pass.
+  o.progressive = true;
+  o.passes = 2;
+  o.memoryLimitBytes = between;
+  EXPECT_TRUE(has(refusal([&] { computePhotonMap(c, *cc, o); }), "the caustic map of 40000 photons needs about"));
+}
+
+// whileHolding: a fixed limit less the held photons' cost, never 0 (which
+// would mean the machine's figure); the machine's figure stays as it is.
+TEST(MemoryLimit, WhileHoldingLeavesWhatTheHeldPhotonsDoNotTake) {
+  PhotonOptions o;
+  o.memoryLimitBytes = 1000000;
+  EXPECT_EQ(whileHolding(o, 10000).memoryLimitBytes, size_t(1000000 - 10000 * 56));
+  EXPECT_EQ(whileHolding(o, 10000, 40000.0).memoryLimitBytes, size_t(1000000 - 10000 * 56 - 40000));
+  EXPECT_EQ(whileHolding(o, 20000).memoryLimitBytes, size_t(1));
+  o.memoryLimitBytes = 0;
+  EXPECT_EQ(whileHolding(o, 20000).memoryLimitBytes, size_t(0));
+}
+
 // The two-pass mode's caustic photons and its image share one limit: an
 // image and a map that each fit alone, but not together, are refused (each
 // was checked alone against the whole limit before, and the kernel's figure

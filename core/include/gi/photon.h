@@ -147,6 +147,16 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
 std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster, const PhotonOptions& opt, size_t first,
                                         size_t count, const Progress& progress, PhotonTraceStats& stats);
 
+// The options of a trace that runs while `heldPhotons` photons of the same
+// run (and `otherBytes` more) are kept: a fixed memoryLimitBytes less what
+// they take at the run's peak, at least one byte (a limit they fill refuses
+// the trace at once). A limit of 0, the machine's figure read when the
+// trace starts, counts them already (they are allocated). Without it a
+// second trace was checked against the whole limit beside the first's
+// photons: the caustic projection beside the global photons, the two-pass
+// view's sky and sun trace beside its projection.
+PhotonOptions whileHolding(const PhotonOptions& o, size_t heldPhotons, double otherBytes = 0.0);
+
 // Where the openings are the only way in from outside (findSkyOpenings), the
 // sky's and the sun's photons aim at a sphere around their portals instead
 // of the scene's (opt.outsideAimCentre and outsideAimRadius): the same lines
