@@ -87,6 +87,7 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
     for (const std::string& n : b.notes) r.stats.note(n);
     // Everything is computed: only now does the document change. Files are
     // written whole or not at all (a full disk keeps the file that was there).
+    checkResultFits(b, r);  // a layer's attribute of another type under a result's name: refused, nothing written
     writeOutputFiles(r, files::atomicWriter());
     writeResult(b, r);
     addRasters(md, r);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <stdexcept>
 
@@ -10,6 +11,7 @@
 
 #include <cstring>
 #include <type_traits>
+#include <typeinfo>
 
 #include <vcg/complex/algorithms/update/bounding.h>
 #include <vcg/complex/algorithms/update/color.h>
@@ -18,6 +20,60 @@
 #include "vertex_file.h"
 
 namespace gi::ml {
+
+namespace {
+
+// A layer's transformation matrix (CMeshO::Tr): MeshLab shows the layer
+// through it, and tools such as Align, the manipulator and the Matrix
+// filters set it without moving the vertices until it is frozen. The
+// filters see the layers where MeshLab shows them: a second layer moved
+// from z = 1 to z = 5 by an unfrozen matrix was lit as if it had not moved
+// (an outside audit). Affine matrices only (MeshLab's tools make no other).
+struct LayerMatrix {
+  glm::dmat3 linear{1.0};
+  glm::dvec3 shift{0.0};
+  bool identity = true;
+  explicit LayerMatrix(const MeshModel& mm) {
+    const Matrix44m& T = mm.cm.Tr;
+    bool finite = true;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const double x = double(T[i][j]);
+        finite = finite && std::isfinite(x);
+        if (x != (i == j ? 1.0 : 0.0)) identity = false;
+      }
+    if (identity) return;
+    const std::string layer = "layer '" + mm.label().toStdString() + "' ";
+    if (!finite) throw std::invalid_argument(layer + "has a transformation matrix with a NaN or infinite entry: reset it "
+                                             "(Matrix: Reset to Identity) and run the filter again");
+    if (T[3][0] != 0 || T[3][1] != 0 || T[3][2] != 0 || T[3][3] != 1)
+      throw std::invalid_argument(layer + "has a projective transformation matrix (its last row is not 0 0 0 1): "
+                                  "these filters take rotations, scales, shears and translations only");
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) linear[j][i] = double(T[i][j]);  // glm is column-major
+      shift[i] = double(T[i][3]);
+    }
+    const double det = glm::determinant(linear);
+    if (!(std::fabs(det) > 0.0) || !std::isfinite(det))
+      throw std::invalid_argument(layer + "has a singular transformation matrix (it flattens the layer): reset it "
+                                  "(Matrix: Reset to Identity) and run the filter again");
+  }
+  glm::dvec3 operator()(const Point3m& p) const {
+    const glm::dvec3 x{double(p[0]), double(p[1]), double(p[2])};
+    return identity ? x : linear * x + shift;
+  }
+  // A direction of the scene (a normal) back into the layer's own
+  // coordinates: normals go by the inverse transpose, so back by the transpose.
+  Point3m normalToLayer(const glm::vec3& n) const {
+    if (identity) return Point3m(n.x, n.y, n.z);
+    glm::dvec3 x = glm::transpose(linear) * glm::dvec3(n);
+    const double l = glm::length(x);
+    if (l > 0.0) x /= l;
+    return Point3m(Scalarm(x.x), Scalarm(x.y), Scalarm(x.z));
+  }
+};
+
+}  // namespace
 
 std::vector<MeshModel*> participatingLayers(MeshDocument& md, SceneExtent extent, size_t* faceless) {
   std::vector<MeshModel*> out;
@@ -60,6 +116,7 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
     part.vertexOffset = pts.size();
     part.faceOffset = tris.size();
     part.sceneVertex.assign(m.vert.size(), -1);
+    const LayerMatrix where(*mm);
     const bool vc = mm->hasDataMask(MeshModel::MM_VERTCOLOR);
     const bool fc = mm->hasDataMask(MeshModel::MM_FACECOLOR);
     const bool fq = mm->hasDataMask(MeshModel::MM_FACEQUALITY);
@@ -77,7 +134,7 @@ BridgeScene toScene(const std::vector<MeshModel*>& layers) {
       const CVertexO& v = m.vert[i];
       if (v.IsD()) continue;
       part.sceneVertex[i] = int(pts.size());
-      pts.emplace_back(v.cP()[0], v.cP()[1], v.cP()[2]);
+      pts.push_back(where(v.cP()));
       if (anyVertColor) {
         // Layers without vertex colours count as white-less grey: 188 = 0.5 linear.
         b.attrs.vertexColor.push_back(vc ? glm::u8vec3(v.cC()[0], v.cC()[1], v.cC()[2]) : glm::u8vec3(188));
@@ -200,18 +257,58 @@ double documentDiagonal(MeshDocument& md) {
   for (MeshModel* m : compat::meshes(md)) {
     if (!(m == md.mm() || m->isVisible())) continue;
     bool faces = false;
+    std::optional<LayerMatrix> where;
+    try {
+      where.emplace(*m);
+    } catch (const std::invalid_argument&) {  // the filter refuses it; the dialog's defaults need only a size
+    }
     for (const CFaceO& f : m->cm.face) {
       if (f.IsD()) continue;
-      for (int k = 0; k < 3; ++k) box.Add(f.cP(k));
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 p = where ? (*where)(f.cP(k)) : glm::dvec3(f.cP(k)[0], f.cP(k)[1], f.cP(k)[2]);
+        box.Add(vcg::Point3<MESHLAB_SCALAR>(MESHLAB_SCALAR(p.x), MESHLAB_SCALAR(p.y), MESHLAB_SCALAR(p.z)));
+      }
       faces = true;
     }
-    if (!faces && m == md.mm()) box.Add(m->cm.bbox);
+    if (!faces && m == md.mm()) box.Add(m->cm.Tr, m->cm.bbox);
   }
   const double d = box.IsNull() ? 1.0 : double(box.Diag());
   return d > 0 && std::isfinite(d) ? d : 1.0;
 }
 
+namespace {
+
+// Whether the layer holds a per-vertex attribute `name` of another type
+// than T (another size, or another type of the same size). vcg's
+// GetPerVertexAttribute<T> matches names by size only and, finding none of
+// T's size, adds one whose name is taken: that fails (its assert compiled
+// out) and hands back the other attribute's storage, which writing T ran
+// past: MeshLab crashed (an outside audit: MeshLab's own 'Define New Per
+// Vertex Attribute' names its float 'Radiosity' by default, and radiosity
+// writes three floats under that name).
+template <class T>
+bool clashes(const CMeshO& m, const std::string& name) {
+  for (const auto& a : m.vert_attr)
+    if (a._name == name) return a._sizeof != sizeof(T) || (a._type != typeid(void) && a._type != typeid(T));
+  return false;
+}
+
+}  // namespace
+
+void checkResultFits(const BridgeScene& b, const FilterResult& r) {
+  for (const VertexAttribute& a : r.attributes)
+    for (const LayerPart& p : b.parts) {
+      const CMeshO& m = p.mm->cm;
+      if (a.components == 3 ? clashes<Point3m>(m, a.name) : clashes<Scalarm>(m, a.name))
+        throw std::invalid_argument(
+            "layer '" + p.mm->label().toStdString() + "' already has a per-vertex attribute '" + a.name +
+            "' of another type (this filter writes " + (a.components == 3 ? "three numbers" : "one number") +
+            " a vertex under that name): remove or rename that attribute and run the filter again");
+    }
+}
+
 void writeResult(BridgeScene& b, FilterResult& r) {
+  checkResultFits(b, r);
   if (r.refined) {
     const RefinedOrder order = replaceWithRefined(b, *r.refined);
     r.reorder(order.vertex, order.face);
@@ -222,13 +319,14 @@ void writeResult(BridgeScene& b, FilterResult& r) {
   if (!r.vertexNormal.empty()) vmask |= MeshModel::MM_VERTNORMAL;
   for (LayerPart& p : b.parts) p.mm->updateDataMask(vmask);
   for (LayerPart& p : b.parts) {
+    const LayerMatrix where(*p.mm);
     for (size_t i = 0; i < p.mm->cm.vert.size(); ++i) {
       if (p.sceneVertex[i] < 0) continue;
       const size_t s = size_t(p.sceneVertex[i]);
       CVertexO& v = p.mm->cm.vert[i];
       if (!r.vertexQuality.empty()) v.Q() = r.vertexQuality[s];
       if (!r.vertexColor.empty()) v.C() = vcg::Color4b(r.vertexColor[s].r, r.vertexColor[s].g, r.vertexColor[s].b, 255);
-      if (!r.vertexNormal.empty()) v.N() = Point3m(r.vertexNormal[s].x, r.vertexNormal[s].y, r.vertexNormal[s].z);
+      if (!r.vertexNormal.empty()) v.N() = where.normalToLayer(r.vertexNormal[s]);
     }
   }
   if (!r.faceQuality.empty() || !r.faceColor.empty()) {
@@ -325,6 +423,8 @@ std::vector<VertexAttribute> readAttributes(const BridgeScene& b) {
       bool everywhere = true;
       for (const LayerPart& p : b.parts) {
         CMeshO& m = p.mm->cm;
+        // Of type T exactly: vcg finds an attribute by its size only (an int read as a float).
+        if (clashes<T>(m, name)) { everywhere = false; break; }
         auto h = vcg::tri::Allocator<CMeshO>::FindPerVertexAttribute<T>(m, name);
         if (!vcg::tri::Allocator<CMeshO>::IsValidHandle<T>(m, h)) { everywhere = false; break; }
         for (size_t i = 0; i < m.vert.size(); ++i) {
@@ -449,6 +549,20 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
   in.scene = std::move(b.scene);  // the bridge keeps the layers' indexing, the engine the geometry
   in.attrs = b.attrs;
   for (const LayerPart& p : b.parts) in.layers.push_back({p.mm->label().toStdString(), p.faceOffset, p.faceCount});
+  // MeshLab's face numbers, where deleted faces make them differ from the
+  // scene's: each layer's faces after the faces of the layers before it,
+  // deleted ones counted (face_index named the wrong face; an outside audit).
+  bool deleted = false;
+  for (const LayerPart& p : b.parts) deleted |= p.mm->cm.face.size() != p.faceCount;
+  if (deleted) {
+    uint64_t base = 0;
+    for (const LayerPart& p : b.parts) {
+      const CMeshO& m = p.mm->cm;
+      for (size_t i = 0; i < m.face.size(); ++i)
+        if (!m.face[i].IsD()) in.faceNumbers.push_back(base + i);
+      base += m.face.size();
+    }
+  }
   in.attributes = readAttributes(b);
   in.readVertexFile = io::readVertexFile;  // a reference file a parameter names
   if (md.mm() && md.mm()->cm.shot.IsValid()) in.layerCamera = toShotData(md.mm()->cm.shot);

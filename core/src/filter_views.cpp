@@ -16,16 +16,38 @@
 #include "gi/sampling.h"
 #include "scene_defects.h"
 
+namespace gi {
+
+std::optional<uint32_t> FilterInput::sceneFace(uint64_t number) const {
+  if (faceNumbers.empty()) return number < scene.faceCount() ? std::optional<uint32_t>(uint32_t(number)) : std::nullopt;
+  const auto it = std::lower_bound(faceNumbers.begin(), faceNumbers.end(), number);  // increasing
+  if (it == faceNumbers.end() || *it != number) return std::nullopt;
+  return uint32_t(it - faceNumbers.begin());
+}
+
+}  // namespace gi
+
 namespace gi::detail {
 
 namespace {
+
+// The face face_index names (in the front end's numbering), or the one
+// selected face.
+uint32_t chosenFace(const FilterInput& in) {
+  const int k = in.values.getInt("face_index");
+  if (k < 0 || in.faceNumbers.empty()) return gi::chosenFace(k, in.attrs.faceSelected, in.scene.faceCount());
+  if (const auto f = in.sceneFace(uint64_t(k))) return *f;
+  throw std::invalid_argument("face_index " + std::to_string(k) + " names no face of the layers: " +
+                              (uint64_t(k) < in.faceNumbers.back() ? "that face was deleted" : "it is beyond their last, " +
+                               std::to_string(in.faceNumbers.back())));
+}
 
 // Why a face's row is empty: 64 cosine rays from its centre find only the
 // backs of faces (it lies inside a solid: the floor under a block) or
 // nothing (it faces away from the scene). The log said "0 faces reached,
 // lost 1" alone (an outside audit); radiosity's says which patches are
 // buried.
-std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t face) {
+std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t face, uint64_t number) {
   const glm::uvec3& t = s.triangles[face];
   const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, face));
   const Frame frame(n);
@@ -41,10 +63,10 @@ std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t fac
     else if (h.face != face && glm::dot(ray.d, faceNormalUnnormalized(s, h.face)) > 0.f) ++backs;
   }
   if (backs == kRays)
-    return "face " + std::to_string(face) + " sees only the backs of faces: it lies inside a solid (buried under "
+    return "face " + std::to_string(number) + " sees only the backs of faces: it lies inside a solid (buried under "
            "another surface, as a floor under a block), where no light reaches; its row is 0";
   if (misses == kRays)
-    return "face " + std::to_string(face) + " faces away from every other face: nothing is in front of it; its "
+    return "face " + std::to_string(number) + " faces away from every other face: nothing is in front of it; its "
            "row is 0";
   return "";
 }
@@ -53,23 +75,25 @@ std::string emptyRowReason(const Scene& s, const RayCaster& caster, uint32_t fac
 
 void runFormFactors(FilterInput& in, FilterResult& res) {
   const Scene& s = in.scene;
-  const uint32_t chosen = chosenFace(in.values.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t chosen = chosenFace(in);
   const uint32_t face = originalFace(res, chosen);  // a duplicated face's copy stands for its original
-  if (face != chosen) res.stats.note("face " + std::to_string(chosen) + " repeats face " + std::to_string(face) + ": computed for it");
+  if (face != chosen)
+    res.stats.note("face " + std::to_string(in.faceNumber(chosen)) + " repeats face " + std::to_string(in.faceNumber(face)) +
+                   ": computed for it");
   const auto caster = makeEmbreeCaster(s);
   const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(in.values), face);
   FormFactorOutput out = formFactorOutput(s, rep, face);
   res.vertexQuality = std::move(out.vertexF);
   res.faceQuality = std::move(out.faceF);
   res.faceColor = std::move(out.faceColor);
-  res.stats.add("face", double(face));
+  res.stats.add("face", double(in.faceNumber(face)));
   res.stats.add("row_sum", rep.rowSum);
   res.stats.add("lost", rep.escaped);
   res.stats.add("max_reciprocity_error", rep.maxReciprocityError);
   res.stats.add("seconds", rep.seconds);
   res.stats.note(out.summary);
   if (!(rep.rowSum > 0.0))
-    if (const std::string why = emptyRowReason(s, *caster, face); !why.empty()) res.stats.note(why);
+    if (const std::string why = emptyRowReason(s, *caster, face, in.faceNumber(face)); !why.empty()) res.stats.note(why);
   if (const std::string w = cutShortWarning(rep.pairsCutShort); !w.empty()) res.stats.warn(w);
   if (const auto w = narrowPatchWarning(s, narrowPatch(s, face, sceneScale(s).rayEpsilon), "its form factors"))
     res.stats.warn(*w);
@@ -80,10 +104,12 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
 void runHemicube(FilterInput& in, FilterResult& res) {
   const Scene& s = in.scene;
   const ParamValues& v = in.values;
-  const uint32_t chosen = chosenFace(v.getInt("face_index"), in.attrs.faceSelected, s.faceCount());
+  const uint32_t chosen = chosenFace(in);
   const uint32_t face = originalFace(res, chosen);  // a duplicated face's copy stands for its original
-  if (face != chosen) res.stats.note("face " + std::to_string(chosen) + " repeats face " + std::to_string(face) + ": computed for it");
-  if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(face) + " is degenerate");
+  if (face != chosen)
+    res.stats.note("face " + std::to_string(in.faceNumber(chosen)) + " repeats face " + std::to_string(in.faceNumber(face)) +
+                   ": computed for it");
+  if (!usableFaceMask(s)[face]) throw std::invalid_argument("face " + std::to_string(in.faceNumber(face)) + " is degenerate");
   const Timer timer;
   const auto caster = makeEmbreeCaster(s);
   HemicubeView hv = hemicubeView(s, *caster, face, v.getInt("hemicube_resolution"), v.getInt("nusselt_resolution"));
@@ -120,7 +146,7 @@ void runHemicube(FilterInput& in, FilterResult& res) {
   add("Hemicube cells by patch", std::move(hv.byPatch), path, crossFov);
   add("Hemicube delta form factors", std::move(hv.deltaF), stem + "_dff.png", crossFov);
   add("Nusselt disk", std::move(hv.nusselt), stem + "_nusselt.png", 90.0);
-  res.stats.add("face", double(face));
+  res.stats.add("face", double(in.faceNumber(face)));
   res.stats.add("row_sum", rowSum);
   res.stats.add("lost", c.lost);
   res.stats.add("cells_dF_sum", c.total);

@@ -76,8 +76,10 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
       s.push_back(geometrySceneSpecs().front());  // scene extent
       s.push_back({.name = "face_index", .label = "Face",
                    .help = "The face whose form factors are computed: -1 = the one selected face (MeshLab), else its "
-                           "index among the scene's triangles (the command-line tool needs it; a file's polygon of n "
-                           "corners counts as its n - 2 triangles, in its place, as MeshLab counts after loading).",
+                           "index among the scene's triangles, the layers' one after another (the command-line tool "
+                           "needs it; a file's polygon of n corners counts as its n - 2 triangles, in its place, as "
+                           "MeshLab counts after loading; in MeshLab a deleted face keeps its number until the layer "
+                           "is compacted, and the log's face numbers are MeshLab's).",
                    .type = ParamType::Int, .def = -1, .min = -1, .max = 2147483647});
       add(formFactorSpecs());
       s.push_back(seedSpec("form-factor rays"));

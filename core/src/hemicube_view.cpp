@@ -158,7 +158,8 @@ std::vector<ParamSpec> hemicubeViewSpecs() {
   return {
       {.name = "face_index", .label = "Face",
        .help = "The face whose hemicube is shown: -1 = the one selected face (MeshLab; none or several selected is "
-               "refused), else its index in the scene (the command-line tool needs it).",
+               "refused), else its index in the scene, as the form-factor filter counts it (the command-line tool "
+               "needs it).",
        .type = ParamType::Int, .def = -1, .min = -1, .max = 2147483647},
       {.name = "hemicube_resolution", .label = "Hemicube resolution",
        .help = "Cells across the hemicube's top face (the sides have half as many rows; rounded down to an even "

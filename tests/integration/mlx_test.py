@@ -4,7 +4,8 @@ script (written by `gi script`) in the real, staged meshlabserver under
 xvfb-run, and the saved PLY must carry per-vertex quality and colour with the
 values expected for the scene. Bad inputs must fail with a non-zero exit and
 a clear reason in the log. The harness is mlx_common.py; the cases of
-radiosity and the eye pass are in mlx_radiosity_cases.py.
+radiosity and the eye pass are in mlx_radiosity_cases.py, those of mesh
+states only MeshLab makes in mlx_mesh_state_cases.py.
 
 usage: mlx_test.py CASE --build BUILD_DIR --meshes TEST_MESHES_DIR
 """
@@ -20,6 +21,7 @@ import tempfile
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mlx_common import Ctx, check, fail, nearest, run_gi, scaled_box, vertices  # noqa: E402
 from mlx_radiosity_cases import case_formfactors, case_radiosity, case_raytrace, case_refine  # noqa: E402
+from mlx_mesh_state_cases import case_mesh_states  # noqa: E402
 from plyread import read_ply  # noqa: E402
 
 
@@ -421,7 +423,7 @@ def case_robust(c):
 
 CASES = {"raytrace": case_raytrace, "cli": case_cli, "examples": case_examples, "layers": case_layers, "reference": case_reference, "formfactors": case_formfactors, "ao": case_ao, "obscurance_sky": case_obscurance_sky, "radiosity": case_radiosity, "refine": case_refine,
          "photonmap": case_photonmap, "caustic": case_caustic, "bad_input": case_bad_input, "dump": case_dump,
-         "robust": case_robust}
+         "robust": case_robust, "mesh_states": case_mesh_states}
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()

@@ -71,6 +71,15 @@ struct FilterInput {
   VertexPart vertices;
   // Reads a mesh file a parameter names; unset: the front end reads none.
   VertexFileReader readVertexFile;
+  // The number the front end shows for each scene face, where it differs
+  // from the face's place in the scene: MeshLab counts a layer's deleted
+  // faces until they are compacted (its face k is then not scene face k),
+  // after the faces of the layers before it. face_index and the log's face
+  // numbers are in it. Empty: the scene's own (the command-line tool).
+  std::vector<uint64_t> faceNumbers;
+  // The scene face a front end's face number names (faceNumbers), and back.
+  std::optional<uint32_t> sceneFace(uint64_t number) const;
+  uint64_t faceNumber(uint32_t sceneFace) const { return faceNumbers.empty() ? sceneFace : faceNumbers[sceneFace]; }
   const VertexAttribute* attribute(const std::string& name) const;
 };
 
