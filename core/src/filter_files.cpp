@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -93,6 +94,7 @@ void writeOutputFiles(const FilterResult& r, const FileWriter& writer) {
     write(img.path, [&](const std::string& to) { writePng(to, img.image, img.exposure); });
     write(pfmPath(img.path), [&](const std::string& to) { writePfm(to, img.image); });
   }
+  for (const std::string& stale : r.staleFiles) std::remove(stale.c_str());  // gone already: nothing to do
 }
 
 }  // namespace gi

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <stdexcept>
 
@@ -236,6 +237,18 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
     res.images.push_back(std::move(img));
     res.images.push_back(std::move(err));
     return;
+  }
+  // An earlier path-traced view's error images under this name would
+  // describe another image beside this one (an outside audit): removed.
+  if (!img.path.empty()) {
+    const std::string png = stdErrorImagePath(img.path), pfm = pfmPath(png);
+    std::vector<std::string> found;
+    for (const std::string& f : {png, pfm})
+      if (std::ifstream(f).good()) found.push_back(f);
+    if (!found.empty())
+      res.stats.note("removes " + png + (found.size() == 2 ? " and .pfm" : "") +
+                     ", the error bars of an earlier path-traced view (this mode has none)");
+    res.staleFiles = std::move(found);
   }
   res.images.push_back(std::move(img));
 }

@@ -4,7 +4,10 @@
 // pass's direct part, and the vertex colours it leaves behind.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -234,6 +237,46 @@ TEST(RenderUnits, PathTracedViewGivesItsErrorBarsPerPixel) {
   in.values.set("image_path", std::string("dir/view.png"));
   EXPECT_EQ(runFilter(FilterKind::RayTracedView, in).images.size(), 1u);  // distributed
   EXPECT_EQ(filterFiles(FilterKind::RayTracedView, in.values).writes.size(), 2u);  // the PNG and the PFM
+}
+
+// A view of another mode written to a name a path-traced view used before
+// removes that view's NAME_stderr.png and .pfm (they stayed beside the new
+// image, error bars of another picture; an outside audit) and says so; a
+// path-traced view writes its own over them.
+TEST(RenderUnits, ErrorImagesOfAnEarlierPathTracedViewAreRemoved) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("gi_stale_stderr_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string png = (dir / "view.png").string(), errPng = (dir / "view_stderr.png").string(),
+                    errPfm = (dir / "view_stderr.pfm").string();
+  auto run = [&](RenderMode mode) {
+    FilterInput in = skyFloor(FilterKind::RayTracedView);
+    in.values.set("width", 8);
+    in.values.set("height", 6);
+    in.values.set("samples_per_pixel", 4);
+    in.values.set("image_path", png);
+    in.values.set("mode", kRenderModes.index(mode));
+    FilterResult r = runFilter(FilterKind::RayTracedView, in);
+    writeOutputFiles(r);
+    return r;
+  };
+  run(RenderMode::PathTraced);
+  ASSERT_TRUE(fs::exists(errPng) && fs::exists(errPfm));
+  for (RenderMode m : {RenderMode::Whitted, RenderMode::Distributed}) {
+    const FilterResult r = run(m);
+    EXPECT_TRUE(fs::exists(png));
+    EXPECT_FALSE(fs::exists(errPng) || fs::exists(errPfm)) << renderModeName(m);
+    bool said = false;
+    for (const std::string& n : r.stats.notes) said |= n.find("the error bars of an earlier path-traced view") != std::string::npos;
+    EXPECT_TRUE(said) << renderModeName(m);
+    run(RenderMode::PathTraced);
+    EXPECT_TRUE(fs::exists(errPng) && fs::exists(errPfm));
+  }
+  // With none there, nothing is said.
+  fs::remove(errPng), fs::remove(errPfm);
+  const FilterResult r = run(RenderMode::Whitted);
+  for (const std::string& n : r.stats.notes) EXPECT_EQ(n.find("earlier path-traced"), std::string::npos) << n;
+  fs::remove_all(dir);
 }
 
 // The two-pass view takes the first pass's caustics out of its stored light

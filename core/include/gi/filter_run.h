@@ -129,6 +129,10 @@ struct FilterResult {
   std::optional<RefinedMesh> refined;  // the geometry was refined; the arrays above refer to it
   std::vector<FilterImage> images;
   std::vector<FilterFile> files;
+  // Files of an earlier run that would describe another result beside
+  // this one's (a path-traced view's NAME_stderr images beside a Whitted
+  // image written to the same NAME): removed once the result is written.
+  std::vector<std::string> staleFiles;
   std::vector<FilterLayer> layers;  // new layers (the input's are not among them)
   // Per face, the linear RGB value the estimate leaves for the output step
   // to map to faceQuality and faceColor (radiosity's face output).
