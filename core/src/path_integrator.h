@@ -64,9 +64,11 @@ class Sampler {
 struct Counts {
   uint64_t primary = 0, shadow = 0, specular = 0, glossy = 0, diffuse = 0, gather = 0;
   uint64_t cutAtMaxDepth = 0, belowWeight = 0, roulette = 0;
+  uint64_t gatherNear = 0;  // the two-pass view's gather hits relit at the point (render_integrators.cpp)
   void add(const Counts& o) {
     primary += o.primary; shadow += o.shadow; specular += o.specular; glossy += o.glossy; diffuse += o.diffuse;
     gather += o.gather; cutAtMaxDepth += o.cutAtMaxDepth; belowWeight += o.belowWeight; roulette += o.roulette;
+    gatherNear += o.gatherNear;
   }
   uint64_t rays() const { return primary + shadow + specular + glossy + diffuse + gather; }
 };

@@ -377,6 +377,7 @@ RenderResult render(const Scene& s, const RayCaster& caster, const RenderOptions
   st.add("glossy_rays", double(c.glossy));
   st.add("diffuse_rays", double(c.diffuse));
   if (c.gather) st.add("gather_rays", double(c.gather));
+  if (c.gatherNear) st.add("gather_near_hits_relit", double(c.gatherNear));
   st.add("rays", double(c.rays()));
   st.add("seconds", timer.seconds());
   st.add("rays_per_second", traceSeconds > 0 ? double(c.rays()) / traceSeconds : 0.0);

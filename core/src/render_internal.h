@@ -43,7 +43,8 @@ class CausticMap {
 // The first pass's data for the two-pass mode (render_twopass.cpp).
 struct TwoPassData {
   std::vector<glm::vec3> R;         // reflected radiosity B - E per vertex (>= 0)
-  std::vector<glm::vec3> indirect;  // its indirect part (DirectIndirect, Caustics); noise may make it < 0
+  std::vector<glm::vec3> indirect;  // its indirect part (DirectIndirect, Caustics, FinalGather); noise may make it < 0
+  std::vector<float> nearT;         // FinalGather: per face, the distance within which a gather hit is relit
   std::unique_ptr<CausticMap> caustics;  // null: none (no mirror or glass, or not asked for)
   float r2max = HUGE_VALF;
   glm::vec3 caustic(const glm::vec3& x, const glm::vec3& n, int k) const {
@@ -81,6 +82,8 @@ class Context : public paths::Integrator, private paths::StoredLight {
   glm::vec3 reflected(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const override;
   glm::vec3 interpolate(const std::vector<glm::vec3>& perVertex, const SurfacePoint& sp) const;
   glm::vec3 finalGather(const SurfacePoint& sp, Sampler& smp, Counts& c) const;
+  glm::vec3 gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const;  // the R one gather ray sees
+  glm::vec3 nearReflected(const SurfacePoint& q, int levels, Sampler& smp, Counts& c) const;  // a near hit's R
   // Whitted: direct irradiance at x, exact area-light factors with one shadow ray each.
   glm::vec3 whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const;
   // Whitted: what reaches the end of a shadow ray: 0 past an opaque face,

@@ -147,7 +147,10 @@ std::vector<ParamSpec> RenderOptions::specs() {
                .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::Caustics), kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "gather_rays", .label = "Final-gather rays",
                .help = "Rays per diffuse hit (and per eye ray) for the final gather: cosine-distributed, through "
-                       "mirrors and glass, reading the first pass's reflected radiosity where they land.",
+                       "mirrors and glass, reading the first pass's reflected radiosity where they land; a ray that "
+                       "lands within two patch edges (the floor beside a block standing on it) relights that point "
+                       "from this view's lights and gathers its indirect light again with one more ray, two levels "
+                       "deep, as the first pass's values interpolated over a coarse patch are wrong up close.",
                .type = ParamType::Int, .def = 16, .min = 1, .max = 1 << 16,
                .usedWhen = {{"mode", {kRenderModes.index(RenderMode::TwoPass)}}, {"two_pass_diffuse", {kTwoPassDiffuse.index(TwoPassDiffuse::FinalGather)}}}});
   s.push_back({.name = "vertex_radiance", .label = "Also per-vertex radiance towards the camera",

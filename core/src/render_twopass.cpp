@@ -6,7 +6,7 @@
 //   R        = B - E (>= 0)               reflected radiosity (Map, FinalGather)
 //   indirect = B - Bdirect [- rho Hc]     the part due to light that bounced on a
 //                                         diffuse surface first (DirectIndirect,
-//                                         Caustics), where Bdirect = E + rho H_direct
+//                                         Caustics; FinalGather at near hits), where Bdirect = E + rho H_direct
 //                                         (photon mapping's own, the attribute
 //                                         RadiosityDirect, else estimated here at
 //                                         the vertices) and Hc the caustic map's
@@ -152,7 +152,14 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
   } else if (wantCaustics) {
     stats.note("no caustic map: the scene has no mirror, glass or glossy faces");
   }
-  if (o.twoPass == TwoPassDiffuse::DirectIndirect || o.twoPass == TwoPassDiffuse::Caustics) {
+  if (o.twoPass == TwoPassDiffuse::FinalGather) {
+    // Near gather hits are relit at the point (render_integrators.cpp):
+    // within two patch edges of a hit face, as radiosity's own gather.
+    tp.nearT.resize(s.faceCount());
+    for (size_t f = 0; f < s.faceCount(); ++f) tp.nearT[f] = float(2.0 * std::sqrt(2.0 * faceArea(s, f)));
+  }
+  if (o.twoPass == TwoPassDiffuse::DirectIndirect || o.twoPass == TwoPassDiffuse::Caustics ||
+      o.twoPass == TwoPassDiffuse::FinalGather) {
     std::vector<glm::vec3> Bd = o.firstPassBdirect;
     if (!Bd.empty()) {
       checkPerVertex(Bd, nv, "the first pass's direct radiosity");
@@ -168,7 +175,9 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
                    " vertices (left by another run): not used");
         Bd.clear();
       } else {
-        stats.note("the first pass's own direct part replaced by ray-traced direct light");
+        stats.note(o.twoPass == TwoPassDiffuse::FinalGather
+                       ? "the first pass's own direct part replaced by ray-traced direct light at near gather hits"
+                       : "the first pass's own direct part replaced by ray-traced direct light");
       }
     }
     if (Bd.empty()) {
@@ -193,7 +202,8 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
       for (size_t i = 0; i < nv; ++i) Bd[i] = mat.E[i] + mat.rho[i] * Hd[i];
       stats.add("vertex_direct_seconds", t.seconds());
       stats.note("the first pass's direct part estimated at the vertices (" + std::to_string(kVertexDirectSamples) +
-                 " shadow rays each) and replaced by ray-traced direct light");
+                 " shadow rays each) and replaced by ray-traced direct light" +
+                 (o.twoPass == TwoPassDiffuse::FinalGather ? " at near gather hits" : ""));
     }
     tp.indirect.resize(nv);
     const bool removeCaustics = tp.caustics && o.firstPassHasCaustics;
