@@ -57,6 +57,13 @@ struct LayerMatrix {
     if (!(std::fabs(det) > 0.0) || !std::isfinite(det))
       throw std::invalid_argument(layer + "has a singular transformation matrix (it flattens the layer): reset it "
                                   "(Matrix: Reset to Identity) and run the filter again");
+    // A mirror turns the faces' corner order, the side they face, against
+    // the normals MeshLab lights them with: which side emits and reflects
+    // would be a guess.
+    if (det < 0.0)
+      throw std::invalid_argument(layer + "has a mirroring transformation matrix (negative determinant) that is not "
+                                  "frozen: freeze it (Matrix: Freeze Current Matrix) and check the faces' "
+                                  "orientation, or reset it, and run the filter again");
   }
   glm::dvec3 operator()(const Point3m& p) const {
     const glm::dvec3 x{double(p[0]), double(p[1]), double(p[2])};
@@ -565,7 +572,13 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
   }
   in.attributes = readAttributes(b);
   in.readVertexFile = io::readVertexFile;  // a reference file a parameter names
-  if (md.mm() && md.mm()->cm.shot.IsValid()) in.layerCamera = toShotData(md.mm()->cm.shot);
+  if (md.mm() && md.mm()->cm.shot.IsValid()) {
+    // The layer's camera moves with its unfrozen matrix, as freezing it
+    // would move it (MeshLab's Freeze applies the matrix to the shot).
+    Shotm shot = md.mm()->cm.shot;
+    if (!LayerMatrix(*md.mm()).identity) shot.ApplyRigidTransformation(md.mm()->cm.Tr);
+    in.layerCamera = toShotData(shot);
+  }
   return in;
 }
 

@@ -517,9 +517,11 @@ void appendMesh(LoadedMesh& into, const LoadedMesh& other, Reframing when) {
   merge(into.attrs.faceSelected, other.attrs.faceSelected, nf0, nf1, uint8_t(0));
   merge(into.attrs.vertexSelected, other.attrs.vertexSelected, nv0, nv1, uint8_t(0));
   const bool normals = !into.scene.vertexNormals.empty() || !other.scene.vertexNormals.empty();
-  if (normals) {
-    // Missing normals of one part: computed from its faces.
-    if (into.scene.vertexNormals.empty()) into.scene.vertexNormals = computeVertexNormals(into.scene);
+  if (normals && into.scene.vertexNormals.empty()) {
+    // Missing normals of one part: computed from its faces, in the frame
+    // re-framing at each part would have given (the same bits either way).
+    if (when == Reframing::Deferred) reframe(into);
+    into.scene.vertexNormals = computeVertexNormals(into.scene);
   }
   std::vector<glm::vec3> otherNormals = other.scene.vertexNormals;
   if (normals && otherNormals.empty()) otherNormals = computeVertexNormals(other.scene);

@@ -39,8 +39,9 @@ uint32_t chosenFace(const FilterInput& in) {
   if (k < 0 || in.faceNumbers.empty()) return gi::chosenFace(k, in.attrs.faceSelected, in.scene.faceCount());
   if (const auto f = in.sceneFace(uint64_t(k))) return *f;
   throw std::invalid_argument("face_index " + std::to_string(k) + " names no face of the layers: " +
-                              (uint64_t(k) < in.faceNumbers.back() ? "that face was deleted" : "it is beyond their last, " +
-                               std::to_string(in.faceNumbers.back())));
+                              (uint64_t(k) < in.faceNumbers.back() ? std::string("that face was deleted")
+                                                                    : "that face was deleted, or lies beyond their "
+                                                                      "last, " + std::to_string(in.faceNumbers.back())));
 }
 
 // Why a face's row is empty: 64 cosine rays from its centre find only the
@@ -83,7 +84,7 @@ void runFormFactors(FilterInput& in, FilterResult& res) {
                    ": computed for it");
   const auto caster = makeEmbreeCaster(s);
   const FormFactorReport rep = formFactorsOfFace(s, *caster, formFactorSettings(in.values), face);
-  FormFactorOutput out = formFactorOutput(s, rep, face);
+  FormFactorOutput out = formFactorOutput(s, rep, face, in.faceNumber(face));
   res.vertexQuality = std::move(out.vertexF);
   res.faceQuality = std::move(out.faceF);
   res.faceColor = std::move(out.faceColor);
@@ -157,10 +158,10 @@ void runHemicube(FilterInput& in, FilterResult& res) {
   res.stats.add("seconds", timer.seconds());
   char b[400];
   std::snprintf(b, sizeof b,
-                "GI: Hemicube of Selected Face: face %u, %d cells across, %zu patches seen; hemicube row sum %.6f "
+                "GI: Hemicube of Selected Face: face %llu, %d cells across, %zu patches seen; hemicube row sum %.6f "
                 "(cells' dF sum %.6f before normalising), Nusselt disk %d pixels across: covered area / pi %.6f, "
                 "largest |F_hemicube - F_Nusselt| %.4g",
-                face, c.resolution, seen, rowSum, c.total, hv.nusseltResolution, nusseltSum, maxDiff);
+                (unsigned long long)in.faceNumber(face), c.resolution, seen, rowSum, c.total, hv.nusseltResolution, nusseltSum, maxDiff);
   res.stats.note(b);
 }
 
@@ -246,7 +247,7 @@ void runRender(FilterInput& in, FilterResult& res, const Progress& progress) {
     for (const std::string& f : {png, pfm})
       if (std::ifstream(f).good()) found.push_back(f);
     if (!found.empty())
-      res.stats.note("removes " + png + (found.size() == 2 ? " and .pfm" : "") +
+      res.stats.note("removes " + (found.size() == 2 ? png + " and .pfm" : found[0]) +
                      ", the error bars of an earlier path-traced view (this mode has none)");
     res.staleFiles = std::move(found);
   }

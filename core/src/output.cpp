@@ -38,7 +38,7 @@ std::vector<Rgb8> greyColors(const std::vector<float>& value) {
   return c;
 }
 
-FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face) {
+FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face, uint64_t number) {
   FormFactorOutput o;
   o.faceF.assign(s.faceCount(), 0.f);
   float maxF = 0;
@@ -56,9 +56,9 @@ FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, u
   }
   char b[256];
   std::snprintf(b, sizeof b,
-                "GI: Form Factors of Selected Face: face %u, %zu faces reached, row sum %.6f, lost %.6f, max F %.6g, "
+                "GI: Form Factors of Selected Face: face %llu, %zu faces reached, row sum %.6f, lost %.6f, max F %.6g, "
                 "reciprocity error max %.3g over the %d strongest receivers, %.3f s",
-                face, rep.row.j.size(), rep.rowSum, rep.escaped, double(maxF), rep.maxReciprocityError,
+                (unsigned long long)(number == UINT64_MAX ? face : number), rep.row.j.size(), rep.rowSum, rep.escaped, double(maxF), rep.maxReciprocityError,
                 rep.reciprocityChecked, rep.seconds);
   o.summary = b;
   return o;

@@ -248,6 +248,10 @@ class PhotonLights {
 // peak 102 MB above a run of 10,000, 55 bytes each; rounded up.
 constexpr double kStoredPhotonBytes = 56.0;
 
+std::string defaultMemoryRemedy() {
+  return "lower the photons (per pass when progressive: more passes take no more memory)";
+}
+
 // The photons stored so far against the memory limit: once over it the
 // remaining blocks are skipped, and check() refuses the run with the need
 // extrapolated from the paths traced. The run is refused, not cut short: a
@@ -287,9 +291,7 @@ class StoreBudget {
   }
 
  private:
-  std::string remedy() const {
-    return remedy_.empty() ? "lower the photons (per pass when progressive: more passes take no more memory)" : remedy_;
-  }
+  std::string remedy() const { return remedy_.empty() ? defaultMemoryRemedy() : remedy_; }
   size_t limit_, paths_;
   std::string remedy_;
   std::atomic<size_t> stored_{0}, traced_{0};
@@ -316,8 +318,13 @@ PhotonKeys photonKeys(uint32_t seed, uint64_t g, uint32_t posSalt, uint32_t dirS
 PhotonOptions whileHolding(const PhotonOptions& o, size_t heldPhotons, double otherBytes) {
   PhotonOptions out = o;
   if (o.memoryLimitBytes == 0) return out;
-  const double left = double(o.memoryLimitBytes) - double(heldPhotons) * kStoredPhotonBytes - otherBytes;
+  const double held = double(heldPhotons) * kStoredPhotonBytes + otherBytes;
+  const double left = double(o.memoryLimitBytes) - held;
   out.memoryLimitBytes = left >= 1.0 ? size_t(left) : 1;
+  // A refusal names what is left: it says what the rest of the run holds.
+  if (held > 0.0)
+    out.memoryRemedy = (o.memoryRemedy.empty() ? defaultMemoryRemedy() : o.memoryRemedy) + " (the run's other photons "
+                       "hold " + memoryAmount(held) + " of the " + memoryAmount(double(o.memoryLimitBytes)) + ")";
   return out;
 }
 

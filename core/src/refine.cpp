@@ -77,7 +77,11 @@ struct MeshRefiner::Impl {
     std::unordered_map<EdgeKey, std::vector<uint32_t>> edgeFaces;
     edgeFaces.reserve(n * 2);
     std::unordered_map<int32_t, std::vector<uint32_t>> greenChildren;
+    // Faces never split (indices out of range, left out) take no part: their
+    // indices may not name vertices, and an edge of theirs split elsewhere
+    // would hang on them for ever.
     for (uint32_t f = 0; f < n; ++f) {
+      if (!srcValid[faces[f].src]) continue;
       for (int k = 0; k < 3; ++k) edgeFaces[key(faces[f].v[k], faces[f].v[(k + 1) % 3])].push_back(f);
       if (faces[f].green != kNotGreen) greenChildren[faces[f].green].push_back(f);
     }
@@ -107,7 +111,7 @@ struct MeshRefiner::Impl {
     // Edges that already have a midpoint but are still edges of a face: left
     // hanging when an undone green parent was red-split next to finer faces.
     for (uint32_t f = 0; f < n; ++f)
-      for (int k = 0; k < 3; ++k) {
+      for (int k = 0; k < 3 && srcValid[faces[f].src]; ++k) {
         const uint32_t a = faces[f].v[k], b = faces[f].v[(k + 1) % 3];
         if (canonMidpoint.count(key(a, b))) splitEdge(a, b);
       }
@@ -172,9 +176,9 @@ struct MeshRefiner::Impl {
       if (p.removed[f]) continue;
       if (p.red[f]) { red(F.v, F.src, F.depth); continue; }
       int k1 = -1, count = 0;
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3 && srcValid[F.src]; ++k)
         if (p.split.count(key(F.v[k], F.v[(k + 1) % 3]))) { ++count; k1 = k; }
-      if (count == 0 || !srcValid[F.src]) {
+      if (count == 0) {
         out.push_back(F);
         continue;
       }
@@ -197,7 +201,9 @@ struct MeshRefiner::Impl {
     for (int pass = 0; pass < 64; ++pass) {
       const Plan p = plan({});
       if (p.split.empty()) break;
+      const size_t faceCount = faces.size(), vertexCount = positions.size();
       apply(p);
+      if (faces.size() == faceCount && positions.size() == vertexCount) break;  // nothing left to split
     }
   }
 

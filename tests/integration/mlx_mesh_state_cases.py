@@ -41,11 +41,11 @@ def quality_function(expr):
             '  <Param type="RichBool" value="false" name="onselected"/>\n </filter>' % expr)
 
 
-def set_matrix(tz, freeze):
+def set_matrix(tz, freeze, scale_x=1):
     """MeshLab's 'Matrix: Set from translation/rotation/scale' on the current layer."""
     p = "".join('  <Param type="RichFloat" value="%s" name="%s"/>\n' % (v, n) for n, v in
                 (("translationX", 0), ("translationY", 0), ("translationZ", tz), ("rotationX", 0), ("rotationY", 0),
-                 ("rotationZ", 0), ("scaleX", 1), ("scaleY", 1), ("scaleZ", 1)))
+                 ("rotationZ", 0), ("scaleX", scale_x), ("scaleY", 1), ("scaleZ", 1)))
     return (' <filter name="Matrix: Set from translation/rotation/scale">\n' + p +
             '  <Param type="RichBool" value="false" name="compose"/>\n'
             '  <Param type="RichBool" value="%s" name="Freeze"/>\n'
@@ -167,6 +167,9 @@ def case_mesh_states(c):
     check(means["none"] < 0.9 and means["frozen"] > 0.97, "the plates shade each other only when close: %s" % means)
     check(abs(means["unfrozen"] - means["frozen"]) < 0.002,
           "unfrozen matrix as frozen: mean AO %.4f against %.4f" % (means["unfrozen"], means["frozen"]))
+    # A mirroring matrix turns the side the faces face: refused by name.
+    log = c.server([a, b], script(c, "plates_mirror", set_matrix(0, False, -1), ao_all), expect_ok=False)
+    check("has a mirroring transformation matrix" in log, "an unfrozen mirroring matrix is refused")
 
     # 4. Deleted faces keep MeshLab's numbers until compacted: face_index
     # 1300 after deleting faces 0 to 199 is MeshLab's face 1300 (it named

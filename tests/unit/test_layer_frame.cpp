@@ -24,6 +24,19 @@ std::string obj(const std::vector<glm::dvec3>& p) {
   return s + "f 1 2 3\nf 1 3 4\n";
 }
 
+// The same quad as an ASCII PLY with a normal per vertex.
+std::string plyWithNormals(const std::vector<glm::dvec3>& p) {
+  std::string s = "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+                  "property float nx\nproperty float ny\nproperty float nz\nelement face 2\n"
+                  "property list uchar int vertex_indices\nend_header\n";
+  char b[160];
+  for (const auto& x : p) {
+    std::snprintf(b, sizeof b, "%.17g %.17g %.17g 0 0 1\n", x.x, x.y, x.z);
+    s += b;
+  }
+  return s + "3 0 1 2\n3 0 2 3\n";
+}
+
 TEST(LayerFrame, AppendedFilesShareTheWholeScenesFrame) {
   // A room's floor and a block reaching a little below it (as the caustic
   // Cornell box's glossy block does), at coordinates with many digits.
@@ -54,7 +67,11 @@ TEST(LayerFrame, DeferredReframingGivesTheSameScene) {
   gi::io::LoadedMesh now = gi::io::parseMesh(obj(parts[0]), "obj", "p0.obj");
   gi::io::LoadedMesh later = now;
   for (size_t k = 1; k < parts.size(); ++k) {
-    const gi::io::LoadedMesh part = gi::io::parseMesh(obj(parts[k]), "obj", "p" + std::to_string(k) + ".obj");
+    // The second part carries normals (a PLY's): the first's, missing, are
+    // computed from its faces, in the frame either way gives.
+    const gi::io::LoadedMesh part = k == 1 ? gi::io::parseMesh(plyWithNormals(parts[k]), "ply", "p1.ply")
+                                           : gi::io::parseMesh(obj(parts[k]), "obj", "p" + std::to_string(k) + ".obj");
+    ASSERT_EQ(part.scene.vertexNormals.empty(), k != 1);
     gi::io::appendMesh(now, part);
     gi::io::appendMesh(later, part, gi::io::Reframing::Deferred);
   }
@@ -64,6 +81,8 @@ TEST(LayerFrame, DeferredReframingGivesTheSameScene) {
   EXPECT_EQ(later.scene.positions, now.scene.positions);
   EXPECT_EQ(later.scene.triangles, now.scene.triangles);
   EXPECT_EQ(later.points, now.points);
+  EXPECT_FALSE(now.scene.vertexNormals.empty());
+  EXPECT_EQ(later.scene.vertexNormals, now.scene.vertexNormals);
   // And both are the frame of all the files' coordinates at once.
   std::vector<glm::dvec3> all;
   for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());

@@ -158,3 +158,46 @@ TEST(RefineTwins, SealedRoomWithATwoSidedPartitionKeepsItsLight) {
   EXPECT_LT(std::fabs(escaped) / emitted, 0.005);
   EXPECT_NEAR(b / a, 1.0, 0.02);
 }
+
+// Sheets meeting along an edge at copies of their vertices (a floor and a
+// wall, unwelded, as the shipped Cornell box is): refining the floor's
+// faces along the seam splits the wall's seam edges too, so no floor
+// midpoint hangs on an unsplit wall edge (a T-junction: 43 on the refined
+// Cornell box before, 0 now).
+TEST(RefineTwins, SheetsMeetingAtCopiesOfTheirVerticesLeaveNoTJunction) {
+  std::vector<glm::dvec3> p;
+  std::vector<glm::uvec3> t;
+  addGrid(p, t, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 4, 4);  // floor z = 0
+  const size_t floorFaces = t.size();
+  addGrid(p, t, {0, 0, 0}, {0, 0, 1}, {1, 0, 0}, 4, 4);  // wall y = 0, meeting the floor along y = 0
+  Scene s = Scene::fromAbsolute(p, t);
+  MeshRefiner r(s);
+  std::vector<uint32_t> seam;
+  for (uint32_t f = 0; f < floorFaces; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (p[t[f][k]].y == 0.0) { seam.push_back(f); break; }
+  r.refine(seam);
+  r.refine({});
+  const RefinedMesh& m = r.mesh();
+  // Every vertex on the seam (y = 0, z = 0) is a corner of a wall face.
+  std::map<std::array<float, 3>, int> wallAt;
+  for (size_t f = 0; f < m.scene.faceCount(); ++f)
+    if (m.sourceFace[f] >= floorFaces)
+      for (int k = 0; k < 3; ++k) {
+        const glm::vec3 q = m.scene.positions[m.scene.triangles[f][k]];
+        wallAt[{q.x, q.y, q.z}] = 1;
+      }
+  size_t seamVertices = 0, hanging = 0;
+  for (size_t f = 0; f < m.scene.faceCount(); ++f)
+    if (m.sourceFace[f] < floorFaces)
+      for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 w = m.scene.toWorld(m.scene.positions[m.scene.triangles[f][k]]);
+        if (std::fabs(w.y) > 1e-9) continue;
+        ++seamVertices;
+        const glm::vec3 q = m.scene.positions[m.scene.triangles[f][k]];
+        hanging += wallAt.count({q.x, q.y, q.z}) == 0;
+      }
+  EXPECT_GT(m.scene.faceCount(), s.faceCount());
+  EXPECT_GT(seamVertices, 0u);
+  EXPECT_EQ(hanging, 0u) << "floor vertices on the seam that no wall face has as a corner";
+}

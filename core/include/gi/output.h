@@ -1,6 +1,7 @@
 // Per-vertex results into the common output convention (docs/design.md, "Conventions"):
 // quality = the physical scalar, colour = its display mapping.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@ struct FormFactorOutput {
   std::vector<Rgb8> faceColor;
   std::string summary;
 };
-FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face);
+// `number`: the face's number in the log (the front end's; default the face's own).
+FormFactorOutput formFactorOutput(const Scene& s, const FormFactorReport& rep, uint32_t face,
+                                  uint64_t number = UINT64_MAX);
 
 }  // namespace gi
