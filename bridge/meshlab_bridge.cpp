@@ -315,7 +315,6 @@ void checkResultFits(const BridgeScene& b, const FilterResult& r) {
 }
 
 void writeResult(BridgeScene& b, FilterResult& r) {
-  checkResultFits(b, r);
   if (r.refined) {
     const RefinedOrder order = replaceWithRefined(b, *r.refined);
     r.reorder(order.vertex, order.face);

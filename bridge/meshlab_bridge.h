@@ -53,10 +53,10 @@ double documentDiagonal(MeshDocument& md);
 // Writes a filter's result into the layers, after any refined geometry has
 // replaced theirs: quality, colour, normals, face values and per-vertex
 // attributes (Scalarm or Point3m), each only when the result has it.
-// First checks (checkResultFits) that no layer holds a per-vertex attribute
-// of a result's name but another type; throws std::invalid_argument before
-// any change if one does.
+// The caller checks first (checkResultFits, before it writes any file).
 void writeResult(BridgeScene& b, FilterResult& r);
+// Throws std::invalid_argument, before any change, where a layer holds a
+// per-vertex attribute of a result's name but another type.
 void checkResultFits(const BridgeScene& b, const FilterResult& r);
 
 // Replaces each layer's geometry by its part of `m`, a refinement of

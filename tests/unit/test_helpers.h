@@ -17,6 +17,22 @@
 
 namespace gi::test {
 
+// Appends an nx x ny grid of quads (two triangles each, vertices of its
+// own) spanned by p0 + u s + v t, counter-clockwise seen from the side
+// u x v points to.
+inline void addGrid(std::vector<glm::dvec3>& pts, std::vector<glm::uvec3>& tris, glm::dvec3 p0, glm::dvec3 u,
+                    glm::dvec3 v, int nx, int ny) {
+  const uint32_t base = uint32_t(pts.size());
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) pts.push_back(p0 + u * (double(i) / nx) + v * (double(j) / ny));
+  auto id = [&](int i, int j) { return base + uint32_t(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+}
+
 // Index of the vertex nearest to p (local coordinates), among those accepted by `keep`.
 inline size_t nearestVertex(const Scene& s, const glm::dvec3& pWorld,
                             const std::function<bool(size_t)>& keep = nullptr) {

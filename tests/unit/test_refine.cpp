@@ -15,26 +15,13 @@
 #include "gi/form_factor_analytic.h"
 #include "gi/radiosity.h"
 #include "gi/refine.h"
+#include "test_helpers.h"
 #include "gi/scenes.h"
 
 using namespace gi;
+using gi::test::addGrid;
 
 namespace {
-
-// Appends an nx x ny grid of quads (two triangles each) spanned by p0 + u s + v t,
-// counter-clockwise seen from the side u x v points to.
-void addGrid(std::vector<glm::dvec3>& pts, std::vector<glm::uvec3>& tris, glm::dvec3 p0, glm::dvec3 u, glm::dvec3 v,
-             int nx, int ny) {
-  const uint32_t base = uint32_t(pts.size());
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) pts.push_back(p0 + u * (double(i) / nx) + v * (double(j) / ny));
-  auto id = [&](int i, int j) { return base + uint32_t(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-}
 
 // Floor [-1,1]^2 at z = 0 (rho 0.5, n x n quads), a small light (0.06 x 0.06,
 // E = 250, black) at z = 2 facing down, a black occluder x in [0.2, 1.6] at

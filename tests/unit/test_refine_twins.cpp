@@ -17,25 +17,12 @@
 #include "gi/color.h"
 #include "gi/radiosity.h"
 #include "gi/refine.h"
+#include "test_helpers.h"
 
 using namespace gi;
+using gi::test::addGrid;
 
 namespace {
-
-// An nx x ny grid of quads spanned by p0 + u s + v t, counter-clockwise seen
-// from the side u x v points to (vertices of its own).
-void addGrid(std::vector<glm::dvec3>& pts, std::vector<glm::uvec3>& tris, glm::dvec3 p0, glm::dvec3 u, glm::dvec3 v,
-             int nx, int ny) {
-  const uint32_t base = uint32_t(pts.size());
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) pts.push_back(p0 + u * (double(i) / nx) + v * (double(j) / ny));
-  auto id = [&](int i, int j) { return base + uint32_t(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      tris.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      tris.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-}
 
 // A face by its corner positions: sorted, and whether its turn is the sorted order's.
 std::pair<std::array<std::array<float, 3>, 3>, bool> corners(const Scene& s, const glm::uvec3& t) {
