@@ -66,6 +66,9 @@ int GiFilterPlugin::giPostCondition(compat::FilterId f) const {
   // postCondition cannot see the parameters: a filter that may refine the mesh
   // makes MeshLab refresh geometry and topology every time.
   if (w & WritesGeometry) mask |= MeshModel::MM_GEOMETRY_AND_TOPOLOGY_CHANGE;
+  // A re-run refills its earlier layer in place (addLayers): with as many
+  // points as before, only this makes the GUI re-read their positions.
+  if (w & WritesLayer) mask |= MeshModel::MM_VERTCOORD | MeshModel::MM_VERTNORMAL;
   return mask;
 }
 
@@ -91,7 +94,7 @@ QString GiFilterPlugin::giApply(compat::FilterId f, MeshDocument& md, const Rich
     writeOutputFiles(r, files::atomicWriter());
     writeResult(b, r);
     addRasters(md, r);
-    addLayers(md, r);
+    for (const std::string& n : addLayers(md, r)) r.stats.note(n);
     for (const std::string& line : r.logLines(name.toStdString())) logLine(line);
   });
   return why;

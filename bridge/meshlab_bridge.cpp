@@ -513,9 +513,46 @@ void addRasters(MeshDocument& md, const FilterResult& r) {
   }
 }
 
-void addLayers(MeshDocument& md, const FilterResult& r) {
+namespace {
+// Marks a layer a filter of ours made: a per-mesh attribute holding the
+// result's name and the label MeshLab gave the layer (it lives as long as the
+// layer in MeshLab's memory and is never saved with it).
+struct ResultLayerMark {
+  std::string result, label;
+};
+constexpr const char* kResultLayerMark = "gi_result_layer";
+
+// The layer an earlier run made for this result, or null. Only a marked
+// layer still under the label it was given: a layer of the user's under the
+// same name (loaded, or made by another tool) and one of ours the user
+// renamed (to keep it) are never touched.
+MeshModel* earlierResultLayer(MeshDocument& md, const std::string& result) {
+  for (MeshModel* m : compat::meshes(md)) {
+    if (!vcg::tri::HasPerMeshAttribute(m->cm, kResultLayerMark)) continue;
+    auto h = vcg::tri::Allocator<CMeshO>::FindPerMeshAttribute<ResultLayerMark>(m->cm, kResultLayerMark);
+    if (vcg::tri::Allocator<CMeshO>::IsValidHandle(m->cm, h) && h().result == result &&
+        h().label == m->label().toStdString())
+      return m;
+  }
+  return nullptr;
+}
+}  // namespace
+
+std::vector<std::string> addLayers(MeshDocument& md, const FilterResult& r) {
+  std::vector<std::string> notes;
   for (const FilterLayer& L : r.layers) {
-    MeshModel* mm = compat::addMeshLayer(md, QString::fromStdString(L.name));
+    // A re-run refills the layer it made before, in place (it may be the
+    // current layer), rather than stacking "Photons(1)", "Photons(2)"...
+    MeshModel* mm = earlierResultLayer(md, L.name);
+    if (mm) {
+      mm->cm.Clear();
+      mm->cm.Tr.SetIdentity();  // positions are written in world coordinates
+      notes.push_back("layer '" + mm->label().toStdString() + "' (an earlier run's " + L.name + ") refilled");
+    } else {
+      mm = compat::addMeshLayer(md, QString::fromStdString(L.name));
+      auto h = vcg::tri::Allocator<CMeshO>::GetPerMeshAttribute<ResultLayerMark>(mm->cm, kResultLayerMark);
+      h() = {L.name, mm->label().toStdString()};
+    }
     CMeshO& m = mm->cm;
     const size_t nv = L.mesh.vertexCount();
     int mask = 0;
@@ -540,6 +577,7 @@ void addLayers(MeshDocument& md, const FilterResult& r) {
     }
     vcg::tri::UpdateBounding<CMeshO>::Box(m);
   }
+  return notes;
 }
 
 FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKind kind, BridgeScene& b) {

@@ -91,7 +91,9 @@ FilterInput gatherInput(MeshDocument& md, const RichParameterList& par, FilterKi
 // Each image of the result as a new raster layer with the camera it was seen from.
 void addRasters(MeshDocument& md, const FilterResult& r);
 // Each new layer of the result (points or triangles, colour, quality,
-// normals) as a new mesh layer; the current layer stays current.
-void addLayers(MeshDocument& md, const FilterResult& r);
+// normals) as a new mesh layer; the current layer stays current. A layer an
+// earlier run of ours made under the same name is refilled instead (a
+// re-run does not stack copies); the notes say which.
+std::vector<std::string> addLayers(MeshDocument& md, const FilterResult& r);
 
 }  // namespace gi::ml

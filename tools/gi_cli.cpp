@@ -376,7 +376,7 @@ int listFilters(bool asJson) {
     const std::pair<unsigned, const char*> bits[] = {
         {WritesVertexQuality, "vertex_quality"}, {WritesVertexColor, "vertex_color"}, {WritesVertexNormal, "vertex_normal"},
         {WritesFaceQuality, "face_quality"},     {WritesFaceColor, "face_color"},     {WritesGeometry, "geometry"},
-        {WritesImage, "image"}};
+        {WritesImage, "image"},                  {WritesLayer, "layer"}};
     for (const auto& [bit, name] : bits)
       if (d.writes & bit) writes.push_back(name);
     all.push_back({{"cli", d.cliName}, {"meshlab", d.meshlabName}, {"plugin", d.plugin}, {"summary", d.summary},

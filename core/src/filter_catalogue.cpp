@@ -118,7 +118,7 @@ const std::vector<FilterDesc>& allFilters() {
        "'Scene extent' to all visible layers. Glass objects must be closed meshes with outward normals. Vertices "
        "on mirrors and glass get no diffuse radiosity (0).<br>"
        "Emitters, reflectance and output conventions are those of 'GI: Radiosity', so the two compare directly.",
-       WritesVertexQuality | WritesVertexColor},
+       WritesVertexQuality | WritesVertexColor | WritesLayer},
       {FilterKind::PathTracedReference, "GI: Path Traced Reference", "reference", "filter_reference",
        "per-vertex path-traced reference solution with error bars",
        "A <b>reference solution</b> of the rendering equation (Kajiya 1986) at every vertex, for diffuse "

@@ -62,8 +62,8 @@ std::vector<ParamSpec> filterSpecs(FilterKind k) {
                            "the output, NAME.Photons.ply): each photon of the maps the estimates read is a point "
                            "where it landed, coloured by its map (global map orange, caustic map blue), with "
                            "quality = its power (luminance, W) and normal = the side it arrived on. Colour by power "
-                           "with MeshLab's Colorize by vertex quality. Not with progressive photon mapping, which "
-                           "keeps no map.",
+                           "with MeshLab's Colorize by vertex quality. A re-run refills the layer the last run made "
+                           "(rename it to keep it). Not with progressive photon mapping, which keeps no map.",
                    .type = ParamType::Bool, .def = false});
       s.push_back({.name = "photon_layer_max", .label = "Most points in the photon layer",
                    .help = "A cap on the photon layer's points (about 40 bytes each in MeshLab): with more stored "

@@ -1,10 +1,11 @@
 """meshlabserver integration tests of mesh states only MeshLab makes: an
 attribute of another type under a result's name, texture coordinates and
 the layer's own attributes through refinement, a layer's unfrozen
-transformation matrix, and face numbers after faces were deleted (cases of
-mlx_test.py). MeshLab's own filters make each state before ours run."""
+transformation matrix, face numbers after faces were deleted, and a re-run
+of a filter that adds a layer (cases of mlx_test.py). MeshLab's own filters make each state before ours run."""
 import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -195,3 +196,41 @@ def case_mesh_states(c):
           "the row of MeshLab's face 1300 is the compacted mesh's 1100, bit for bit")
     log = c.server(box, script(c, "ff_deleted", select("fi &lt; 200"), delete, ff(100)), expect_ok=False)
     check("face_index 100 names no face of the layers: that face was deleted" in log, "a deleted face is refused by name")
+
+    # 5. A re-run of photon mapping with its photon layer refills the layer
+    # the first run made (it stacked Photons(1), Photons(2)...), and never
+    # touches a layer of the user's under the same name (here a point cloud
+    # a project file labels "Photons").
+    proj = os.path.join(c.tmp, "rerun")
+    os.makedirs(proj, exist_ok=True)
+    shutil.copy(box, os.path.join(proj, "box.ply"))
+    with open(os.path.join(proj, "cloud.ply"), "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex 7\nproperty float x\nproperty float y\nproperty float z\n"
+                "end_header\n" + "".join("%d 0 0\n" % i for i in range(7)))
+    eye = "   <MLMatrix44>\n1 0 0 0 \n0 1 0 0 \n0 0 1 0 \n0 0 0 1 \n</MLMatrix44>\n"
+    with open(os.path.join(proj, "in.mlp"), "w") as f:  # the last layer loaded is the current one: the box
+        f.write("<!DOCTYPE MeshLabDocument>\n<MeshLabProject>\n <MeshGroup>\n" +
+                "".join('  <MLMesh label="%s" filename="%s" visible="1">\n%s  </MLMesh>\n' % (lab, fn, eye)
+                        for lab, fn in (("Photons", "cloud.ply"), ("box", "box.ply"))) +
+                " </MeshGroup>\n <RasterGroup/>\n</MeshLabProject>\n")
+    pm = ["--photons", "20000", "--light_samples", "4", "--photon_layer", "true", "--photon_layer_max", "500"]
+    runs = [filters_of(c.script("pm_%d" % s, "photonmap", *(pm + ["--seed", str(s)]))) for s in (1, 2)]
+    once = os.path.join(proj, "once.mlp")
+    p = subprocess.run([c.mlx_run, "-p", os.path.join(proj, "in.mlp"), "-w", once, "-s", script(c, "pm_once", runs[0])],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+    check(p.returncode == 0, "photon mapping with its layer in a project (exit %d)" % p.returncode)
+    first = read_ply(os.path.join(proj, "Photons(1)_out.ply"))["vertex"]
+    twice = os.path.join(proj, "twice.mlp")
+    p = subprocess.run([c.mlx_run, "-p", os.path.join(proj, "in.mlp"), "-w", twice, "-s", script(c, "pm_twice", *runs)],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300)
+    log = p.stdout.decode("utf-8", "replace")
+    check(p.returncode == 0, "photon mapping run twice (exit %d)" % p.returncode)
+    labels = re.findall(r'<MLMesh [^>]*\blabel="([^"]*)"', open(twice).read())  # Qt orders the attributes at random
+    check(labels == ["cloud_out.ply", "box_out.ply", "Photons(1)_out.ply"],
+          "the second run refills its own layer, no third: %s" % labels)
+    check("layer 'Photons(1)' (an earlier run's Photons) refilled" in log, "the log says which layer was refilled")
+    second = read_ply(os.path.join(proj, "Photons(1)_out.ply"))["vertex"]
+    pos = lambda v: sorted((r["x"], r["y"], r["z"]) for r in v)
+    check(len(second) == len(first) == 500 and pos(second) != pos(first),
+          "the layer holds the second run's 500 photons (seed 2), not the first's")
+    check(len(read_ply(os.path.join(proj, "cloud_out.ply"))["vertex"]) == 7, "the user's 'Photons' layer untouched")

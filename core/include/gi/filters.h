@@ -35,6 +35,7 @@ enum FilterWrites : unsigned {
   WritesFaceColor = 1u << 4,
   WritesGeometry = 1u << 5,  // the mesh may be refined (new vertices and faces)
   WritesImage = 1u << 6,     // an image (MeshLab: a raster layer with its camera)
+  WritesLayer = 1u << 7,     // a mesh layer of its own (photon mapping's photons; a re-run refills it)
 };
 
 struct FilterDesc {
