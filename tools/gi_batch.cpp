@@ -157,7 +157,10 @@ std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSp
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(where + e.what());
     }
-    if (w.empty() || w[0][0] == '#') continue;
+    // A comment line starts with # itself; a quoted name may start with one
+    // ("#1.ply" was dropped as a comment, silently; an outside audit).
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (w.empty() || (first != std::string::npos && line[first] == '#')) continue;
     // A # where a parameter's name would come ends the line (a comment
     // after a mesh's parameters); a value may start with one (a colour
     // #ff8800).

@@ -186,7 +186,7 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
       glm::dvec3 sum(0.0);
       double sl = 0, sl2 = 0;
       for (int j = 0; j < N; ++j) {
-        const glm::vec3 c = sampleDirectIrradiance(lights, caster, origins[i], mat.n[i], seq.next(), eps);
+        const glm::vec3 c = sampleDirectIrradiance(lights, caster, s.positions[i], origins[i], mat.n[i], seq.next(), eps);
         sum += glm::dvec3(c);
         const double l = luminance(c * mat.rho[i]);
         sl += l;
@@ -275,15 +275,18 @@ class DirectLight {
   // (direction) for the MIS samples; dimension 0 is left to the caller (the
   // point on a patch). With luminaires: `budget` shadow rays at most per
   // luminaire, keyed by `key`; light from the luminaire of face `skip` is left out.
-  LuminaireEstimate estimate(const glm::vec3& x, const glm::vec3& n, const PaddedSobol& smp, uint32_t k, int budget,
-                             uint32_t key, uint32_t skip, LuminaireSums* sums = nullptr) const {
+  // x: the surface point, whose geometry counts; from: where its rays start
+  // (x lifted off its surface).
+  LuminaireEstimate estimate(const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, const PaddedSobol& smp,
+                             uint32_t k, int budget, uint32_t key, uint32_t skip,
+                             LuminaireSums* sums = nullptr) const {
     if (!exact_) {
       LuminaireEstimate e;
-      e.H = sampleDirectIrradianceMIS(lights_, s_, caster_, x, n, smp(k, 1), smp(k, 2), eps_);
+      e.H = sampleDirectIrradianceMIS(lights_, s_, caster_, x, from, n, smp(k, 1), smp(k, 2), eps_);
       e.rays = 1;
       return e;
     }
-    return luminaireIrradiance(lums_, caster_, x, n, budget, key, eps_, unoccluded_, luminaireOf(skip), sums);
+    return luminaireIrradiance(lums_, caster_, x, from, n, budget, key, eps_, unoccluded_, luminaireOf(skip), sums);
   }
   // With luminaires: the one face f belongs to (kNoHit: none).
   uint32_t luminaireOf(uint32_t f) const { return f < lumOfFace_.size() ? lumOfFace_[f] : kNoHit; }
@@ -347,7 +350,8 @@ glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint
   if (impl_->empty()) return glm::vec3(0.f);
   const PaddedSobol smp(hash3(key, 0xd8u, 0x5au));
   glm::vec3 sum(0.f);
-  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x + n * impl_->eps(), n, smp, uint32_t(k), 1, key, kNoHit).H;
+  for (int k = 0; k < samples_; ++k)
+    sum += impl_->estimate(x, x + n * impl_->eps(), n, smp, uint32_t(k), 1, key, kNoHit).H;
   return sum / float(samples_);
 }
 
@@ -380,7 +384,7 @@ glm::vec3 patchMean(const detail::DirectLight& direct, const Scene& s, size_t i,
     } else {
       LuminaireSums one(direct.luminaires());
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd4u));
-      const LuminaireEstimate e = direct.estimate(glm::vec3(best) + n * direct.eps(), n, smp, 0, budget,
+      const LuminaireEstimate e = direct.estimate(glm::vec3(best), glm::vec3(best) + n * direct.eps(), n, smp, 0, budget,
                                                   hash3(uint32_t(i), seed, 0xd9u), uint32_t(i), &one);
       rays += e.rays;
       if (one.F[L] > 0.0) V = one.FV[L] / one.F[L];
@@ -430,9 +434,8 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       for (int k = 0; k < points; ++k) {
         if (!lit.empty()) before = sums.FV, before.insert(before.end(), sums.F.begin(), sums.F.end());
         const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
-        const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] +
-                            n * direct.eps();
-        const LuminaireEstimate est = direct.estimate(x, n, smp, uint32_t(k), budget,
+        const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z];
+        const LuminaireEstimate est = direct.estimate(x, x + n * direct.eps(), n, smp, uint32_t(k), budget,
                                                       hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i), &sums);
         if (!direct.exact()) sum += glm::dvec3(est.H);  // with luminaires the sums give the patch's value
         r += est.rays;
@@ -479,7 +482,7 @@ std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster&
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xdau));
       glm::dvec3 sum(0.0);
       for (size_t k = 0; k < m; ++k)
-        sum += glm::dvec3(direct.estimate(points[i][k] + n * direct.eps(), n, smp, uint32_t(k), budget,
+        sum += glm::dvec3(direct.estimate(points[i][k], points[i][k] + n * direct.eps(), n, smp, uint32_t(k), budget,
                                           hash3(uint32_t(i), seed ^ uint32_t(k), 0xdbu), uint32_t(i)).H);
       H[i] = glm::vec3(sum / double(m));
     }
@@ -525,7 +528,8 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
       double sl = 0, sl2 = 0;
       for (int k = 0; k < points; ++k) {
         const glm::vec3 h =
-            direct.estimate(origins[i], mat.n[i], smp, uint32_t(k), budget, hash3(uint32_t(i), seed ^ uint32_t(k), 0xd7u),
+            direct.estimate(s.positions[i], origins[i], mat.n[i], smp, uint32_t(k), budget,
+                            hash3(uint32_t(i), seed ^ uint32_t(k), 0xd7u),
                             kNoHit).H;
         sum += glm::dvec3(h);
         const double l = luminance(mat.rho[i] * h);  // of rho H, B's reflected light

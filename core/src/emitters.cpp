@@ -85,7 +85,22 @@ void PointLight::check() const {
                                 "direction but the axis in single precision, and would emit nothing)");
 }
 
-glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n) {
+namespace {
+// The shadow ray from `from` (a surface point lifted off its surface) to the
+// light point y, stopping `stop` before it; tfar <= 0: y is nearer than that.
+Ray shadowRayTo(const glm::vec3& from, const glm::vec3& y, float stop) {
+  Ray ray;
+  ray.o = from;
+  const glm::vec3 w = y - from;
+  const float len = glm::length(w);
+  ray.d = len > 0.f ? w / len : glm::vec3(0.f, 0.f, 1.f);
+  ray.tfar = len * (1.f - 1e-4f) - stop;
+  return ray;
+}
+}  // namespace
+
+glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& from,
+                               const glm::vec3& n) {
   if (!L.on()) return glm::vec3(0.f);
   glm::vec3 w = L.position - x;
   const float r2 = glm::dot(w, w);
@@ -94,15 +109,12 @@ glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, con
   w /= r;
   const float cx = glm::dot(n, w);
   if (cx <= 0.f || !L.spot().contains(-w)) return glm::vec3(0.f);
-  Ray ray;
-  ray.o = x;
-  ray.d = w;
-  ray.tfar = r * (1.f - 1e-4f);
-  return caster.occluded(ray) ? glm::vec3(0.f) : L.intensity * cx / r2;
+  const Ray ray = shadowRayTo(from, L.position, 0.f);
+  return ray.tfar > 0.f && caster.occluded(ray) ? glm::vec3(0.f) : L.intensity * cx / r2;
 }
 
 glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
-                                 const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip) {
+                                 const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip) {
   const auto L = lights.sample(u);
   if (L.face == skip) return glm::vec3(0.f);
   glm::vec3 w = L.p - x;
@@ -112,16 +124,13 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
   w /= r;
   const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
   if (cx <= 0.f || ce <= 0.f) return glm::vec3(0.f);  // behind x or the emitter's back
-  Ray ray;
-  ray.o = x;
-  ray.d = w;
-  ray.tfar = r * (1.f - 1e-4f) - eps;
+  const Ray ray = shadowRayTo(from, L.p, eps);
   if (ray.tfar > 0.f && caster.occluded(ray)) return glm::vec3(0.f);
   return L.E * (0.318309886f * cx * ce / (r2 * L.pdfArea));
 }
 
-glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
-                         glm::vec2 u, float eps, uint64_t* rays) {
+glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
+                         const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps, uint64_t* rays) {
   const auto L = lights.sample(u);
   glm::vec3 w = L.p - x;
   const float r2 = glm::dot(w, w);
@@ -130,10 +139,7 @@ glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, 
   w /= r;
   const float cx = glm::dot(n, w), ce = -glm::dot(L.n, w);
   if (cx <= 0.f || ce <= 0.f) return glm::vec3(0.f);
-  Ray ray;
-  ray.o = x;
-  ray.d = w;
-  ray.tfar = r * (1.f - 1e-4f) - eps;
+  const Ray ray = shadowRayTo(from, L.p, eps);
   if (rays) ++*rays;
   if (ray.tfar > 0.f && caster.occluded(ray)) return glm::vec3(0.f);
   const float pdfL = L.pdfArea * r2 / ce;  // solid angle
@@ -141,14 +147,15 @@ glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, 
 }
 
 glm::vec3 sampleDirectIrradianceMIS(const EmitterSampler& lights, const Scene& s, const RayCaster& caster,
-                                    const glm::vec3& x, const glm::vec3& n, glm::vec2 uLight, glm::vec2 uDir, float eps) {
-  glm::vec3 H = sampleLightMIS(lights, caster, x, n, uLight, eps);
+                                    const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, glm::vec2 uLight,
+                                    glm::vec2 uDir, float eps) {
+  glm::vec3 H = sampleLightMIS(lights, caster, x, from, n, uLight, eps);
   {
     const glm::vec3 w = Frame(n).toWorld(cosineHemisphere(uDir));
     const float cx = glm::dot(n, w);
     if (cx > 0.f) {
       Ray ray;
-      ray.o = x;
+      ray.o = from;
       ray.d = w;
       const Hit h = caster.intersect(ray);
       if (h.valid()) {

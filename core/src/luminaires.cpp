@@ -313,8 +313,8 @@ struct VisibilitySums {
 // Rays from x to `count` points of luminaire L that next(&y) gives (false:
 // no point this draw; at most 4 count draws), into v.
 template <class Next>
-void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
-              const Next& next, int count, float eps, VisibilitySums& v) {
+void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& from,
+              const glm::vec3& n, const Next& next, int count, float eps, VisibilitySums& v) {
   constexpr int kBlock = 16;
   Ray rays[kBlock];
   float kern[kBlock];
@@ -339,9 +339,12 @@ void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const g
       w /= r;
       const float kxy = std::max(0.f, glm::dot(n, w)) * std::max(0.f, sgn * glm::dot(nL, w)) / r2;
       if (!(kxy > 0.f)) continue;  // behind x's tangent plane: outside the clipped polygon
-      rays[used].o = x;
-      rays[used].d = w;
-      rays[used].tfar = lum.portal ? std::numeric_limits<float>::infinity() : r * (1.f - 1e-4f) - eps;
+      // The kernel is x's; the ray leaves from x lifted, aimed at y.
+      const glm::vec3 wo = y - from;
+      const float ro = glm::length(wo);
+      rays[used].o = from;
+      rays[used].d = ro > 0.f ? wo / ro : w;
+      rays[used].tfar = lum.portal ? std::numeric_limits<float>::infinity() : ro * (1.f - 1e-4f) - eps;
       kern[used++] = kxy;
     }
     done += m;
@@ -361,8 +364,8 @@ void castRays(const Luminaires& lums, size_t L, const RayCaster& caster, const g
 }  // namespace
 
 LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& caster, const glm::vec3& x,
-                                      const glm::vec3& n, int budget, uint32_t key, float eps, bool unoccluded,
-                                      uint32_t skip, LuminaireSums* sums) {
+                                      const glm::vec3& from, const glm::vec3& n, int budget, uint32_t key, float eps,
+                                      bool unoccluded, uint32_t skip, LuminaireSums* sums) {
   LuminaireEstimate out;
   const int first = Luminaires::kFirstRays, total = std::max(first, budget);
   double var = 0;
@@ -379,20 +382,20 @@ LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& c
     SobolOwenStream seq(hash3(key, uint32_t(L), 0x1ea5u));
     auto stratified = [&](glm::vec3* y) { return lums.point(L, seq.next(), y); };
     VisibilitySums v;
-    castRays(lums, L, caster, x, n, stratified, first, eps, v);
+    castRays(lums, L, caster, x, from, n, stratified, first, eps, v);
     bool penumbra = v.split();
     if (!penumbra && v.k > 0) {  // the corners: a verdict they contradict is a penumbra
       const auto& probes = lums.list()[L].probes;
       size_t c = 0;
       auto corner = [&](glm::vec3* y) { return c < probes.size() ? (*y = glm::vec3(probes[c++]), true) : false; };
       VisibilitySums pv;
-      castRays(lums, L, caster, x, n, corner, int(probes.size()), eps, pv);
+      castRays(lums, L, caster, x, from, n, corner, int(probes.size()), eps, pv);
       out.rays += pv.rays;
       penumbra = pv.k > 0 && (pv.split() || (pv.kv > 0) != (v.kv > 0));
     }
     if (penumbra) {  // the same stratified sequence, continued
       out.penumbra = true;
-      castRays(lums, L, caster, x, n, stratified, total - first, eps, v);
+      castRays(lums, L, caster, x, from, n, stratified, total - first, eps, v);
     }
     out.rays += v.rays;
     out.H += float(F * v.V()) * E;

@@ -136,8 +136,11 @@ Bsdf Integrator::bsdfAt(const SurfacePoint& sp, const glm::vec3& wo) const {
 }
 
 glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bsdf& b, Sampler& smp, Counts& c, int nL,
-                                float lift) const {
+                                float lift, const glm::vec3* from) const {
   glm::vec3 L(0.f);
+  // Where the shadow rays leave: x lifted by `lift`, or `from` as given.
+  const glm::vec3& o = from ? *from : x;
+  const float up = from ? 0.f : lift;
   const float fn = float(nL);
   for (int k = 0; k < nL; ++k) {
     if (!emitters_.empty()) {
@@ -150,7 +153,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
         const float cx = glm::dot(n, w), ce = -glm::dot(e.n, w);
         const glm::vec3 f = cx > 0.f && ce > 0.f ? b.f(w) : glm::vec3(0.f);
         if (positive(f)) {
-          const Ray ray = shadowRay(x, n, w, e.p, lift, eps_);
+          const Ray ray = shadowRay(o, n, w, e.p, up, eps_);
           const bool cast = ray.tfar > 0.f;  // else the emitter point is closer than the offset: visible
           c.shadow += cast;
           if (!cast || !caster_.occluded(ray)) {
@@ -166,7 +169,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
       const glm::vec3 f = cx > 0.f ? b.f(w) : glm::vec3(0.f);
       if (positive(f)) {
         ++c.shadow;
-        if (!caster_.occluded(spawn(x, n, w, lift)))
+        if (!caster_.occluded(spawn(o, n, w, up)))
           L += f * sunL_ * (cx / sunPdf_) * (powerHeuristic(fn * sunPdf_, b.pdf(w)) / fn);
       }
     }
@@ -177,7 +180,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
     const glm::vec3 f = cx > 0.f ? b.f(w) : glm::vec3(0.f);
     if (positive(f)) {
       ++c.shadow;
-      if (!caster_.occluded(spawn(x, n, w, lift))) L += f * L_.sunIrradiance * cx;
+      if (!caster_.occluded(spawn(o, n, w, up))) L += f * L_.sunIrradiance * cx;
     }
   }
   if (hasPoint_) {
@@ -189,7 +192,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
       const float cx = glm::dot(n, w);
       const glm::vec3 f = cx > 0.f && spot_.contains(-w) ? b.f(w) : glm::vec3(0.f);
       if (positive(f)) {
-        const Ray ray = shadowRay(x, n, w, L_.point.position, lift, 0.f);
+        const Ray ray = shadowRay(o, n, w, L_.point.position, up, 0.f);
         ++c.shadow;
         if (!caster_.occluded(ray)) L += f * L_.point.intensity * (cx / r2);
       }
@@ -317,12 +320,12 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
   return L;
 }
 
-glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c,
-                                       glm::vec3* parts) const {
+glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, Sampler& smp,
+                                       Counts& c, glm::vec3* parts) const {
   Bsdf b(n);
   b.rho = glm::vec3(1.f);
   const int nL = rules_.firstLightSamples;
-  glm::vec3 L = nextEvent(x, n, b, smp, c, nL, 0.f);
+  glm::vec3 L = nextEvent(x, n, b, smp, c, nL, 0.f, &from);
   if (parts) parts[kPathDirect] += L;  // light sampled at x0 itself: L D
   const bool lightRays = !emitters_.empty() || hasSky_ || sunDisk_;
   const bool wanted = rules_.interreflection && rules_.maxDiffuseBounces != 0;
@@ -334,7 +337,7 @@ glm::vec3 Integrator::traceFromSurface(const glm::vec3& x, const glm::vec3& n, S
   if (!b.sample(smp.next2D(), wi, st.beta, st.pdfPrev)) return L;
   st.delta = false;
   st.nLPrev = float(nL);
-  st.ray = spawn(x, n, wi, 0.f);
+  st.ray = spawn(from, n, wi, 0.f);
   st.diffuseVertices = 1;
   st.depth = goOn ? 1 : 0;
   st.lightOnly = !goOn;

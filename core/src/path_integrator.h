@@ -182,10 +182,12 @@ class Integrator {
                   glm::vec3* parts = nullptr) const;
   // Radiance a white Lambertian surface at x (unit normal n) reflects, i.e.
   // its incident irradiance / pi, by next-event estimation at x and a path
-  // continued from there. x must already lie off the surface (a vertex's ray
-  // origin): rays leave from x itself.
+  // continued from there. Rays leave from `from`, x already lifted off the
+  // surface (a vertex's ray origin); the lights' distances and cosines are
+  // x's own (taken at the lifted point they read eps / h low for a light at
+  // height h; an outside audit).
   // parts: as for trace (x is the start vertex x0).
-  glm::vec3 traceFromSurface(const glm::vec3& x, const glm::vec3& n, Sampler& smp, Counts& c,
+  glm::vec3 traceFromSurface(const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, Sampler& smp, Counts& c,
                              glm::vec3* parts = nullptr) const;
 
   SurfacePoint surfaceAt(const Ray& r, const Hit& h) const;
@@ -212,9 +214,10 @@ class Integrator {
   // under cosine cosO, MIS-weighted against light sampling after a BSDF sample.
   glm::vec3 emitted(uint32_t face, float t, float cosO, bool delta, float pdfPrev, float nLPrev) const;
   // Next-event estimation at x for BSDF b (see the top of this file); shadow
-  // rays lifted by `lift`.
+  // rays lifted by `lift`, or leaving from `from` where given (x lifted
+  // already).
   glm::vec3 nextEvent(const glm::vec3& x, const glm::vec3& n, const Bsdf& b, Sampler& smp, Counts& c, int nL,
-                      float lift) const;
+                      float lift, const glm::vec3* from = nullptr) const;
   glm::vec3 nextEvent(const glm::vec3& x, const glm::vec3& n, const Bsdf& b, Sampler& smp, Counts& c, int nL) const {
     return nextEvent(x, n, b, smp, c, nL, eps_);
   }

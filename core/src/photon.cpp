@@ -142,7 +142,7 @@ std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& cas
   if (!L.on()) return H;
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i)
-      if (mat.valid[i]) H[i] = pointLightIrradiance(L, caster, origins[i], mat.n[i]);
+      if (mat.valid[i]) H[i] = pointLightIrradiance(L, caster, s.positions[i], origins[i], mat.n[i]);
   });
   return H;
 }

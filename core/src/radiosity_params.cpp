@@ -53,7 +53,8 @@ std::vector<ParamSpec> RadiosityOptions::specs() {
                "relative to the emitted power, is below this.",
        .type = ParamType::Float, .def = 1e-4, .min = 1e-12, .max = 1.0},
       {.name = "max_iterations", .label = "Maximum iterations",
-       .help = "Upper bound on sweeps (Jacobi, Gauss-Seidel) or on shots per patch (progressive refinement). 0 = "
+       .help = "Upper bound on sweeps (Jacobi, Gauss-Seidel; hierarchical: per round of link refinement, at most 4 "
+               "rounds) or on shots per patch (progressive refinement). 0 = "
                "automatic: each sweep shrinks the remaining error at least by the largest reflectance rho_max (the "
                "spectral radius of rho F is at most rho_max, as rows of F sum to at most 1), so 1.5 ln(tolerance) / "
                "ln(rho_max) sweeps reach the tolerance: 13,809 for rho_max = 0.999 (tolerance 1e-4), 132 for 0.9. A "

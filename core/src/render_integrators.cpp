@@ -109,7 +109,7 @@ glm::vec3 Context::gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const
 glm::vec3 Context::nearReflected(const SurfacePoint& q, int levels, Sampler& smp, Counts& c) const {
   ++c.gatherNear;
   const glm::vec3 rho = s_.faceRho(q.face);
-  const glm::vec3 direct = kPi * traceFromSurface(q.x + q.n * eps(), q.n, smp, c);  // H_direct of a white surface
+  const glm::vec3 direct = kPi * traceFromSurface(q.x, q.x + q.n * eps(), q.n, smp, c);  // H_direct of a white surface
   glm::vec3 H = direct + tp_->caustic(q.x, q.n, o_.causticK);
   if (levels > 0) {
     const Frame frame(q.n);

@@ -358,6 +358,18 @@ def case_keep(a, tmp):
     s = load(os.path.join(tmp, "keep_sky", names[1] + ".json"))
     check(rep["baked"] == 1 and s["parameters"].get("sky_color") == "#ff8800",
           "a colour #ff8800 on a manifest line is a value, the # after it a comment (%s)" % s.get("parameters"))
+    # A quoted name may start with # (only a line whose first character is #
+    # is a comment): "#1.ply" was dropped in silence.
+    hashed = os.path.join(tmp, "hash_names")
+    os.makedirs(hashed)
+    shutil.copy(os.path.join(meshes, names[1] + ".ply"), os.path.join(hashed, "#1.ply"))
+    with open(os.path.join(hashed, "list.txt"), "w") as f:
+        f.write('# a comment\n  # an indented comment\n"#1.ply"\n')
+    rep = json.loads(run([a.gi, "batch", "sky", "--manifest", os.path.join(hashed, "list.txt"), "-o",
+                          os.path.join(tmp, "hash_out"), "--rays_per_vertex", "8", "--json"], expect=0).stdout)
+    check(rep["baked"] == 1 and os.path.exists(os.path.join(tmp, "hash_out", "#1.ply")),
+          "a quoted name starting with # is a mesh, the lines starting with # comments (%s)" %
+          {k: rep[k] for k in ("baked", "failed")})
     # The error map's reference file: relative to the manifest, and part of
     # the hash (a reference computed anew was taken as done before).
     refdir = os.path.join(tmp, "keep_ref")

@@ -119,7 +119,7 @@ TEST(Luminaires, HalfOccludedLightGivesHalf) {
     ASSERT_EQ(lums.count(), 1u);
     const glm::vec3 x(glm::dvec3(0, 0, h) - s.origin), n(0.f, 0.f, -1.f);
     const float eps = float(sceneScale(s).rayEpsilon);
-    const LuminaireEstimate e = luminaireIrradiance(lums, *caster, x, n, 256, 7, eps, false);
+    const LuminaireEstimate e = luminaireIrradiance(lums, *caster, x, x, n, 256, 7, eps, false);
     EXPECT_EQ(e.rays, c.rays) << "occluder " << c.x0 << ".." << c.x1;
     EXPECT_EQ(e.penumbra, c.V == 0.5);
     const double Fx = lums.formFactor(0, glm::dvec3(x), glm::dvec3(n));
@@ -166,7 +166,8 @@ TEST(Luminaires, AgreesWithPowerSamplingOnCornellBox) {
   size_t count = 0, far = 0, penumbra = 0, dark = 0;
   for (size_t v = 0; v < s.vertexCount(); ++v) {
     if (!mat.valid[v]) continue;
-    const LuminaireEstimate e = luminaireIrradiance(lums, *caster, origins[v], mat.n[v], 256, uint32_t(v), eps, false);
+    const LuminaireEstimate e = luminaireIrradiance(lums, *caster, s.positions[v], origins[v], mat.n[v], 256, uint32_t(v), eps,
+                                                    false);
     const double yl = luminance(mat.rho[v] * e.H), yp = luminance(mat.rho[v] * p.H[v]);
     const double sl = luminance(e.H) > 0 ? e.stdError * yl / luminance(e.H) : 0.0, sp = p.stdError[v];
     penumbra += e.penumbra;
@@ -228,7 +229,7 @@ TEST(Luminaires, ManyLuminairesFallBackToPowerSampling) {
   const auto& t = s.triangles[best];
   const glm::vec3 c = (s.positions[t.x] + s.positions[t.y] + s.positions[t.z]) / 3.f;
   const float eps = float(sceneScale(s).rayEpsilon);
-  const LuminaireEstimate e = luminaireIrradiance(lums, *caster, c + glm::vec3(0, 0, eps), {0, 0, 1}, 64, 1, eps, false);
+  const LuminaireEstimate e = luminaireIrradiance(lums, *caster, c, c + glm::vec3(0, 0, eps), {0, 0, 1}, 64, 1, eps, false);
   std::printf("below the sphere: power sampling %.5f, luminaires %.5f (%u rays)\n", H[best].g, e.H.g, e.rays);
   EXPECT_GT(e.H.g, 0.1f);
   EXPECT_NEAR(H[best].g / e.H.g, 1.0, 0.05);

@@ -619,3 +619,26 @@ TEST(Thickness, PlateThinnerThanTheRayOffsetIsSaid) {
     EXPECT_NEAR(mean / count, slabMean(share * eps, kPi / 3), 0.05 * share * eps);
   }
 }
+
+// An open hemisphere (an icosphere's faces above its equator): every vertex
+// finds the far side with some rays (none reads 0), but most of them with
+// fewer than half, the rest leaving through the opening. The log warns that
+// the mesh is open; it said nothing while no vertex found nothing at all.
+TEST(Thickness, OpenMeshIsWarnedOfWhenEveryVertexFindsSomething) {
+  const auto sf = scenes::sphere(1.0, 4, false);
+  const Scene& full = sf.scene;
+  std::vector<glm::dvec3> P;
+  std::vector<glm::uvec3> T;
+  for (size_t i = 0; i < full.vertexCount(); ++i) P.push_back(full.toWorld(full.positions[i]));
+  for (const glm::uvec3& t : full.triangles)
+    if (P[t.x].z + P[t.y].z + P[t.z].z > 0.0) T.push_back(t);
+  const Scene s = Scene::fromAbsolute(P, T);
+  const ThicknessResult r = runThickness(s, 64, 60.0, true);
+  EXPECT_EQ(r.stats.get("no_opposite_side"), 0.0);
+  bool warned = false;
+  for (const auto& w : r.stats.warnings) warned |= w.find("the mesh is open") != std::string::npos;
+  EXPECT_TRUE(warned);
+  // The closed sphere is not warned of.
+  for (const auto& w : runThickness(full, 64, 60.0, true).stats.warnings)
+    EXPECT_EQ(w.find("the mesh is open"), std::string::npos) << w;
+}

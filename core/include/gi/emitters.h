@@ -73,15 +73,23 @@ struct PointLight {
   // its area. Build it once outside a loop over shadow rays.
   Cone spot() const;
 };
-// Irradiance I cos / r^2 from the point light at x (unit normal n), 0 if the
-// shadow ray is blocked or x lies outside the spot's cone.
-glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n);
+// Irradiance I cos / r^2 from the point light at the surface point x (unit
+// normal n), 0 if the shadow ray is blocked or x lies outside the spot's
+// cone. The shadow ray starts at `from` (x lifted off its surface, the ray
+// origin), aimed at the light; r and cos are x's own: taken at the lifted
+// origin they read the plane eps / h low for a light at height h (a wall
+// lamp 5 cm off the wall of a 100 m site -2.8%; an outside audit).
+glm::vec3 pointLightIrradiance(const PointLight& L, const RayCaster& caster, const glm::vec3& x, const glm::vec3& from,
+                               const glm::vec3& n);
 
 // One-sample estimate of the direct irradiance at x (unit normal n) from the
 // emitters: a power-sampled emitter point y, E_y cos(x) cos(y) / (pi r^2 pdf)
-// if the shadow ray x -> y is free, else 0. Points on face `skip` are ignored.
+// if the shadow ray from -> y is free, else 0 (from: x lifted off its
+// surface; the geometry is x's, as for pointLightIrradiance). Points on face
+// `skip` are ignored.
 glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
-                                 const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip = 0xffffffffu);
+                                 const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps,
+                                 uint32_t skip = 0xffffffffu);
 
 // Multiple importance sampling, power heuristic (Veach 1997): the weight of a
 // sample drawn with density a against another strategy of density b.
@@ -102,14 +110,16 @@ inline float powerHeuristic(float a, float b) {
 // One power-sampled emitter point's irradiance at x (unit normal n),
 // weighted for MIS against cosine-weighted direction sampling; 0 if the
 // shadow ray is blocked. Adds the shadow rays it casts to *rays.
-glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
-                         glm::vec2 u, float eps, uint64_t* rays = nullptr);
+glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
+                         const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps, uint64_t* rays = nullptr);
 
 // The same with multiple importance sampling (power heuristic): one light
 // sample and one cosine-weighted direction, whose emitter hits count too.
 // Bounded where the plain estimate is heavy-tailed (points on or next to an
-// emitter). s is the scene the sampler was built on.
+// emitter). s is the scene the sampler was built on. The light sample's
+// geometry is x's; both rays start at `from` (x lifted off its surface).
 glm::vec3 sampleDirectIrradianceMIS(const EmitterSampler& lights, const Scene& s, const RayCaster& caster,
-                                    const glm::vec3& x, const glm::vec3& n, glm::vec2 uLight, glm::vec2 uDir, float eps);
+                                    const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, glm::vec2 uLight,
+                                    glm::vec2 uDir, float eps);
 
 }  // namespace gi

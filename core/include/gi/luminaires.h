@@ -158,14 +158,17 @@ struct LuminaireSums {
   explicit LuminaireSums(size_t count = 0) : F(count, 0.0), FV(count, 0.0) {}
 };
 
-// H(x) = sum_L E_L F(x -> L) V(x, L) at x (lifted off its surface, unit
-// normal n): kFirstRays rays per luminaire, continued to `budget` rays (at
+// H(x) = sum_L E_L F(x -> L) V(x, L) at the surface point x (unit normal n;
+// its shadow rays start at `from`, x lifted off its surface: F taken at the
+// lifted point read eps / h low for a luminaire at height h, an outside
+// audit): kFirstRays rays per luminaire, continued to `budget` rays (at
 // least kFirstRays) for a luminaire in penumbra; no rays when `unoccluded`
 // (nothing in the scene can block). Random numbers keyed by key. Luminaire
 // `skip` (the one x lies on, if any) is left out. sums (optional): F and
 // F V of each luminaire added.
 LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& caster, const glm::vec3& x,
-                                      const glm::vec3& n, int budget, uint32_t key, float eps, bool unoccluded,
+                                      const glm::vec3& from, const glm::vec3& n, int budget, uint32_t key, float eps,
+                                      bool unoccluded,
                                       uint32_t skip = 0xffffffffu, LuminaireSums* sums = nullptr);
 
 }  // namespace gi
