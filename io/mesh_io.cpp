@@ -157,13 +157,20 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   }
   std::string text(bytes);
   std::map<std::string, glm::dvec3> kd;  // material -> Kd, the first library's that defines it
+  std::vector<std::string> missing;
   if (ext == "obj" && !path.empty()) {
-    // OpenMesh opens each library as the file's folder + its name: check those it will read.
+    // Each library beside the file, or where an absolute path says (OpenMesh
+    // opens only the first: an absolute one was dropped in silence whenever
+    // the OBJ's own path had a folder in it; an outside audit). The faces'
+    // colours are the Kd read here.
     const std::string folder = path.substr(0, path.rfind('/') + 1);
     for (const std::string& lib : declared.materialFiles) {
-      const std::string file = folder + lib;
+      const std::string file = std::filesystem::path(lib).is_absolute() ? lib : folder + lib;
       std::error_code ec;
-      if (!std::filesystem::exists(file, ec)) continue;  // OpenMesh reads the mesh without it
+      if (!std::filesystem::exists(file, ec)) {  // the mesh is read without it, and the log says so
+        missing.push_back(lib);
+        continue;
+      }
       std::string material;
       try {
         // A pipe or a device would block OpenMesh or never end; 64 MB is far beyond any material library.
@@ -195,6 +202,10 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
     failRead(name, std::string("the reader failed (") + e.what() + ")");
   }
   if (!ok) failRead(name, "OpenMesh could not parse it as a ." + ext + " mesh");
+  std::vector<std::string> warnings;
+  for (const std::string& lib : missing)
+    warnings.push_back(name + ": its material library " + lib +
+                       " was not found (beside it, or at that absolute path): its materials' colours are not read");
   // STL: OpenMesh merges equal corners and drops triangles left with a repeated corner (no area).
   const size_t hidden = declared.repeatLines.size();
   if (ext == "obj" && (m.n_faces() + hidden != declared.faces || m.n_vertices() < declared.vertices))
@@ -249,6 +260,7 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
       if (!set[v]) p.normals[v] = glm::vec3(0.f);
   }
   if (ext == "obj") objAsTheFileSays(declared, kd, p);
+  p.warnings = std::move(warnings);
   return p;
 }
 
@@ -287,6 +299,7 @@ LoadedMesh parse(std::string_view bytes, const std::string& ext, const std::stri
   if (p.faceStart.size() < 2) failRead(name, "the file has no faces");
 
   LoadedMesh out;  // triangleToFace: index of the polygon as read
+  out.warnings = p.warnings;
   const size_t nf = p.faceStart.size() - 1;
   std::vector<glm::uvec3> tris;
   tris.reserve(p.index.size());

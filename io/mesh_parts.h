@@ -33,6 +33,8 @@ struct Polygons {
   // Layers this tool wrote into one PLY: "comment gi_layer COUNT NAME"
   // header lines, in face order (PLY only; empty: none).
   std::vector<std::pair<std::string, size_t>> layers;
+  // What the run's log should warn of (an OBJ's material library not found).
+  std::vector<std::string> warnings;
 };
 
 // Throws std::runtime_error "cannot read NAME: WHY." (one line).

@@ -388,11 +388,23 @@ int listFilters(bool asJson) {
 
 // MeshLab reads a script's numbers in single precision (docs/design.md,
 // "Precision of parameters"): a number beyond the largest float would be
-// written as inf. Each Float and Distance value, and each distance's range
-// (its maximum fraction of the diagonal), must be finite as a float.
+// written as inf. Each Float and Distance value, each distance's range (its
+// maximum fraction of the diagonal) and each Point's coordinates must be
+// finite as a float.
 void checkSinglePrecision(const std::vector<ParamSpec>& specs, const ParamValues& v, double diag, const std::string& mesh) {
   const double largest = std::numeric_limits<float>::max();
   for (const ParamSpec& p : specs) {
+    if (p.type == ParamType::Point) {  // written as three floats: 1e39 was written as inf (an outside audit)
+      const glm::dvec3 q = v.getPoint(p.name);
+      const double x = std::max({std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+      if (x > largest) {
+        char b[64];
+        std::snprintf(b, sizeof b, "%g", x);
+        throw std::invalid_argument("cannot write --" + p.name + " into the script: a coordinate is " + b +
+                                    ", beyond the largest single-precision number (3.4e+38) that MeshLab reads");
+      }
+      continue;
+    }
     if (p.type != ParamType::Float && p.type != ParamType::Distance) continue;
     const double x = std::fabs(v.getFloat(p.name));
     const double range = p.type == ParamType::Distance ? (p.max > 0 ? p.max : 1.0) * diag : 0.0;
@@ -436,6 +448,19 @@ int writeScript(const std::vector<FilterKind>& kinds, const CommonArgs& a) {
   for (FilterKind k : kinds) {
     steps.push_back({k, resolve(filterSpecs(k), a, diag)});
     checkSinglePrecision(filterSpecs(k), steps.back().values, diag, a.mesh);
+    // An XML script is UTF-8: other bytes (a Latin-1 file name) made a file
+    // no XML reader takes, and meshlabserver read another name (an outside
+    // audit). The filters themselves take such names as bytes.
+    for (const ParamSpec& p : filterSpecs(k)) {
+      if (p.type != ParamType::String) continue;
+      try {
+        (void)json(steps.back().values.getString(p.name)).dump();
+      } catch (const json::exception&) {
+        throw std::invalid_argument("cannot write --" + p.name +
+                                    " into the script: its text is not UTF-8 (MeshLab reads scripts as UTF-8); "
+                                    "rename the file or layer, or run the filter with gi itself");
+      }
+    }
   }
   const std::string text = mlxScript(steps, diag);
   if (toFile) io::writeFileAtomically(a.output, text);

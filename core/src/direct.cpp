@@ -186,7 +186,8 @@ VertexRadiometry computeDirect(const Scene& s, const RayCaster& caster, const Di
       glm::dvec3 sum(0.0);
       double sl = 0, sl2 = 0;
       for (int j = 0; j < N; ++j) {
-        const glm::vec3 c = sampleDirectIrradiance(lights, caster, s.positions[i], origins[i], mat.n[i], seq.next(), eps);
+        const glm::vec3 c = sampleDirectIrradiance(lights, caster, vertexLightPoint(origins[i], mat.n[i], eps), origins[i],
+                                                   mat.n[i], seq.next(), eps);
         sum += glm::dvec3(c);
         const double l = luminance(c * mat.rho[i]);
         sl += l;
@@ -528,7 +529,7 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
       double sl = 0, sl2 = 0;
       for (int k = 0; k < points; ++k) {
         const glm::vec3 h =
-            direct.estimate(s.positions[i], origins[i], mat.n[i], smp, uint32_t(k), budget,
+            direct.estimate(vertexLightPoint(origins[i], mat.n[i], direct.eps()), origins[i], mat.n[i], smp, uint32_t(k), budget,
                             hash3(uint32_t(i), seed ^ uint32_t(k), 0xd7u),
                             kNoHit).H;
         sum += glm::dvec3(h);

@@ -117,7 +117,7 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
                                  const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps, uint32_t skip) {
   const auto L = lights.sample(u);
   if (L.face == skip) return glm::vec3(0.f);
-  glm::vec3 w = L.p - x;
+  glm::vec3 w = L.p - lightSeenFrom(x, from, L.p, L.n, eps);
   const float r2 = glm::dot(w, w);
   if (!(r2 > 0.f)) return glm::vec3(0.f);
   const float r = std::sqrt(r2);
@@ -132,7 +132,7 @@ glm::vec3 sampleDirectIrradiance(const EmitterSampler& lights, const RayCaster& 
 glm::vec3 sampleLightMIS(const EmitterSampler& lights, const RayCaster& caster, const glm::vec3& x,
                          const glm::vec3& from, const glm::vec3& n, glm::vec2 u, float eps, uint64_t* rays) {
   const auto L = lights.sample(u);
-  glm::vec3 w = L.p - x;
+  glm::vec3 w = L.p - lightSeenFrom(x, from, L.p, L.n, eps);
   const float r2 = glm::dot(w, w);
   if (!(r2 > 0.f)) return glm::vec3(0.f);
   const float r = std::sqrt(r2);

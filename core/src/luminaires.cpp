@@ -371,7 +371,9 @@ LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& c
   double var = 0;
   for (size_t L = 0; L < lums.count(); ++L) {
     if (L == skip) continue;
-    const double F = lums.formFactor(L, glm::dvec3(x), glm::dvec3(n));
+    const Luminaire& lum = lums.list()[L];
+    const glm::vec3& at = lightSeenFrom(x, from, glm::vec3(lum.origin), glm::vec3(lum.normal), eps);
+    const double F = lums.formFactor(L, glm::dvec3(at), glm::dvec3(n));
     if (!(F > 0.0)) continue;
     const glm::vec3 E = lums.list()[L].E;
     if (unoccluded) {
@@ -382,20 +384,20 @@ LuminaireEstimate luminaireIrradiance(const Luminaires& lums, const RayCaster& c
     SobolOwenStream seq(hash3(key, uint32_t(L), 0x1ea5u));
     auto stratified = [&](glm::vec3* y) { return lums.point(L, seq.next(), y); };
     VisibilitySums v;
-    castRays(lums, L, caster, x, from, n, stratified, first, eps, v);
+    castRays(lums, L, caster, at, from, n, stratified, first, eps, v);
     bool penumbra = v.split();
     if (!penumbra && v.k > 0) {  // the corners: a verdict they contradict is a penumbra
       const auto& probes = lums.list()[L].probes;
       size_t c = 0;
       auto corner = [&](glm::vec3* y) { return c < probes.size() ? (*y = glm::vec3(probes[c++]), true) : false; };
       VisibilitySums pv;
-      castRays(lums, L, caster, x, from, n, corner, int(probes.size()), eps, pv);
+      castRays(lums, L, caster, at, from, n, corner, int(probes.size()), eps, pv);
       out.rays += pv.rays;
       penumbra = pv.k > 0 && (pv.split() || (pv.kv > 0) != (v.kv > 0));
     }
     if (penumbra) {  // the same stratified sequence, continued
       out.penumbra = true;
-      castRays(lums, L, caster, x, from, n, stratified, total - first, eps, v);
+      castRays(lums, L, caster, at, from, n, stratified, total - first, eps, v);
     }
     out.rays += v.rays;
     out.H += float(F * v.V()) * E;

@@ -145,7 +145,7 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
   for (int k = 0; k < nL; ++k) {
     if (!emitters_.empty()) {
       const auto e = emitters_.sample(smp.next2D());
-      glm::vec3 w = e.p - x;
+      glm::vec3 w = e.p - (from ? lightSeenFrom(x, *from, e.p, e.n, eps_) : x);
       const float r2 = glm::dot(w, w);
       if (r2 > 0.f) {
         const float r = std::sqrt(r2);

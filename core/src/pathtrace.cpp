@@ -205,7 +205,8 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       glm::vec3 H(0.f), RH(0.f);
       for (int sd = 0; sd < 2; ++sd) {
         glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
-        const glm::vec3 h = float(M_PI) * tracer.traceFromSurface(s.positions[i], o[sd], sides.n[sd][size_t(slot)], smp, counts[i],
+        const glm::vec3 h = float(M_PI) * tracer.traceFromSurface(vertexLightPoint(o[sd], sides.n[sd][size_t(slot)], eps), o[sd],
+                                                                  sides.n[sd][size_t(slot)], smp, counts[i],
                                                                   opt.lightPathSplit ? parts : nullptr);
         const glm::vec3 rho = sides.rho[sd][size_t(slot)];
         for (int p = 0; p < kPathKinds; ++p) a.sumPart[p] += glm::dvec3(0.5f * float(M_PI) * rho * parts[p]);
@@ -223,7 +224,7 @@ PathTraceResult pathTrace(const Scene& s, const RayCaster& caster, const PathTra
       // Independent numbers keyed by (vertex, path, seed): honest error bars, any thread count.
       paths::Sampler smp(hash3(uint32_t(i), opt.seed, 0x9a7eu), a.first + uint32_t(a.n), false);
       glm::vec3 parts[kPathKinds] = {glm::vec3(0.f), glm::vec3(0.f), glm::vec3(0.f)};
-      const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(s.positions[i], origins[i], mat.n[i], smp, counts[i],
+      const glm::vec3 H = float(M_PI) * tracer.traceFromSurface(vertexLightPoint(origins[i], mat.n[i], eps), origins[i], mat.n[i], smp, counts[i],
                                                                 opt.lightPathSplit ? parts : nullptr);
       for (int p = 0; p < kPathKinds; ++p) a.sumPart[p] += glm::dvec3(float(M_PI) * parts[p]);
       a.add(luminance(mat.rho[i] * H), H);

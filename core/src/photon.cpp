@@ -137,12 +137,12 @@ bool anyDiffuseReflection(const Scene& s) {
 
 // Irradiance from the point or spot light at every vertex (one shadow ray each).
 std::vector<glm::vec3> pointLightAtVertices(const Scene& s, const RayCaster& caster, const PointLight& L,
-                                            const VertexMaterial& mat, const std::vector<glm::vec3>& origins) {
+                                            const VertexMaterial& mat, const std::vector<glm::vec3>& origins, float eps) {
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   if (!L.on()) return H;
   parallelBlocks(s.vertexCount(), Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i)
-      if (mat.valid[i]) H[i] = pointLightIrradiance(L, caster, s.positions[i], origins[i], mat.n[i]);
+      if (mat.valid[i]) H[i] = pointLightIrradiance(L, caster, vertexLightPoint(origins[i], mat.n[i], eps), origins[i], mat.n[i]);
   });
   return H;
 }
@@ -159,7 +159,7 @@ std::vector<glm::vec3> directAtVertices(const PhotonRun& r, const Progress& prog
   stdError.assign(r.s.vertexCount(), 0.f);
   if (!r.opt.directLight) return Hd;
   Hd = vertexDirectIrradiance(r.s, r.caster, r.opt.lightSamples, r.opt.seed, progress, VertexPart(), nullptr, &stdError);
-  const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins);
+  const auto Hp = pointLightAtVertices(r.s, r.caster, r.opt.point, r.mat, r.origins, r.eps);
   const auto Ho = vertexSkySunIrradiance(r.s, r.caster, r.opt.outside, r.opt.lightSamples, r.opt.seed, VertexPart(),
                                          Progress(nullptr), &r.openings);
   for (size_t i = 0; i < Hd.size(); ++i) Hd[i] += Hp[i] + Ho[i];

@@ -196,7 +196,8 @@ void prepareTwoPass(TwoPassData& tp, const Scene& s, const RayCaster& caster, co
         const float eps = float(sceneScale(s).rayEpsilon);
         const std::vector<glm::vec3> origins = vertexRayOrigins(s, mat.n, eps);
         for (size_t i = 0; i < nv; ++i)
-          if (mat.valid[i]) Hd[i] += pointLightIrradiance(o.point, caster, s.positions[i], origins[i], mat.n[i]);
+          if (mat.valid[i]) Hd[i] += pointLightIrradiance(o.point, caster, vertexLightPoint(origins[i], mat.n[i], eps), origins[i],
+                                            mat.n[i]);
       }
       Bd.resize(nv);
       for (size_t i = 0; i < nv; ++i) Bd[i] = mat.E[i] + mat.rho[i] * Hd[i];

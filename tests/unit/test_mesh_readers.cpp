@@ -291,6 +291,21 @@ TEST(MeshReaders, ObjKeepsDoublePrecisionAndOnlyWholeColours) {
   const auto red = gi::io::loadMesh(dir + "/m.obj");
   ASSERT_EQ(red.attrs.faceColor.size(), 2u);
   EXPECT_EQ(red.attrs.faceColor[0], glm::u8vec3(218, 170, 89));  // linear 0.7 0.4 0.1 as sRGB bytes
+  EXPECT_TRUE(red.warnings.empty());
+  // A library named by its absolute path is read wherever the OBJ lies (it
+  // was dropped in silence when the OBJ's own path had a folder in it; an
+  // outside audit); one not found is warned of by name.
+  const std::string lib = fs::absolute(dir + "/m.mtl").string();
+  std::ofstream(dir + "/abs.obj") << "mtllib " + lib + "\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl red\nf 1 2 3\nf 1 3 4\n";
+  const auto abs = gi::io::loadMesh(dir + "/abs.obj");
+  ASSERT_EQ(abs.attrs.faceColor.size(), 2u);
+  EXPECT_EQ(abs.attrs.faceColor[1], glm::u8vec3(218, 170, 89));
+  EXPECT_TRUE(abs.warnings.empty());
+  std::ofstream(dir + "/lost.obj") << "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl red\nf 1 2 3\n";
+  const auto lost = gi::io::loadMesh(dir + "/lost.obj");
+  EXPECT_TRUE(lost.attrs.faceColor.empty());
+  ASSERT_EQ(lost.warnings.size(), 1u);
+  EXPECT_NE(lost.warnings[0].find("its material library gone.mtl was not found"), std::string::npos) << lost.warnings[0];
   fs::remove_all(dir);
   const auto partial = gi::io::parseMesh("v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n", "obj", "p.obj");
   EXPECT_TRUE(partial.attrs.vertexColor.empty());

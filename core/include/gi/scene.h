@@ -184,4 +184,23 @@ namespace gi {
 // the origin leaves the normal's side of one of its own faces.
 std::vector<glm::vec3> vertexRayOrigins(const Scene& s, const std::vector<glm::vec3>& normals, float eps,
                                         const std::vector<uint8_t>* usable = nullptr);
+// The point a vertex's lights are seen from (their distances and angles):
+// its ray origin less the lift along the normal. That is the vertex itself,
+// or at borders and creases the vertex pulled up to 2 eps into its faces'
+// wedge, off the crease (a lamp whose plane meets the vertex would be seen
+// edge-on from the crease itself). With the lift, a plane read eps / h low
+// under a light at height h (an outside audit).
+inline glm::vec3 vertexLightPoint(const glm::vec3& origin, const glm::vec3& normal, float eps) {
+  return origin - eps * normal;
+}
+// Where a light whose plane passes through y (unit normal m) is seen from:
+// the surface point x, unless x lies within 2 eps of that plane (a lamp's
+// own plane through the vertex, the walls of a furnace meeting at its
+// corner): there x would see it edge-on, and the lifted point `from` is
+// used, as before 7 December 2026 (a light that close is within the
+// offsets' bias anyway).
+inline const glm::vec3& lightSeenFrom(const glm::vec3& x, const glm::vec3& from, const glm::vec3& y,
+                                      const glm::vec3& m, float eps) {
+  return std::fabs(glm::dot(m, x - y)) < 2.f * eps ? from : x;
+}
 }  // namespace gi
