@@ -157,7 +157,7 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
   }
   std::string text(bytes);
   std::map<std::string, glm::dvec3> kd;  // material -> Kd, the first library's that defines it
-  std::vector<std::string> missing;
+  std::vector<std::string> warnings;
   if (ext == "obj" && !path.empty()) {
     // Each library beside the file, or where an absolute path says (OpenMesh
     // opens only the first: an absolute one was dropped in silence whenever
@@ -168,7 +168,8 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
       const std::string file = std::filesystem::path(lib).is_absolute() ? lib : folder + lib;
       std::error_code ec;
       if (!std::filesystem::exists(file, ec)) {  // the mesh is read without it, and the log says so
-        missing.push_back(lib);
+        warnings.push_back(name + ": its material library " + lib +
+                           " was not found (beside it, or at that absolute path): its materials' colours are not read");
         continue;
       }
       std::string material;
@@ -202,10 +203,6 @@ Polygons readWithOpenMesh(std::string_view bytes, const std::string& ext, const 
     failRead(name, std::string("the reader failed (") + e.what() + ")");
   }
   if (!ok) failRead(name, "OpenMesh could not parse it as a ." + ext + " mesh");
-  std::vector<std::string> warnings;
-  for (const std::string& lib : missing)
-    warnings.push_back(name + ": its material library " + lib +
-                       " was not found (beside it, or at that absolute path): its materials' colours are not read");
   // STL: OpenMesh merges equal corners and drops triangles left with a repeated corner (no area).
   const size_t hidden = declared.repeatLines.size();
   if (ext == "obj" && (m.n_faces() + hidden != declared.faces || m.n_vertices() < declared.vertices))
