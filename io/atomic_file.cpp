@@ -160,6 +160,24 @@ void writeAtomically(const std::string& path, const std::function<void(const std
   struct stat st {};
   const bool exists = ::stat(target.c_str(), &st) == 0;
   if (exists && !S_ISREG(st.st_mode)) {  // a device or a pipe: no file to replace
+    // A pipe no process reads would block the write's open for ever (an
+    // outside audit: `gi ao in.ply -o fifo.ply` hung): its open without
+    // waiting fails then, and is said. One that a process reads is written
+    // to, the probe held open until the write is done (closing it first
+    // would end the reader's input).
+    int probe = -1;
+    if (S_ISFIFO(st.st_mode)) {
+      probe = ::open(target.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+      if (probe < 0)
+        throw std::runtime_error("cannot write " + path + ": " +
+                                 (errno == ENXIO ? std::string("it is a pipe that no process reads") : std::strerror(errno)));
+    }
+    struct Probe {
+      int fd;
+      ~Probe() {
+        if (fd >= 0) ::close(fd);
+      }
+    } held{probe};
     write(path);
     return;
   }

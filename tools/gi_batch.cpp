@@ -1,6 +1,5 @@
 #include "gi_batch.h"
-
-#include <fnmatch.h>
+#include "gi_batch_inputs.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -32,217 +31,8 @@ namespace gi::batch {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-using Texts = std::map<std::string, std::string>;  // parameter name -> value as the CLI takes it
 
 namespace {
-
-struct Job {
-  std::string input;  // path
-  Texts overrides;    // this manifest line's parameters
-  std::string where;  // "manifest line 7" (for messages)
-  std::string stem;   // output name: OUT/stem.ply, OUT/stem.json
-  std::string base;   // the manifest's folder: files its line's parameters name are relative to it
-};
-
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  return s;
-}
-
-// Whitespace-separated words; "double" or 'single' quotes keep spaces.
-std::vector<std::string> words(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  bool in = false;
-  char quote = 0;
-  for (char c : line) {
-    if (quote) {
-      if (c == quote) quote = 0;
-      else cur += c;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-      in = true;
-    } else if (c == ' ' || c == '\t' || c == '\r') {
-      if (in) out.push_back(cur), cur.clear(), in = false;
-    } else {
-      cur += c;
-      in = true;
-    }
-  }
-  if (quote) throw std::invalid_argument("unclosed quote");
-  if (in) out.push_back(cur);
-  return out;
-}
-
-// "--name value" and "--name=value" pairs, each name one of the filter's parameters.
-Texts parameterPairs(const std::vector<std::string>& w, size_t from, const std::vector<ParamSpec>& specs,
-                     const std::string& filter, const std::string& where) {
-  Texts out;
-  for (size_t i = from; i < w.size(); ++i) {
-    std::string k = w[i];
-    if (k.rfind("--", 0) != 0) throw std::invalid_argument(where + "unexpected '" + k + "' (parameters are --name value)");
-    k = k.substr(2);
-    std::string v;
-    const size_t eq = k.find('=');
-    if (eq != std::string::npos) v = k.substr(eq + 1), k = k.substr(0, eq);
-    else if (i + 1 < w.size()) v = w[++i];
-    else throw std::invalid_argument(where + "--" + k + " needs a value");
-    const ParamSpec* p = findSpec(specs, k);
-    if (!p || p->meshlabOnly) throw std::invalid_argument(where + "'" + filter + "' has no parameter --" + k);
-    if (out.count(k)) throw std::invalid_argument(where + "--" + k + " is given twice");
-    out[k] = v;
-  }
-  return out;
-}
-
-// A parameter file: {"filter": "ao" or its MeshLab name, "parameters": {name: value}};
-// values as the CLI takes them ("10%", "255,255,255"), or JSON numbers, booleans and [x, y, z].
-std::pair<std::string, Texts> readParamsFile(const std::string& path) {
-  const std::string text = files::readTextFile(path, "parameter file", size_t(64) << 20);
-  json j;
-  try {
-    j = gi::io::parseJson(text);
-  } catch (const std::exception& e) {
-    throw std::invalid_argument("the parameter file " + path + " is not JSON: " + oneLine(e.what()));
-  }
-  if (!j.is_object()) throw std::invalid_argument("the parameter file " + path + " must hold a JSON object");
-  // A key it does not know is refused, as an unknown parameter is: a typo
-  // ("paramters") dropped every parameter in silence (an outside audit).
-  for (const auto& [k, v] : j.items())
-    if (k != "filter" && k != "parameters")
-      throw std::invalid_argument("the parameter file " + path + " has a key '" + k +
-                                  "' it does not know (it takes \"filter\" and \"parameters\")");
-  if (j.contains("filter") && !j["filter"].is_string())
-    throw std::invalid_argument("\"filter\" in " + path + " must be a string");
-  std::string filter = j.value("filter", "");
-  Texts t;
-  const json p = j.value("parameters", json::object());
-  if (!p.is_object()) throw std::invalid_argument("\"parameters\" in " + path + " must be an object");
-  for (const auto& [k, v] : p.items()) {
-    if (v.is_string()) t[k] = v.get<std::string>();
-    else if (v.is_boolean()) t[k] = v.get<bool>() ? "true" : "false";
-    else if (v.is_number_float() && std::isfinite(v.get<double>()) && v.get<double>() == std::trunc(v.get<double>()) &&
-             std::fabs(v.get<double>()) < 9.0e15)
-      t[k] = std::to_string(int64_t(v.get<double>()));  // 8.0 and 1e2 are the integers JSON wrote them as
-    else if (v.is_number()) t[k] = v.dump();
-    else if (v.is_array() && v.size() == 3) t[k] = v[0].dump() + "," + v[1].dump() + "," + v[2].dump();
-    else throw std::invalid_argument("parameter " + k + " in " + path + ": expected a string, number, boolean or [x, y, z]");
-  }
-  return {filter, t};
-}
-
-const FilterDesc& findFilter(const std::string& name) {
-  if (const FilterDesc* d = gi::findFilter(name)) return *d;
-  throw std::invalid_argument("unknown filter '" + name + "' (" + cliFilterNames() + ")");
-}
-
-std::vector<Job> readManifest(const std::string& path, const std::vector<ParamSpec>& specs, const std::string& filter) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec))
-    throw std::invalid_argument("the manifest " + path + " is a folder: give a file listing the meshes, or --dir for a folder of meshes");
-  std::string text = files::readTextFile(path, "manifest", size_t(256) << 20);
-  if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);  // a UTF-8 byte order mark is no part of a name
-  std::istringstream f(text);
-  const fs::path base = fs::path(path).parent_path();
-  std::vector<Job> jobs;
-  std::string line;
-  for (int n = 1; std::getline(f, line); ++n) {
-    const std::string where = "manifest " + path + " line " + std::to_string(n) + ": ";
-    if (line.find('\0') != std::string::npos)  // no file name holds one: a binary file or a damaged line
-      throw std::invalid_argument(where + "holds a NUL byte (is the manifest a text file?)");
-    std::vector<std::string> w;
-    try {
-      w = words(line);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(where + e.what());
-    }
-    // A comment line starts with # itself; a quoted name may start with one
-    // ("#1.ply" was dropped as a comment, silently; an outside audit).
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (w.empty() || (first != std::string::npos && line[first] == '#')) continue;
-    // A # where a parameter's name would come ends the line (a comment
-    // after a mesh's parameters); a value may start with one (a colour
-    // #ff8800).
-    for (size_t k = 1; k < w.size();) {
-      if (w[k][0] == '#') {
-        w.resize(k);
-        break;
-      }
-      k += w[k].rfind("--", 0) == 0 && w[k].find('=') == std::string::npos ? 2 : 1;
-    }
-    Job j;
-    j.input = fs::path(w[0]).is_absolute() || base.empty() ? w[0] : (base / w[0]).string();
-    j.overrides = parameterPairs(w, 1, specs, filter, where);
-    j.base = base.string();
-    j.where = where;
-    jobs.push_back(j);
-  }
-  if (f.bad()) throw std::invalid_argument("cannot read the manifest " + path + ": " + std::strerror(errno));
-  if (jobs.empty()) throw std::invalid_argument("the manifest " + path + " lists no mesh");
-  return jobs;
-}
-
-std::vector<Job> readFolder(const std::string& dir, const std::string& pattern) {
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) throw std::invalid_argument("--dir " + dir + " is not a folder");
-  // Every entry the pattern matches but a folder is a job: one that is no
-  // regular file (a dangling link, a FIFO, a link in a loop) fails as that
-  // mesh, as it does from a manifest (it was skipped in silence, and a link
-  // in a loop stopped the whole batch with the library's message; an
-  // outside audit). Folders are no meshes (an output folder inside --dir).
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    std::error_code kind;
-    if (fnmatch(pattern.c_str(), e.path().filename().c_str(), 0) == 0 && !e.is_directory(kind))
-      names.push_back(e.path().filename().string());
-  }
-  if (ec) throw std::invalid_argument("cannot list " + dir + ": " + ec.message());
-  if (names.empty()) throw std::invalid_argument("no file in " + dir + " matches --glob '" + pattern + "'");
-  std::sort(names.begin(), names.end());
-  std::vector<Job> jobs;
-  for (const std::string& n : names) jobs.push_back({(fs::path(dir) / n).string(), {}, n + ": ", ""});
-  return jobs;
-}
-
-// "I/N" from --shard, else a Slurm job array's task (id - min) / step of count, else 0/1.
-std::pair<size_t, size_t> chooseShard(const std::string& text) {
-  long long i = 0, n = 1;
-  if (!text.empty()) {
-    char slash = 0, rest = 0;
-    errno = 0;
-    if (std::sscanf(text.c_str(), "%lld %c %lld %c", &i, &slash, &n, &rest) != 3 || slash != '/')
-      throw std::invalid_argument("--shard '" + text + "': expected I/N, e.g. 0/16");
-    if (errno == ERANGE || n > (1LL << 40) || i > (1LL << 40))
-      throw std::invalid_argument("--shard '" + text + "': I and N must be below 2^40");
-  } else if (std::getenv("SLURM_ARRAY_TASK_COUNT")) {
-    // Each variable an integer (a garbled one must not make every task shard
-    // 0; nor an empty one, which was read as its default: an outside audit);
-    // the task's index must be set, MIN and STEP may be left out.
-    auto num = [](const char* name, long long fallback) {
-      const char* v = std::getenv(name);
-      if (!v && fallback < 0) throw std::invalid_argument(std::string(name) + " is not set, though SLURM_ARRAY_TASK_COUNT is");
-      if (!v) return fallback;
-      char* end = nullptr;
-      errno = 0;
-      const long long x = std::strtoll(v, &end, 10);
-      if (end == v || *end != '\0' || errno == ERANGE || x < 0 || x > (1LL << 40))
-        throw std::invalid_argument(std::string(name) + " = '" + v + "' is not a Slurm array index or count");
-      return x;
-    };
-    n = num("SLURM_ARRAY_TASK_COUNT", 1);
-    if (n < 1) throw std::invalid_argument("SLURM_ARRAY_TASK_COUNT = 0: the job array has no task (or pass --shard I/N)");
-    const long long step = std::max(1LL, num("SLURM_ARRAY_TASK_STEP", 1));
-    const long long offset = num("SLURM_ARRAY_TASK_ID", -1) - num("SLURM_ARRAY_TASK_MIN", 0);
-    i = offset < 0 || offset % step != 0 ? -1 : offset / step;
-    if (i < 0 || i >= n)
-      throw std::invalid_argument("SLURM_ARRAY_TASK_ID " + std::string(std::getenv("SLURM_ARRAY_TASK_ID") ? std::getenv("SLURM_ARRAY_TASK_ID") : "?") +
-                                  " is not one of " + std::to_string(n) +
-                                  " evenly spaced tasks: submit with --array=0-" + std::to_string(n - 1) + " or pass --shard I/N");
-  }
-  if (n < 1 || i < 0 || i >= n) throw std::invalid_argument("--shard " + text + ": needs 0 <= I < N");
-  return {size_t(i), size_t(n)};
-}
 
 // The result PLY's digest and its new layers' (photon mapping's photons
 // beside it, listed under "layers" in the summary), "" if one cannot be read.
@@ -302,6 +92,8 @@ json readJson(const fs::path& p) {
   }
 }
 
+bool isBatchSummary(const json& j) { return j.is_object() && j.contains("gi_batch"); }
+
 // Written whole or not at all: a file that exists is complete.
 void writeJson(const fs::path& p, const json& j) { io::writeFileAtomically(p.string(), io::dumpJson(j, 2) + "\n"); }
 
@@ -358,6 +150,7 @@ json bake(const FilterDesc& d, const Texts& params, const Job& job, const fs::pa
 void checkFiles(const Args& a, const FilterDesc& d, const Texts& common, const std::vector<Job>& jobs, size_t shard,
                 size_t shards, bool explicitShard) {
   std::vector<files::Named> inputs, outputs;
+  std::string inTheWay;  // the first file of the user's at a path the batch writes
   if (!a.manifest.empty()) inputs.push_back({a.manifest, "--manifest"});
   if (!a.paramsFile.empty()) inputs.push_back({a.paramsFile, "--params"});
   for (const Job& j : jobs) {
@@ -378,12 +171,33 @@ void checkFiles(const Args& a, const FilterDesc& d, const Texts& common, const s
       inputs.push_back({summary, "the summary of " + j.input});
       continue;
     }
+    // A file at a result's or a summary's path is replaced only where a
+    // batch wrote it: a summary of ours (a JSON object with "gi_batch") says
+    // so for itself, its result and its layers. A file of the user's (an
+    // a.ply beside a.obj where -o is the meshes' folder, a notes.json) is
+    // refused before any work (it was overwritten; an outside audit).
+    // (Said after the check against the inputs, whose message is clearer.)
+    if (!isBatchSummary(readJson(summary)) && inTheWay.empty()) {
+      std::error_code ec;
+      std::vector<std::string> written{ply};
+      for (const std::string& name : plan.layers) written.push_back(layerPath(ply, name));
+      if (fs::exists(summary, ec)) inTheWay = summary + " is in the way: it is no summary of gi batch";
+      for (const std::string& w : written)
+        if (inTheWay.empty() && (fs::exists(w, ec) || fs::is_symlink(w, ec)))
+          inTheWay = w + " is in the way: no summary of gi batch says a batch wrote it";
+    }
     outputs.push_back({ply, "the result of " + j.input});
     outputs.push_back({summary, "the summary of " + j.input});
     for (const std::string& name : plan.layers) outputs.push_back({layerPath(ply, name), "a layer of " + j.input});
   }
-  outputs.push_back({(fs::path(a.outDir) / reportName(a, shard, shards, explicitShard)).string(), "the report"});
+  const fs::path report = fs::path(a.outDir) / reportName(a, shard, shards, explicitShard);
+  outputs.push_back({report.string(), "the report"});
   files::check(inputs, outputs);
+  const json old = readJson(report);  // the report likewise: one of ours holds "shard" and "meshes"
+  std::error_code ec;
+  if (inTheWay.empty() && fs::exists(report, ec) && !(old.is_object() && old.contains("shard") && old.contains("meshes")))
+    inTheWay = report.string() + " is in the way: it is no report of gi batch";
+  if (!inTheWay.empty()) throw std::invalid_argument(inTheWay + " (move it, or choose another --output-dir)");
 }
 
 }  // namespace
@@ -402,7 +216,8 @@ void addOptions(CLI::App* sub, Args& a) {
                                             "64, \"max_distance\": \"5%\"}}; command-line parameters override it, a "
                                             "manifest line's override both");
   sub->add_option("--shard", a.shard, "I/N: take every N-th mesh from the I-th (0-based); default: a Slurm job "
-                                      "array's task (SLURM_ARRAY_TASK_ID - MIN of COUNT) if set, else all");
+                                      "array's task (SLURM_ARRAY_TASK_ID - MIN of COUNT) if set, else all")
+      ->check([](const std::string& t) { return t.empty() ? std::string("expected I/N, e.g. 0/16, not an empty text") : ""; });
   sub->add_option("--threads", a.threads, "worker threads of this process (default: SLURM_CPUS_PER_TASK if set, "
                                           "else all cores); several processes may share a node")
       ->check(CLI::Range(1, 4096));
@@ -548,6 +363,22 @@ int run(const Args& a, const std::vector<std::string>& extras) {
     s["params_hash"] = hash;
     s["parameters"] = params;
     s["shard"] = std::to_string(shard) + "/" + std::to_string(shards);
+    // An earlier run's result that this run may replace: its summary goes on
+    // with this one's (a failed re-run keeps the result, and says whose).
+    json earlier;
+    if (fs::exists(ply, ec)) {
+      if (text("status") == "ok") earlier = old;
+      else if (old.is_object() && old.contains("earlier_run")) earlier = old["earlier_run"];
+    }
+    // The summary first, saying the mesh is being computed: every result
+    // file in the folder then has a summary of ours beside it, even after a
+    // kill between the two, and a file without one is the user's (checkFiles).
+    {
+      json running = s;
+      running["status"] = "running";
+      if (!earlier.is_null()) running["earlier_run"] = earlier;
+      writeJson(sum, running);
+    }
     try {
       json r = bake(d, params, job, ply);
       s.update(r);
@@ -571,8 +402,7 @@ int run(const Args& a, const std::vector<std::string>& extras) {
       // and keeps that run's summary, so its parameters stay known.
       if (fs::exists(ply, ec)) {
         s["earlier_result"] = ply.string() + " is not this run's result: it is kept from an earlier run";
-        if (text("status") == "ok") s["earlier_run"] = old;
-        else if (old.is_object() && old.contains("earlier_run")) s["earlier_run"] = old["earlier_run"];
+        if (!earlier.is_null()) s["earlier_run"] = earlier;
         std::string e = s["error"].get<std::string>();
         if (!e.empty() && e.back() == '.') e.pop_back();
         s["error"] = e + " (the earlier result " + ply.filename().string() + " is kept)";

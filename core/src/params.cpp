@@ -198,6 +198,8 @@ std::optional<std::string> validate(const std::vector<ParamSpec>& specs, const P
           for (const char c : v.getString(s.name))
             if ((static_cast<unsigned char>(c) < 0x20) || c == 0x7f)
               return "parameter '" + s.name + "' must be one line of text (no line breaks, tabs or control characters)";
+          if (s.checkText)
+            if (std::string why = s.checkText(v.getString(s.name)); !why.empty()) return why;
           break;
       }
     } catch (const std::bad_variant_access&) {

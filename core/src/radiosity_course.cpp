@@ -31,7 +31,15 @@ std::vector<ParamSpec> radiosityCourseSpecs() {
                "term when it is on). A step is a sweep for Jacobi and Gauss-Seidel (with 'Bounces' k: bounce "
                "k), a shot of one patch for progressive refinement; step 0 is the direct light only. A step the "
                "solve does not reach keeps the final state (the log says so). Empty: no snapshots.",
-       .type = ParamType::String, .defText = ""},
+       .type = ParamType::String, .defText = "",
+       .checkText = [](const std::string& t) {
+         try {
+           (void)parseSnapshotSteps(t);
+           return std::string();
+         } catch (const std::invalid_argument& e) {
+           return std::string(e.what());
+         }
+       }},
       {.name = "residual_csv", .label = "Residual per step (CSV file)",
        .help = "If not empty, a CSV file 'step,residual' written after the solve: per sweep the change of the "
                "reflected power, per shot (progressive refinement) the unshot power, both relative to the "

@@ -160,14 +160,24 @@ def case_kill(a, tmp):
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 300
     done = []
+    def finished():  # a summary is written first, saying "running", then again when the mesh is done
+        out_ = []
+        for p in glob.glob(os.path.join(out, "bunny_*.json")):
+            try:
+                if load(p)["status"] == "ok":
+                    out_.append(os.path.basename(p)[:-5])
+            except (OSError, ValueError, KeyError):
+                pass
+        return sorted(out_)
+
     while time.time() < deadline and proc.poll() is None:
-        done = glob.glob(os.path.join(out, "bunny_*.json"))
+        done = finished()
         if len(done) >= 2:
             break
         time.sleep(0.01)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    done = sorted(os.path.basename(p)[:-5] for p in glob.glob(os.path.join(out, "bunny_*.json")))
+    done = finished()
     check(2 <= len(done) < len(names), "killed half-way: %d of %d meshes finished" % (len(done), len(names)))
     stamps = {n: (stamp(os.path.join(out, n + ".ply")), stamp(os.path.join(out, n + ".json"))) for n in done}
     p = run(cmd)
@@ -310,6 +320,45 @@ def case_inputs(a, tmp):
         with open(params, "w") as f:
             f.write(doc)
         one_line(["--params", params, "--dir", meshes, "-o", out], "it does not know", "a parameter file " + doc)
+    # A key given twice: nlohmann kept the last in silence (an outside audit).
+    with open(params, "w") as f:
+        f.write('{"filter": "ao", "parameters": {"rays_per_vertex": 8, "rays_per_vertex": 64}}')
+    one_line(["--params", params, "--dir", meshes, "-o", out], "twice", "a parameter file giving a key twice")
+    one_line(["ao", "--dir", meshes, "-o", out, "--shard", ""], "--shard", "an empty --shard (it meant no shard)")
+    one_line(["ao", "--dir", meshes, "-o", out, "--shard", "0/%d" % 2 ** 40], "2^40", "--shard N of 2^40")
+    # A hidden file is matched only by a pattern starting with a dot, as in
+    # a shell (*.ply took an editor's .bowl.ply).
+    shutil.copy(os.path.join(meshes, "bowl.ply"), os.path.join(meshes, ".hidden.ply"))
+    rep = json.loads(run([a.gi, "batch", "ao", "--dir", meshes, "-o", os.path.join(tmp, "hidden_out"),
+                          "--rays_per_vertex", "8", "--json"], expect=0).stdout)
+    check(rep["meshes"] == len(names), "*.ply leaves .hidden.ply out (%d meshes)" % rep["meshes"])
+    os.remove(os.path.join(meshes, ".hidden.ply"))
+    # A file of the user's at a result's, a summary's or the report's path
+    # is refused before any work: with -o the meshes' folder, a.ply beside
+    # a.obj was replaced by a.obj's result (an outside audit). A batch's own
+    # files are replaced by a re-run, also after a kill between the summary
+    # and the result (the summary, saying "running", is written first).
+    own = os.path.join(tmp, "own_files")
+    os.makedirs(own)
+    with open(os.path.join(own, "tent.obj"), "w") as f:
+        f.write("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 0.5\nf 1 2 3\nf 1 3 4\nf 1 2 5\nf 2 3 5\n")
+    base = ["ao", "--dir", own, "--glob", "*.obj", "-o", own, "--rays_per_vertex", "8"]
+    for name, content in (("tent.ply", "my scan\n"), ("tent.json", '{"mine": true}'), ("report-0-of-1.json", "[]")):
+        path = os.path.join(own, name)
+        with open(path, "w") as f:
+            f.write(content)
+        one_line(base, name, "a file of the user's at the batch's path " + name)
+        check(open(path).read() == content, name + " is kept")
+        os.remove(path)
+    run([a.gi, "batch"] + base, expect=0)
+    with open(os.path.join(own, "tent.json")) as f:
+        summary = json.load(f)
+    summary["status"] = "running"  # as a kill between the summary and the result leaves it
+    with open(os.path.join(own, "tent.json"), "w") as f:
+        json.dump(summary, f)
+    rep = json.loads(run([a.gi, "batch"] + base + ["--json"], expect=0).stdout)
+    check(rep["baked"] == 1 and load(os.path.join(own, "tent.json"))["status"] == "ok",
+          "a result whose summary says running is the batch's: baked again (%s)" % rep)
 
 
 def case_keep(a, tmp):

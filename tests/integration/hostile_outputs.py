@@ -17,6 +17,8 @@ import resource
 import signal
 import struct
 import subprocess
+import threading
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 MESHES = os.path.join(HERE, "..", "..", "test_meshes")
@@ -278,6 +280,14 @@ def check_numbers_and_batches(gi, tmp):
                                              "0/99999999999999999999"], "2^40", 1, "bout/report-0-of-1.json"),
         ("a script parameter given twice", ["script", "ao", "--mesh", "in.ply", "--rays_per_vertex", "8",
                                             "--rays_per_vertex", "16", "-o", "s.mlx"], "given twice", 1, "s.mlx"),
+        # Text with a syntax of its own is checked with the ranges: a script
+        # the filter then refused was written with exit 0, and a batch failed
+        # each mesh in turn (an outside audit).
+        ("a script with snapshot steps that are no counts", ["script", "radiosity", "--snapshot_steps", "0,ten",
+                                                            "-o", "s.mlx"], "snapshot_steps", 1, "s.mlx"),
+        ("a batch with snapshot steps that are no counts", ["batch", "radiosity", "--manifest", "list.txt", "-o",
+                                                           "bout", "--snapshot_steps", "-1"], "snapshot_steps", 1,
+         "bout/in.json"),
         ("a parameter file whose filter is a number", ["batch", "ao", "--manifest", "list.txt", "-o", "bout",
                                                        "--params", "filter5.json"], "must be a string", 1,
          "bout/report-0-of-1.json"),
@@ -517,9 +527,40 @@ def check_signal_while_writing(gi, tmp):
     return failures
 
 
+def check_pipes(gi, tmp):
+    """-o naming a pipe: one that no process reads is said in one line (the
+    write's open waited for a reader for ever; an outside audit), one that a
+    process reads gets the whole output."""
+    failures = []
+    d = os.path.join(tmp, "pipes")
+    os.makedirs(d)
+    cornell(d)
+    for what, args in (("a result", fast(["ao", "in.ply", "-o", "p.ply", "-q"])), ("a script", ["script", "ao", "-o", "p.mlx"])):
+        pipe = os.path.join(d, args[args.index("-o") + 1])
+        os.mkfifo(pipe)
+        rc, _, lines = run([gi] + args, cwd=d, timeout=60)
+        report(failures, what + " into a pipe no process reads", one_error(rc, lines, "no process reads"), rc, lines)
+        got = []
+        reader = threading.Thread(target=lambda: got.append(open(pipe, "rb").read()), daemon=True)
+        reader.start()
+        time.sleep(0.3)  # the reader waiting in its open: a reader the probe finds
+        rc, _, lines = run([gi] + args, cwd=d, timeout=60)
+        reader.join(60)
+        if reader.is_alive():  # gi never opened the pipe: release the reader
+            os.close(os.open(pipe, os.O_WRONLY | os.O_NONBLOCK))
+            reader.join(10)
+        whole = got and (got[0].startswith(b"ply") and b"end_header" in got[0] if what == "a result"
+                         else got[0].rstrip().endswith(b"</FilterScript>"))
+        report(failures, what + " into a pipe a process reads", None if rc == 0 and whole else
+               "expected exit 0 and the whole output through the pipe; got %d bytes" % (len(got[0]) if got else -1),
+               rc, lines)
+        os.remove(pipe)
+    return failures
+
+
 def check_all(gi, tmp):
     failures = []
     for check in (check_overwrite, check_failed_writes, check_early, check_latin1_names, check_numbers_and_batches,
-                  check_side_files, check_stdout_and_address_space, check_signal_while_writing):
+                  check_side_files, check_stdout_and_address_space, check_signal_while_writing, check_pipes):
         failures += check(gi, tmp)
     return failures

@@ -256,6 +256,19 @@ TEST(RadiosityCourse, BadSnapshotStepsAreRefused) {
   for (int i = 0; i < 65; ++i) many += std::to_string(i) + ",";
   EXPECT_THROW(parseSnapshotSteps(many), std::invalid_argument);
   EXPECT_TRUE(parseSnapshotSteps(" ").empty());
+  // validate() checks the text with the ranges (a script or a batch is
+  // refused before any work; the filter refused it only when it ran).
+  const auto specs = filterSpecs(FilterKind::Radiosity);
+  ParamValues v = defaultValues(specs, 1.0);
+  EXPECT_FALSE(validate(specs, v, 1.0).has_value());
+  v.set("snapshot_steps", std::string("0, 10, 100"));
+  EXPECT_FALSE(validate(specs, v, 1.0).has_value());
+  for (const char* bad : {"-1", "0,ten", many.c_str()}) {
+    v.set("snapshot_steps", std::string(bad));
+    const auto why = validate(specs, v, 1.0);
+    ASSERT_TRUE(why.has_value()) << bad;
+    EXPECT_NE(why->find("snapshot_steps"), std::string::npos) << *why;
+  }
 }
 
 // Through runFilter (what MeshLab and the CLI run): the snapshots become the

@@ -50,6 +50,10 @@ struct ParamSpec {
   // a 2 m room (an absolute caustic radius of 0.17) must still run a 1 cm
   // part in a mode that has no caustic map.
   std::vector<ParamUse> usedWhen;
+  // String: the text's own syntax (a list of step counts), checked by
+  // validate() with the ranges, so that a script, a batch or the dialog is
+  // refused before any work; returns "" when the text is fine, else why not.
+  std::string (*checkText)(const std::string& text) = nullptr;
 };
 
 // Colours and directions in float; positions (Point) in double, so that a
