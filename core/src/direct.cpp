@@ -349,10 +349,14 @@ DirectLightAt::DirectLightAt(const Scene& s, const RayCaster& caster, int sample
 DirectLightAt::~DirectLightAt() = default;
 glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const {
   if (impl_->empty()) return glm::vec3(0.f);
+  return (*this)(x, x + n * impl_->eps(), n, key);
+}
+
+glm::vec3 DirectLightAt::operator()(const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, uint32_t key) const {
+  if (impl_->empty()) return glm::vec3(0.f);
   const PaddedSobol smp(hash3(key, 0xd8u, 0x5au));
   glm::vec3 sum(0.f);
-  for (int k = 0; k < samples_; ++k)
-    sum += impl_->estimate(x, x + n * impl_->eps(), n, smp, uint32_t(k), 1, key, kNoHit).H;
+  for (int k = 0; k < samples_; ++k) sum += impl_->estimate(x, from, n, smp, uint32_t(k), 1, key, kNoHit).H;
   return sum / float(samples_);
 }
 

@@ -9,6 +9,7 @@
 #include "gi/color.h"
 #include "gi/run.h"
 #include "gi/specular.h"
+#include "hit_origin.h"
 
 namespace gi::paths {
 
@@ -47,7 +48,7 @@ bool Bsdf::sample(glm::vec2 u, glm::vec3& wi, glm::vec3& weight, float& pdfOut) 
 Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& lights, const PathRules& rules,
                        const StoredLight* stored)
     : s_(s), caster_(c), L_(lights), rules_(rules), stored_(stored), emitters_(s), faceN_(unitFaceNormals(s)),
-      eps_(0.f), farT_(0.f) {
+      faceAlt_(faceMinAltitudes(s)), eps_(0.f), farT_(0.f) {
   const SceneScale scale = sceneScale(s);
   eps_ = float(scale.rayEpsilon);
   farT_ = float(2.0 * scale.diagonal);
@@ -89,6 +90,12 @@ SurfacePoint Integrator::surfaceAt(const Ray& r, const Hit& h) const {
   sp.v = h.v;
   sp.t = h.t;
   return sp;
+}
+
+glm::vec3 Integrator::leaveFrom(const Ray& in, const SurfacePoint& sp) const {
+  if (sp.t <= farT_)
+    return hitRayOrigin(caster_, in.o, in.d, sp.t, sp.n, eps_, hitBorder(faceAlt_, sp.face, sp.u, sp.v));
+  return sp.x + (glm::dot(in.d, sp.n) < 0.f ? sp.n : -sp.n) * eps_;
 }
 
 Ray Integrator::spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, float lift) const {
@@ -201,14 +208,16 @@ glm::vec3 Integrator::nextEvent(const glm::vec3& x, const glm::vec3& n, const Bs
   return L;
 }
 
-void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& smp) const {
+void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& smp, bool given) const {
   const Material m = s_.faceMaterial(sp.face);
   const float ior = s_.ior.empty() ? 1.5f : s_.ior[sp.face];
   const SpecularEvent ev = scatterSpecular(m, st.ray.d, sp.n, s_.faceRho(sp.face), ior, smp.next1D());
   st.beta *= ev.weight * ev.radianceScale;
   st.delta = true;
   st.kind = PathState::Kind::Specular;
-  st.ray = spawn(sp.x, sp.n, ev.d);
+  // A reflection leaves on the side the ray came from (leaveFrom), a refraction through the other.
+  const bool reflected = !given && glm::dot(ev.d, sp.n) * glm::dot(st.ray.d, sp.n) < 0.f;
+  st.ray = reflected ? spawn(leaveFrom(st.ray, sp), sp.n, ev.d, 0.f) : spawn(sp.x, sp.n, ev.d);
 }
 
 glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c,
@@ -232,6 +241,10 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
   };
   for (;;) {
     SurfacePoint sp;
+    // A point given by the caller (a primary hit, a vertex) need not lie
+    // along st.ray: its rays leave lifted along its normal (leaveFrom
+    // reads the ray that reached the point).
+    const bool given = first != nullptr;
     if (first) {
       sp = *first;
       first = nullptr;
@@ -263,16 +276,18 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       } else {
         ++st.depth;
       }
-      specularStep(sp, st, smp);
+      specularStep(sp, st, smp, given);
     } else {
       const float cosO = -glm::dot(sp.n, st.ray.d);
       if (!(cosO > 0.f)) break;  // seen from behind: black
       int nL = 1;
       bool wanted = true;
       const Bsdf b = bsdfAt(sp, -st.ray.d);
+      // Where the light samples and the BSDF sample leave.
+      const glm::vec3 o = given ? sp.x + sp.n * eps_ : leaveFrom(st.ray, sp);
       if (m == Material::Glossy) {
         if (st.lightOnly) break;
-        sampled(st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1));
+        sampled(st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1, 0.f, &o));
       } else {
         if (emits(sp.face)) found(st.beta * emitted(sp.face, sp.t, cosO, st.delta, st.pdfPrev, st.nLPrev));
         if (st.lightOnly) break;
@@ -283,7 +298,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
         }
         ++st.diffuseVertices;
         nL = st.diffuseVertices == 1 ? rules_.firstLightSamples : 1;
-        glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL);
+        glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL, 0.f, &o);
         // A first pass's indirect part is a difference of noisy estimates: keep the sum >= 0.
         if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, b.rho, smp, c), glm::vec3(0.f));
         sampled(st.beta * Ld);  // after ++diffuseVertices: indirect when x0 started the path
@@ -303,7 +318,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       st.delta = false;
       st.pdfPrev = pdf;
       st.nLPrev = float(nL);
-      st.ray = spawn(sp.x, sp.n, wi);
+      st.ray = spawn(o, sp.n, wi, 0.f);
       st.kind = m == Material::Glossy ? PathState::Kind::Glossy : PathState::Kind::Diffuse;
       if (goOn) ++st.depth;
       st.lightOnly = !goOn;
@@ -438,7 +453,10 @@ std::string unsampledLightPaths(const Scene& s, const LightSettings& lights, boo
 // light is missing, a bias outside the error bars. No limit (maxDepth -1):
 // only paths caught between perfect mirrors reach `cap`. A limit k: in a
 // closed room of the scene's mean reflectance rho the light of more than k
-// bounces is a share rho^(k+1) of B; warn when that may exceed the mean
+// bounces is a share rho^(k+1) of B where the surface does not emit (the
+// series E (1 + rho + ... + rho^k) rho against its sum: the warning's
+// figure, an upper bound), rho^(k+2) where it also emits (a furnace, whose
+// B holds E besides); warn when that may exceed the mean
 // relative error (the reference and the path-traced view; the view only noted the
 // cut paths until 5 December 2026, when a white furnace's image read 26% of
 // its radiance at max_depth 32 without a warning).

@@ -196,6 +196,11 @@ class Integrator {
   float eps() const { return eps_; }
   const std::vector<glm::vec3>& faceNormals() const { return faceN_; }
 
+  // Where rays leaving a surface point reached by `in` start on the side it
+  // was reached from: hitRayOrigin (hit_origin.h), the normal lift unless
+  // that crosses a surface near a corner; the lift itself where the hit
+  // was projected onto its face (a far camera: no short segment there).
+  glm::vec3 leaveFrom(const Ray& in, const SurfacePoint& sp) const;
   // A ray leaving x (normal n) in direction d, lifted by `lift` to d's side.
   Ray spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d, float lift) const;
   Ray spawn(const glm::vec3& x, const glm::vec3& n, const glm::vec3& d) const { return spawn(x, n, d, eps_); }
@@ -223,7 +228,7 @@ class Integrator {
   }
   // A mirror or glass event at sp: the sampled direction, beta times its
   // weight and eta^2, the ray continued.
-  void specularStep(const SurfacePoint& sp, PathState& st, Sampler& smp) const;
+  void specularStep(const SurfacePoint& sp, PathState& st, Sampler& smp, bool given) const;
 
  protected:
   const Scene& s_;
@@ -233,6 +238,7 @@ class Integrator {
   const StoredLight* stored_;
   EmitterSampler emitters_;
   std::vector<glm::vec3> faceN_;
+  std::vector<float> faceAlt_;  // faceMinAltitudes (hit_origin.h)
   float eps_;
   // Hits farther than this (twice the diagonal: only rays from outside the
   // scene, a camera's) are put back onto their face's plane (surfaceAt).

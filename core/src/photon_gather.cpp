@@ -197,8 +197,8 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
     count(e.used);
     // max_depth 0: no reflection may be added at y.
     if (opt.maxDepth < 1) return s.faceRho(g.face) * e.H;
-    const glm::vec3 o = g.point + g.normal * r.eps;
-    const glm::vec3 direct = directAt(g.point, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, g.point, o, g.normal) +
+    const glm::vec3 o = g.from;  // on the ray's last leg, eps off the face (hit_origin.h)
+    const glm::vec3 direct = directAt(g.point, o, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, g.point, o, g.normal) +
                              skySunIrradianceAt(opt.outside, r.caster, o, g.normal, 4, g.key);
     // A far hit: the photons' estimate, but for the direct light, taken at
     // y itself (the direct photons' estimate blurs a shadow edge over the

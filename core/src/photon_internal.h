@@ -62,12 +62,15 @@ constexpr int kFewPhotons = 4;
 void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, double unit, RunStats& st);
 
 // A final-gather ray's diffuse hit: the face, the point, its unit normal,
-// the length of the ray's last leg and a key of its own (vertex, ray).
+// the length of the ray's last leg, a key of its own (vertex, ray), and
+// where rays leaving the point start (hitRayOrigin, hit_origin.h: on the
+// ray's last leg).
 struct PhotonGatherHit {
   uint32_t face;
   glm::vec3 point, normal;
   float t;
   uint32_t key;
+  glm::vec3 from;
 };
 // Final gather at every vertex through mirrors, glass and glossy faces:
 // cosine-weighted rays from origins[v] follow them (up to 16 interactions;

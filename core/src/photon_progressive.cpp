@@ -11,6 +11,7 @@
 #include "gi/glossy.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
+#include "hit_origin.h"
 #include "photon_internal.h"
 #include "photon_grid.h"
 #include "photon_map.h"
@@ -308,6 +309,7 @@ std::vector<glm::vec3> specularFinalGather(
     uint32_t key, float eps, const std::function<glm::vec3(const PhotonGatherHit&)>& value,
     const std::vector<uint8_t>* only, const Progress& progress, std::vector<double>* variance) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
+  const std::vector<float> faceAlt = faceMinAltitudes(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   if (variance) variance->assign(s.vertexCount(), 0.0);
   parallelBlocks(s.vertexCount(), progress, "final gather", [&](size_t b, size_t e) {
@@ -331,7 +333,9 @@ std::vector<glm::vec3> specularFinalGather(
           const glm::vec3 y = ray.o + ray.d * h.t;
           const Material m = s.faceMaterial(h.face);
           if (m == Material::Diffuse) {
-            if (glm::dot(ray.d, ng) < 0.f) sum += glm::dvec3(weight * value({h.face, y, ng, h.t, hash3(uint32_t(v), key ^ 0x9e3779b9u, uint32_t(k))}));
+            if (glm::dot(ray.d, ng) < 0.f)
+              sum += glm::dvec3(weight * value({h.face, y, ng, h.t, hash3(uint32_t(v), key ^ 0x9e3779b9u, uint32_t(k)),
+                                                hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v))}));
             break;
           }
           if (m == Material::Glossy) {

@@ -154,6 +154,9 @@ class DirectLightAt {
   ~DirectLightAt();
   // x on a face, n its unit normal (the lit side); the ray origin is lifted by the scene's offset.
   glm::vec3 operator()(const glm::vec3& x, const glm::vec3& n, uint32_t key) const;
+  // The same with the shadow rays leaving from `from` (a hit's origin on
+  // the free segment its ray came along: hit_origin.h).
+  glm::vec3 operator()(const glm::vec3& x, const glm::vec3& from, const glm::vec3& n, uint32_t key) const;
 
  private:
   std::unique_ptr<detail::DirectLight> impl_;
