@@ -59,9 +59,12 @@ std::vector<ParamSpec> AmbientOptions::specs(AmbientMode mode) {
                            ? "Hits farther than this count as fully open (obscurance 1); nearer hits count "
                              "min(1, d/d_max)^k. Absolute length or % of the bounding-box diagonal; above 0 "
                              "(0 is refused: every hit would count as fully open)."
+                           : mode == AmbientMode::Sky
+                           ? "Geometry farther than this does not occlude the sky or the sun (0 = infinite): the "
+                             "rays, the sun's too, stop there."
                            : "Geometry farther than this does not occlude (0 = infinite). Rays stop there, and "
                              "vertices with no geometry above their tangent plane within this distance get 1 without "
-                             "casting rays.",
+                             "casting rays (with 'Light from a cone only' off).",
                .type = ParamType::Distance, .def = obscurance ? 0.1 : 0.0, .min = 0.0, .max = 10.0});
   s.push_back(seedSpec("sampling sequences"));
   if (mode == AmbientMode::Occlusion) {

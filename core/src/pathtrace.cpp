@@ -49,8 +49,9 @@ std::vector<ParamSpec> PathTraceOptions::specs() {
                "largest channel of the path's throughput) ends paths, after about 1 / (1 - rho) bounces; a path still "
                "going after 100,000 bounces (caught between perfect mirrors) is cut, with a warning. k >= 0: paths "
                "end after k bounces (diffuse, glossy, mirror or glass; 0 = direct light only); the light of more bounces is missing (in a closed room of "
-               "reflectance rho, a share rho^(k+1): 37% for rho = 0.999 and k = 1000) and is not in the error bars: "
-               "a warning says so when it may exceed them.",
+               "reflectance rho, a share rho^(k+1) of what a surface that does not emit reflects: 37% for rho = "
+               "0.999 and k = 1000; rho^(k+2) of B in a furnace, where every surface also emits) and is not in "
+               "the error bars: a warning says so when it may exceed them.",
        .type = ParamType::Int, .def = -1, .min = -1, .max = 100000},
   };
   for (const ParamSpec& p : SkySun::specs()) out.push_back(p);

@@ -104,7 +104,9 @@ std::vector<ParamSpec> pointLightSpecs() {
        .type = ParamType::Point, .defVec = glm::vec3(0.f)},
       {.name = "point_intensity", .label = "Point light intensity (W/sr)",
        .help = "Radiant intensity of the point or spot light; 0 = none. Its power is 4 pi I (point) or 2 pi (1 - cos "
-               "a) I (spot of half angle a).",
+               "a) I (spot of half angle a). Its irradiance I cos(theta) / d^2 takes the distance d in the mesh's units: "
+               "W/m^2 for a mesh in metres, W/mm^2 for one in millimetres (give I 1e6 times larger there for the "
+               "same light in W/m^2); the light of emitting faces, sun and sky does not depend on the unit.",
        .type = ParamType::Float, .def = 0.0, .min = 0.0, .max = 1e12},
       {.name = "point_color", .label = "Point light colour",
        .help = "Colour of the point or spot light (sRGB).",
