@@ -116,10 +116,14 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   // wholly dark, 0 +- 0 (an outside audit); now the ramp's end, as an error
   // beyond single precision is.
   std::vector<size_t> unbounded;
+  // Vertices with no error to map (untraced, not finite, no error bar): 0
+  // written, painted grey. White, the ramp's 0, read as a perfect match
+  // where nothing was compared (an outside audit).
+  std::vector<uint8_t> noData(n, 0);
   for (size_t i = 0; i < n; ++i) {
     const double v = value[i], r = reference[i];
-    if (!isTraced(i)) { ++untraced; continue; }
-    if (!std::isfinite(v) || !std::isfinite(r)) { ++notFinite; continue; }
+    if (!isTraced(i)) { ++untraced; noData[i] = 1; continue; }
+    if (!std::isfinite(v) || !std::isfinite(r)) { ++notFinite; noData[i] = 1; continue; }
     const double d = v - r;
     sumD2 += d * d, sumR2 += r * r, sumD += d, maxAbs = std::max(maxAbs, std::abs(d));
     ++used;
@@ -135,6 +139,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
       const double s = std::sqrt(sr * sr + sv * sv);
       if (!std::isfinite(s) || sr < 0.0 || sv < 0.0) {  // a negative error bar is no error bar: no z, 0 written
         ++noBar;
+        noData[i] = 1;
         continue;
       }
       if (!(s > 0.0)) {
@@ -198,7 +203,7 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
   out.range = R;
   out.color.resize(n);
   for (size_t i = 0; i < n; ++i)
-    out.color[i] = isTraced(i) ? divergingColor(R > 0.0 ? out.error[i] / R : 0.0) : kUntracedColor;
+    out.color[i] = noData[i] ? kNoErrorColor : divergingColor(R > 0.0 ? out.error[i] / R : 0.0);
 
   RunStats& st = out.stats;
   st.add("vertices", double(used));
@@ -234,9 +239,9 @@ ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float
     st.warn("the reference traced none of the vertices compared: no error is measured");
   if (notFinite)
     st.warn(std::to_string(notFinite) + " vertices where the value or the reference is not a finite number: 0 "
-            "written, left out of every statistic");
+            "written in grey, left out of every statistic");
   if (noBar)
-    st.warn(std::to_string(noBar) + " vertices with a negative or non-finite error bar: no z-score, 0 written");
+    st.warn(std::to_string(noBar) + " vertices with a negative or non-finite error bar: no z-score, 0 written in grey");
   return out;
 }
 
@@ -313,8 +318,15 @@ void computeErrorMap(const FilterInput& in, FilterResult& res) {
   // reference), for its own attribute Reference only.
   if (o.source == ReferenceSource::Attribute) {
     if (!o.file.empty()) res.stats.warn("reference_file is not read: the reference comes from an attribute of the mesh");
+    // A reference_file given with the attribute source: the message of a
+    // missing attribute says the file was not read, and how to read it (it
+    // spoke of the attribute only; an outside audit).
+    const std::string fileHint =
+        o.file.empty() ? std::string()
+                       : "; reference_file " + o.file + " is read only with reference_source 'PLY file'";
     r = attributeValues(in.attributes, o.reference, mesh,
-                        o.reference == "Reference" ? ": run 'GI: Path Traced Reference' on this layer first" : "");
+                        (o.reference == "Reference" ? ": run 'GI: Path Traced Reference' on this layer first" : "") +
+                            fileHint);
     if (!o.referenceError.empty() && find(in.attributes, o.referenceError))
       sr = attributeValues(in.attributes, o.referenceError, mesh, "", true);
     from = "attribute " + o.reference;

@@ -183,6 +183,13 @@ TEST(ErrorMap, ReferenceFileAndClearErrors) {
   const std::string noRef = messageOf([&] { errorMapOf(sf, {{kQualityAttribute, 1, ref.vertexQuality}}, {}); });
   EXPECT_NE(noRef.find("'Reference'"), std::string::npos) << noRef;
   EXPECT_NE(noRef.find("GI: Path Traced Reference"), std::string::npos) << noRef;
+  // A reference_file given with the attribute source: the message says the
+  // file was not read and how to read it (it spoke of the attribute only).
+  const std::string fileIgnored = messageOf([&] {
+    errorMapOf(sf, {{kQualityAttribute, 1, ref.vertexQuality}}, {{"reference_file", "ref.ply"}});
+  });
+  EXPECT_NE(fileIgnored.find("reference_file ref.ply is read only with reference_source 'PLY file'"), std::string::npos)
+      << fileIgnored;
   const std::string noSigma = messageOf([&] {
     errorMapOf(sf, leftOnMesh(ref), {{"reference_error", "Nothing"}, {"error_measure", "2"}});
   });
@@ -234,6 +241,8 @@ TEST(ErrorMap, UnusableErrorBarsAreSaid) {
   EXPECT_FLOAT_EQ(typo.vertexQuality[1], 2.f);  // (2 - 1) / 0.5
   const FilterResult negative = errorMapOf(sf, attrs, {{"reference_error", "Bad"}, {"error_measure", "2"}});
   EXPECT_EQ(negative.vertexQuality[0], 0.f);
+  EXPECT_EQ(negative.vertexColor[0].r, kNoErrorColor.r);  // no z-score: grey, not white
+  EXPECT_EQ(negative.vertexColor[0].g, kNoErrorColor.g);
   EXPECT_FLOAT_EQ(negative.vertexQuality[1], 2.f);
   ASSERT_EQ(negative.stats.warnings.size(), 1u);
   EXPECT_NE(negative.stats.warnings[0].find("1 vertices with a negative or non-finite error bar"), std::string::npos)
@@ -322,6 +331,17 @@ TEST(ErrorMap, UnboundedErrorsAreShownNotHidden) {
     EXPECT_EQ(m->stats.warnings[1].rfind("1 vertices where the value or the reference is not a finite", 0), 0u)
         << m->stats.warnings[1];
   }
+  // The vertex that could not be compared (NaN) is grey, not white ("no
+  // error"), in every measure; the one that agrees exactly is white.
+  for (const ErrorMapResult* m : {&z, &r}) {
+    EXPECT_EQ(m->color[4].r, kNoErrorColor.r);
+    EXPECT_EQ(m->color[4].g, kNoErrorColor.g);
+    EXPECT_EQ(m->color[4].b, kNoErrorColor.b);
+    const Rgb8 white = divergingColor(0.0);
+    EXPECT_EQ(m->color[1].r, white.r);
+    EXPECT_EQ(m->color[1].g, white.g);
+    EXPECT_NE(m->color[4].r, white.r);
+  }
   const Rgb8 red = divergingColor(1.0);  // the ramp's end
   EXPECT_EQ(z.color[0].r, red.r);
   EXPECT_EQ(z.color[0].g, red.g);
@@ -365,7 +385,7 @@ TEST(ErrorMap, PartialReferenceComparesTracedVerticesOnly) {
     for (size_t i = 1; i < nv; ++i) {
       ASSERT_EQ(r.vertexQuality[i], 0.f) << measure << " vertex " << i;
       if (traced[i] == 0.f) {
-        ASSERT_EQ(r.vertexColor[i].r, kUntracedColor.r) << measure << " vertex " << i;
+        ASSERT_EQ(r.vertexColor[i].r, kNoErrorColor.r) << measure << " vertex " << i;
       }
     }
     EXPECT_GT(r.vertexQuality[0], 0.f) << measure;

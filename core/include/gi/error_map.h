@@ -66,8 +66,9 @@ struct ErrorMapResult {
 ErrorMapResult errorMap(const std::vector<float>& value, const std::vector<float>& reference,
                         const std::vector<float>& sigmaRef, const std::vector<float>& sigmaValue,
                         ErrorMeasure measure, double colorRange, const std::vector<float>& traced = {});
-// The colour of a vertex the reference did not trace.
-inline constexpr Rgb8 kUntracedColor{128, 128, 128};
+// The colour of a vertex with no error to map: the reference did not trace
+// it, its value or reference is not finite, or its error bar is unusable.
+inline constexpr Rgb8 kNoErrorColor{128, 128, 128};
 
 // The diverging ramp at t in [-1, 1] (clamped): blue, white at 0, red.
 Rgb8 divergingColor(double t);
