@@ -283,10 +283,13 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
       int nL = 1;
       bool wanted = true;
       const Bsdf b = bsdfAt(sp, -st.ray.d);
-      // Where the light samples and the BSDF sample leave.
-      const glm::vec3 o = given ? sp.x + sp.n * eps_ : leaveFrom(st.ray, sp);
+      // Where the light samples and the BSDF sample leave: found once the
+      // path goes on from here (leaveFrom may cast a ray near a corner).
+      glm::vec3 o;
+      const auto leave = [&] { o = given ? sp.x + sp.n * eps_ : leaveFrom(st.ray, sp); };
       if (m == Material::Glossy) {
         if (st.lightOnly) break;
+        leave();
         sampled(st.beta * nextEvent(sp.x, sp.n, b, smp, c, 1, 0.f, &o));
       } else {
         if (emits(sp.face)) found(st.beta * emitted(sp.face, sp.t, cosO, st.delta, st.pdfPrev, st.nLPrev));
@@ -298,6 +301,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
         }
         ++st.diffuseVertices;
         nL = st.diffuseVertices == 1 ? rules_.firstLightSamples : 1;
+        leave();
         glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL, 0.f, &o);
         // A first pass's indirect part is a difference of noisy estimates: keep the sum >= 0.
         if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, b.rho, smp, c), glm::vec3(0.f));
