@@ -3,7 +3,7 @@
 // folder by a file-name pattern. Each result is written next to its own
 // name in the output folder (NAME.ply) with a summary (NAME.json) carrying
 // the hash of everything that decides the result (filter, parameters, the
-// input's name, size and time). A rerun skips every mesh whose PLY and
+// input's name and the hash of its bytes). A rerun skips every mesh whose PLY and
 // summary exist with the same hash, so a batch killed half-way loses
 // nothing it had finished; a mesh that fails is reported and the others go
 // on. `--shard I/N` (or a Slurm job array's task id and count) takes every

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
@@ -116,6 +117,11 @@ std::string hex64(uint64_t h) {
 }
 
 std::string fileDigest(const std::string& path) {
+  // Only a regular file: a pipe's open waits for a writer, and its bytes,
+  // read here, would be gone for the filter (a batch lists a FIFO as a mesh
+  // that fails as such).
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return "";
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";
   uint64_t h = kFnvOffset, size = 0;

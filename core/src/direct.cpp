@@ -16,6 +16,7 @@
 #include "gi/sampling.h"
 #include "gi/sky.h"
 #include "gi/vertex_graph.h"
+#include "hit_origin.h"
 
 namespace gi {
 
@@ -425,11 +426,11 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       // takes the most points light_samples allows.
       const int most = direct.maxPoints(lightSamples), first = std::min(most, std::max(2, direct.points(lightSamples, i)));
       int points = first;
-      const auto& t = s.triangles[i];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
       // Point k on the patch (dimension 0) and its light sample (dimensions 1
       // and 2) from one padded sequence: independent of each other.
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xd3u));
+      const FacePoints onFace(s, uint32_t(i), n, direct.eps(), caster);
       glm::dvec3 sum(0.0);
       if (direct.exact()) sums.F.assign(direct.luminaires(), 0.0), sums.FV.assign(direct.luminaires(), 0.0);
       std::vector<double> before;
@@ -438,8 +439,7 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
       if (direct.exact() && first < most) lit.assign(direct.luminaires(), 0), dark.assign(direct.luminaires(), 0);
       for (int k = 0; k < points; ++k) {
         if (!lit.empty()) before = sums.FV, before.insert(before.end(), sums.F.begin(), sums.F.end());
-        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
-        const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z];
+        const glm::vec3 x = onFace.at(smp(uint32_t(k), 0));
         const LuminaireEstimate est = direct.estimate(x, x + n * direct.eps(), n, smp, uint32_t(k), budget,
                                                       hash3(uint32_t(i), seed ^ uint32_t(k), 0xd5u), uint32_t(i), &sums);
         if (!direct.exact()) sum += glm::dvec3(est.H);  // with luminaires the sums give the patch's value
@@ -576,7 +576,7 @@ std::vector<glm::vec3> finalGather(const Scene& s, const RayCaster& caster, cons
         // not from a table of face normals: on a large mesh that lookup was
         // a cache miss per ray.
         if (!h.valid() || !(glm::dot(ray.d, h.ng) < 0.f)) continue;
-        const glm::vec3 x = value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k)});
+        const glm::vec3 x = value(GatherHit{h.face, ray.o + ray.d * h.t, h.t, uint32_t(v), uint32_t(k), ray.o, ray.d, h.u, h.v});
         sum += glm::dvec3(x);
         if (lum) {
           const double y = luminance(x);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -50,7 +51,7 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
   const EmitterSampler lights(s);
   if (lights.empty() || rays < 1) return std::nullopt;
   const float eps = float(sceneScale(s).rayEpsilon);
-  int front = 0, back = 0, escaped = 0;
+  int front = 0, back = 0, escaped = 0, past = 0;
   Rng rng(0x11e7u);
   for (int k = 0; k < rays; ++k) {
     const EmitterSampler::Sample smp = lights.sample({rng.next(), rng.next()});
@@ -63,8 +64,28 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
     // from the lamp still lit the floor, warned of as lost; an outside audit).
     else if (glm::dot(r.d, h.ng) < 0.f || isSpecular(s.faceMaterial(h.face))) ++front;
     else ++back;
+    // Whether the ray started past a surface closer than the offset (the
+    // light's own face left out): then nothing is turned away.
+    Ray near;
+    near.o = smp.p;
+    near.d = smp.n;
+    near.tnear = 0.01f * eps;
+    near.tfar = eps;
+    past += caster.occluded(near);
   }
   if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;
+  // Plates 1e-5 of the diagonal apart facing each other were told to turn
+  // their faces round (an outside audit).
+  if (2 * past >= rays) {
+    char b[480];
+    std::snprintf(b, sizeof b,
+                  "the lights face no surface they can reach: %d of %d rays cast from their fronts start past a "
+                  "surface closer than the ray offset (%.3g in mesh units), so that surface and the light do not see "
+                  "each other and the light between them is lost (the lights themselves still show); keep surfaces "
+                  "facing a light farther apart than ten offsets, or let them touch (shared vertices)",
+                  past, rays, double(eps) * s.unit);
+    return std::string(b);
+  }
   return "the lights face no surface: of " + std::to_string(rays) + " rays cast from their fronts, " +
          std::to_string(escaped) + " left the scene and " + std::to_string(back) + " met the back of a face (" +
          std::to_string(front) + " a front), so their light is lost: the surfaces they should light stay dark (the "

@@ -10,6 +10,7 @@
 #include "gi/form_factor_analytic.h"
 #include "gi/run.h"
 #include "gi/sampling.h"
+#include "hit_origin.h"
 
 #include <stdexcept>
 #include <string>
@@ -259,8 +260,6 @@ FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   FormFactorRow r;
   const int N = set_.raysPerPatch;
   const uint32_t seed = set_.seed;
-  const auto& t = s_.triangles[i];
-  const glm::vec3 a = s_.positions[t.x], b = s_.positions[t.y], c = s_.positions[t.z];
   const glm::vec3 n = normal_[i];
   const Frame frame(n);
   // Origin (dimension 0) and direction (dimension 1) of ray k from a padded
@@ -268,14 +267,14 @@ FormFactorRow FormFactors::monteCarloRow(uint32_t i) const {
   // nothing about its direction (two streams stepped together did, and the
   // row did not converge to F on large patches).
   const PaddedSobol smp(hash3(i, seed, 0xf1u));
+  const FacePoints points(s_, i, n, eps_, caster_);
   std::vector<uint32_t> hits;
   hits.reserve(size_t(N));
   int lost = 0;
   Ray ray;
   for (int k = 0; k < N; ++k) {
-    // Strictly inside the triangle, then lifted off the plane.
-    const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
-    ray.o = w.x * a + w.y * b + (1.f - w.x - w.y) * c + n * eps_;
+    // Strictly inside the triangle (off an acute edge), then lifted off the plane.
+    ray.o = points.at(smp(uint32_t(k), 0)) + n * eps_;
     ray.d = frame.toWorld(cosineHemisphere(smp(uint32_t(k), 1)));
     ray.tnear = 0.f;
     ray.tfar = std::numeric_limits<float>::infinity();

@@ -10,6 +10,7 @@
 #include "gi/form_factor_analytic.h"
 #include "gi/run.h"
 #include "gi/sampling.h"
+#include "hit_origin.h"
 
 namespace gi::hierarchy {
 
@@ -364,14 +365,12 @@ std::vector<float> rowClosures(const Geometry& g, const RayCaster& caster, int r
     Ray ray;
     for (size_t f = b; f < e; ++f) {
       if (!(g.A[f] > 0)) continue;
-      const glm::uvec3 tri = g.s.triangles[f];
-      const glm::vec3 p0 = g.s.positions[tri.x], p1 = g.s.positions[tri.y], p2 = g.s.positions[tri.z];
       const Frame frame(g.n[f]);
       const PaddedSobol smp(hash3(uint32_t(f), seed, 0xc105u));
+      const FacePoints points(g.s, uint32_t(f), g.n[f], eps, caster);
       int hits = 0;
       for (int k = 0; k < rays; ++k) {
-        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
-        ray.o = w.x * p0 + w.y * p1 + (1.f - w.x - w.y) * p2 + g.n[f] * eps;
+        ray.o = points.at(smp(uint32_t(k), 0)) + g.n[f] * eps;
         ray.d = frame.toWorld(cosineHemisphere(smp(uint32_t(k), 1)));
         ray.tnear = 0.f;
         ray.tfar = std::numeric_limits<float>::infinity();

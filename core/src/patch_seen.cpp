@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "gi/sampling.h"
+#include "hit_origin.h"
 
 namespace gi {
 
@@ -16,9 +17,7 @@ namespace {
 bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::vec3& n, const Frame& frame, float eps,
                  const PaddedSobol& points, uint32_t k, uint32_t seed, uint64_t& rays,
                  std::vector<glm::vec3>* open = nullptr) {
-  const auto& t = s.triangles[i];
-  const glm::vec2 w = strictlyInside(uniformTriangle(points(k, 0)));
-  const glm::vec3 x = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z];
+  const glm::vec3 x = FacePoints(s, uint32_t(i), n, eps, caster).at(points(k, 0));
   Ray ray;
   ray.o = x + n * eps;
   // Directions of their own per point: the point's rays stratify its hemisphere.

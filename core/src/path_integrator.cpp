@@ -48,7 +48,7 @@ bool Bsdf::sample(glm::vec2 u, glm::vec3& wi, glm::vec3& weight, float& pdfOut) 
 Integrator::Integrator(const Scene& s, const RayCaster& c, const LightSettings& lights, const PathRules& rules,
                        const StoredLight* stored)
     : s_(s), caster_(c), L_(lights), rules_(rules), stored_(stored), emitters_(s), faceN_(unitFaceNormals(s)),
-      faceAlt_(faceMinAltitudes(s)), eps_(0.f), farT_(0.f) {
+      faceAlt_(faceAltitudes(s)), eps_(0.f), farT_(0.f) {
   const SceneScale scale = sceneScale(s);
   eps_ = float(scale.rayEpsilon);
   farT_ = float(2.0 * scale.diagonal);
@@ -241,10 +241,11 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
   };
   for (;;) {
     SurfacePoint sp;
-    // A point given by the caller (a primary hit, a vertex) need not lie
-    // along st.ray: its rays leave lifted along its normal (leaveFrom
-    // reads the ray that reached the point).
-    const bool given = first != nullptr;
+    // A point given by the caller apart from st.ray (a vertex) does not
+    // lie along it: its rays leave lifted along its normal (leaveFrom reads
+    // the ray that reached the point). A camera's primary hit, given with
+    // st.firstOnRay, is its ray's own hit and leaves as any hit.
+    const bool given = first != nullptr && !st.firstOnRay;
     if (first) {
       sp = *first;
       first = nullptr;
@@ -296,7 +297,8 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
         if (st.lightOnly) break;
         if (stored_ && stored_->alone()) {
           ++st.diffuseVertices;  // the stored light lies beyond this diffuse vertex
-          sampled(st.beta * stored_->reflected(sp, b.rho, smp, c));
+          // (Read from the stored per-vertex values: it casts no ray.)
+          sampled(st.beta * stored_->reflected(sp, sp.x + sp.n * eps_, b.rho, smp, c));
           break;
         }
         ++st.diffuseVertices;
@@ -304,7 +306,7 @@ glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& sm
         leave();
         glm::vec3 Ld = nextEvent(sp.x, sp.n, b, smp, c, nL, 0.f, &o);
         // A first pass's indirect part is a difference of noisy estimates: keep the sum >= 0.
-        if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, b.rho, smp, c), glm::vec3(0.f));
+        if (stored_) Ld = glm::max(Ld + stored_->reflected(sp, o, b.rho, smp, c), glm::vec3(0.f));
         sampled(st.beta * Ld);  // after ++diffuseVertices: indirect when x0 started the path
         wanted = rules_.interreflection &&
                  (rules_.maxDiffuseBounces < 0 || st.diffuseVertices <= rules_.maxDiffuseBounces);

@@ -142,8 +142,10 @@ class StoredLight {
   // True: the vertex's reflected light is `reflected` alone (no light
   // sampling); false: next-event estimation + `reflected`, clamped at 0.
   virtual bool alone() const = 0;
-  // Radiance reflected at sp (reflectance rho) towards the path.
-  virtual glm::vec3 reflected(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const = 0;
+  // Radiance reflected at sp (reflectance rho) towards the path; rays it
+  // casts leave from `from` (sp off its face: Integrator::leaveFrom).
+  virtual glm::vec3 reflected(const SurfacePoint& sp, const glm::vec3& from, const glm::vec3& rho, Sampler& smp,
+                              Counts& c) const = 0;
 };
 
 // Where a path stands between vertices: its next ray and throughput beta
@@ -151,13 +153,16 @@ class StoredLight {
 // ray came from a mirror, glass or the camera (emitters count fully);
 // pdfPrev, nLPrev: the BSDF sample's density and the light samples taken at
 // its vertex, for the MIS weights of what the ray finds; lightOnly: the ray
-// may only find a light directly (its vertex was the last).
+// may only find a light directly (its vertex was the last); firstOnRay:
+// the first point trace is given is the ray's own hit (a camera's primary
+// ray), so its rays leave as any hit's (leaveFrom), not lifted along the
+// normal as a point given apart from the ray (a vertex).
 struct PathState {
   enum class Kind : uint8_t { Primary, Specular, Glossy, Diffuse };
   Ray ray;
   Kind kind = Kind::Primary;  // what spawned the ray (counted when cast; primary rays by the caller)
   glm::vec3 beta{1.f};
-  bool delta = true, lightOnly = false;
+  bool delta = true, lightOnly = false, firstOnRay = false;
   float pdfPrev = 0.f, nLPrev = 1.f;
   int depth = 0, diffuseVertices = 0;
 };
@@ -238,7 +243,7 @@ class Integrator {
   const StoredLight* stored_;
   EmitterSampler emitters_;
   std::vector<glm::vec3> faceN_;
-  std::vector<float> faceAlt_;  // faceMinAltitudes (hit_origin.h)
+  std::vector<glm::vec3> faceAlt_;  // faceAltitudes (hit_origin.h)
   float eps_;
   // Hits farther than this (twice the diagonal: only rays from outside the
   // scene, a camera's) are put back onto their face's plane (surfaceAt).

@@ -34,6 +34,7 @@
 #include "gi/sampling.h"
 #include "gi/scene_setup.h"
 #include "gi/vertex_graph.h"
+#include "hit_origin.h"
 #include "photon_internal.h"
 #include "photon_map.h"
 #include "photon_surface.h"
@@ -197,7 +198,8 @@ std::vector<glm::vec3> gatherPhotonMap(const PhotonRun& r, const PhotonMap& all,
     count(e.used);
     // max_depth 0: no reflection may be added at y.
     if (opt.maxDepth < 1) return s.faceRho(g.face) * e.H;
-    const glm::vec3 o = g.from;  // on the ray's last leg, eps off the face (hit_origin.h)
+    // Eps off the face, on the ray's last leg near a corner (hit_origin.h).
+    const glm::vec3 o = hitRayOrigin(r.caster, g.legOrigin, g.legDir, g.t, g.normal, r.eps, g.border);
     const glm::vec3 direct = directAt(g.point, o, g.normal, g.key) + pointLightIrradiance(opt.point, r.caster, g.point, o, g.normal) +
                              skySunIrradianceAt(opt.outside, r.caster, o, g.normal, 4, g.key);
     // A far hit: the photons' estimate, but for the direct light, taken at

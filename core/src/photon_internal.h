@@ -62,15 +62,18 @@ constexpr int kFewPhotons = 4;
 void warnMeaninglessPhotonParameters(const PhotonOptions& opt, const PhotonGatherCheck& c, double unit, RunStats& st);
 
 // A final-gather ray's diffuse hit: the face, the point, its unit normal,
-// the length of the ray's last leg, a key of its own (vertex, ray), and
-// where rays leaving the point start (hitRayOrigin, hit_origin.h: on the
-// ray's last leg).
+// the length of the ray's last leg, a key of its own (vertex, ray), that
+// leg's origin and direction and a lower bound of the point's distance to
+// its triangle's border (hitBorder), from which hitRayOrigin (hit_origin.h)
+// finds where rays leaving the point start, where they are cast (near a
+// corner it casts a ray itself).
 struct PhotonGatherHit {
   uint32_t face;
   glm::vec3 point, normal;
   float t;
   uint32_t key;
-  glm::vec3 from;
+  glm::vec3 legOrigin, legDir;
+  float border;
 };
 // Final gather at every vertex through mirrors, glass and glossy faces:
 // cosine-weighted rays from origins[v] follow them (up to 16 interactions;

@@ -309,7 +309,7 @@ std::vector<glm::vec3> specularFinalGather(
     uint32_t key, float eps, const std::function<glm::vec3(const PhotonGatherHit&)>& value,
     const std::vector<uint8_t>* only, const Progress& progress, std::vector<double>* variance) {
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
-  const std::vector<float> faceAlt = faceMinAltitudes(s);
+  const std::vector<glm::vec3> faceAlt = faceAltitudes(s);
   std::vector<glm::vec3> H(s.vertexCount(), glm::vec3(0.f));
   if (variance) variance->assign(s.vertexCount(), 0.0);
   parallelBlocks(s.vertexCount(), progress, "final gather", [&](size_t b, size_t e) {
@@ -335,7 +335,7 @@ std::vector<glm::vec3> specularFinalGather(
           if (m == Material::Diffuse) {
             if (glm::dot(ray.d, ng) < 0.f)
               sum += glm::dvec3(weight * value({h.face, y, ng, h.t, hash3(uint32_t(v), key ^ 0x9e3779b9u, uint32_t(k)),
-                                                hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v))}));
+                                                ray.o, ray.d, hitBorder(faceAlt, h.face, h.u, h.v)}));
             break;
           }
           if (m == Material::Glossy) {
@@ -346,7 +346,7 @@ std::vector<glm::vec3> specularFinalGather(
             const GgxLobe::Sample g = GgxLobe(s.faceRoughness(h.face), s.faceRho(h.face)).sample(fr.toLocal(-ray.d), u);
             if (!g.valid) break;
             weight *= g.weight;
-            ray.o = y + ng * eps;
+            ray.o = hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v));
             ray.d = fr.toWorld(g.wi);
             ray.tnear = 0.f;
             ray.tfar = std::numeric_limits<float>::infinity();
@@ -355,7 +355,10 @@ std::vector<glm::vec3> specularFinalGather(
           const float ior = s.ior.empty() ? 1.5f : s.ior[h.face];
           const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());
           weight *= ev.weight * ev.radianceScale;
-          ray.o = y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+          // A reflection leaves on the side the ray came from (hitRayOrigin), a refraction through the other.
+          ray.o = glm::dot(ev.d, ng) * glm::dot(ray.d, ng) < 0.f
+                      ? hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v))
+                      : y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
           ray.d = ev.d;
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();

@@ -13,25 +13,42 @@
 #include "gi/photon.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
+#include "hit_origin.h"
 #include "photon_internal.h"
 
 namespace gi {
 
 namespace {
 
+// Where a photon's ray, which hit face h.face (unit normal ng) at distance
+// h.t, leaves on the side it came from (hitRayOrigin, hit_origin.h: lifted
+// along the normal, or near an acute corner on the segment it came along,
+// where the lift crossed the neighbouring face and photons left a closed
+// room through its corners).
+struct PhotonLeave {
+  const RayCaster& caster;
+  const std::vector<glm::vec3>& altitudes;
+  float eps;
+  glm::vec3 operator()(const Ray& in, const Hit& h, const glm::vec3& ng) const {
+    return hitRayOrigin(caster, in.o, in.d, h.t, ng, eps, hitBorder(altitudes, h.face, h.u, h.v));
+  }
+};
+
 // A photon meets a mirror or glass face (unit normal ng) at x: its new
 // direction and power, with Russian roulette on the tint (a white mirror or
-// clear glass always passes); the ray starts again on the side it leaves by.
-// False if the photon is absorbed.
-bool specularStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::vec3& x, float eps, Rng& rng, Ray& ray,
-                  glm::vec3& power, size_t& totalInternal) {
+// clear glass always passes); the ray starts again on the side it leaves by
+// (a reflection where leave says). False if the photon is absorbed.
+bool specularStep(const Scene& s, const Hit& h, const glm::vec3& ng, const glm::vec3& x, float eps,
+                  const PhotonLeave& leave, Rng& rng, Ray& ray, glm::vec3& power, size_t& totalInternal) {
+  const uint32_t face = h.face;
   const float ior = s.ior.empty() ? 1.5f : s.ior[face];
   const SpecularEvent ev = scatterSpecular(s.faceMaterial(face), ray.d, ng, s.faceRho(face), ior, rng.next());
   totalInternal += ev.totalInternal;
   const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
   if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return false;
   power *= ev.weight / q;
-  ray.o = x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+  const bool reflected = glm::dot(ev.d, ng) * glm::dot(ray.d, ng) < 0.f;
+  ray.o = reflected ? leave(ray, h, ng) : x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
   ray.d = ev.d;
   ray.tnear = 0.f;
   ray.tfar = std::numeric_limits<float>::infinity();
@@ -46,8 +63,9 @@ bool specularStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm:
 // (a one-sample estimate of the lobe's albedo): survival q = its largest
 // channel, the power divided by q. A direction drawn below the surface is
 // lost (the lobe's G2 < G1 energy loss). False if the photon is absorbed.
-bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::vec3& x, float eps, Rng& rng, Ray& ray,
+bool glossyStep(const Scene& s, const Hit& h, const glm::vec3& ng, const PhotonLeave& leave, Rng& rng, Ray& ray,
                 glm::vec3& power) {
+  const uint32_t face = h.face;
   const GgxLobe lobe(s.faceRoughness(face), s.faceRho(face));
   const Frame frame(ng);
   const glm::vec2 u{rng.next(), rng.next()};
@@ -56,7 +74,7 @@ bool glossyStep(const Scene& s, uint32_t face, const glm::vec3& ng, const glm::v
   const float q = std::min(1.f, std::max({smp.weight.r, smp.weight.g, smp.weight.b}));
   if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return false;
   power *= smp.weight / q;
-  ray.o = x + ng * eps;
+  ray.o = leave(ray, h, ng);
   ray.d = frame.toWorld(smp.wi);
   ray.tnear = 0.f;
   ray.tfar = std::numeric_limits<float>::infinity();
@@ -337,6 +355,8 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
                                 "quality, with emitter_intensity above 0 and an emitter_color that is not black), no "
                                 "point or spot light, no sky and no sun");
   const float eps = float(sceneScale(s).rayEpsilon);
+  const std::vector<glm::vec3> altitudes = faceAltitudes(s);
+  const PhotonLeave leave{caster, altitudes, eps};
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   // Fixed-size blocks, concatenated in order: the result is independent of threads.
   constexpr size_t kBlock = 4096;
@@ -377,7 +397,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           const Material m = s.faceMaterial(h.face);
           const glm::vec3 ng = faceN[h.face];
           if (isSpecular(m)) {
-            if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, st.totalInternal)) break;
+            if (!specularStep(s, h, ng, x, eps, leave, rng, ray, power, st.totalInternal)) break;
             ++st.specularBounces;
             viaSpecular = true;
             continue;
@@ -387,7 +407,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           if (glm::dot(ng, ray.d) > 0.f) break;
           if (m == Material::Glossy) {
             // Not stored (no diffuse light to estimate there); a caustic path's S (gi/specular.h).
-            if (!glossyStep(s, h.face, ng, x, eps, rng, ray, power)) break;
+            if (!glossyStep(s, h, ng, leave, rng, ray, power)) break;
             ++st.glossyBounces;
             viaSpecular = true;
             continue;
@@ -409,7 +429,7 @@ std::vector<Photon> tracePhotons(const Scene& s, const RayCaster& caster, const 
           power *= rho / q;
           ++diffuse;
           ++st.diffuseBounces;
-          ray.o = x + ng * eps;
+          ray.o = leave(ray, h, ng);
           ray.d = Frame(ng).toWorld(cosineHemisphere({rng.next(), rng.next()}));
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();
@@ -547,6 +567,8 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
   const std::vector<SpecularTarget> targets = specularTargets(s);
   if (lights.empty() || targets.empty()) return {};
   const float eps = float(sceneScale(s).rayEpsilon);
+  const std::vector<glm::vec3> altitudes = faceAltitudes(s);
+  const PhotonLeave leave{caster, altitudes, eps};
   const std::vector<glm::vec3> faceN = unitFaceNormals(s);
   constexpr size_t kBlock = 4096;
   const size_t nBlocks = (count + kBlock - 1) / kBlock;
@@ -600,11 +622,11 @@ std::vector<Photon> traceCausticPhotons(const Scene& s, const RayCaster& caster,
             break;
           }
           if (m == Material::Glossy) {
-            if (glm::dot(ng, ray.d) > 0.f || !glossyStep(s, h.face, ng, x, eps, rng, ray, power)) break;
+            if (glm::dot(ng, ray.d) > 0.f || !glossyStep(s, h, ng, leave, rng, ray, power)) break;
             ++glossy[b];
           } else {
             size_t tir = 0;
-            if (!specularStep(s, h.face, ng, x, eps, rng, ray, power, tir)) break;
+            if (!specularStep(s, h, ng, x, eps, leave, rng, ray, power, tir)) break;
             ++specular[b];
           }
           viaSpecular = true;

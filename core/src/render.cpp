@@ -61,10 +61,12 @@ void validate(const RenderOptions& o) {
   if (!o.renderImage && !o.vertexRadiance) throw std::invalid_argument("neither an image nor vertex radiance was asked for");
 }
 
-// One sample of the radiance along `ray`, whose first surface point is sp.
-glm::vec3 sampleRadiance(const Context& ctx, RenderMode mode, const Ray& ray, const SurfacePoint& sp, Sampler& smp,
-                         Counts& c, uint64_t& nonFinite) {
-  const glm::vec3 L = mode == RenderMode::Whitted ? ctx.traceWhitted(ray, &sp, c) : ctx.traceSampled(ray, &sp, smp, c);
+// One sample of the radiance along `ray`, whose first surface point is sp:
+// its hit (onRay: a camera's ray) or a point given apart from it (a vertex).
+glm::vec3 sampleRadiance(const Context& ctx, RenderMode mode, const Ray& ray, const SurfacePoint& sp, bool onRay,
+                         Sampler& smp, Counts& c, uint64_t& nonFinite) {
+  const glm::vec3 L =
+      mode == RenderMode::Whitted ? ctx.traceWhitted(ray, &sp, c, onRay) : ctx.traceSampled(ray, &sp, smp, c, onRay);
   if (finite3(L)) return L;
   ++nonFinite;
   return glm::vec3(0.f);
@@ -192,7 +194,7 @@ void renderImage(const Scene& s, const RayCaster& caster, const RenderOptions& o
           const SurfacePoint sp = ctx.surfaceAt(rays[i], hits[i]);
           if (k == 0 && sp.valid() && ctx.emits(sp.face) && glm::dot(sp.n, rays[i].d) < 0.f)
             res.seesEmitter[size_t(y) * size_t(W) + size_t(x)] = 1;
-          const glm::vec3 L = sampleRadiance(ctx, o.mode, rays[i], sp, smp[i], tl.counts, tl.nonFinite);
+          const glm::vec3 L = sampleRadiance(ctx, o.mode, rays[i], sp, true, smp[i], tl.counts, tl.nonFinite);
           sum[i] += glm::dvec3(L);
           const double l = luminance(L);
           sl[i] += l;
@@ -293,7 +295,7 @@ std::vector<glm::vec3> vertexRadiance(const Scene& s, const RenderOptions& o, co
       double sl = 0, sl2 = 0;
       for (int k = 0; k < spp; ++k) {
         Sampler smp(hash3(uint32_t(v), o.seed, 0x7e47u), uint32_t(k), qmc);
-        const glm::vec3 L = sampleRadiance(ctx, o.mode, ray, sp, smp, local.counts, local.nonFinite);
+        const glm::vec3 L = sampleRadiance(ctx, o.mode, ray, sp, false, smp, local.counts, local.nonFinite);
         sum += glm::dvec3(L);
         const double l = luminance(L);
         sl += l, sl2 += l * l;

@@ -25,19 +25,21 @@ constexpr int kGatherMaxEvents = 16;  // specular and glossy events a gather ray
 constexpr int kNearLevels = 2;        // near gather hits relit by one more ray, levels deep
 }  // namespace
 
-glm::vec3 Context::traceSampled(const Ray& ray, const SurfacePoint* first, Sampler& smp, Counts& c) const {
+glm::vec3 Context::traceSampled(const Ray& ray, const SurfacePoint* first, Sampler& smp, Counts& c, bool onRay) const {
   PathState st;
   st.ray = ray;
+  st.firstOnRay = onRay;
   return trace(st, first, smp, c);
 }
 
 bool Context::alone() const { return o_.twoPass == TwoPassDiffuse::Map; }
 
-glm::vec3 Context::reflected(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const {
+glm::vec3 Context::reflected(const SurfacePoint& sp, const glm::vec3& from, const glm::vec3& rho, Sampler& smp,
+                             Counts& c) const {
   if (o_.twoPass == TwoPassDiffuse::Map) return interpolate(tp_->R, sp) * kInvPi;
   glm::vec3 L(0.f);
   if (o_.twoPass != TwoPassDiffuse::DirectIndirect) L += rho * kInvPi * tp_->caustic(sp.x, sp.n, o_.causticK);
-  if (o_.twoPass == TwoPassDiffuse::FinalGather) L += rho * kInvPi * finalGather(sp, smp, c);
+  if (o_.twoPass == TwoPassDiffuse::FinalGather) L += rho * kInvPi * finalGather(sp, from, smp, c);
   else L += interpolate(tp_->indirect, sp) * kInvPi;
   return L;
 }
@@ -52,11 +54,11 @@ glm::vec3 Context::interpolate(const std::vector<glm::vec3>& perVertex, const Su
 // reaches sp from an emitter with no diffuse bounce between), by cosine-
 // weighted rays that follow mirrors, glass and glossy lobes to the first
 // diffuse face: H = pi mean(L) = mean(R seen), each weighted by its path.
-glm::vec3 Context::finalGather(const SurfacePoint& sp, Sampler& smp, Counts& c) const {
+glm::vec3 Context::finalGather(const SurfacePoint& sp, const glm::vec3& from, Sampler& smp, Counts& c) const {
   glm::dvec3 H(0.0);
   const Frame frame(sp.n);
   for (int g = 0; g < o_.gatherRays; ++g)
-    H += glm::dvec3(gatherRay(spawn(sp.x, sp.n, frame.toWorld(cosineHemisphere(smp.next2D()))), kNearLevels, smp, c));
+    H += glm::dvec3(gatherRay(spawn(from, sp.n, frame.toWorld(cosineHemisphere(smp.next2D())), 0.f), kNearLevels, smp, c));
   return glm::vec3(H / double(o_.gatherRays));
 }
 
@@ -80,7 +82,9 @@ glm::vec3 Context::gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const
       const float ior = s_.ior.empty() ? 1.5f : s_.ior[q.face];
       const SpecularEvent ev = scatterSpecular(m, ray.d, q.n, s_.faceRho(q.face), ior, smp.next1D());
       w *= ev.weight * ev.radianceScale;
-      ray = spawn(q.x, q.n, ev.d);
+      // A reflection leaves on the side the ray came from (leaveFrom), a refraction through the other.
+      const bool reflected = glm::dot(ev.d, q.n) * glm::dot(ray.d, q.n) < 0.f;
+      ray = reflected ? spawn(leaveFrom(ray, q), q.n, ev.d, 0.f) : spawn(q.x, q.n, ev.d);
       continue;
     }
     if (!(glm::dot(q.n, ray.d) < 0.f)) break;
@@ -89,11 +93,11 @@ glm::vec3 Context::gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const
       float pdf;
       if (!bsdfAt(q, -ray.d).sample(smp.next2D(), wi, weight, pdf)) break;
       w *= weight;
-      ray = spawn(q.x, q.n, wi);
+      ray = spawn(leaveFrom(ray, q), q.n, wi, 0.f);
       continue;
     }
     const bool near = k == 0 && !tp_->nearT.empty() && q.t < tp_->nearT[q.face];
-    return w * (near ? nearReflected(q, levels, smp, c) : interpolate(tp_->R, q));
+    return w * (near ? nearReflected(q, leaveFrom(ray, q), levels, smp, c) : interpolate(tp_->R, q));
   }
   return glm::vec3(0.f);
 }
@@ -106,14 +110,15 @@ glm::vec3 Context::gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const
 // past them the first pass's indirect part interpolated (it varies on the
 // scale of the room, but under a block it is the dark of the buried
 // vertices).
-glm::vec3 Context::nearReflected(const SurfacePoint& q, int levels, Sampler& smp, Counts& c) const {
+glm::vec3 Context::nearReflected(const SurfacePoint& q, const glm::vec3& from, int levels, Sampler& smp,
+                                 Counts& c) const {
   ++c.gatherNear;
   const glm::vec3 rho = s_.faceRho(q.face);
-  const glm::vec3 direct = kPi * traceFromSurface(q.x, q.x + q.n * eps(), q.n, smp, c);  // H_direct of a white surface
+  const glm::vec3 direct = kPi * traceFromSurface(q.x, from, q.n, smp, c);  // H_direct of a white surface
   glm::vec3 H = direct + tp_->caustic(q.x, q.n, o_.causticK);
   if (levels > 0) {
     const Frame frame(q.n);
-    H += gatherRay(spawn(q.x, q.n, frame.toWorld(cosineHemisphere(smp.next2D()))), levels - 1, smp, c);
+    H += gatherRay(spawn(from, q.n, frame.toWorld(cosineHemisphere(smp.next2D())), 0.f), levels - 1, smp, c);
     return rho * H;
   }
   return glm::max(rho * H + interpolate(tp_->indirect, q), glm::vec3(0.f));

@@ -71,21 +71,27 @@ class Context : public paths::Integrator, private paths::StoredLight {
   Context(const Scene& s, const RayCaster& c, const RenderOptions& o, const TwoPassData* twoPass);
 
   // Radiance arriving along an eye ray; `first` (optional) is its first
-  // surface point, already found (a batch of primary rays, or a vertex).
-  glm::vec3 traceSampled(const Ray& ray, const SurfacePoint* first, Sampler& smp, Counts& c) const;
-  glm::vec3 traceWhitted(const Ray& ray, const SurfacePoint* first, Counts& c) const;
+  // surface point, already found: the ray's own hit (onRay: a batch of
+  // primary rays), whose rays leave as any hit's (Integrator::leaveFrom),
+  // or a point given apart from it (a vertex), lifted along its normal.
+  glm::vec3 traceSampled(const Ray& ray, const SurfacePoint* first, Sampler& smp, Counts& c, bool onRay) const;
+  glm::vec3 traceWhitted(const Ray& ray, const SurfacePoint* first, Counts& c, bool onRay) const;
   size_t areaLightCount() const { return areaLights_.size(); }
 
  private:
   // The two-pass mode's reflected light at a diffuse hit besides the direct light (paths::StoredLight).
   bool alone() const override;
-  glm::vec3 reflected(const SurfacePoint& sp, const glm::vec3& rho, Sampler& smp, Counts& c) const override;
+  glm::vec3 reflected(const SurfacePoint& sp, const glm::vec3& from, const glm::vec3& rho, Sampler& smp,
+                      Counts& c) const override;
   glm::vec3 interpolate(const std::vector<glm::vec3>& perVertex, const SurfacePoint& sp) const;
-  glm::vec3 finalGather(const SurfacePoint& sp, Sampler& smp, Counts& c) const;
+  // Rays of the gather at sp (and at a near hit q) leave from `from` (Integrator::leaveFrom).
+  glm::vec3 finalGather(const SurfacePoint& sp, const glm::vec3& from, Sampler& smp, Counts& c) const;
   glm::vec3 gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const;  // the R one gather ray sees
-  glm::vec3 nearReflected(const SurfacePoint& q, int levels, Sampler& smp, Counts& c) const;  // a near hit's R
-  // Whitted: direct irradiance at x, exact area-light factors with one shadow ray each.
-  glm::vec3 whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const;
+  glm::vec3 nearReflected(const SurfacePoint& q, const glm::vec3& from, int levels, Sampler& smp,
+                          Counts& c) const;  // a near hit's R
+  // Whitted's direct light at x (unit normal n) from every light, its
+  // shadow rays leaving from `from` (x off the surface on n's side).
+  glm::vec3 whittedIrradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec3& from, Counts& c) const;
   // Whitted: what reaches the end of a shadow ray: 0 past an opaque face,
   // through glass the tint times 1 - F at each interface crossed; a ray
   // aimed at area light `light` that meets the front of one of its faces

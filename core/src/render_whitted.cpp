@@ -79,7 +79,7 @@ bool frontCentroid(const glm::dvec3& x, const glm::dvec3& n, const glm::dvec3 (&
 }
 }  // namespace
 
-glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Counts& c) const {
+glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec3& from, Counts& c) const {
   glm::vec3 H(0.f);
   const glm::dvec3 xd(x), nd(n);
   for (size_t li = 0; li < areaLights_.size(); ++li) {
@@ -122,13 +122,13 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
     const float r = glm::length(w);
     if (!(r > 0.f)) continue;
     w /= r;
-    const Ray ray = shadowRay(x, n, w, glm::vec3(centre), eps(), eps());
+    const Ray ray = shadowRay(from, n, w, glm::vec3(centre), 0.f, eps());
     if (ray.tfar > 0.f) H += glm::vec3(Hl) * whittedTransmittance(ray, c, int(li));
     else H += glm::vec3(Hl);
   }
   if (hasSun_) {
     const float cx = glm::dot(n, o_.sunDirection);
-    if (cx > 0.f) H += o_.sunIrradiance * cx * whittedTransmittance(spawn(x, n, o_.sunDirection), c);
+    if (cx > 0.f) H += o_.sunIrradiance * cx * whittedTransmittance(spawn(from, n, o_.sunDirection, 0.f), c);
   }
   if (hasPoint_) {
     glm::vec3 w = o_.point.position - x;
@@ -138,7 +138,7 @@ glm::vec3 Context::whittedIrradiance(const glm::vec3& x, const glm::vec3& n, Cou
       w /= r;
       const float cx = glm::dot(n, w);
       if (cx > 0.f && spot_.contains(-w)) {
-        const Ray ray = shadowRay(x, n, w, o_.point.position, eps(), 0.f);
+        const Ray ray = shadowRay(from, n, w, o_.point.position, 0.f, 0.f);
         H += o_.point.intensity * (cx / r2) * whittedTransmittance(ray, c);
       }
     }
@@ -168,7 +168,7 @@ glm::vec3 Context::whittedTransmittance(Ray ray, Counts& c, int light) const {
   }
 }
 
-glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, Counts& c) const {
+glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, Counts& c, bool onRay) const {
   thread_local std::vector<Branch> stack;
   stack.clear();
   stack.push_back({primary, glm::vec3(1.f), 1.f, 0});
@@ -186,6 +186,12 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
     const Branch br = stack.back();
     stack.pop_back();
     SurfacePoint sp;
+    // A point given apart from the ray (a vertex) leaves lifted along its
+    // normal; a hit of the ray (a camera's too) as the path integrator's
+    // (leaveFrom: off the free segment it came along near a corner, where
+    // the lift crossed the neighbouring face and mirrors showed the sky
+    // outside a closed tetrahedron).
+    const bool given = first != nullptr && !onRay;
     if (first) {
       sp = *first;
       first = nullptr;
@@ -193,6 +199,8 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
       sp = surfaceAt(br.ray, caster_.intersect(br.ray));
     }
     const glm::vec3 d = br.ray.d;
+    // Where rays leaving sp on the side br.ray came from start.
+    const auto leave = [&] { return given ? sp.x + (glm::dot(d, sp.n) < 0.f ? sp.n : -sp.n) * eps_ : leaveFrom(br.ray, sp); };
     if (!sp.valid()) {
       L += br.w * br.scale * escaped(d, true, 0.f, 1.f);
       continue;
@@ -204,7 +212,7 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
     }
     const glm::vec3 tint = s_.faceRho(sp.face);
     if (m == Material::Mirror) {
-      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, sp.n))), br.w * tint, br.scale, br.depth + 1);
+      push(spawn(leave(), sp.n, glm::normalize(reflectDir(d, sp.n)), 0.f), br.w * tint, br.scale, br.depth + 1);
       continue;
     }
     if (m == Material::Glass) {
@@ -214,7 +222,7 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
       const float eta = entering ? 1.f / ior : ior;
       const float cosI = std::min(1.f, -glm::dot(d, nf));
       const float F = fresnelDielectric(cosI, eta);  // 1 beyond the critical angle
-      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, nf))), br.w * tint * F, br.scale, br.depth + 1);
+      push(spawn(leave(), sp.n, glm::normalize(reflectDir(d, nf)), 0.f), br.w * tint * F, br.scale, br.depth + 1);
       if (F < 1.f) {
         const float sin2T = eta * eta * std::max(0.f, 1.f - cosI * cosI);
         const float cosT = std::sqrt(std::max(0.f, 1.f - sin2T));
@@ -227,13 +235,14 @@ glm::vec3 Context::traceWhitted(const Ray& primary, const SurfacePoint* first, C
     if (!(cosO > 0.f)) continue;  // seen from behind: black
     if (m == Material::Glossy) {
       const GgxLobe lobe(s_.faceRoughness(sp.face), tint);
-      push(spawn(sp.x, sp.n, glm::normalize(reflectDir(d, sp.n))), br.w * lobe.fresnel(cosO), br.scale, br.depth + 1);
+      push(spawn(leave(), sp.n, glm::normalize(reflectDir(d, sp.n)), 0.f), br.w * lobe.fresnel(cosO), br.scale,
+           br.depth + 1);
       continue;
     }
     const glm::vec3 w = br.w * br.scale;
     L += w * s_.faceEmission(sp.face) * kInvPi;
     const glm::vec3 rho = s_.faceRho(sp.face);
-    if (rho.r > 0.f || rho.g > 0.f || rho.b > 0.f) L += w * rho * kInvPi * whittedIrradiance(sp.x, sp.n, c);
+    if (rho.r > 0.f || rho.g > 0.f || rho.b > 0.f) L += w * rho * kInvPi * whittedIrradiance(sp.x, sp.n, leave(), c);
   }
   return L;
 }

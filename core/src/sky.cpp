@@ -7,6 +7,7 @@
 #include "gi/color.h"
 #include "gi/direct.h"
 #include "gi/sampling.h"
+#include "hit_origin.h"
 
 namespace gi {
 
@@ -124,16 +125,14 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
   parallelBlocks(s.faceCount(), openings ? progress.sub(0.5, 1.0) : progress, "sky and sun", [&](size_t b, size_t e) {
     for (size_t f = b; f < e; ++f) {
       if (!ok[f]) continue;
-      const auto& t = s.triangles[f];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
       const Frame frame(n);
       // Point k on the patch (dimension 0), its sky and sun directions (1, 2).
       const PaddedSobol smp(hash3(uint32_t(f), seed, 0x5c3u));
+      const FacePoints points(s, uint32_t(f), n, eps, caster);
       glm::dvec3 sum(0.0);
       for (int k = 0; k < rays; ++k) {
-        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
-        const glm::vec3 x =
-            w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
+        const glm::vec3 x = points.at(smp(uint32_t(k), 0)) + n * eps;
         sum += glm::dvec3(skySunSample(o, caster, x, frame, n, sunFrame, sunCos, sunScale, smp, uint32_t(k), 1, openings));
       }
       H[f] += glm::vec3(sum / double(rays));

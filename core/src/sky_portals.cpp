@@ -23,6 +23,7 @@
 #include "gi/luminaires.h"
 #include "gi/sampling.h"
 #include "gi/sky.h"
+#include "hit_origin.h"
 
 namespace gi {
 
@@ -271,14 +272,13 @@ void probe(const Scene& s, const std::vector<uint8_t>& ok, const RayCaster& cast
     uint64_t r = 0, esc = 0, rs = 0;
     for (size_t i = b; i < e; ++i) {
       const uint32_t f = faces[i * stride];
-      const auto& t = s.triangles[f];
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
       const PaddedSobol smp(hash3(f, seed, 0x90b1u));
       const Frame frame(n);
+      const FacePoints points(s, f, n, eps, caster);
       for (int k = 0; k < SkyOpenings::kProbeRays; ++k) {
-        const glm::vec2 w = strictlyInside(uniformTriangle(smp(uint32_t(k), 0)));
         Ray ray;
-        ray.o = w.x * s.positions[t.x] + w.y * s.positions[t.y] + (1.f - w.x - w.y) * s.positions[t.z] + n * eps;
+        ray.o = points.at(smp(uint32_t(k), 0)) + n * eps;
         ray.d = frame.toWorld(cosineHemisphere(smp(uint32_t(k), 1)));
         ++r;
         if (caster.occluded(ray)) continue;

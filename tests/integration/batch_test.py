@@ -127,6 +127,31 @@ def case_basic(a, tmp):
           "a truncated result is baked again, the others not (%s)" % {k: rep[k] for k in ("baked", "done_before")})
     check(os.path.getsize(victim) > 1000, "the truncated result was rewritten whole")
 
+    # An input edited in place, its size and time kept (a tool that restores
+    # times, a copy with -p): its result is not done (compared by size and
+    # time, it was; an outside audit).
+    edited = os.path.join(meshes, names[0] + ".ply")
+    st = os.stat(edited)
+    with open(edited, "r+b") as f:
+        data = f.read()
+        at = data.index(b"end_header\n") + len(b"end_header\n")
+        if b"format ascii" in data[:at]:
+            while not data[at:at + 1].isdigit():
+                at += 1
+            f.seek(at)
+            f.write(b"1" if data[at:at + 1] != b"1" else b"2")
+        else:  # the lowest byte of the first coordinate: a nudge
+            at += 3 if b"binary_big_endian" in data[:at] else 0
+            f.seek(at)
+            f.write(bytes([data[at] ^ 1]))
+    os.utime(edited, ns=(st.st_atime_ns, st.st_mtime_ns))
+    check(os.path.getsize(edited) == st.st_size and os.stat(edited).st_mtime_ns == st.st_mtime_ns,
+          "the edited input keeps its size and time")
+    rep = json.loads(run(cmd).stdout)
+    check(rep["baked"] == 1 and rep["done_before"] == len(names) - 1,
+          "an input edited in place, size and time kept, is baked again, the others not (%s)" %
+          {k: rep[k] for k in ("baked", "done_before")})
+
     # A result's new layer (photon mapping's photons beside it) is in the digest too.
     lit = os.path.join(tmp, "lit_meshes")
     copy_meshes(a.meshes, lit, ["cornell_box"])
@@ -266,6 +291,21 @@ def case_inputs(a, tmp):
         f.write(os.path.join(meshes, "bowl.ply") + "\n" + os.path.join(a.meshes, "bowl.ply") + "\n")
     one_line(["ao", "--manifest", bad, "-o", out], "bowl.ply", "two meshes of one name")
     one_line(["ao", "-o", out], "--manifest", "neither manifest nor folder")
+    # A mesh whose summary would take a report's name, whatever the shard
+    # count: refused with one shard too (only the count that made the same
+    # name clashed; an outside audit).
+    for stem in ("report-0-of-2", "report-only-1-of-3", "report"):
+        with open(bad, "w") as f:
+            f.write(os.path.join(a.meshes, "bowl.ply") + "\n" + os.path.join(tmp, stem + ".ply") + "\n")
+        shutil.copy(os.path.join(a.meshes, "bowl.ply"), os.path.join(tmp, stem + ".ply"))
+        one_line(["ao", "--manifest", bad, "-o", out], stem + ".json", "a mesh named %s.ply" % stem)
+    shutil.copy(os.path.join(a.meshes, "bowl.ply"), os.path.join(tmp, "report-0-of-2x.ply"))
+    with open(bad, "w") as f:
+        f.write(os.path.join(tmp, "report-0-of-2x.ply") + "\n")
+    p = run([a.gi, "batch", "ao", "--manifest", bad, "-o", os.path.join(tmp, "report_like_out"), "--rays_per_vertex",
+             "8", "--json"])
+    check(p.returncode == 0 and json.loads(p.stdout)["baked"] == 1, "a name only like a report's is baked (%s)" %
+          p.stderr.strip())
     one_line(["ao", "--dir", meshes, "-o", out, "--shard", "3/3"], "--shard", "a shard outside 0..N-1")
     one_line(["render", "--dir", meshes, "-o", out, "--image_path", os.path.join(tmp, "v.png")], "image_path",
              "a filter that writes an image at one path")
@@ -445,14 +485,18 @@ def case_keep(a, tmp):
     p = run([a.gi, "batch", "radiosity", "--dir", meshes, "-o", os.path.join(tmp, "keep_csv"), "--residual_csv", "r.csv"])
     check(p.returncode == 1 and p.stderr.count("\n") == 1 and "residual_csv" in p.stderr,
           "residual_csv in a batch: one line (%s)" % p.stderr.strip())
-    # --report-only writes report.json: not over the summary of a mesh named report.
+    # --report-only writes report.json: a mesh named report, whose summary
+    # would be report.json, is refused by the baking run and by
+    # --report-only alike (the baking run took it until 7 December 2026),
+    # in one line, before anything is written.
     shutil.copy(os.path.join(meshes, names[1] + ".ply"), os.path.join(meshes, "report.ply"))
-    run(cmd, expect=0)
     summary = os.path.join(out, "report.json")
-    before = load(summary)
-    p = run([a.gi, "batch", "ao", "--dir", meshes, "-o", out, "--rays_per_vertex", "8", "--report-only"])
-    check(p.returncode == 1 and load(summary) == before and "report.json" in p.stderr,
-          "--report-only beside a mesh named report: refused, its summary kept (%s)" % p.stderr.strip())
+    for extra in ([], ["--report-only"]):
+        p = run(cmd + extra)
+        check(p.returncode == 1 and p.stderr.count("\n") == 1 and "report.json" in p.stderr and
+              not os.path.exists(summary), "a mesh named report%s: refused in one line, nothing written (%s)" %
+              (" with --report-only" if extra else "", p.stderr.strip()))
+    os.remove(os.path.join(meshes, "report.ply"))
 
 
 CASES = {"basic": case_basic, "kill": case_kill, "shards": case_shards, "inputs": case_inputs, "keep": case_keep}

@@ -22,6 +22,7 @@
 #include "gi/scenes.h"
 #include "filter_input.h"
 #include "mesh_io.h"
+#include "render_test_helpers.h"
 
 using namespace gi;
 
@@ -651,6 +652,31 @@ TEST(LightWarnings, LightsFacingNoSurface) {
   const auto w = emitterOrientationWarning(inverted, *caster, false);
   ASSERT_TRUE(w.has_value());
   EXPECT_NE(w->find("(0 a front)"), std::string::npos) << *w;
+}
+
+// Two emitting unit plates facing each other (8 x 8 cells each): 0.01
+// apart they light each other and nothing is said; 1e-6 apart, below the
+// ray offset (1e-5 of the diagonal), every light ray starts past the other
+// plate and leaves the scene. The warning says why, not that the faces
+// are turned the wrong way (it told the user to invert them; an outside
+// audit).
+TEST(LightWarnings, LightsBehindASurfaceCloserThanTheOffset) {
+  for (const double gap : {0.01, 1e-6}) {
+    test::SceneBuilder b;
+    b.quad({0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, glm::vec3(0.5f), glm::vec3(1.f), Material::Diffuse, 8);
+    b.quad({0, 0, gap}, {0, 1, gap}, {1, 1, gap}, {1, 0, gap}, glm::vec3(0.5f), glm::vec3(1.f), Material::Diffuse, 8);
+    const Scene s = b.build();
+    auto caster = makeEmbreeCaster(s);
+    const auto w = emitterOrientationWarning(s, *caster, false);
+    if (gap > 1e-3) {
+      EXPECT_FALSE(w.has_value()) << *w;
+      continue;
+    }
+    ASSERT_TRUE(w.has_value()) << "gap " << gap;
+    EXPECT_NE(w->find("closer than the ray offset"), std::string::npos) << *w;
+    EXPECT_NE(w->find("1024 of 1024 rays"), std::string::npos) << *w;
+    EXPECT_EQ(w->find("Invert Faces"), std::string::npos) << *w;
+  }
 }
 
 // Where other lights light the scene, emitters facing open space may be

@@ -120,14 +120,18 @@ std::vector<glm::vec3> vertexDirectIrradiance(const Scene& s, const RayCaster& c
                                               const SkyOpenings* portals = nullptr,
                                               std::vector<float>* stdError = nullptr);
 
-// One gather ray's hit: the face, the point and its distance, and which
-// vertex cast it as its how-manyth ray (so that what the hit samples in
-// turn can be stratified with the vertex's other rays).
+// One gather ray's hit on a face's front: the face, the point and its
+// distance, which vertex cast it as its how-manyth ray (so that what the
+// hit samples in turn can be stratified with the vertex's other rays), and
+// the ray (origin, unit direction) and the hit's barycentrics (where rays
+// leaving the hit start: hit_origin.h).
 struct GatherHit {
   uint32_t face;
   glm::vec3 point;
   float t;
   uint32_t vertex, ray;
+  glm::vec3 origin, dir;
+  float u, v;
 };
 
 // Final gather at every vertex: the mean over `rays` cosine-weighted rays of
