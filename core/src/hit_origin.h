@@ -122,6 +122,9 @@ class FacePoints {
     glm::vec3 y = x;
     for (int i = 0; i < 3; ++i)
       if (d[i] < gap_) y += off_[i] * (gap_ - d[i]);
+    // Kept on the face (a face narrower than the pushes: as sampled).
+    for (int i = 0; i < 3; ++i)
+      if (glm::dot(y - p_[(i + 1) % 3], off_[i]) < 0.f) return x;
     return liftCrosses(y) ? x : y;
   }
 
