@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "gi/color.h"
 #include "gi/luminaires.h"
 #include "gi/raycaster.h"
 #include "gi/sampling.h"
 #include "gi/specular.h"
+#include "hit_origin.h"
 
 namespace gi {
 
@@ -51,10 +53,13 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
   const EmitterSampler lights(s);
   if (lights.empty() || rays < 1) return std::nullopt;
   const float eps = float(sceneScale(s).rayEpsilon);
-  int front = 0, back = 0, escaped = 0, past = 0;
+  int front = 0, back = 0, escaped = 0;
+  std::vector<EmitterSampler::Sample> points;  // for the probe below, where a warning follows
+  points.reserve(size_t(rays));
   Rng rng(0x11e7u);
   for (int k = 0; k < rays; ++k) {
     const EmitterSampler::Sample smp = lights.sample({rng.next(), rng.next()});
+    points.push_back(smp);
     Ray r;
     r.o = smp.p + smp.n * eps;
     r.d = Frame(smp.n).toWorld(cosineHemisphere({rng.next(), rng.next()}));
@@ -64,16 +69,12 @@ std::optional<std::string> emitterOrientationWarning(const Scene& s, const RayCa
     // from the lamp still lit the floor, warned of as lost; an outside audit).
     else if (glm::dot(r.d, h.ng) < 0.f || isSpecular(s.faceMaterial(h.face))) ++front;
     else ++back;
-    // Whether the ray started past a surface closer than the offset (the
-    // light's own face left out): then nothing is turned away.
-    Ray near;
-    near.o = smp.p;
-    near.d = smp.n;
-    near.tnear = 0.01f * eps;
-    near.tfar = eps;
-    past += caster.occluded(near);
   }
   if (100 * front >= rays || (otherLights && 2 * back < rays)) return std::nullopt;
+  // How many rays started past a surface closer than the offset (the
+  // light's own face left out): then nothing is turned away.
+  int past = 0;
+  for (const EmitterSampler::Sample& smp : points) past += surfaceWithinOffset(caster, smp.p, smp.n, eps);
   // Plates 1e-5 of the diagonal apart facing each other were told to turn
   // their faces round (an outside audit).
   if (2 * past >= rays) {

@@ -69,6 +69,32 @@ inline glm::vec3 hitRayOrigin(const RayCaster& caster, const glm::vec3& o, const
   return caster.occluded(r) ? q : lifted;
 }
 
+// Where a ray that arrived along `in` and was turned by a mirror or glass
+// at the hit y (unit normal n) into `out` leaves: a reflection (out on the
+// side the ray came from) from back(), the hit's ray origin (hitRayOrigin,
+// through the caller's own access to the hit); a refraction, through the
+// face, from y lifted by eps to out's side. Shared by the eye views, the
+// reference and photon mapping's paths and gathers.
+template <class Back>
+glm::vec3 specularOrigin(const glm::vec3& in, const glm::vec3& out, const glm::vec3& y, const glm::vec3& n, float eps,
+                         const Back& back) {
+  if (glm::dot(out, n) * glm::dot(in, n) < 0.f) return back();
+  return y + (glm::dot(out, n) > 0.f ? n : -n) * eps;
+}
+
+// Whether a surface lies within eps of the point x of a face along the
+// unit direction d, x's own face left out (the ray starts 0.01 eps off):
+// a lift along d would start past it. FacePoints' check, and the light
+// probe's (emitters.cpp) for plates closer than the offset.
+inline bool surfaceWithinOffset(const RayCaster& caster, const glm::vec3& x, const glm::vec3& d, float eps) {
+  Ray r;
+  r.o = x;
+  r.d = d;
+  r.tnear = 0.01f * eps;
+  r.tfar = eps;
+  return caster.occluded(r);
+}
+
 // The distance to its triangle's border of the hit at barycentrics (u, v)
 // (the hit (1 - u - v) t.x + u t.y + v t.z, as Embree reports it).
 inline float hitBorder(const std::vector<glm::vec3>& altitudes, uint32_t face, float u, float v) {
@@ -129,14 +155,7 @@ class FacePoints {
   }
 
  private:
-  bool liftCrosses(const glm::vec3& x) const {
-    Ray r;
-    r.o = x;
-    r.d = n_;
-    r.tnear = 0.01f * eps_;  // past the face itself
-    r.tfar = eps_;
-    return caster_.occluded(r);
-  }
+  bool liftCrosses(const glm::vec3& x) const { return surfaceWithinOffset(caster_, x, n_, eps_); }
   glm::vec3 p_[3], off_[3], n_;
   float h_[3], gap_, eps_;
   const RayCaster& caster_;

@@ -14,10 +14,10 @@ namespace {
 // cosine-weighted rays meets the front of another face or leaves the scene
 // (the first that does proves it open). `rays` counts those cast; an open
 // point is added to `open` (on the face) when given.
-bool pointBuried(const Scene& s, const RayCaster& caster, size_t i, const glm::vec3& n, const Frame& frame, float eps,
-                 const PaddedSobol& points, uint32_t k, uint32_t seed, uint64_t& rays,
+bool pointBuried(const FacePoints& on, const RayCaster& caster, size_t i, const glm::vec3& n, const Frame& frame,
+                 float eps, const PaddedSobol& points, uint32_t k, uint32_t seed, uint64_t& rays,
                  std::vector<glm::vec3>* open = nullptr) {
-  const glm::vec3 x = FacePoints(s, uint32_t(i), n, eps, caster).at(points(k, 0));
+  const glm::vec3 x = on.at(points(k, 0));
   Ray ray;
   ray.o = x + n * eps;
   // Directions of their own per point: the point's rays stratify its hemisphere.
@@ -55,12 +55,13 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
       const glm::vec3 nrm = glm::normalize(faceNormalUnnormalized(s, i));
       const Frame frame(nrm);
       const PaddedSobol points(hash3(uint32_t(i), seed, 0x5e3cu));
+      const FacePoints on(s, uint32_t(i), nrm, eps, caster);
       // The first points of the sequence screen the patch; where one is
       // buried the estimate takes kPoints (the screen's among them).
       int buried = 0;
       std::vector<glm::vec3> open;
       for (uint32_t k = 0; k < uint32_t(PatchSeen::kScreenPoints); ++k)
-        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r, &open);
+        buried += pointBuried(on, caster, i, nrm, frame, eps, points, k, seed, r, &open);
       if (buried == 0) continue;
       // Every screening point buried: the patch is taken as wholly buried
       // (a seen part under 1/16 of it goes with it), which spares a large
@@ -71,7 +72,7 @@ PatchSeen patchSeenFractions(const Scene& s, const RayCaster& caster, uint32_t s
         continue;
       }
       for (uint32_t k = PatchSeen::kScreenPoints; k < uint32_t(PatchSeen::kPoints); ++k)
-        buried += pointBuried(s, caster, i, nrm, frame, eps, points, k, seed, r, &open);
+        buried += pointBuried(on, caster, i, nrm, frame, eps, points, k, seed, r, &open);
       out.fraction[i] = float(1.0 - double(buried) / PatchSeen::kPoints);
       if (out.fraction[i] > 0.f) out.seenPoints[i] = std::move(open);
     }

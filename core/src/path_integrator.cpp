@@ -215,9 +215,12 @@ void Integrator::specularStep(const SurfacePoint& sp, PathState& st, Sampler& sm
   st.beta *= ev.weight * ev.radianceScale;
   st.delta = true;
   st.kind = PathState::Kind::Specular;
-  // A reflection leaves on the side the ray came from (leaveFrom), a refraction through the other.
-  const bool reflected = !given && glm::dot(ev.d, sp.n) * glm::dot(st.ray.d, sp.n) < 0.f;
-  st.ray = reflected ? spawn(leaveFrom(st.ray, sp), sp.n, ev.d, 0.f) : spawn(sp.x, sp.n, ev.d);
+  // A reflection leaves on the side the ray came from (leaveFrom), a
+  // refraction through the other (specularOrigin); a point given apart from
+  // a ray, lifted.
+  st.ray = given ? spawn(sp.x, sp.n, ev.d)
+                 : spawn(specularOrigin(st.ray.d, ev.d, sp.x, sp.n, eps_, [&] { return leaveFrom(st.ray, sp); }),
+                         sp.n, ev.d, 0.f);
 }
 
 glm::vec3 Integrator::trace(PathState st, const SurfacePoint* first, Sampler& smp, Counts& c,

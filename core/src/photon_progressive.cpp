@@ -356,9 +356,9 @@ std::vector<glm::vec3> specularFinalGather(
           const SpecularEvent ev = scatterSpecular(m, ray.d, ng, s.faceRho(h.face), ior, rng.next());
           weight *= ev.weight * ev.radianceScale;
           // A reflection leaves on the side the ray came from (hitRayOrigin), a refraction through the other.
-          ray.o = glm::dot(ev.d, ng) * glm::dot(ray.d, ng) < 0.f
-                      ? hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v))
-                      : y + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+          ray.o = specularOrigin(ray.d, ev.d, y, ng, eps, [&] {
+            return hitRayOrigin(caster, ray.o, ray.d, h.t, ng, eps, hitBorder(faceAlt, h.face, h.u, h.v));
+          });
           ray.d = ev.d;
           ray.tnear = 0.f;
           ray.tfar = std::numeric_limits<float>::infinity();

@@ -47,8 +47,7 @@ bool specularStep(const Scene& s, const Hit& h, const glm::vec3& ng, const glm::
   const float q = std::min(1.f, std::max({ev.weight.r, ev.weight.g, ev.weight.b}));
   if (!(q > 0.f) || (q < 1.f && rng.next() >= q)) return false;
   power *= ev.weight / q;
-  const bool reflected = glm::dot(ev.d, ng) * glm::dot(ray.d, ng) < 0.f;
-  ray.o = reflected ? leave(ray, h, ng) : x + (glm::dot(ev.d, ng) > 0.f ? ng : -ng) * eps;
+  ray.o = specularOrigin(ray.d, ev.d, x, ng, eps, [&] { return leave(ray, h, ng); });
   ray.d = ev.d;
   ray.tnear = 0.f;
   ray.tfar = std::numeric_limits<float>::infinity();

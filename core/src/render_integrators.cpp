@@ -14,6 +14,7 @@
 
 #include "gi/color.h"
 #include "gi/specular.h"
+#include "hit_origin.h"
 #include "render_internal.h"
 
 namespace gi::eye {
@@ -83,8 +84,7 @@ glm::vec3 Context::gatherRay(Ray ray, int levels, Sampler& smp, Counts& c) const
       const SpecularEvent ev = scatterSpecular(m, ray.d, q.n, s_.faceRho(q.face), ior, smp.next1D());
       w *= ev.weight * ev.radianceScale;
       // A reflection leaves on the side the ray came from (leaveFrom), a refraction through the other.
-      const bool reflected = glm::dot(ev.d, q.n) * glm::dot(ray.d, q.n) < 0.f;
-      ray = reflected ? spawn(leaveFrom(ray, q), q.n, ev.d, 0.f) : spawn(q.x, q.n, ev.d);
+      ray = spawn(specularOrigin(ray.d, ev.d, q.x, q.n, eps(), [&] { return leaveFrom(ray, q); }), q.n, ev.d, 0.f);
       continue;
     }
     if (!(glm::dot(q.n, ray.d) < 0.f)) break;
