@@ -81,9 +81,9 @@ std::vector<ParamSpec> RefineOptions::specs() {
        .type = ParamType::Float, .def = 0.1, .min = 1e-4, .max = 100.0},
       {.name = "refine_shadow_threshold", .label = "Refinement: shadow boundary",
        .help = "Split a patch when the fraction of the lights visible from its vertices (64 shadow rays each) "
-               "differs by more than this between two of its vertices: a shadow boundary crosses it. The lights "
-               "here are the emitting faces; the sun's and the sky's shadows are found by the B jump test only "
-               "(refine_threshold). 1 turns this test off.",
+               "differs by more than this between two of its vertices: a shadow boundary crosses it. Each light "
+               "apart: the emitting faces (shadow rays to points on them) and the sun (rays in its disk); the "
+               "sky's soft shadows are found by the B jump test (refine_threshold). 1 turns this test off.",
        .type = ParamType::Float, .def = 0.3, .min = 0.0, .max = 1.0},
   };
 }
@@ -125,8 +125,11 @@ AdaptiveRadiosity solveRadiosityAdaptive(const Scene& s, const RadiosityOptions&
     levelOpt.memoryBudgetMB = std::max(1.0, opt.memoryBudgetMB - double(sc.faceCount()) * kRefinerBytesPerPatch / MB);
     res = solveRadiosity(sc, *rc, levelOpt, stage(k));
     changed = false;
-    const std::vector<float> V =
-        ro.shadowThreshold < 1.0 ? emitterVisibility(sc, *rc, ro.visibilityRays, ro.seed) : std::vector<float>();
+    std::vector<std::vector<float>> V;
+    if (ro.shadowThreshold < 1.0) {
+      V.push_back(emitterVisibility(sc, *rc, ro.visibilityRays, ro.seed));
+      V.push_back(sunVisibility(sc, *rc, levelOpt.outside, ro.visibilityRays, ro.seed));
+    }
     RefineMarks marks = markForRefinement(sc, res.B, res.Bvertex, V, refiner.mesh().depth, ro);
     const size_t n = sc.faceCount(), budget = size_t(ro.maxPatches);
     if (marks.faces.empty()) {

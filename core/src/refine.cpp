@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -340,8 +341,37 @@ std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, in
   return V;
 }
 
+std::vector<float> sunVisibility(const Scene& s, const RayCaster& caster, const SkySun& o, int rays, uint32_t seed) {
+  const size_t nv = s.vertexCount();
+  std::vector<float> V(nv, -1.f);
+  if (!o.sun() || rays < 1) return V;
+  const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos();
+  const Frame sunFrame(o.sunDirection);
+  const std::vector<glm::vec3> normals = vertexNormalsForRays(s);
+  const std::vector<glm::vec3> origins = vertexRayOrigins(s, normals, eps);
+  parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      if (!(glm::dot(normals[i], normals[i]) > 0.5f)) continue;
+      SobolOwenStream seq(hash3(uint32_t(i), seed, 0x5a7u));
+      int facing = 0, seen = 0;
+      Ray r;
+      r.o = origins[i];
+      for (int j = 0; j < rays; ++j) {
+        r.d = sunFrame.toWorld(uniformCone(seq.next(), sunCos));
+        if (!(glm::dot(r.d, normals[i]) > 0.f)) continue;  // below the tangent plane
+        ++facing;
+        r.tnear = 0.f;
+        r.tfar = std::numeric_limits<float>::infinity();
+        seen += caster.occluded(r) ? 0 : 1;
+      }
+      if (facing > 0) V[i] = float(seen) / float(facing);
+    }
+  });
+  return V;
+}
+
 RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<glm::vec3>& Bvertex,
-                              const std::vector<float>& visibility, const std::vector<uint8_t>& depth,
+                              const std::vector<std::vector<float>>& visibility, const std::vector<uint8_t>& depth,
                               const RefineOptions& opt) {
   const size_t n = s.faceCount();
   const auto ok = usableFaceMask(s);
@@ -386,17 +416,20 @@ RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, c
       jump[f] = std::max(jump[f], std::fabs(R[f] - corners) / std::max({R[f], corners, floorR, 1e-30}));
     }
   }
-  if (visibility.size() == s.vertexCount()) {
+  // Each light apart: one vertex seeing the emitters and another the sun
+  // is no shadow boundary.
+  for (const std::vector<float>& light : visibility) {
+    if (light.size() != s.vertexCount()) continue;
     for (size_t f = 0; f < n; ++f) {
       if (!ok[f]) continue;
       float lo = 2.f, hi = -2.f;
       for (int k = 0; k < 3; ++k) {
-        const float v = visibility[s.triangles[f][k]];
+        const float v = light[s.triangles[f][k]];
         if (v < 0.f) continue;
         lo = std::min(lo, v);
         hi = std::max(hi, v);
       }
-      if (hi >= lo) shadow[f] = hi - lo;
+      if (hi >= lo) shadow[f] = std::max(shadow[f], double(hi - lo));
     }
   }
   RefineMarks m;

@@ -309,6 +309,50 @@ TEST(Refine, ConcentratesAtTheShadowBoundary) {
   EXPECT_EQ(m.scene.faceCount(), size_t(r.result.stats.get("refined_patches")));
 }
 
+// The same floor and occluder lit by a sun straight overhead (the light
+// square dark): the occluder's shadow edge runs along y at x = 0.2, its
+// penumbra 1 tan(0.27 deg) = 0.005 either side. With the B jump test off,
+// the sun's visibility alone must refine there (the shadow test counted
+// only emitting faces: nothing was refined).
+TEST(Refine, ConcentratesAtTheSunsShadowBoundary) {
+  const int n = 8;
+  Scene s = shadowScene(n);
+  s.emission.assign(s.faceCount(), glm::vec3(0.f));
+  RadiosityOptions o = cheapOptions();
+  o.outside.sunDirection = glm::vec3(0.f, 0.f, 1.f);
+  o.outside.sunIrradiance = glm::vec3(100.f);
+  o.refinement.threshold = 100;  // shadow test only
+  o.refinement.maxDepth = 3;
+  const AdaptiveRadiosity r = solveRadiosityAdaptive(s, o);
+  const RefinedMesh& m = r.mesh;
+  size_t refined = 0;
+  double far = 0;
+  for (size_t f = 0; f < m.scene.faceCount(); ++f) {
+    if (m.sourceFace[f] >= kFloorFaces(n) || m.depth[f] == 0) continue;
+    ++refined;
+    const glm::dvec3 c = m.scene.toWorld((m.scene.positions[m.scene.triangles[f].x] +
+                                          m.scene.positions[m.scene.triangles[f].y] +
+                                          m.scene.positions[m.scene.triangles[f].z]) / 3.f);
+    far = std::max(far, std::fabs(c.x - 0.2));
+  }
+  EXPECT_GT(refined, 100u) << r.result.stats.line("refine");
+  EXPECT_LT(far, 0.005 + 2 * 0.25) << r.result.stats.line("refine");
+  // The emitters' test alone sees no light and refines nothing.
+  const std::vector<float> none = emitterVisibility(s, *makeEmbreeCaster(s), 64, 0);
+  EXPECT_TRUE(std::all_of(none.begin(), none.end(), [](float v) { return v == -1.f; }));
+  // Per vertex: 0 under the occluder and under the dark light square (the
+  // floor's centre), 1 in the open, -1 for faces turned from the sun (the
+  // occluder's and the light's, facing down).
+  const std::vector<float> sun = sunVisibility(s, *makeEmbreeCaster(s), o.outside, 64, 0);
+  for (size_t v = 0; v < size_t((n + 1) * (n + 1)); ++v) {
+    const glm::dvec3 p = s.toWorld(s.positions[v]);
+    const bool underLight = std::fabs(p.x) < kLight && std::fabs(p.y) < kLight;
+    if ((p.x > 0.21 && p.x < 0.99) || underLight) EXPECT_EQ(sun[v], 0.f) << p.x << " " << p.y;
+    else if (p.x < 0.19) EXPECT_EQ(sun[v], 1.f) << p.x << " " << p.y;
+  }
+  for (size_t v = size_t((n + 1) * (n + 1)); v < s.vertexCount(); ++v) EXPECT_EQ(sun[v], -1.f);
+}
+
 TEST(Refine, ErrorFallsWithFewerPatchesThanUniform) {
   const int n = 8;
   const Scene s = shadowScene(n);

@@ -25,6 +25,7 @@
 #include "gi/raycaster.h"
 #include "gi/scene.h"
 #include "gi/scene_setup.h"
+#include "gi/sky.h"
 
 namespace gi {
 
@@ -63,7 +64,7 @@ struct RefineOptions {
                                 // may split a neighbour once more where input triangles differ in size)
   int maxPatches = 200000;      // never more faces than this
   double threshold = 0.1;       // relative jump of the reflected radiosity across an edge
-  double shadowThreshold = 0.3; // difference of emitter visibility between a face's vertices
+  double shadowThreshold = 0.3; // difference of a light's visibility between a face's vertices (emitters, sun)
   int visibilityRays = 64;      // shadow rays per vertex for that visibility
   double creaseDegrees = 30.0;  // no B-jump test across sharper creases (a true discontinuity)
   uint32_t seed = 0;
@@ -78,21 +79,31 @@ struct RefineOptions {
 // emitter faces the vertex. Deterministic per (vertex, ray, seed).
 std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, int rays, uint32_t seed);
 
+// Per vertex: the fraction of `rays` directions uniform in the sun's cone
+// (those above the vertex's tangent plane) in which a ray from the vertex
+// leaves the scene; -1 where the whole cone lies below that plane, and for
+// every vertex without a sun. Deterministic per (vertex, ray, seed). The
+// sun's shadow is the sharpest a scene lit from outside has, and on a
+// coarse mesh the B jump test misses one that dims a patch by less than
+// the jump threshold (a pole's shadow across a floor patch).
+std::vector<float> sunVisibility(const Scene& s, const RayCaster& caster, const SkySun& o, int rays, uint32_t seed);
+
 // Faces that need refinement, most needing first. B jumps: across an edge
 // between faces less than creaseDegrees apart, |R_i - R_j| / max(R_i, R_j,
 // 1% of the area-weighted mean R) > threshold (R = luminance of B - E, the
 // reflected radiosity); or, given per-vertex values (else pass {}), between
 // the patch's R and the mean of its corners' R (the error of the displayed
 // linear interpolation), with the same measure and threshold. Shadow
-// boundaries: max - min of the vertices' emitter visibility >
-// shadowThreshold. Priority = area x the larger excess ratio. Faces already
+// boundaries: for one of the lights (`visibility`: per light, per vertex,
+// as emitterVisibility and sunVisibility give; empty ones skipped), max -
+// min of the vertices' visibility > shadowThreshold. Priority = area x the larger excess ratio. Faces already
 // at maxDepth are left out.
 struct RefineMarks {
   std::vector<uint32_t> faces;  // by decreasing priority (ties: by index)
   size_t byJump = 0, byShadow = 0;
 };
 RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<glm::vec3>& Bvertex,
-                              const std::vector<float>& visibility, const std::vector<uint8_t>& depth,
+                              const std::vector<std::vector<float>>& visibility, const std::vector<uint8_t>& depth,
                               const RefineOptions& opt);
 
 // The attributes of the input mesh carried to the refined one: face colour,
