@@ -307,33 +307,29 @@ size_t MeshRefiner::refine(const std::vector<uint32_t>& faces) {
   return impl_->faces.size() - before;
 }
 
-std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, int rays, uint32_t seed) {
+namespace {
+
+// Per vertex, the share of `rays` rays from its ray origin x (vertex normal
+// n) that reach a light, -1 where none faces it: see(x, n, u) for a sample
+// u of the vertex's own sequence (seeded by vertex, seed and salt) is -1
+// where the light is not in front of x, else whether its ray arrives.
+template <class See>
+std::vector<float> visibleShare(const Scene& s, int rays, uint32_t seed, uint32_t salt, const See& see) {
   const size_t nv = s.vertexCount();
   std::vector<float> V(nv, -1.f);
-  const EmitterSampler lights(s);
-  if (lights.empty() || rays < 1) return V;
   const float eps = float(sceneScale(s).rayEpsilon);
   const std::vector<glm::vec3> normals = vertexNormalsForRays(s);
   const std::vector<glm::vec3> origins = vertexRayOrigins(s, normals, eps);
   parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       if (!(glm::dot(normals[i], normals[i]) > 0.5f)) continue;
-      SobolOwenStream seq(hash3(uint32_t(i), seed, 0x5eu));
-      const glm::vec3 x = origins[i];
+      SobolOwenStream seq(hash3(uint32_t(i), seed, salt));
       int facing = 0, seen = 0;
       for (int j = 0; j < rays; ++j) {
-        const EmitterSampler::Sample y = lights.sample(seq.next());
-        if (glm::dot(y.n, x - y.p) <= 0.f) continue;  // its emitting side looks away
+        const int v = see(origins[i], normals[i], seq.next());
+        if (v < 0) continue;
         ++facing;
-        const glm::vec3 d = y.p - x;
-        const float dist = glm::length(d);
-        if (!(dist > 2 * eps)) { ++seen; continue; }
-        Ray r;
-        r.o = x;
-        r.d = d / dist;
-        r.tnear = 0.f;
-        r.tfar = dist * (1.f - 1e-4f) - eps;
-        seen += caster.occluded(r) ? 0 : 1;
+        seen += v;
       }
       if (facing > 0) V[i] = float(seen) / float(facing);
     }
@@ -341,33 +337,40 @@ std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, in
   return V;
 }
 
-std::vector<float> sunVisibility(const Scene& s, const RayCaster& caster, const SkySun& o, int rays, uint32_t seed) {
-  const size_t nv = s.vertexCount();
-  std::vector<float> V(nv, -1.f);
-  if (!o.sun() || rays < 1) return V;
-  const float eps = float(sceneScale(s).rayEpsilon), sunCos = o.sunCos();
-  const Frame sunFrame(o.sunDirection);
-  const std::vector<glm::vec3> normals = vertexNormalsForRays(s);
-  const std::vector<glm::vec3> origins = vertexRayOrigins(s, normals, eps);
-  parallelBlocks(nv, Progress(nullptr), "", [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (!(glm::dot(normals[i], normals[i]) > 0.5f)) continue;
-      SobolOwenStream seq(hash3(uint32_t(i), seed, 0x5a7u));
-      int facing = 0, seen = 0;
-      Ray r;
-      r.o = origins[i];
-      for (int j = 0; j < rays; ++j) {
-        r.d = sunFrame.toWorld(uniformCone(seq.next(), sunCos));
-        if (!(glm::dot(r.d, normals[i]) > 0.f)) continue;  // below the tangent plane
-        ++facing;
-        r.tnear = 0.f;
-        r.tfar = std::numeric_limits<float>::infinity();
-        seen += caster.occluded(r) ? 0 : 1;
-      }
-      if (facing > 0) V[i] = float(seen) / float(facing);
-    }
+}  // namespace
+
+std::vector<float> emitterVisibility(const Scene& s, const RayCaster& caster, int rays, uint32_t seed) {
+  const EmitterSampler lights(s);
+  if (lights.empty() || rays < 1) return std::vector<float>(s.vertexCount(), -1.f);
+  const float eps = float(sceneScale(s).rayEpsilon);
+  return visibleShare(s, rays, seed, 0x5eu, [&](const glm::vec3& x, const glm::vec3&, glm::vec2 u) {
+    const EmitterSampler::Sample y = lights.sample(u);
+    if (glm::dot(y.n, x - y.p) <= 0.f) return -1;  // its emitting side looks away
+    const glm::vec3 d = y.p - x;
+    const float dist = glm::length(d);
+    if (!(dist > 2 * eps)) return 1;
+    Ray r;
+    r.o = x;
+    r.d = d / dist;
+    r.tnear = 0.f;
+    r.tfar = dist * (1.f - 1e-4f) - eps;
+    return caster.occluded(r) ? 0 : 1;
   });
-  return V;
+}
+
+std::vector<float> sunVisibility(const Scene& s, const RayCaster& caster, const SkySun& o, int rays, uint32_t seed) {
+  if (!o.sun() || rays < 1) return std::vector<float>(s.vertexCount(), -1.f);
+  const float sunCos = o.sunCos();
+  const Frame sunFrame(o.sunDirection);
+  return visibleShare(s, rays, seed, 0x5a7u, [&](const glm::vec3& x, const glm::vec3& n, glm::vec2 u) {
+    Ray r;
+    r.o = x;
+    r.d = sunFrame.toWorld(uniformCone(u, sunCos));
+    if (!(glm::dot(r.d, n) > 0.f)) return -1;  // below the tangent plane
+    r.tnear = 0.f;
+    r.tfar = std::numeric_limits<float>::infinity();
+    return caster.occluded(r) ? 0 : 1;
+  });
 }
 
 RefineMarks markForRefinement(const Scene& s, const std::vector<glm::vec3>& B, const std::vector<glm::vec3>& Bvertex,

@@ -284,14 +284,11 @@ TEST(Refine, GreenFacesAreNeverBisectedTwice) {
   EXPECT_GE(minAngle(m2.scene), angleBound(plane.scene) - 1e-3);
 }
 
-TEST(Refine, ConcentratesAtTheShadowBoundary) {
-  const int n = 8;
-  const Scene s = shadowScene(n);
-  RadiosityOptions o = cheapOptions();
-  o.refinement.threshold = 100;  // shadow test only
-  o.refinement.maxDepth = 3;
-  const AdaptiveRadiosity r = solveRadiosityAdaptive(s, o);
-  const RefinedMesh& m = r.mesh;
+namespace {
+
+// The refined floor faces of shadowScene(n)'s refinement: how many, and the
+// farthest of their centroids from the line x = x0.
+std::pair<size_t, double> refinedFloor(const RefinedMesh& m, int n, double x0) {
   size_t refined = 0;
   double far = 0;
   for (size_t f = 0; f < m.scene.faceCount(); ++f) {
@@ -300,8 +297,22 @@ TEST(Refine, ConcentratesAtTheShadowBoundary) {
     const glm::dvec3 c = m.scene.toWorld((m.scene.positions[m.scene.triangles[f].x] +
                                           m.scene.positions[m.scene.triangles[f].y] +
                                           m.scene.positions[m.scene.triangles[f].z]) / 3.f);
-    far = std::max(far, std::fabs(c.x - 0.4));
+    far = std::max(far, std::fabs(c.x - x0));
   }
+  return {refined, far};
+}
+
+}  // namespace
+
+TEST(Refine, ConcentratesAtTheShadowBoundary) {
+  const int n = 8;
+  const Scene s = shadowScene(n);
+  RadiosityOptions o = cheapOptions();
+  o.refinement.threshold = 100;  // shadow test only
+  o.refinement.maxDepth = 3;
+  const AdaptiveRadiosity r = solveRadiosityAdaptive(s, o);
+  const RefinedMesh& m = r.mesh;
+  const auto [refined, far] = refinedFloor(m, n, 0.4);
   EXPECT_GT(refined, 100u);
   // The penumbra is 0.03 either side of x = 0.4; a coarse cell is 0.25 wide:
   // refined faces stay within the penumbra plus two coarse cells.
@@ -324,17 +335,7 @@ TEST(Refine, ConcentratesAtTheSunsShadowBoundary) {
   o.refinement.threshold = 100;  // shadow test only
   o.refinement.maxDepth = 3;
   const AdaptiveRadiosity r = solveRadiosityAdaptive(s, o);
-  const RefinedMesh& m = r.mesh;
-  size_t refined = 0;
-  double far = 0;
-  for (size_t f = 0; f < m.scene.faceCount(); ++f) {
-    if (m.sourceFace[f] >= kFloorFaces(n) || m.depth[f] == 0) continue;
-    ++refined;
-    const glm::dvec3 c = m.scene.toWorld((m.scene.positions[m.scene.triangles[f].x] +
-                                          m.scene.positions[m.scene.triangles[f].y] +
-                                          m.scene.positions[m.scene.triangles[f].z]) / 3.f);
-    far = std::max(far, std::fabs(c.x - 0.2));
-  }
+  const auto [refined, far] = refinedFloor(r.mesh, n, 0.2);
   EXPECT_GT(refined, 100u) << r.result.stats.line("refine");
   EXPECT_LT(far, 0.005 + 2 * 0.25) << r.result.stats.line("refine");
   // The emitters' test alone sees no light and refines nothing.
