@@ -472,16 +472,18 @@ std::vector<glm::vec3> patchDirectIrradiance(const Scene& s, const RayCaster& ca
 }
 
 std::vector<glm::vec3> seenPartDirectIrradiance(const Scene& s, const RayCaster& caster, int lightSamples, uint32_t seed,
-                                                const std::vector<std::vector<glm::vec3>>& points) {
+                                                const std::vector<std::vector<glm::vec3>>& points,
+                                                const SkyOpenings* portals) {
   if (lightSamples < 1) throw std::invalid_argument("light_samples must be >= 1");
   if (points.size() != s.faceCount()) throw std::logic_error("seen points: one list per face");
   std::vector<glm::vec3> H(s.faceCount(), glm::vec3(0.f));
-  const DirectLight direct(s, caster, false);
+  if (portals && !portals->any()) return H;
+  const DirectLight direct(s, caster, false, portals);
   if (direct.empty()) return H;
   const int budget = lightSamples / direct.maxPoints(lightSamples);
   parallelBlocks(s.faceCount(), Progress(nullptr), "direct light of seen parts", [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      const size_t m = std::min(points[i].size(), kSeenPartLightPoints);
+      const size_t m = points[i].size();  // every one: a seen part's light changes fast beside what buries it
       if (m == 0) continue;
       const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, i));
       const PaddedSobol smp(hash3(uint32_t(i), seed, 0xdau));

@@ -102,6 +102,7 @@ struct DirectSetup {
   SkyOpenings openings;
   Setup u;
   std::vector<glm::vec3> emitters;  // the emitters' share of u.Hd (the patch means)
+  std::vector<glm::vec3> outside;   // the sky's and sun's share
   RunStats stats;
   double seconds = 0;
   // Its numbers and notes after the solver's, and the shadow rays per patch.
@@ -146,8 +147,8 @@ DirectSetup directSetup(const Scene& s, const RayCaster& caster, const Radiosity
   DirectSetup d;
   d.openings = findSkyOpenings(s, caster, opt.outside, seed);
   d.emitters = patchDirectIrradiance(s, caster, opt.lightSamples, seed, emitters, &d.stats);
-  d.u = setup(s, d.emitters,
-              patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, seed, outside, &d.openings));
+  d.outside = patchSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, seed, outside, &d.openings);
+  d.u = setup(s, d.emitters, d.outside);
   d.seconds = timer.seconds();
   return d;
 }
@@ -352,9 +353,9 @@ MemoryPlan planMemory(size_t n, const FormFactors& ff, const RadiosityOptions& o
 
 std::string megabytes(double bytes) { return std::to_string(int(bytes / 1048576.0 + 0.5)); }
 
-// The emitters' light on the seen part of each partly buried patch, from its
-// own seen points (seenPartDirectIrradiance): u.Hd becomes a H_seen plus the
-// outside light, so that u.Hd / a, which every solver takes, is H_seen. The
+// The light on the seen part of each partly buried patch, from its own seen
+// points (seenPartDirectIrradiance, seenPartSkySunIrradiance): u.Hd becomes
+// a H_seen, so that u.Hd / a, which every solver takes, is H_seen. The
 // patch mean over the share (u.Hd / a as it was) divided an estimate from
 // patchDirectIrradiance's few points by one from the seen-part points: on
 // the Cornell box a floor triangle 3% seen beside the short block, one of
@@ -366,9 +367,11 @@ void seenPartsDirect(const Scene& s, const RayCaster& caster, const RadiosityOpt
                      const PatchSeen& seen, DirectSetup& d) {
   if (!seen.any()) return;
   const std::vector<glm::vec3> Hs = seenPartDirectIrradiance(s, caster, opt.lightSamples, seed, seen.seenPoints);
+  const std::vector<glm::vec3> Ho =
+      seenPartSkySunIrradiance(s, caster, opt.outside, opt.lightSamples, seed, seen.seenPoints, &d.openings);
   for (size_t i = 0; i < d.u.n; ++i) {
     const float a = seen.fraction[i];
-    if (a > 0.f && a < 1.f) d.u.Hd[i] += a * Hs[i] - d.emitters[i];
+    if (a > 0.f && a < 1.f) d.u.Hd[i] += a * (Hs[i] + Ho[i]) - d.emitters[i] - d.outside[i];
   }
 }
 

@@ -1,5 +1,6 @@
 #include "gi/sky.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -156,6 +157,32 @@ std::vector<glm::vec3> vertexSkySunIrradiance(const Scene& s, const RayCaster& c
     for (size_t v = b; v < e; ++v)
       if (mat.valid[v] && part.contains(v, s.vertexCount()))
         H[v] += skySunAt(o, caster, origins[v], mat.n[v], rays, hash3(uint32_t(v), seed, 0x5c4u), openings);
+  });
+  return H;
+}
+
+std::vector<glm::vec3> seenPartSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
+                                                uint32_t seed, const std::vector<std::vector<glm::vec3>>& points,
+                                                const SkyOpenings* openings) {
+  if (points.size() != s.faceCount()) throw std::logic_error("seen points: one list per face");
+  if (openings && !openings->any()) openings = nullptr;
+  std::vector<glm::vec3> H = openings && rays >= 1
+                                 ? seenPartDirectIrradiance(s, caster, rays, seed ^ kPortalSalt, points, openings)
+                                 : std::vector<glm::vec3>(s.faceCount(), glm::vec3(0.f));
+  if (!o.any() || rays < 1 || (openings && !openings->rest && !o.sun())) return H;
+  const float eps = float(sceneScale(s).rayEpsilon);
+  parallelBlocks(s.faceCount(), Progress(nullptr), "sky and sun of seen parts", [&](size_t b, size_t e) {
+    for (size_t f = b; f < e; ++f) {
+      const size_t m = points[f].size();
+      if (m == 0) continue;
+      const glm::vec3 n = glm::normalize(faceNormalUnnormalized(s, f));
+      const int each = std::max(1, rays / int(m));
+      glm::dvec3 sum(0.0);
+      for (size_t k = 0; k < m; ++k)
+        sum += glm::dvec3(skySunAt(o, caster, points[f][k] + n * eps, n, each,
+                                   hash3(uint32_t(f), seed ^ uint32_t(k), 0x5c5u), openings));
+      H[f] += glm::vec3(sum / double(m));
+    }
   });
   return H;
 }

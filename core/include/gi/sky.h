@@ -116,6 +116,19 @@ std::vector<glm::vec3> patchSkySunIrradiance(const Scene& s, const RayCaster& ca
                                              uint32_t seed, const Progress& progress = Progress(nullptr),
                                              const SkyOpenings* openings = nullptr);
 
+// The mean of H_out over given points of each face (points[f] on face f,
+// not lifted; faces without points get 0): the seen part of a partly buried
+// patch (PatchSeen::seenPoints), whose outside light, like its emitters'
+// (seenPartDirectIrradiance), is the mean over its own points. The patch
+// mean over all of it divided by the seen share, two estimates from
+// different points, read a floor patch half inside a box, under a sun
+// straight above, 4% high or low (it is lit wherever it is seen). Every
+// point of a face (PatchSeen keeps up to 64), each with rays / points (at
+// least one) sky and sun rays; `openings` as for the patches.
+std::vector<glm::vec3> seenPartSkySunIrradiance(const Scene& s, const RayCaster& caster, const SkySun& o, int rays,
+                                                uint32_t seed, const std::vector<std::vector<glm::vec3>>& points,
+                                                const SkyOpenings* openings = nullptr);
+
 // H_out at every vertex of `part` (the others, and vertices without a usable
 // face, 0), from the per-vertex ray origins (vertexRayOrigins); `openings`
 // as for the patches.
