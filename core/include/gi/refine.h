@@ -96,8 +96,8 @@ std::vector<float> sunVisibility(const Scene& s, const RayCaster& caster, const 
 // linear interpolation), with the same measure and threshold. Shadow
 // boundaries: for one of the lights (`visibility`: per light, per vertex,
 // as emitterVisibility and sunVisibility give; empty ones skipped), max -
-// min of the vertices' visibility > shadowThreshold. Priority = area x the larger excess ratio. Faces already
-// at maxDepth are left out.
+// min of the vertices' visibility > shadowThreshold. Priority = area x the
+// larger excess ratio. Faces already at maxDepth are left out.
 struct RefineMarks {
   std::vector<uint32_t> faces;  // by decreasing priority (ties: by index)
   size_t byJump = 0, byShadow = 0;
